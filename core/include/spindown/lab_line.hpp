@@ -1,0 +1,23 @@
+#pragma once
+// The lab sketch's serial protocol: one sample per line, "millis<TAB>volts" (volts from
+// Serial.println(float), two decimals), CR LF. A pure function so the file reader, the
+// serial bridge and the fuzzer share one parser.
+#include <cstdint>
+#include <string_view>
+
+namespace spindown {
+
+struct LabLine {
+  enum class Kind { sample, blank, garbled };
+  Kind kind = Kind::garbled;
+  std::int64_t millis = 0;  // device time as printed (ms), valid for Kind::sample
+  double value = 0;         // the printed reading, finite, valid for Kind::sample
+  std::string_view why;     // for Kind::garbled: what was wrong, in words (static storage)
+};
+
+// Parses one line without its terminator (a trailing CR is tolerated). Accepts a tab or
+// other whitespace between the fields; rejects extra fields, non-numbers, negative times,
+// NaN/inf and values outside what an Arduino can print.
+LabLine parse_lab_line(std::string_view line);
+
+}  // namespace spindown

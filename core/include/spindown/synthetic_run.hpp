@@ -1,0 +1,54 @@
+#pragma once
+// Synthetic spin-down recordings as a real bench produces them: lead-in before the cut
+// (zeros, a floating pin or the supply voltage), the coast from the simulator, sensor
+// offset, commutator ripple, white noise, 10-bit ADC, 2-decimal printing, loop period with
+// jitter. Used by the virtual bench, by tests and by benchmarks.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "spindown/bench.hpp"
+#include "spindown/friction.hpp"
+
+namespace spindown {
+
+enum class LeadIn { zeros, floating, supply };
+
+struct SyntheticRunSpec {
+  BenchParams bench;
+  FrictionTerms friction{1.822e-7, 1.1389e-4};
+  double e0_v = 2.8;           // back-EMF at the cut
+  double supply_v = 3.0;       // what the pin reads before the cut with LeadIn::supply
+  LeadIn lead_in = LeadIn::zeros;
+  double lead_in_s = 3.0;      // recorded time before the cut
+  double tail_s = 3.0;         // recorded time after the stop (or after max_coast_s)
+  double max_coast_s = 120.0;  // stop recording a coast that does not stop by then
+  double period_s = 0.020;     // loop period
+  double jitter_s = 0.0005;    // uniform ± jitter on each period
+  double noise_v = 0.003;      // white noise on the reading (V, before the ADC)
+  double ripple = 0.0;         // relative commutator ripple
+  int ripple_per_rev = 6;      // ripple cycles per revolution
+  double offset_v = 0.0;       // sensor offset after the cut
+  int adc_bits = 10;           // 0 = no ADC quantization
+  double adc_ref_v = 5.0;
+  int decimals = 2;            // printing; negative = full precision
+  double t0_ms = 5234;         // device time of the first sample
+  std::uint64_t seed = 1;
+};
+
+struct SyntheticRun {
+  std::vector<double> t_ms;   // device time of each sample (integer ms as the sketch prints)
+  std::vector<double> volts;  // the printed value
+  std::vector<int> adc;       // raw ADC counts (−1 when not quantized)
+  double t_cut_ms = 0;        // device time of the power cut
+  double t_stop_s = 0;        // seconds from the cut to the stop (or max_coast_s)
+  double omega0 = 0;          // rad/s at the cut
+  bool stopped = false;
+};
+
+SyntheticRun make_synthetic_run(const SyntheticRunSpec& spec);
+
+// The Arduino sketch's text: "millis\tvolts\r\n" per sample, optionally after a PuTTY header.
+std::string to_arduino_text(const SyntheticRun& run, int decimals = 2, bool putty_header = false);
+
+}  // namespace spindown
