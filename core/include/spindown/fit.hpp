@@ -1,0 +1,73 @@
+#pragma once
+// Fitting the lab's friction models to one run, with the stop modelled and ω0 free.
+//   viscous   T = c1·ω        ω = ω0·e^(−c1 τ/J)                        (never stops)
+//   coulomb   T = c2          ω = max(ω0 − c2 τ/J, 0)
+//   combined  T = c3·ω + c4   ω = max(−c4/c3 + (ω0 + c4/c3)·e^(−c3 τ/J), 0)
+// τ is time since the cut; the reading is zero_level + k·ω (k = K_b for volts). Starting
+// points from separable/linear fits (Eigen), refinement with NLopt under bounds, standard
+// errors from the Jacobian at the optimum (widened when residuals are correlated).
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "spindown/bench.hpp"
+#include "spindown/recording.hpp"
+#include "spindown/runs.hpp"
+
+namespace spindown {
+
+enum class ModelKind { viscous, coulomb, combined };
+std::string_view model_name(ModelKind k);
+std::optional<ModelKind> parse_model(std::string_view name);
+inline constexpr ModelKind all_models[] = {ModelKind::viscous, ModelKind::coulomb, ModelKind::combined};
+
+struct Parameter {
+  std::string name;   // c1…c4, omega0, A, B, C
+  double value = 0;   // SI (curve constants in the reading's unit and seconds)
+  double std_error = 0;  // one standard error, same unit ("stderr" in JSON)
+  std::string unit;   // "N*m*s/rad", "N*m", "rad/s", "V", "1/s", …
+};
+
+struct ModelFit {
+  ModelKind kind = ModelKind::combined;
+  std::vector<Parameter> params;  // friction coefficients, omega0, then the seed's curve constants
+  double omega0 = 0;              // rad/s at the cut
+  double rate = 0;                // c_viscous/J (1/s), 0 for coulomb
+  double decel = 0;               // c_coulomb/J (rad/s²), 0 for viscous
+  double rmse = 0;                // in the reading's unit
+  double r2 = 0, aic = 0, bic = 0;
+  double t_stop_pred_s = 0;       // predicted stop, seconds after the cut (inf if never)
+  std::size_t n = 0;              // samples fitted
+  int evaluations = 0;
+  bool converged = false;
+  std::string message;            // why it did not converge, etc.
+
+  const Parameter* param(std::string_view name) const;
+  double omega_at(double tau) const;  // model speed (rad/s) at τ seconds after the cut
+};
+
+struct FitOptions {
+  BenchParams bench;
+  std::vector<ModelKind> models{all_models[0], all_models[1], all_models[2]};
+  bool is_valid(std::string* why) const;
+};
+
+struct RunFit {
+  Run run;
+  BenchParams bench;
+  Quantity quantity = Quantity::back_emf_volts;
+  std::vector<ModelFit> models;
+  std::string best;         // model name with the lowest BIC among converged fits
+  std::string best_reason;  // why, in words (ΔBIC, RMSE)
+  const ModelFit* model(ModelKind k) const;
+};
+
+// Fits the chosen models to samples [run.cut_index, run.end_index) of rec.
+RunFit fit_run(const Recording& rec, const Run& run, const FitOptions& opt);
+
+// The same on raw arrays (t in seconds on the recording's clock), for the live fitter.
+RunFit fit_run(std::span<const double> t_s, std::span<const double> value, Quantity q, const Run& run,
+               const FitOptions& opt);
+
+}  // namespace spindown

@@ -1,0 +1,48 @@
+#pragma once
+// Finding spin-down runs in a recording: the power cut (the reading before it may sit at 0,
+// float on an unconnected pin, or sit at the supply voltage) and the stop (speed reaches
+// zero and stays). One streaming detector serves both the offline readers (find_runs feeds
+// it every sample) and the live fitter (feeds it as samples arrive), so both find the same
+// runs; its memory is bounded.
+#include <cstddef>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "spindown/recording.hpp"
+
+namespace spindown {
+
+struct RunOptions {
+  double stop_hold_s = 1.0;        // reading must stay at the zero level this long to call a stop
+  double min_coast_s = 0.5;        // shorter coasts are reported and ignored
+  std::size_t min_samples = 8;     // fewer coasting samples: reported and ignored
+  double max_coast_s = 600.0;      // a coast that does not stop by then is closed as "never stopped"
+  double tail_s = 2.0;             // standstill kept after the stop for the fit (pins the stop)
+  std::size_t max_buffer = 200000; // samples buffered per stream (bounded memory)
+  bool is_valid(std::string* why) const;
+};
+
+struct Run {
+  int number = 0;                  // 1-based, in order of the cut
+  std::size_t cut_index = 0;       // first coasting sample (index into the recording/stream)
+  std::size_t stop_index = 0;      // first sample at standstill (== end_index if never stopped)
+  std::size_t end_index = 0;       // one past the last sample given to the fit (tail included)
+  double t_cut_s = 0;              // estimated cut: midway between last powered and first coasting sample
+  double t_stop_s = std::numeric_limits<double>::quiet_NaN();  // device time of the stop
+  bool stopped = false;
+  double zero_level = 0;           // reading at standstill (median of the stopped tail)
+  double noise_level = 0;          // standard deviation of the reading at standstill
+  std::string lead_in;             // "zeros", "floating", "supply", "powered", "none"
+  double period_s = 0;             // median sample period within the coast
+};
+
+struct Segmentation {
+  std::vector<Run> runs;
+  std::vector<Diagnostic> diagnostics;  // runs ignored and why, clipping, etc.
+};
+
+Segmentation find_runs(const Recording& rec, const RunOptions& opt = {});
+
+}  // namespace spindown
