@@ -1,0 +1,59 @@
+#pragma once
+// Reporting fitted runs: design §5's JSON object and a text table like the lab report's
+// (model | curve constants | coefficients ± standard error | RMSE | R² | BIC | predicted
+// stop), plus which model fits best and why. Shared by `spindown fit` and the live fitter.
+#include <cstddef>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "spindown/fit.hpp"
+#include "spindown/recording.hpp"
+
+namespace spindown {
+
+// Everything `spindown fit` learnt about one input file.
+struct FileFit {
+  std::string file;                     // as named by the user
+  std::size_t samples = 0;              // samples read
+  std::size_t lines_read = 0, lines_skipped = 0;
+  std::vector<Diagnostic> diagnostics;  // reading, segmentation and fitting problems
+  std::vector<RunFit> runs;
+  // Why the file, or a run in it, could not be used; non-empty means exit code 1.
+  std::vector<std::string> failures;
+  bool usable() const { return failures.empty(); }
+};
+
+struct ReportOptions {
+  bool lab_units = false;          // add g·cm², g·cm²·s⁻¹, g·cm²·rad·s⁻² beside SI
+  std::size_t max_diagnostics = 8; // shown per file before the rest is summarised; 0 = all
+  bool diagnostics_in_text = true; // false when the caller prints them elsewhere (stderr)
+};
+
+// JSON keeps insertion order so the object reads like the contract.
+using Json = nlohmann::ordered_json;
+
+// Design §5: {"files":[{"file":…,"runs":[{"run":1,"t_cut_s":…,"t_stop_s":…,"samples":…,
+// "models":[{"name":…,"params":{"c1":{"value":…,"stderr":…,"unit":…},…},"rmse":…,
+// "residual_unit":…,"r2":…,"aic":…,"bic":…}],"best":…}]}]}, plus extra fields (never fewer).
+// Non-finite numbers become null.
+Json run_fit_json(const RunFit& fit, const ReportOptions& opt = {});
+Json file_fit_json(const FileFit& file, const ReportOptions& opt = {});
+Json fit_report_json(std::span<const FileFit> files, const ReportOptions& opt = {});
+
+// Text for people.
+std::string format_run_fit(const RunFit& fit, const ReportOptions& opt = {});
+std::string format_file_fit(const FileFit& file, const ReportOptions& opt = {});
+// "file:line: warning: …" lines, errors first; past max_shown the rest is counted per
+// severity in one closing line. max_shown 0 = all.
+std::vector<std::string> summarize_diagnostics(std::span<const Diagnostic> diagnostics, std::size_t max_shown);
+// Why the best model is best: ΔBIC to the runner-up and both RMSEs; fit.best_reason when set.
+std::string explain_best(const RunFit& fit);
+
+// "value ± error" with the error to two significant digits and the value to the same
+// place, e.g. "1.3973 ± 0.0021" or "(1.3973 ± 0.0021)e-06".
+std::string format_value_error(double value, double std_error);
+
+}  // namespace spindown

@@ -1,0 +1,329 @@
+#include "spindown/fit_report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "spindown/lab_units.hpp"
+#include "spindown/quantity.hpp"
+
+namespace spindown {
+
+namespace {
+
+// JSON has no inf/NaN: a stop that never comes or an undefined R² is null.
+Json number(double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); }
+
+bool is_curve_constant(const Parameter& p) { return p.name == "A" || p.name == "B" || p.name == "C"; }
+
+const char* severity_name(Diagnostic::Severity s) {
+  switch (s) {
+    case Diagnostic::Severity::error: return "error";
+    case Diagnostic::Severity::warning: return "warning";
+    case Diagnostic::Severity::note: return "note";
+  }
+  return "warning";
+}
+
+std::size_t samples_in(const Run& run) {
+  return run.end_index > run.cut_index ? run.end_index - run.cut_index : 0;
+}
+
+// Display width of UTF-8 text: code points, not bytes (·, ², ω, ± are multibyte).
+std::size_t display_width(std::string_view s) {
+  return static_cast<std::size_t>(
+      std::count_if(s.begin(), s.end(), [](char c) { return (static_cast<unsigned char>(c) & 0xC0) != 0x80; }));
+}
+
+std::vector<std::string> split_lines(const std::string& s) {
+  std::vector<std::string> lines;
+  std::istringstream in(s);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  if (lines.empty()) lines.emplace_back();
+  return lines;
+}
+
+// A left-aligned table whose cells may span several lines.
+std::string render_table(const std::vector<std::vector<std::string>>& rows, std::string_view indent) {
+  if (rows.empty()) return {};
+  const std::size_t ncol = rows.front().size();
+  std::vector<std::vector<std::vector<std::string>>> cells;
+  std::vector<std::size_t> width(ncol, 0);
+  for (const auto& row : rows) {
+    auto& r = cells.emplace_back();
+    for (std::size_t c = 0; c < ncol; ++c) {
+      r.push_back(split_lines(c < row.size() ? row[c] : std::string{}));
+      for (const auto& l : r.back()) width[c] = std::max(width[c], display_width(l));
+    }
+  }
+  std::string out;
+  for (std::size_t ri = 0; ri < cells.size(); ++ri) {
+    std::size_t height = 0;
+    for (const auto& cell : cells[ri]) height = std::max(height, cell.size());
+    for (std::size_t li = 0; li < height; ++li) {
+      std::string line(indent);
+      for (std::size_t c = 0; c < ncol; ++c) {
+        const std::string text = li < cells[ri][c].size() ? cells[ri][c][li] : std::string{};
+        line += text;
+        if (c + 1 < ncol) line.append(width[c] - display_width(text) + 2, ' ');
+      }
+      while (!line.empty() && line.back() == ' ') line.pop_back();
+      out += line + '\n';
+    }
+    if (ri == 0) {  // rule under the header
+      std::size_t total = 0;
+      for (std::size_t c = 0; c < ncol; ++c) total += width[c] + (c + 1 < ncol ? 2 : 0);
+      out += std::string(indent) + std::string(total, '-') + '\n';
+    }
+  }
+  return out;
+}
+
+std::string display_name(const Parameter& p) { return p.name == "omega0" ? "ω0" : p.name; }
+
+std::string with_unit(std::string text, std::string_view ascii_unit) {
+  if (ascii_unit.empty()) return text;
+  return text + " " + std::string(pretty_unit(ascii_unit));
+}
+
+std::string coefficient_cell(const ModelFit& m, const ReportOptions& opt) {
+  std::string cell;
+  for (const auto& p : m.params) {
+    if (is_curve_constant(p)) continue;
+    if (!cell.empty()) cell += '\n';
+    cell += display_name(p) + " = " + with_unit(format_value_error(p.value, p.std_error), p.unit);
+    if (opt.lab_units)
+      if (auto lab = lab_unit_for(p.unit))
+        cell += fmt::format(" = {} {}", format_value_error(p.value * lab->per_si, p.std_error * lab->per_si),
+                            lab->pretty);
+  }
+  return cell.empty() ? "-" : cell;
+}
+
+std::string curve_cell(const ModelFit& m) {
+  std::string cell;
+  for (const auto& p : m.params) {
+    if (!is_curve_constant(p)) continue;
+    if (!cell.empty()) cell += '\n';
+    cell += p.name + " = " + with_unit(fmt::format("{:.6g}", p.value), p.unit);
+  }
+  return cell.empty() ? "-" : cell;
+}
+
+std::string stop_cell(double t_stop_pred_s) {
+  return std::isfinite(t_stop_pred_s) ? fmt::format("{:.2f} s", t_stop_pred_s) : std::string("never");
+}
+
+// The lowest-BIC converged model other than the best, to compare against.
+const ModelFit* runner_up(const RunFit& fit, const ModelFit* best) {
+  const ModelFit* second = nullptr;
+  for (const auto& m : fit.models) {
+    if (&m == best || !m.converged || !std::isfinite(m.bic)) continue;
+    if (!second || m.bic < second->bic) second = &m;
+  }
+  return second;
+}
+
+const ModelFit* best_model(const RunFit& fit) {
+  for (const auto& m : fit.models)
+    if (model_name(m.kind) == fit.best) return &m;
+  return nullptr;
+}
+
+// Kass & Raftery's reading of a BIC difference.
+std::string_view evidence(double delta_bic) {
+  if (delta_bic > 10) return "very strong";
+  if (delta_bic > 6) return "strong";
+  if (delta_bic > 2) return "positive";
+  return "weak";
+}
+
+}  // namespace
+
+std::string format_value_error(double value, double std_error) {
+  if (!std::isfinite(value)) return fmt::format("{}", value);
+  if (!std::isfinite(std_error) || std_error <= 0) {
+    const std::string v = fmt::format("{:.6g}", value);
+    return std::isnan(std_error) || std::isinf(std_error) ? v + " ± ?" : v;
+  }
+  const int err_exp = static_cast<int>(std::floor(std::log10(std_error)));
+  const int val_exp = value != 0 ? static_cast<int>(std::floor(std::log10(std::fabs(value)))) : err_exp;
+  const int magnitude = std::max(val_exp, err_exp);
+  if (magnitude >= -3 && magnitude < 6) {
+    const int decimals = std::clamp(1 - err_exp, 0, 12);
+    return fmt::format("{:.{}f} ± {:.{}f}", value, decimals, std_error, decimals);
+  }
+  // Shared exponent: both numbers as mantissas of 10^magnitude, error to two digits.
+  const double scale = std::pow(10.0, magnitude);
+  const int decimals = std::clamp(magnitude - err_exp + 1, 0, 12);
+  return fmt::format("({:.{}f} ± {:.{}f})e{:+03d}", value / scale, decimals, std_error / scale, decimals, magnitude);
+}
+
+std::string explain_best(const RunFit& fit) {
+  if (!fit.best_reason.empty()) return fit.best_reason;
+  const ModelFit* best = best_model(fit);
+  if (!best) return "no model converged";
+  const ModelFit* second = runner_up(fit, best);
+  if (!second) return fmt::format("{} is the only model that converged", fit.best);
+  const double delta = second->bic - best->bic;
+  return fmt::format("lowest BIC: ΔBIC = {:.1f} below {} ({} evidence); RMSE {:.4g} vs {:.4g}", delta,
+                     model_name(second->kind), evidence(delta), best->rmse, second->rmse);
+}
+
+Json run_fit_json(const RunFit& fit, const ReportOptions& opt) {
+  const std::string residual_unit(quantity_unit(fit.quantity));
+  Json models = Json::array();
+  for (const auto& m : fit.models) {
+    Json params = Json::object();
+    for (const auto& p : m.params) {
+      Json jp = {{"value", number(p.value)}, {"stderr", number(p.std_error)}, {"unit", p.unit}};
+      if (opt.lab_units)
+        if (auto lab = lab_unit_for(p.unit))
+          jp["lab"] = {{"value", number(p.value * lab->per_si)},
+                       {"stderr", number(p.std_error * lab->per_si)},
+                       {"unit", lab->ascii}};
+      params[p.name] = std::move(jp);
+    }
+    Json jm = {{"name", model_name(m.kind)},
+               {"params", std::move(params)},
+               {"rmse", number(m.rmse)},
+               {"residual_unit", residual_unit},
+               {"r2", number(m.r2)},
+               {"aic", number(m.aic)},
+               {"bic", number(m.bic)},
+               {"t_stop_pred_s", number(m.t_stop_pred_s)},
+               {"n", m.n},
+               {"converged", m.converged}};
+    if (!m.message.empty()) jm["message"] = m.message;
+    models.push_back(std::move(jm));
+  }
+  const Run& run = fit.run;
+  Json j = {{"run", run.number},
+            {"t_cut_s", number(run.t_cut_s)},
+            {"t_stop_s", run.stopped ? number(run.t_stop_s) : Json(nullptr)},
+            {"samples", samples_in(run)},
+            {"models", std::move(models)},
+            {"best", fit.best.empty() ? Json(nullptr) : Json(fit.best)},
+            {"best_reason", explain_best(fit)},
+            {"stopped", run.stopped},
+            {"lead_in", run.lead_in},
+            {"zero_level", number(run.zero_level)},
+            {"noise_level", number(run.noise_level)},
+            {"period_s", number(run.period_s)},
+            {"quantity", residual_unit},
+            {"bench",
+             {{"J", number(fit.bench.inertia_kg_m2)},
+              {"J_unit", "kg*m^2"},
+              {"J_source", fit.bench.inertia_source},
+              {"Kb", number(fit.bench.kb_v_s_per_rad)},
+              {"Kb_unit", "V*s/rad"},
+              {"Kb_source", fit.bench.kb_source}}}};
+  if (opt.lab_units) j["bench"]["J_lab"] = {{"value", number(inertia_to_g_cm2(fit.bench.inertia_kg_m2))},
+                                            {"unit", "g*cm^2"}};
+  return j;
+}
+
+Json file_fit_json(const FileFit& file, const ReportOptions& opt) {
+  Json runs = Json::array();
+  for (const auto& r : file.runs) runs.push_back(run_fit_json(r, opt));
+  Json diagnostics = Json::array();
+  for (const auto& d : file.diagnostics)
+    diagnostics.push_back({{"severity", severity_name(d.severity)}, {"line", d.line}, {"message", d.message}});
+  return Json{{"file", file.file},
+              {"runs", std::move(runs)},
+              {"samples_read", file.samples},
+              {"lines_read", file.lines_read},
+              {"lines_skipped", file.lines_skipped},
+              {"diagnostics", std::move(diagnostics)},
+              {"failures", file.failures}};
+}
+
+Json fit_report_json(std::span<const FileFit> files, const ReportOptions& opt) {
+  Json list = Json::array();
+  for (const auto& f : files) list.push_back(file_fit_json(f, opt));
+  return Json{{"files", std::move(list)}};
+}
+
+std::vector<std::string> summarize_diagnostics(std::span<const Diagnostic> diagnostics, std::size_t max_shown) {
+  std::vector<const Diagnostic*> order;
+  for (const auto& d : diagnostics) order.push_back(&d);
+  auto rank = [](const Diagnostic* d) {
+    return d->severity == Diagnostic::Severity::error ? 0 : d->severity == Diagnostic::Severity::warning ? 1 : 2;
+  };
+  std::stable_sort(order.begin(), order.end(), [&](auto* a, auto* b) { return rank(a) < rank(b); });
+  std::vector<std::string> lines;
+  const std::size_t shown = max_shown == 0 ? order.size() : std::min(max_shown, order.size());
+  for (std::size_t i = 0; i < shown; ++i) lines.push_back(order[i]->to_string());
+  if (shown < order.size()) {
+    std::size_t count[3] = {0, 0, 0};
+    for (std::size_t i = shown; i < order.size(); ++i) ++count[rank(order[i])];
+    std::string rest;
+    const char* names[3] = {"error", "warning", "note"};
+    for (int s = 0; s < 3; ++s) {
+      if (count[s] == 0) continue;
+      if (!rest.empty()) rest += ", ";
+      rest += fmt::format("{} {}{}", count[s], names[s], count[s] == 1 ? "" : "s");
+    }
+    lines.push_back(fmt::format("{}: ... and {} more not shown ({})", order[shown]->source, order.size() - shown, rest));
+  }
+  return lines;
+}
+
+std::string format_run_fit(const RunFit& fit, const ReportOptions& opt) {
+  const Run& run = fit.run;
+  const std::string unit(quantity_unit(fit.quantity));
+  std::string out;
+  out += fmt::format("run {}: cut at t = {:.3f} s", run.number, run.t_cut_s);
+  if (run.stopped && std::isfinite(run.t_stop_s))
+    out += fmt::format(", stopped at t = {:.3f} s ({:.2f} s after the cut)", run.t_stop_s, run.t_stop_s - run.t_cut_s);
+  else
+    out += ", did not stop";
+  out += fmt::format(", {} samples", samples_in(run));
+  if (!run.lead_in.empty()) out += fmt::format(", lead-in: {}", run.lead_in);
+  out += fmt::format("\n  zero level {:.3g} {}, noise {:.2g} {}, period {:.1f} ms\n", run.zero_level, unit,
+                     run.noise_level, unit, run.period_s * 1e3);
+  out += fmt::format("  bench: J = {:.6g} kg·m² ({}), K_b = {:.6g} V·s/rad ({})", fit.bench.inertia_kg_m2,
+                     fit.bench.inertia_source, fit.bench.kb_v_s_per_rad, fit.bench.kb_source);
+  if (opt.lab_units) out += fmt::format("; J = {:.6g} g·cm²", inertia_to_g_cm2(fit.bench.inertia_kg_m2));
+  out += "\n\n";
+
+  std::vector<std::vector<std::string>> rows;
+  rows.push_back({"model", "curve constants", "coefficients ± standard error", "RMSE", "R²", "BIC", "stop pred."});
+  for (const auto& m : fit.models) {
+    std::string name(model_name(m.kind));
+    if (!m.converged) name += "\n(not converged)";
+    rows.push_back({name, curve_cell(m), coefficient_cell(m, opt), fmt::format("{:.4g} {}", m.rmse, unit),
+                    fmt::format("{:.5f}", m.r2), fmt::format("{:.1f}", m.bic), stop_cell(m.t_stop_pred_s)});
+  }
+  out += render_table(rows, "  ");
+  out += fit.best.empty() ? fmt::format("\n  best: none ({})\n", explain_best(fit))
+                          : fmt::format("\n  best: {} — {}\n", fit.best, explain_best(fit));
+  for (const auto& m : fit.models)
+    if (!m.message.empty()) out += fmt::format("  {}: {}\n", model_name(m.kind), m.message);
+  return out;
+}
+
+std::string format_file_fit(const FileFit& file, const ReportOptions& opt) {
+  std::size_t errors = 0, warnings = 0;
+  for (const auto& d : file.diagnostics) {
+    if (d.severity == Diagnostic::Severity::error) ++errors;
+    if (d.severity == Diagnostic::Severity::warning) ++warnings;
+  }
+  std::string out = fmt::format("== {}: {} samples from {} lines ({} skipped), {} run{} fitted", file.file,
+                                file.samples, file.lines_read, file.lines_skipped, file.runs.size(),
+                                file.runs.size() == 1 ? "" : "s");
+  if (errors + warnings > 0) out += fmt::format(", {} errors, {} warnings", errors, warnings);
+  out += '\n';
+  if (opt.diagnostics_in_text) {
+    for (const auto& line : summarize_diagnostics(file.diagnostics, opt.max_diagnostics)) out += "  " + line + '\n';
+    for (const auto& why : file.failures) out += fmt::format("  not used: {}\n", why);
+  }
+  for (const auto& r : file.runs) out += '\n' + format_run_fit(r, opt);
+  return out;
+}
+
+}  // namespace spindown

@@ -1,0 +1,249 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "spindown/fit_report.hpp"
+
+using namespace spindown;
+
+namespace {
+
+constexpr double inf = std::numeric_limits<double>::infinity();
+constexpr double not_a_number = std::numeric_limits<double>::quiet_NaN();
+
+Parameter param(std::string name, double v, double se, std::string unit) {
+  return Parameter{std::move(name), v, se, std::move(unit)};
+}
+
+ModelFit model(ModelKind kind, std::vector<Parameter> params, double rmse, double bic, double t_stop) {
+  ModelFit m;
+  m.kind = kind;
+  m.params = std::move(params);
+  m.rmse = rmse;
+  m.r2 = 0.999;
+  m.aic = bic + 5;
+  m.bic = bic;
+  m.t_stop_pred_s = t_stop;
+  m.n = 1400;
+  m.converged = true;
+  return m;
+}
+
+// A hand-made fit shaped like the lab's 3 V run.
+RunFit lab_like_fit() {
+  RunFit f;
+  f.run.number = 1;
+  f.run.cut_index = 100;
+  f.run.stop_index = 1400;
+  f.run.end_index = 1500;
+  f.run.t_cut_s = 8.244;
+  f.run.t_stop_s = 35.49;
+  f.run.stopped = true;
+  f.run.zero_level = 0.0;
+  f.run.noise_level = 0.004;
+  f.run.lead_in = "zeros";
+  f.run.period_s = 0.020;
+  f.quantity = Quantity::back_emf_volts;
+  f.models.push_back(model(ModelKind::viscous,
+                           {param("c1", 1.3973e-6, 2.1e-9, "N*m*s/rad"), param("omega0", 346.6, 0.23, "rad/s"),
+                            param("A", 2.805, 0.0019, "V"), param("B", 0.124, 0.0002, "1/s")},
+                           0.061, -5000.0, inf));
+  f.models.push_back(model(ModelKind::coulomb,
+                           {param("c2", 1.3827e-4, 1.1e-7, "N*m"), param("omega0", 340.1, 0.1, "rad/s"),
+                            param("A", -0.0993, 0.0001, "V/s"), param("B", 2.75, 0.001, "V")},
+                           0.0068, -8000.0, 27.7));
+  f.models.push_back(model(ModelKind::combined,
+                           {param("c3", 1.822e-7, 3.4e-9, "N*m*s/rad"), param("c4", 1.1389e-4, 2.0e-7, "N*m"),
+                            param("omega0", 345.99, 0.12, "rad/s"), param("A", -5.0581, 0.01, "V"),
+                            param("B", 7.858, 0.01, "V"), param("C", -0.01617, 0.0003, "1/s")},
+                           0.0041, -8412.5, 27.25));
+  f.best = "combined";
+  return f;
+}
+
+FileFit one_file(RunFit run) {
+  FileFit file;
+  file.file = "seed-3v-run1.tsv";
+  file.samples = 1681;
+  file.lines_read = 1683;
+  file.lines_skipped = 2;
+  file.diagnostics.push_back({Diagnostic::Severity::note, file.file, 1, "PuTTY header skipped"});
+  file.runs.push_back(std::move(run));
+  return file;
+}
+
+// Display column of the first occurrence of needle in line (code points, not bytes).
+std::size_t display_column(const std::string& line, const std::string& needle) {
+  const auto pos = line.find(needle);
+  if (pos == std::string::npos) return std::string::npos;
+  std::size_t col = 0;
+  for (std::size_t i = 0; i < pos; ++i)
+    if ((static_cast<unsigned char>(line[i]) & 0xC0) != 0x80) ++col;
+  return col;
+}
+
+}  // namespace
+
+TEST(FitReportJson, HasTheContractKeys) {
+  const FileFit files[] = {one_file(lab_like_fit())};
+  const Json j = fit_report_json(files);
+  ASSERT_TRUE(j.contains("files"));
+  const auto& file = j["files"].at(0);
+  EXPECT_EQ(file["file"], "seed-3v-run1.tsv");
+  const auto& run = file["runs"].at(0);
+  EXPECT_EQ(run["run"], 1);
+  EXPECT_DOUBLE_EQ(run["t_cut_s"].get<double>(), 8.244);
+  EXPECT_DOUBLE_EQ(run["t_stop_s"].get<double>(), 35.49);
+  EXPECT_EQ(run["samples"], 1400);
+  EXPECT_EQ(run["best"], "combined");
+  ASSERT_EQ(run["models"].size(), 3u);
+  const char* names[] = {"viscous", "coulomb", "combined"};
+  for (int i = 0; i < 3; ++i) {
+    const auto& m = run["models"][i];
+    EXPECT_EQ(m["name"], names[i]);
+    for (const char* key : {"params", "rmse", "residual_unit", "r2", "aic", "bic"}) EXPECT_TRUE(m.contains(key)) << key;
+    EXPECT_EQ(m["residual_unit"], "V");
+  }
+  const auto& c3 = run["models"][2]["params"]["c3"];
+  EXPECT_DOUBLE_EQ(c3["value"].get<double>(), 1.822e-7);
+  EXPECT_DOUBLE_EQ(c3["stderr"].get<double>(), 3.4e-9);
+  EXPECT_EQ(c3["unit"], "N*m*s/rad");
+  EXPECT_EQ(run["models"][2]["params"]["c4"]["unit"], "N*m");
+  EXPECT_TRUE(run["models"][2]["params"].contains("C"));
+  EXPECT_DOUBLE_EQ(run["models"][2]["rmse"].get<double>(), 0.0041);
+  EXPECT_DOUBLE_EQ(run["models"][2]["bic"].get<double>(), -8412.5);
+  // Extras the contract allows.
+  EXPECT_DOUBLE_EQ(run["bench"]["J"].get<double>(), BenchParams{}.inertia_kg_m2);
+  EXPECT_EQ(file["diagnostics"].at(0)["line"], 1);
+  // No lab units unless asked.
+  EXPECT_FALSE(c3.contains("lab"));
+}
+
+TEST(FitReportJson, NonFiniteNumbersBecomeNullAndStayValidJson) {
+  RunFit f = lab_like_fit();
+  f.run.stopped = false;
+  f.run.t_stop_s = not_a_number;
+  f.models[0].params[0].std_error = not_a_number;  // a singular Jacobian
+  f.models[1].r2 = -inf;
+  const FileFit files[] = {one_file(f)};
+  const std::string text = fit_report_json(files).dump();
+  EXPECT_EQ(text.find("NaN"), std::string::npos);
+  EXPECT_EQ(text.find("nan"), std::string::npos);
+  EXPECT_EQ(text.find("inf"), std::string::npos);
+  const Json back = Json::parse(text);  // throws if not valid JSON
+  const auto& run = back["files"][0]["runs"][0];
+  EXPECT_TRUE(run["t_stop_s"].is_null());
+  EXPECT_TRUE(run["models"][0]["t_stop_pred_s"].is_null());  // viscous never stops
+  EXPECT_TRUE(run["models"][0]["params"]["c1"]["stderr"].is_null());
+  EXPECT_TRUE(run["models"][1]["r2"].is_null());
+  EXPECT_DOUBLE_EQ(run["models"][2]["t_stop_pred_s"].get<double>(), 27.25);
+}
+
+TEST(FitReportJson, LabUnitsAddedBesideSi) {
+  ReportOptions opt;
+  opt.lab_units = true;
+  const Json run = run_fit_json(lab_like_fit(), opt);
+  const auto& c3 = run["models"][2]["params"]["c3"];
+  EXPECT_NEAR(c3["lab"]["value"].get<double>(), 1.822, 1e-12);
+  EXPECT_EQ(c3["lab"]["unit"], "g*cm^2/s");
+  EXPECT_DOUBLE_EQ(c3["value"].get<double>(), 1.822e-7);  // SI stays
+  const auto& c4 = run["models"][2]["params"]["c4"];
+  EXPECT_NEAR(c4["lab"]["value"].get<double>(), 1138.9, 1e-9);
+  EXPECT_EQ(c4["lab"]["unit"], "g*cm^2*rad/s^2");
+  EXPECT_FALSE(run["models"][2]["params"]["omega0"].contains("lab"));
+  EXPECT_NEAR(run["bench"]["J_lab"]["value"].get<double>(), 112.687602, 1e-9);
+}
+
+TEST(FitReportText, TableLikeTheLabReport) {
+  const std::string text = format_run_fit(lab_like_fit());
+  for (const char* s : {"viscous", "coulomb", "combined", "curve constants", "RMSE", "BIC", "c1 = ", "c2 = ",
+                        "c3 = ", "c4 = ", "A = -5.0581 V", "C = -0.01617 s⁻¹", "N·m·s/rad", "never", "27.25 s",
+                        "best: combined"})
+    EXPECT_NE(text.find(s), std::string::npos) << "missing '" << s << "' in\n" << text;
+  // Why: ΔBIC to the runner-up (coulomb, BIC −8000) and both RMSEs.
+  EXPECT_NE(text.find("ΔBIC = 412.5 below coulomb"), std::string::npos) << text;
+  EXPECT_NE(text.find("RMSE 0.0041 vs 0.0068"), std::string::npos) << text;
+  EXPECT_EQ(text.find("g·cm²·s⁻¹"), std::string::npos);  // SI only by default
+}
+
+TEST(FitReportText, ColumnsAlignDespiteMultibyteUnits) {
+  const std::string text = format_run_fit(lab_like_fit());
+  std::vector<std::string> lines;
+  for (std::size_t a = 0, b; a < text.size(); a = b + 1) {
+    b = text.find('\n', a);
+    if (b == std::string::npos) b = text.size();
+    lines.push_back(text.substr(a, b - a));
+  }
+  std::size_t header_col = std::string::npos, rows = 0;
+  for (const auto& l : lines) {
+    if (l.find("model") != std::string::npos && l.find("RMSE") != std::string::npos) header_col = display_column(l, "RMSE");
+    for (const char* rmse : {"0.061 V", "0.0068 V", "0.0041 V"})
+      if (l.find(rmse) != std::string::npos) {
+        ASSERT_NE(header_col, std::string::npos);
+        EXPECT_EQ(display_column(l, rmse), header_col) << l;
+        ++rows;
+      }
+  }
+  EXPECT_EQ(rows, 3u) << text;
+}
+
+TEST(FitReportText, LabUnitsOnRequest) {
+  ReportOptions opt;
+  opt.lab_units = true;
+  const std::string text = format_run_fit(lab_like_fit(), opt);
+  EXPECT_NE(text.find("g·cm²·s⁻¹"), std::string::npos) << text;
+  EXPECT_NE(text.find("g·cm²·rad·s⁻²"), std::string::npos) << text;
+  EXPECT_NE(text.find("1.822 ± 0.034 g·cm²·s⁻¹"), std::string::npos) << text;
+  EXPECT_NE(text.find("112.688 g·cm²"), std::string::npos) << text;
+}
+
+TEST(FitReportText, FileHeaderAndFailures) {
+  FileFit file = one_file(lab_like_fit());
+  file.failures.push_back("run 2: no model converged");
+  const std::string text = format_file_fit(file);
+  EXPECT_NE(text.find("== seed-3v-run1.tsv: 1681 samples"), std::string::npos) << text;
+  EXPECT_NE(text.find("seed-3v-run1.tsv:1: note: PuTTY header skipped"), std::string::npos) << text;
+  EXPECT_NE(text.find("not used: run 2: no model converged"), std::string::npos) << text;
+  ReportOptions quiet;
+  quiet.diagnostics_in_text = false;
+  EXPECT_EQ(format_file_fit(file, quiet).find("PuTTY header"), std::string::npos);
+  EXPECT_FALSE(file.usable());
+}
+
+TEST(FitReportText, BestReasonFromTheFitWins) {
+  RunFit f = lab_like_fit();
+  f.best_reason = "because the fitter said so";
+  EXPECT_EQ(explain_best(f), "because the fitter said so");
+  f.best_reason.clear();
+  f.models.resize(1);
+  f.best = "viscous";
+  EXPECT_EQ(explain_best(f), "viscous is the only model that converged");
+  f.best.clear();
+  EXPECT_EQ(explain_best(f), "no model converged");
+}
+
+TEST(FormatValueError, ErrorToTwoDigitsValueToTheSamePlace) {
+  EXPECT_EQ(format_value_error(346.614, 0.2345), "346.61 ± 0.23");
+  EXPECT_EQ(format_value_error(0.124, 0.0012), "0.1240 ± 0.0012");
+  EXPECT_EQ(format_value_error(1.3973e-6, 2.1e-9), "(1.3973 ± 0.0021)e-06");
+  EXPECT_EQ(format_value_error(1.1389e-4, 2.0e-7), "(1.1389 ± 0.0020)e-04");
+  EXPECT_EQ(format_value_error(1138.9, 12.0), "1139 ± 12");
+  EXPECT_EQ(format_value_error(2.5, 0), "2.5");
+  EXPECT_EQ(format_value_error(2.5, not_a_number), "2.5 ± ?");
+  EXPECT_EQ(format_value_error(inf, 1), "inf");
+}
+
+TEST(SummarizeDiagnostics, ErrorsFirstThenACount) {
+  std::vector<Diagnostic> d;
+  for (int i = 1; i <= 20; ++i) d.push_back({Diagnostic::Severity::warning, "f.tsv", i, "garbled line"});
+  d.push_back({Diagnostic::Severity::error, "f.tsv", 0, "no run found"});
+  const auto lines = summarize_diagnostics(d, 5);
+  ASSERT_EQ(lines.size(), 6u);
+  EXPECT_EQ(lines[0], "f.tsv: error: no run found");
+  EXPECT_EQ(lines[1], "f.tsv:1: warning: garbled line");
+  EXPECT_EQ(lines[5], "f.tsv: ... and 16 more not shown (16 warnings)");
+  EXPECT_EQ(summarize_diagnostics(d, 0).size(), 21u);
+  EXPECT_TRUE(summarize_diagnostics({}, 5).empty());
+}
