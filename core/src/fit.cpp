@@ -1,0 +1,526 @@
+#include "spindown/fit.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <fmt/format.h>
+#include <limits>
+#include <nlopt.hpp>
+#include <numeric>
+
+namespace spindown {
+namespace {
+
+constexpr double inf = std::numeric_limits<double>::infinity();
+constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+
+// The three lab models are one family in reading units (r = k·ω above the zero level):
+//   r(τ) = max(0, u0·e^(−ατ) − β·τ·φ(ατ)),  φ(x) = (1 − e^(−x))/x,
+// with α = c_viscous/J (1/s) and β = k·c_coulomb/J (reading/s). viscous: β = 0; coulomb:
+// α = 0; combined: both free. Once r reaches 0 it stays 0: for α, β ≥ 0 the closed form is
+// decreasing, so clamping at zero is exactly the stop.
+struct Family {
+  bool alpha_free, beta_free;
+  int size() const { return 1 + alpha_free + beta_free; }
+};
+
+Family family_of(ModelKind k) {
+  switch (k) {
+    case ModelKind::viscous: return {true, false};
+    case ModelKind::coulomb: return {false, true};
+    case ModelKind::combined: return {true, true};
+  }
+  return {true, true};
+}
+
+struct Theta {
+  double u0 = 0, alpha = 0, beta = 0;
+};
+
+Theta unpack(const Family& f, const double* x) {
+  Theta th;
+  int i = 0;
+  th.u0 = x[i++];
+  if (f.alpha_free) th.alpha = x[i++];
+  if (f.beta_free) th.beta = x[i++];
+  return th;
+}
+
+// φ(x) = (1 − e^(−x))/x and dφ/dx from the one exponential already computed; a series where
+// 1 − e would cancel.
+inline void phi(double x, double e, double& p, double& dp) {
+  if (x < 1e-3) {
+    p = 1.0 - x / 2 + x * x / 6 - x * x * x / 24;
+    dp = -0.5 + x / 3 - x * x / 8;
+  } else {
+    p = (1.0 - e) / x;
+    dp = (e * (1.0 + x) - 1.0) / (x * x);
+  }
+}
+
+// Model reading at τ and, when grad is given, its partial derivatives (zero once stopped).
+inline double reading(const Family& f, const Theta& th, double tau, double* grad) {
+  const double x = th.alpha * tau;
+  const double e = std::exp(-x);
+  double p, dp;
+  phi(x, e, p, dp);
+  const double m = th.u0 * e - th.beta * tau * p;
+  const bool moving = m > 0;
+  if (grad) {
+    int i = 0;
+    grad[i++] = moving ? e : 0.0;
+    if (f.alpha_free) grad[i++] = moving ? (-th.u0 * tau * e - th.beta * tau * tau * dp) : 0.0;
+    if (f.beta_free) grad[i++] = moving ? -tau * p : 0.0;
+  }
+  return moving ? m : 0.0;
+}
+
+double stop_time(const Theta& th) {
+  if (th.beta <= 0) return inf;
+  if (th.alpha <= 1e-12) return th.u0 / th.beta;
+  return std::log1p(th.alpha * th.u0 / th.beta) / th.alpha;
+}
+
+struct Problem {
+  Family fam;
+  std::span<const double> tau, y;
+  Eigen::Vector3d scale;  // parameters are optimised as x_j = θ_j / scale_j (conditioning)
+  double sse0 = 1;        // objective normalisation
+  int evals = 0;
+  std::exception_ptr error;
+};
+
+double sse_and_gradient(const Problem& pb, const Theta& th, double* grad) {
+  const int p = pb.fam.size();
+  double g[3];
+  double sse = 0;
+  if (grad) std::fill(grad, grad + p, 0.0);
+  for (std::size_t i = 0; i < pb.tau.size(); ++i) {
+    const double r = pb.y[i] - reading(pb.fam, th, pb.tau[i], grad ? g : nullptr);
+    sse += r * r;
+    if (grad)
+      for (int j = 0; j < p; ++j) grad[j] -= 2 * r * g[j];
+  }
+  return sse;
+}
+
+// NLopt's C++ objective: never let an exception cross it (design §7).
+double nlopt_objective(unsigned n, const double* xs, double* grad, void* data) {
+  auto* pb = static_cast<Problem*>(data);
+  try {
+    ++pb->evals;
+    double x[3];
+    for (unsigned j = 0; j < n; ++j) x[j] = xs[j] * pb->scale[j];
+    const Theta th = unpack(pb->fam, x);
+    const double sse = sse_and_gradient(*pb, th, grad);
+    if (grad)
+      for (unsigned j = 0; j < n; ++j) grad[j] *= pb->scale[j] / pb->sse0;
+    return sse / pb->sse0;
+  } catch (...) {
+    pb->error = std::current_exception();
+    throw nlopt::forced_stop();
+  }
+}
+
+// Starting point from the integral form of the ODE, linear in the unknowns:
+//   r(τ) = u0 − α·∫₀^τ r dt − β·τ     (while moving)
+// one least-squares solve over the samples before the stop: no derivatives of noisy data,
+// no initial guess needed.
+Theta integral_start(const Family& f, std::span<const double> tau, std::span<const double> y,
+                     std::size_t moving) {
+  const int p = f.size();
+  Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d atb = Eigen::Vector3d::Zero();
+  double integral = 0;
+  for (std::size_t i = 0; i < moving; ++i) {
+    if (i > 0) integral += 0.5 * (y[i] + y[i - 1]) * (tau[i] - tau[i - 1]);
+    double row[3];
+    int j = 0;
+    row[j++] = 1.0;
+    if (f.alpha_free) row[j++] = -integral;
+    if (f.beta_free) row[j++] = -tau[i];
+    for (int a = 0; a < p; ++a) {
+      atb[a] += row[a] * y[i];
+      for (int b = 0; b < p; ++b) ata(a, b) += row[a] * row[b];
+    }
+  }
+  Theta th;
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(ata.topLeftCorner(p, p));
+  if (ldlt.info() != Eigen::Success) return th;
+  const Eigen::VectorXd sol = ldlt.solve(atb.head(p));
+  if (!sol.allFinite()) return th;
+  th = unpack(f, sol.data());
+  return th;
+}
+
+// Levenberg–Marquardt in Eigen with the bounds α, β ≥ 0, u0 > 0 enforced by projection. The
+// closed-form Jacobian makes each iteration one pass over the data; from the integral start
+// it converges in a handful of iterations.
+struct LmResult {
+  Theta theta;
+  double sse = 0;
+  int evals = 0;
+  bool converged = false;
+};
+
+double residuals(const Family& f, const Theta& th, std::span<const double> tau, std::span<const double> y,
+                 Eigen::Matrix3d& jtj, Eigen::Vector3d& jtr) {
+  const int p = f.size();
+  jtj.setZero();
+  jtr.setZero();
+  double sse = 0, g[3];
+  for (std::size_t i = 0; i < tau.size(); ++i) {
+    const double r = y[i] - reading(f, th, tau[i], g);
+    sse += r * r;
+    for (int a = 0; a < p; ++a) {
+      jtr[a] += g[a] * r;
+      for (int b = 0; b <= a; ++b) jtj(a, b) += g[a] * g[b];
+    }
+  }
+  for (int a = 0; a < p; ++a)
+    for (int b = a + 1; b < p; ++b) jtj(a, b) = jtj(b, a);
+  return sse;
+}
+
+LmResult levenberg_marquardt(const Family& f, Theta th, std::span<const double> tau, std::span<const double> y) {
+  const int p = f.size();
+  LmResult out;
+  Eigen::Matrix3d jtj, jtj_try;
+  Eigen::Vector3d jtr, jtr_try;
+  double sse = residuals(f, th, tau, y, jtj, jtr);
+  out.evals = 1;
+  double lambda = 1e-3;
+  for (int it = 0; it < 100 && out.evals < 200; ++it) {
+    Eigen::MatrixXd a = jtj.topLeftCorner(p, p);
+    a.diagonal() *= 1.0 + lambda;
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(a);
+    if (ldlt.info() != Eigen::Success) break;
+    const Eigen::VectorXd step = ldlt.solve(jtr.head(p));
+    if (!step.allFinite()) break;
+    double x[3], s[3] = {0, 0, 0};
+    int j = 0;
+    x[j] = th.u0, s[j] = step[j], ++j;
+    if (f.alpha_free) x[j] = th.alpha, s[j] = step[j], ++j;
+    if (f.beta_free) x[j] = th.beta, s[j] = step[j], ++j;
+    for (j = 0; j < p; ++j) x[j] = std::max(x[j] + s[j], j == 0 ? 1e-12 : 0.0);
+    const Theta trial = unpack(f, x);
+    const double sse_try = residuals(f, trial, tau, y, jtj_try, jtr_try);
+    ++out.evals;
+    if (sse_try <= sse) {
+      const double gain = sse - sse_try;
+      th = trial;
+      jtj = jtj_try;
+      jtr = jtr_try;
+      sse = sse_try;
+      lambda = std::max(lambda / 10, 1e-12);
+      bool small = true;
+      j = 0;
+      if (std::abs(s[j]) > 1e-10 * std::abs(th.u0)) small = false;
+      ++j;
+      if (f.alpha_free && std::abs(s[j++]) > 1e-10 * std::max(th.alpha, 1e-9)) small = false;
+      if (f.beta_free && std::abs(s[j++]) > 1e-10 * std::max(th.beta, 1e-9 * th.u0)) small = false;
+      if (small || gain <= 1e-14 * sse) {
+        out.converged = true;
+        break;
+      }
+    } else {
+      lambda *= 10;
+      if (lambda > 1e10) {
+        out.converged = true;  // no step improves: at a (bounded) minimum
+        break;
+      }
+    }
+  }
+  out.theta = th;
+  out.sse = sse;
+  return out;
+}
+
+struct Covariance {
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  bool ok = false;
+};
+
+// Parameter covariance from the Jacobian at the optimum. The classic s²(JᵀJ)⁻¹ assumes white
+// residuals; commutator ripple and quantization make them correlated, so the Newey–West
+// (HAC) sandwich is computed too and the larger variance of the two is kept.
+Covariance covariance(const Family& f, const Theta& th, std::span<const double> tau, std::span<const double> y) {
+  const int p = f.size();
+  const auto n = static_cast<Eigen::Index>(tau.size());
+  Eigen::MatrixXd jac(n, p);
+  Eigen::VectorXd res(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    double g[3];
+    res[i] = y[i] - reading(f, th, tau[i], g);
+    for (int j = 0; j < p; ++j) jac(i, j) = g[j];
+  }
+  Covariance out;
+  const Eigen::MatrixXd jtj = jac.transpose() * jac;
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(jtj);
+  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return out;
+  const Eigen::MatrixXd inv = ldlt.solve(Eigen::MatrixXd::Identity(p, p));
+  if (!inv.allFinite()) return out;
+  const double s2 = res.squaredNorm() / std::max<Eigen::Index>(1, n - p);
+  const Eigen::MatrixXd classic = s2 * inv;
+
+  const int lags = static_cast<int>(std::ceil(4.0 * std::pow(n / 100.0, 2.0 / 9.0)));
+  const Eigen::MatrixXd score = jac.array().colwise() * res.array();  // rows: g_i·r_i
+  Eigen::MatrixXd meat = score.transpose() * score;
+  for (int l = 1; l <= lags && l < n; ++l) {
+    const double w = 1.0 - l / (lags + 1.0);
+    const Eigen::MatrixXd gamma = score.topRows(n - l).transpose() * score.bottomRows(n - l);
+    meat += w * (gamma + gamma.transpose());
+  }
+  const double dof = static_cast<double>(n) / std::max<Eigen::Index>(1, n - p);
+  const Eigen::MatrixXd hac = dof * inv * meat * inv;
+  Eigen::MatrixXd cov = classic;
+  // Keep the correlation structure of the classic estimate, widened per parameter.
+  Eigen::VectorXd widen(p);
+  for (int j = 0; j < p; ++j) widen[j] = std::sqrt(std::max(1.0, hac(j, j) / classic(j, j)));
+  cov = widen.asDiagonal() * classic * widen.asDiagonal();
+  out.cov.topLeftCorner(p, p) = cov;
+  out.ok = cov.allFinite();
+  return out;
+}
+
+Parameter make_param(std::string name, double value, double se, std::string unit) {
+  return {std::move(name), value, se, std::move(unit)};
+}
+
+// Standard error of g(θ) by the delta method, grad in (u0, α, β) order restricted to free params.
+double delta_se(const Family& f, const Eigen::Matrix3d& cov, double d_u0, double d_alpha, double d_beta) {
+  Eigen::Vector3d g;
+  int j = 0;
+  g[j++] = d_u0;
+  if (f.alpha_free) g[j++] = d_alpha;
+  if (f.beta_free) g[j++] = d_beta;
+  const int p = f.size();
+  const double var = g.head(p).dot(cov.topLeftCorner(p, p) * g.head(p));
+  return var > 0 ? std::sqrt(var) : 0.0;
+}
+
+// Bounded quasi-Newton refinement with NLopt (the fallback when LM does not converge).
+// Returns "" on success or why it failed; th is updated to the best point found.
+std::string refine_with_nlopt(const Family& fam, std::span<const double> tau, std::span<const double> y, Theta& th,
+                              int& evals) {
+  const int p = fam.size();
+  const double span_s = std::max(tau.back(), 1e-3);
+  Problem pb{fam, tau, y, {}, 1.0, 0, nullptr};
+  std::vector<double> x(p);
+  {
+    int j = 0;
+    pb.scale[j] = std::max(th.u0, 1e-9), x[j] = th.u0 / pb.scale[j], ++j;
+    if (fam.alpha_free) pb.scale[j] = std::max(th.alpha, 1e-6 / span_s), x[j] = th.alpha / pb.scale[j], ++j;
+    if (fam.beta_free) pb.scale[j] = std::max(th.beta, 1e-6 * th.u0 / span_s), x[j] = th.beta / pb.scale[j], ++j;
+  }
+  pb.sse0 = std::max(sse_and_gradient(pb, th, nullptr), 1e-300);
+  nlopt::opt opt(nlopt::LD_LBFGS, static_cast<unsigned>(p));
+  std::vector<double> lb(p, 0.0), ub(p, 1e6);
+  lb[0] = 1e-9;
+  opt.set_lower_bounds(lb);
+  opt.set_upper_bounds(ub);
+  opt.set_min_objective(nlopt_objective, &pb);
+  opt.set_ftol_rel(1e-13);
+  opt.set_xtol_rel(1e-10);
+  opt.set_maxeval(400);
+  double fmin = 0;
+  std::string why;
+  try {
+    const nlopt::result res = opt.optimize(x, fmin);
+    if (res == nlopt::MAXEVAL_REACHED) why = "no convergence within 400 evaluations";
+  } catch (const nlopt::roundoff_limited&) {
+    // at the optimum to machine precision: accept
+  } catch (const nlopt::forced_stop&) {
+    why = "the objective failed";
+    if (pb.error) {
+      try {
+        std::rethrow_exception(pb.error);
+      } catch (const std::exception& e) {
+        why = fmt::format("the objective failed: {}", e.what());
+      }
+    }
+  } catch (const std::exception& e) {
+    why = fmt::format("NLopt: {}", e.what());
+  }
+  evals += pb.evals;
+  for (int j = 0; j < p; ++j) x[j] *= pb.scale[j];
+  th = unpack(fam, x.data());
+  return why;
+}
+
+ModelFit fit_model(ModelKind kind, std::span<const double> tau, std::span<const double> y, std::size_t moving,
+                   double k, const BenchParams& bench, std::string_view runit) {
+  ModelFit out;
+  out.kind = kind;
+  out.n = tau.size();
+  const Family fam = family_of(kind);
+  const int p = fam.size();
+  if (moving < static_cast<std::size_t>(p) + 2 || tau.size() < static_cast<std::size_t>(p) + 2) {
+    out.message = fmt::format("{} samples while moving: too few to fit {} parameters", moving, p);
+    return out;
+  }
+
+  // Start: the integral form; guard it into the feasible region (α, β ≥ 0, u0 > 0).
+  Theta th = integral_start(fam, tau, y, moving);
+  const double y_first = *std::max_element(y.begin(), y.begin() + std::min<std::size_t>(moving, 5));
+  if (!(th.u0 > 0) || !std::isfinite(th.u0)) th.u0 = std::max(y_first, 1e-6);
+  const double span_s = std::max(tau[moving - 1], 1e-3);
+  if (fam.alpha_free && !(th.alpha > 0)) th.alpha = fam.beta_free ? 1e-3 / span_s : 1.0 / span_s;
+  if (fam.beta_free && !(th.beta > 0)) th.beta = fam.alpha_free ? 1e-3 * th.u0 / span_s : th.u0 / span_s;
+
+  const LmResult lm = levenberg_marquardt(fam, th, tau, y);
+  out.evaluations = lm.evals;
+  th = lm.theta;
+  bool solved = lm.converged;
+  std::string why;
+  if (!solved) {
+    // Fallback: NLopt's L-BFGS under bounds on scaled parameters, from LM's best point.
+    why = refine_with_nlopt(fam, tau, y, th, out.evaluations);
+    solved = why.empty();
+  }
+  Problem pb{fam, tau, y, {}, 1.0, 0, nullptr};
+  const double sse = sse_and_gradient(pb, th, nullptr);
+  const double n = static_cast<double>(tau.size());
+  const double mean = std::accumulate(y.begin(), y.end(), 0.0) / n;
+  double sst = 0;
+  for (double v : y) sst += (v - mean) * (v - mean);
+  out.rmse = std::sqrt(sse / n);
+  out.r2 = sst > 0 ? 1.0 - sse / sst : nan;
+  const double ll = n * std::log(std::max(sse / n, 1e-300));
+  out.aic = ll + 2.0 * p;
+  out.bic = ll + p * std::log(n);
+  out.t_stop_pred_s = stop_time(th);
+  out.omega0 = th.u0 / k;
+  out.rate = th.alpha;
+  out.decel = th.beta / k;
+
+  const Covariance cv = covariance(fam, th, tau, y);
+  out.converged = solved && cv.ok;
+  if (!solved) out.message = why;
+  else if (!cv.ok) out.message = "parameters are not identifiable from this run (singular Jacobian)";
+  const Eigen::Matrix3d& c = cv.cov;
+  const double J = bench.inertia_kg_m2;
+  const auto se = [&](double du0, double dal, double dbe) { return cv.ok ? delta_se(fam, c, du0, dal, dbe) : nan; };
+  const std::string ru(runit), rate_unit = ru + "/s";
+  switch (kind) {
+    case ModelKind::viscous:
+      out.params = {make_param("c1", th.alpha * J, se(0, J, 0), "N*m*s/rad"),
+                    make_param("omega0", out.omega0, se(1 / k, 0, 0), "rad/s"),
+                    make_param("A", th.u0, se(1, 0, 0), ru), make_param("B", th.alpha, se(0, 1, 0), "1/s")};
+      break;
+    case ModelKind::coulomb:
+      out.params = {make_param("c2", th.beta * J / k, se(0, 0, J / k), "N*m"),
+                    make_param("omega0", out.omega0, se(1 / k, 0, 0), "rad/s"),
+                    make_param("A", -th.beta, se(0, 0, 1), rate_unit), make_param("B", th.u0, se(1, 0, 0), ru)};
+      break;
+    case ModelKind::combined: {
+      // y = A + B·e^(Cτ): A = −β/α, B = u0 + β/α, C = −α (the lab's seed curve).
+      const double a = std::max(th.alpha, 1e-300);
+      out.params = {make_param("c3", th.alpha * J, se(0, J, 0), "N*m*s/rad"),
+                    make_param("c4", th.beta * J / k, se(0, 0, J / k), "N*m"),
+                    make_param("omega0", out.omega0, se(1 / k, 0, 0), "rad/s"),
+                    make_param("A", -th.beta / a, se(0, th.beta / (a * a), -1 / a), ru),
+                    make_param("B", th.u0 + th.beta / a, se(1, -th.beta / (a * a), 1 / a), ru),
+                    make_param("C", -th.alpha, se(0, -1, 0), "1/s")};
+      break;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string_view model_name(ModelKind k) {
+  switch (k) {
+    case ModelKind::viscous: return "viscous";
+    case ModelKind::coulomb: return "coulomb";
+    case ModelKind::combined: return "combined";
+  }
+  return "?";
+}
+
+std::optional<ModelKind> parse_model(std::string_view name) {
+  for (ModelKind k : all_models)
+    if (model_name(k) == name) return k;
+  return std::nullopt;
+}
+
+const Parameter* ModelFit::param(std::string_view name) const {
+  for (const auto& p : params)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
+double ModelFit::omega_at(double tau) const {
+  const Family f = family_of(kind);
+  const Theta th{omega0, rate, decel};  // in ω units (k = 1)
+  return reading(f, th, std::max(tau, 0.0), nullptr);
+}
+
+const ModelFit* RunFit::model(ModelKind k) const {
+  for (const auto& m : models)
+    if (m.kind == k) return &m;
+  return nullptr;
+}
+
+bool FitOptions::is_valid(std::string* why) const {
+  if (!bench.is_valid(why)) return false;
+  if (models.empty()) {
+    if (why) *why = "no model chosen";
+    return false;
+  }
+  return true;
+}
+
+RunFit fit_run(std::span<const double> t_s, std::span<const double> value, Quantity q, const Run& run,
+               const FitOptions& opt) {
+  RunFit out;
+  out.run = run;
+  out.bench = opt.bench;
+  out.quantity = q;
+  const std::size_t begin = std::min(run.cut_index, t_s.size());
+  const std::size_t end = std::clamp(run.end_index, begin, t_s.size());
+  const std::size_t stop = std::clamp(run.stop_index, begin, end);
+  const double k = value_per_rad_per_s(q, opt.bench.kb_v_s_per_rad);
+
+  std::vector<double> tau(end - begin), y(end - begin);
+  for (std::size_t i = begin; i < end; ++i) {
+    tau[i - begin] = t_s[i] - run.t_cut_s;
+    y[i - begin] = value[i] - run.zero_level;
+  }
+  const std::size_t moving = (run.stopped ? stop : end) - begin;
+  const std::string_view runit = quantity_unit(q);
+  for (ModelKind kind : opt.models) out.models.push_back(fit_model(kind, tau, y, moving, k, opt.bench, runit));
+
+  // Best model: lowest BIC among converged fits (BIC penalises the extra parameter).
+  const ModelFit* best = nullptr;
+  const ModelFit* second = nullptr;
+  for (const auto& m : out.models) {
+    if (!m.converged) continue;
+    if (!best || m.bic < best->bic) {
+      second = best;
+      best = &m;
+    } else if (!second || m.bic < second->bic) {
+      second = &m;
+    }
+  }
+  if (best) {
+    out.best = std::string(model_name(best->kind));
+    if (second) {
+      const double dbic = second->bic - best->bic;
+      const char* strength = dbic > 10 ? "very strong" : dbic > 6 ? "strong" : dbic > 2 ? "positive" : "weak";
+      out.best_reason = fmt::format("lowest BIC, {:.1f} below {} ({} evidence); RMSE {:.4g} {} vs {:.4g} {}", dbic,
+                                    model_name(second->kind), strength, best->rmse, runit, second->rmse, runit);
+    } else {
+      out.best_reason = "the only model that converged";
+    }
+  }
+  return out;
+}
+
+RunFit fit_run(const Recording& rec, const Run& run, const FitOptions& opt) {
+  return fit_run(rec.t_s, rec.value, rec.quantity, run, opt);
+}
+
+}  // namespace spindown
