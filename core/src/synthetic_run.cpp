@@ -46,8 +46,9 @@ SyntheticRun make_synthetic_run(const SyntheticRunSpec& s) {
     }
     int counts = -1;
     if (s.adc_bits > 0) {
-      // analogRead: floor of v/Vref·2^bits, clipped to the converter's range.
-      counts = static_cast<int>(std::clamp(std::floor(v / s.adc_ref_v * (adc_max + 1)), 0.0, double(adc_max)));
+      // analogRead: v/Vref·2^bits to an integer count, clipped to the converter's range.
+      const double x = v / s.adc_ref_v * (adc_max + 1);
+      counts = static_cast<int>(std::clamp(s.adc_floor ? std::floor(x) : std::round(x), 0.0, double(adc_max)));
       v = counts * s.adc_ref_v / adc_max;  // the sketch: analogRead(A0) * 5.0 / 1023
     }
     if (s.decimals >= 0) v = std::round(v * p10) / p10;

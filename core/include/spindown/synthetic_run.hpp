@@ -30,6 +30,7 @@ struct SyntheticRunSpec {
   int ripple_per_rev = 6;      // ripple cycles per revolution
   double offset_v = 0.0;       // sensor offset after the cut
   int adc_bits = 10;           // 0 = no ADC quantization
+  bool adc_floor = false;      // true: truncating converter (−½ LSB bias); false: rounds to nearest
   double adc_ref_v = 5.0;
   int decimals = 2;            // printing; negative = full precision
   double t0_ms = 5234;         // device time of the first sample
