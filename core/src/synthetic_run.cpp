@@ -49,7 +49,8 @@ SyntheticRun make_synthetic_run(const SyntheticRunSpec& s) {
       // analogRead: v/Vref·2^bits to an integer count, clipped to the converter's range.
       const double x = v / s.adc_ref_v * (adc_max + 1);
       counts = static_cast<int>(std::clamp(s.adc_floor ? std::floor(x) : std::round(x), 0.0, double(adc_max)));
-      v = counts * s.adc_ref_v / adc_max;  // the sketch: analogRead(A0) * 5.0 / 1023
+      // Vref/2^bits per count; the lab sketch's analogRead(A0) * 5.0 / 1023 reads 0.1 % high.
+      v = counts * s.adc_ref_v / (s.sketch_gain ? adc_max : adc_max + 1);
     }
     if (s.decimals >= 0) v = std::round(v * p10) / p10;
     out.t_ms.push_back(std::floor(t_real_ms));

@@ -32,6 +32,7 @@ struct SyntheticRunSpec {
   int adc_bits = 10;           // 0 = no ADC quantization
   bool adc_floor = false;      // true: truncating converter (−½ LSB bias); false: rounds to nearest
   double adc_ref_v = 5.0;
+  bool sketch_gain = false;    // true: volts = counts·Vref/1023 as the lab sketch prints (+0.1 % gain)
   int decimals = 2;            // printing; negative = full precision
   double t0_ms = 5234;         // device time of the first sample
   std::uint64_t seed = 1;
