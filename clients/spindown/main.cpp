@@ -1,0 +1,26 @@
+// spindown: offline analysis of spin-down recordings (design §5).
+// Exit codes: 0 ok, 1 a file or run could not be used, 2 bad usage.
+#include <CLI/CLI.hpp>
+#include <exception>
+#include <iostream>
+
+#include "exit_codes.hpp"
+#include "fit_command.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"spindown: fit friction models to DC-motor spin-down recordings"};
+  app.require_subcommand(1);
+  spindown::cli::setup_fit(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::RuntimeError& e) {  // a subcommand finished with a non-zero exit code
+    return e.get_exit_code();
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);  // prints help, or the usage error
+    return code == 0 ? 0 : spindown::cli::exit_bad_usage;
+  } catch (const std::exception& e) {  // a bug: say so rather than abort
+    std::cerr << "spindown: internal error: " << e.what() << '\n';
+    return spindown::cli::exit_unusable;
+  }
+  return spindown::cli::exit_ok;
+}
