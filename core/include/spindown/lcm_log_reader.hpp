@@ -1,0 +1,124 @@
+#pragma once
+// LCM event logs (what lcm-logger and spindown-logger write), read with lcm::LogFile and the
+// log's own timestamps — never by file:// replay, which hands out wall-clock times (design
+// §7). LcmLogReader streams events one at a time, so a refit never holds a whole log in
+// memory; read_lcm_log() gathers one Recording per bench from SPINDOWN.<bench>.SAMPLE and the
+// latest SPINDOWN.<bench>.CONFIG.
+//
+// A damaged log is read as far as it can be: garbage between events is skipped to the next
+// event marker, a truncated last event or an undecodable message is reported (with its event
+// number, channel and byte offset) and reading goes on.
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <spindown/config_t.hpp>
+#include <spindown/samples_t.hpp>
+
+#include "spindown/bench.hpp"
+#include "spindown/recording.hpp"
+
+namespace lcm {
+class LogFile;
+}
+
+namespace spindown {
+
+// Every LCM log event starts with this big-endian word (and so does the file).
+inline constexpr std::uint32_t lcm_log_magic = 0xEDA1DA01u;
+
+// "SPINDOWN.<bench>.<KIND>" with a valid bench id ([A-Za-z0-9_-]{1,32}); nullopt otherwise.
+struct SpindownChannelName {
+  std::string_view bench;
+  std::string_view kind;  // "SAMPLE", "CONFIG", …
+};
+std::optional<SpindownChannelName> split_spindown_channel(std::string_view channel);
+
+struct LcmLogEvent {
+  enum class Kind {
+    samples,  // a decoded samples_t from SPINDOWN.<bench>.SAMPLE
+    config,   // a decoded config_t from SPINDOWN.<bench>.CONFIG
+    other,    // any other channel: raw payload only
+    problem,  // an event that could not be used, or damage in the file itself
+  };
+  Kind kind = Kind::other;
+  std::int64_t number = 0;       // 1-based position of the event in the file (0: file damage)
+  std::int64_t log_utime = 0;    // receive time the logger wrote (µs since the Unix epoch)
+  std::int64_t file_offset = 0;  // byte offset of the event (or of the damage)
+  std::string channel;
+  std::string bench;             // for SPINDOWN.<bench>.* channels, else empty
+  samples_t samples;             // Kind::samples
+  config_t config;               // Kind::config
+  const void* data = nullptr;    // Kind::other: the payload, valid until the next next()
+  std::int32_t data_size = 0;
+  std::string problem;           // Kind::problem: what was wrong and what was done
+};
+
+class LcmLogReader {
+ public:
+  explicit LcmLogReader(const std::string& path);
+  ~LcmLogReader();
+  LcmLogReader(const LcmLogReader&) = delete;
+  LcmLogReader& operator=(const LcmLogReader&) = delete;
+
+  // False when the file could not be opened; open_error() says why (with errno text).
+  bool good() const { return log_ != nullptr; }
+  const std::string& open_error() const { return open_error_; }
+  const std::string& path() const { return path_; }
+
+  // The next event (or problem); false at the end of the log. event is reused between calls
+  // (its vectors keep their capacity).
+  bool next(LcmLogEvent& event);
+
+  std::int64_t events_read() const { return events_; }
+  std::int64_t file_size() const { return size_; }
+
+ private:
+  bool find_event_start(LcmLogEvent& event);
+  void decode(LcmLogEvent& event, const void* data, std::int32_t size);
+
+  std::string path_;
+  std::string open_error_;
+  std::unique_ptr<lcm::LogFile> log_;
+  std::int64_t size_ = 0;
+  std::int64_t events_ = 0;
+  bool done_ = false;
+};
+
+struct LcmLogOptions {
+  std::size_t max_event_reports = 20;  // problems per bench listed one by one before a count
+  bool is_valid(std::string* why) const;
+};
+
+struct BenchLog {
+  std::string bench;
+  Recording recording;               // source "FILE SPINDOWN.<bench>.SAMPLE"; line = event number
+  std::optional<config_t> config;    // the latest SPINDOWN.<bench>.CONFIG
+  std::int64_t sample_messages = 0;
+  std::int64_t config_messages = 0;
+  std::int64_t samples_lost = 0;     // from gaps in samples_t.seq
+};
+
+struct LcmLogContents {
+  std::string path;
+  std::vector<BenchLog> benches;                      // in order of first appearance
+  std::vector<Diagnostic> diagnostics;                // about the file as a whole
+  std::map<std::string, std::int64_t> other_channels; // events not read as samples or config
+  std::int64_t events = 0;
+  bool has_errors() const;
+};
+
+LcmLogContents read_lcm_log(const std::string& path, const LcmLogOptions& options = {});
+
+// J and K_b from a config message when they are usable; otherwise nullopt and *why.
+std::optional<BenchParams> bench_params_from_config(const config_t& config, std::string* why = nullptr);
+
+std::optional<Quantity> quantity_from_samples_code(std::int8_t code);  // samples_t::QUANTITY_*
+std::int8_t samples_code_of(Quantity quantity);
+
+}  // namespace spindown

@@ -1,0 +1,158 @@
+#include "spindown/arduino_text.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+#include <vector>
+
+#include "spindown/lab_line.hpp"
+#include "spindown/read_recording.hpp"
+#include "text_support.hpp"
+
+namespace spindown {
+
+bool ArduinoTextOptions::is_valid(std::string* why) const {
+  auto fail = [&](std::string msg) {
+    if (why) *why = std::move(msg);
+    return false;
+  };
+  if (max_line_reports == 0) return fail("max_line_reports must be at least 1");
+  if (!std::isfinite(reset_min_back_s) || reset_min_back_s <= 0)
+    return fail(fmt::format("reset_min_back_s {} is not a positive number of seconds", reset_min_back_s));
+  return true;
+}
+
+namespace {
+
+bool is_putty_header(std::string_view line) { return line.starts_with("=~=~=~"); }
+
+// "millis\tvolts", "time volts": words only, as a sketch prints in setup().
+bool is_column_header(std::string_view line) {
+  bool letters = false;
+  for (char c : line) {
+    if (c >= '0' && c <= '9') return false;
+    if ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z')) letters = true;
+  }
+  return letters;
+}
+
+}  // namespace
+
+Recording read_arduino_text(std::string_view text, std::string source, const ArduinoTextOptions& options) {
+  Recording rec;
+  rec.source = std::move(source);
+  rec.quantity = Quantity::back_emf_volts;
+  std::string why;
+  if (!options.is_valid(&why)) {
+    rec.error(0, "invalid reader options: " + why);
+    return rec;
+  }
+  if (text.empty()) {
+    rec.error(0, "no samples: the file is empty");
+    return rec;
+  }
+  std::size_t control = 0, looked = 0;
+  if (text::looks_binary(text, &control, &looked)) {
+    rec.error(0, fmt::format("no samples: binary data, not Arduino text ({} of the first {} bytes are control "
+                             "characters or NUL)",
+                             control, looked));
+    return rec;
+  }
+
+  text::LineReporter reporter(rec, options.max_line_reports);
+  std::vector<text::RawSample> raw;
+  raw.reserve(text.size() / 10 + 1);
+  std::size_t blank = 0, headers = 0, garbled = 0, column_headers = 0;
+  bool session_start = true;   // next sample is the first of a logging session
+  bool first_content = true;   // next non-blank line is the first of a session
+  std::int64_t first_bad_line = 0;
+  std::string_view first_bad_why;
+
+  const std::int64_t lines = text::for_each_line(text, [&](std::int64_t n, std::string_view line) {
+    if (is_putty_header(line)) {
+      ++headers;
+      rec.note(n, fmt::format("PuTTY log header skipped: {}", text::quote_line(line)));
+      session_start = first_content = true;
+      return;
+    }
+    const LabLine parsed = parse_lab_line(line);
+    if (parsed.kind == LabLine::Kind::blank) {
+      ++blank;
+      return;
+    }
+    if (parsed.kind == LabLine::Kind::garbled) {
+      if (first_content && is_column_header(line)) {
+        ++column_headers;
+        rec.note(n, fmt::format("column header {} skipped", text::quote_line(line)));
+      } else {
+        ++garbled;
+        if (first_bad_line == 0) {
+          first_bad_line = n;
+          first_bad_why = parsed.why;
+        }
+        if (first_content)
+          reporter.report(Diagnostic::Severity::note, n,
+                          fmt::format("first line {} is not a sample ({}), probably cut short when logging "
+                                      "started mid-line; skipped",
+                                      text::quote_line(line), parsed.why));
+        else
+          reporter.warn(n, fmt::format("{}: {}; skipped", text::quote_line(line), parsed.why));
+      }
+      first_content = false;
+      return;
+    }
+    raw.push_back({n, static_cast<double>(parsed.millis), parsed.value, session_start, line});
+    session_start = first_content = false;
+  });
+
+  text::TimelineRules rules;
+  rules.units_per_s = 1000;
+  rules.unit = "ms";
+  rules.wrap = 4294967296.0;  // millis() is an unsigned 32-bit counter
+  rules.reset_min_back = options.reset_min_back_s * 1000;
+  rules.drop_cut_first = options.drop_cut_first_line;
+  const text::TimelineCounts timeline = text::build_timeline(raw, rules, rec, reporter);
+  reporter.finish();
+
+  rec.lines_read = static_cast<std::size_t>(lines);
+  rec.lines_skipped = rec.lines_read - rec.size();
+  if (rec.empty()) {
+    if (first_bad_line > 0)
+      rec.error(0, fmt::format("no samples: none of the {} lines is a millis<TAB>volts sample (line {}: {})",
+                               lines, first_bad_line, first_bad_why));
+    else
+      rec.error(0, fmt::format("no samples: {} lines, {} blank, {} header lines, {} samples all unusable", lines,
+                               blank, headers + column_headers, raw.size()));
+    return rec;
+  }
+  std::string summary = fmt::format("{} samples from {} lines", rec.size(), lines);
+  auto add = [&](std::size_t count, std::string_view what) {
+    if (count > 0) summary += fmt::format(", {} {}", count, what);
+  };
+  add(headers, "PuTTY header");
+  add(column_headers, "column header");
+  add(blank, "blank");
+  add(garbled, "garbled");
+  add(timeline.cut_first, "cut first line");
+  add(timeline.backwards, "time going back");
+  add(timeline.ahead, "time jumping ahead");
+  add(timeline.duplicates, "repeated time");
+  add(timeline.restarts, "clock restart");
+  add(timeline.wraps, "clock wrap");
+  rec.note(0, summary);
+  return rec;
+}
+
+Recording read_arduino_text_file(const std::string& path, const ArduinoTextOptions& options) {
+  std::string why;
+  auto bytes = read_file_bytes(path, &why);
+  if (!bytes) {
+    Recording rec;
+    rec.source = path;
+    rec.error(0, why);
+    return rec;
+  }
+  return read_arduino_text(*bytes, path, options);
+}
+
+}  // namespace spindown

@@ -1,0 +1,501 @@
+#include "spindown/lcm_log_reader.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fmt/format.h>
+#include <limits>
+#include <lcm/lcm-cpp.hpp>
+#include <sys/stat.h>
+
+#include "text_support.hpp"
+
+namespace spindown {
+
+namespace {
+
+constexpr std::int64_t event_header_bytes = 28;  // magic, event number, timestamp, 2 lengths
+constexpr std::int32_t max_channel_bytes = 1000; // lcm_eventlog's own limit
+
+std::uint32_t be32(const unsigned char* p) {
+  return (std::uint32_t(p[0]) << 24) | (std::uint32_t(p[1]) << 16) | (std::uint32_t(p[2]) << 8) | p[3];
+}
+std::uint64_t be64(const unsigned char* p) { return (std::uint64_t(be32(p)) << 32) | be32(p + 4); }
+
+bool is_bench_char(char c) {
+  return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-';
+}
+
+std::string printable(std::string_view s) { return text::quote_line(s); }
+
+// samples_t's fixed prefix, checked before the generated decoder resizes vectors to a count
+// taken from the wire: a damaged n must not become a multi-gigabyte allocation.
+bool samples_prefix_ok(const unsigned char* d, std::int32_t size, std::string* why) {
+  const std::int64_t len = size;
+  if (len < 20) {
+    *why = fmt::format("{} bytes, too short for samples_t", len);
+    return false;
+  }
+  const std::int64_t bench_len = static_cast<std::int32_t>(be32(d + 16));
+  if (bench_len < 1 || bench_len > len - 20) {
+    *why = fmt::format("bench string length {} does not fit in {} bytes", bench_len, len);
+    return false;
+  }
+  const std::int64_t n_at = 20 + bench_len + 8 + 4 + 1;
+  if (n_at + 4 > len) {
+    *why = fmt::format("truncated: {} bytes end before the sample count", len);
+    return false;
+  }
+  const std::int64_t n = static_cast<std::int32_t>(be32(d + n_at));
+  const std::int64_t per_sample = 8 + 8 + 8 + 4;
+  if (n < 0 || n * per_sample > len - n_at - 4) {
+    *why = fmt::format("sample count {} does not fit in {} bytes (truncated or damaged)", n, len);
+    return false;
+  }
+  return true;
+}
+
+template <class Msg>
+bool decode_checked(Msg& msg, const void* data, std::int32_t size, std::string* why) {
+  const auto* d = static_cast<const unsigned char*>(data);
+  if (size < 8) {
+    *why = fmt::format("{} bytes, too short for {}", size, Msg::getTypeName());
+    return false;
+  }
+  const std::uint64_t hash = be64(d);
+  if (hash != static_cast<std::uint64_t>(Msg::getHash())) {
+    *why = fmt::format("not a {} (type fingerprint {:#018x}, expected {:#018x})", Msg::getTypeName(), hash,
+                       static_cast<std::uint64_t>(Msg::getHash()));
+    return false;
+  }
+  try {
+    const int used = msg.decode(data, 0, size);
+    if (used < 0) {
+      *why = fmt::format("{} does not decode from {} bytes (truncated or damaged)", Msg::getTypeName(), size);
+      return false;
+    }
+  } catch (const std::exception& e) {  // negative string lengths make std::string throw
+    *why = fmt::format("{} does not decode ({})", Msg::getTypeName(), e.what());
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+std::optional<SpindownChannelName> split_spindown_channel(std::string_view channel) {
+  constexpr std::string_view prefix = "SPINDOWN.";
+  if (!channel.starts_with(prefix)) return std::nullopt;
+  const std::string_view rest = channel.substr(prefix.size());
+  const std::size_t dot = rest.find('.');
+  if (dot == std::string_view::npos || dot == 0 || dot > 32) return std::nullopt;
+  const std::string_view bench = rest.substr(0, dot), kind = rest.substr(dot + 1);
+  if (kind.empty() || !std::all_of(bench.begin(), bench.end(), is_bench_char)) return std::nullopt;
+  return SpindownChannelName{bench, kind};
+}
+
+std::optional<Quantity> quantity_from_samples_code(std::int8_t code) {
+  switch (code) {
+    case samples_t::QUANTITY_BACK_EMF_V: return Quantity::back_emf_volts;
+    case samples_t::QUANTITY_RPM: return Quantity::rpm;
+    case samples_t::QUANTITY_RAD_S: return Quantity::rad_per_s;
+    default: return std::nullopt;
+  }
+}
+
+std::int8_t samples_code_of(Quantity quantity) {
+  switch (quantity) {
+    case Quantity::back_emf_volts: return samples_t::QUANTITY_BACK_EMF_V;
+    case Quantity::rpm: return samples_t::QUANTITY_RPM;
+    case Quantity::rad_per_s: return samples_t::QUANTITY_RAD_S;
+  }
+  return samples_t::QUANTITY_BACK_EMF_V;
+}
+
+std::optional<BenchParams> bench_params_from_config(const config_t& config, std::string* why) {
+  BenchParams p;
+  p.inertia_kg_m2 = config.inertia_kg_m2;
+  p.kb_v_s_per_rad = config.kb_v_s_per_rad;
+  p.inertia_source = config.inertia_source.empty() ? "config" : config.inertia_source;
+  p.kb_source = config.kb_source.empty() ? "config" : config.kb_source;
+  std::string bad;
+  if (!p.is_valid(&bad)) {
+    if (why) *why = fmt::format("config of bench '{}': {}", config.bench, bad);
+    return std::nullopt;
+  }
+  return p;
+}
+
+// ---------------------------------------------------------------------------------------------
+// LcmLogReader
+
+LcmLogReader::LcmLogReader(const std::string& path) : path_(path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) {
+    open_error_ = fmt::format("cannot open {}: {}", path, std::strerror(errno));
+    return;
+  }
+  if (S_ISDIR(st.st_mode)) {
+    open_error_ = fmt::format("cannot read {}: it is a directory", path);
+    return;
+  }
+  size_ = static_cast<std::int64_t>(st.st_size);
+  errno = 0;
+  log_ = std::make_unique<lcm::LogFile>(path, "r");
+  if (!log_->good()) {
+    open_error_ = fmt::format("cannot open {}: {}", path, errno ? std::strerror(errno) : "lcm::LogFile failed");
+    log_.reset();
+  }
+}
+
+LcmLogReader::~LcmLogReader() = default;
+
+// Positioned where no event starts: finds the next event marker and reports the skipped
+// bytes. Always moves forward or ends the log.
+bool LcmLogReader::find_event_start(LcmLogEvent& event) {
+  FILE* f = log_->getFilePtr();
+  const std::int64_t from = ftello(f);
+  std::uint32_t word = 0;
+  std::int64_t pos = from;
+  int c = 0;
+  while ((c = std::getc(f)) != EOF) {
+    word = (word << 8) | static_cast<unsigned char>(c);
+    ++pos;
+    if (pos - from >= 4 && word == lcm_log_magic) break;
+  }
+  event = LcmLogEvent{};
+  event.kind = LcmLogEvent::Kind::problem;
+  event.file_offset = from;
+  if (c == EOF) {
+    done_ = true;
+    event.problem = fmt::format("{} bytes at offset {} (after event {}) are not an LCM event and no event follows; "
+                                "ignored",
+                                size_ - from, from, events_);
+    return true;
+  }
+  const std::int64_t at = pos - 4;
+  fseeko(f, at, SEEK_SET);
+  event.problem = fmt::format("{} bytes at offset {} (after event {}) are not an LCM event; skipped to the next "
+                              "event at offset {}",
+                              at - from, from, events_, at);
+  return true;
+}
+
+bool LcmLogReader::next(LcmLogEvent& event) {
+  if (!log_ || done_) return false;
+  FILE* f = log_->getFilePtr();
+  const std::int64_t at = ftello(f);
+  if (at < 0 || at >= size_) {
+    done_ = true;
+    return false;
+  }
+  unsigned char h[event_header_bytes];
+  const std::size_t got = std::fread(h, 1, sizeof h, f);
+  if (got < 4 || be32(h) != lcm_log_magic) {
+    fseeko(f, at, SEEK_SET);
+    return find_event_start(event);
+  }
+
+  auto problem = [&](std::string text) {
+    event.kind = LcmLogEvent::Kind::problem;
+    event.number = 0;
+    event.file_offset = at;
+    event.problem = std::move(text);
+    return true;
+  };
+  event.channel.clear();
+  event.bench.clear();
+  if (got < sizeof h) {
+    done_ = true;
+    return problem(fmt::format("the log ends inside an event header at offset {} ({} of {} bytes; truncated "
+                               "after event {})",
+                               at, got, event_header_bytes, events_));
+  }
+  const std::int32_t channel_len = static_cast<std::int32_t>(be32(h + 20));
+  const std::int32_t data_len = static_cast<std::int32_t>(be32(h + 24));
+  if (channel_len <= 0 || channel_len >= max_channel_bytes || data_len < 0) {
+    fseeko(f, at + 1, SEEK_SET);
+    return problem(fmt::format("damaged event header at offset {} (channel length {}, data length {}) after event "
+                               "{}; looking for the next event",
+                               at, channel_len, data_len, events_));
+  }
+  const std::int64_t left = size_ - at - event_header_bytes;
+  std::string channel(static_cast<std::size_t>(std::min<std::int64_t>(channel_len, std::max<std::int64_t>(left, 0))),
+                      '\0');
+  channel.resize(std::fread(channel.data(), 1, channel.size(), f));
+  const std::int64_t end = at + event_header_bytes + channel_len + data_len;
+  if (end > size_) {
+    // Truncated (the logger stopped mid-write) or a damaged length: look for a later event.
+    fseeko(f, at + 1, SEEK_SET);
+    LcmLogEvent scan;
+    find_event_start(scan);
+    const bool more = !done_;
+    const std::int64_t resume = ftello(f);
+    return problem(fmt::format("event {} at offset {} (channel {}) needs {} bytes but the log has {} left: "
+                               "truncated or damaged{}",
+                               events_ + 1, at, printable(channel), channel_len + data_len, left,
+                               more ? fmt::format("; skipped to the next event at offset {}", resume)
+                                    : std::string("; it is the last one and is lost")));
+  }
+  // lcm_eventlog rejects (and loses) an event that is not followed by another event or the
+  // end of the file; say so rather than lose it silently.
+  bool followed_ok = true;
+  if (end + 4 <= size_) {
+    unsigned char m[4];
+    fseeko(f, end, SEEK_SET);
+    followed_ok = std::fread(m, 1, 4, f) == 4 && be32(m) == lcm_log_magic;
+  }
+  fseeko(f, at, SEEK_SET);
+  const lcm::LogEvent* e = log_->readNextEvent();
+  if (!e) {
+    if (ftello(f) <= at) fseeko(f, at + 1, SEEK_SET);
+    if (!followed_ok) {
+      fseeko(f, end, SEEK_SET);
+      return problem(fmt::format("event {} at offset {} (channel {}) is followed by bytes that are not an event; "
+                                 "lcm::LogFile rejects it, so it is lost",
+                                 events_ + 1, at, printable(channel)));
+    }
+    return problem(fmt::format("lcm::LogFile could not read the event at offset {} (channel {})", at,
+                               printable(channel)));
+  }
+  ++events_;
+  event.number = events_;
+  event.log_utime = e->timestamp;
+  event.file_offset = at;
+  event.channel = e->channel;
+  event.problem.clear();
+  decode(event, e->data, e->datalen);
+  return true;
+}
+
+void LcmLogReader::decode(LcmLogEvent& event, const void* data, std::int32_t size) {
+  event.data = data;
+  event.data_size = size;
+  event.kind = LcmLogEvent::Kind::other;
+  const auto name = split_spindown_channel(event.channel);
+  if (!name) return;
+  event.bench.assign(name->bench);
+  std::string why;
+  if (name->kind == "SAMPLE") {
+    const auto* d = static_cast<const unsigned char*>(data);
+    const bool right_type = size >= 8 && be64(d) == static_cast<std::uint64_t>(samples_t::getHash());
+    if ((!right_type || samples_prefix_ok(d, size, &why)) && decode_checked(event.samples, data, size, &why)) {
+      event.kind = LcmLogEvent::Kind::samples;
+      return;
+    }
+    event.kind = LcmLogEvent::Kind::problem;
+    event.problem = fmt::format("event {} on {}: {}; skipped", event.number, event.channel, why);
+  } else if (name->kind == "CONFIG") {
+    if (decode_checked(event.config, data, size, &why)) {
+      event.kind = LcmLogEvent::Kind::config;
+      return;
+    }
+    event.kind = LcmLogEvent::Kind::problem;
+    event.problem = fmt::format("event {} on {}: {}; skipped", event.number, event.channel, why);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// read_lcm_log
+
+bool LcmLogOptions::is_valid(std::string* why) const {
+  if (max_event_reports == 0) {
+    if (why) *why = "max_event_reports must be at least 1";
+    return false;
+  }
+  return true;
+}
+
+bool LcmLogContents::has_errors() const {
+  return std::any_of(diagnostics.begin(), diagnostics.end(),
+                     [](const Diagnostic& d) { return d.severity == Diagnostic::Severity::error; }) ||
+         std::any_of(benches.begin(), benches.end(), [](const BenchLog& b) { return b.recording.has_errors(); });
+}
+
+namespace {
+
+struct BenchState {
+  BenchState(std::string bench, const std::string& path, std::size_t max_reports)
+      : reporter(log.recording, max_reports) {
+    log.bench = std::move(bench);
+    log.recording.source = fmt::format("{} SPINDOWN.{}.SAMPLE", path, log.bench);
+  }
+  BenchLog log;
+  text::LineReporter reporter;
+  bool have_seq = false, have_epoch = false, quantity_known = false, bench_field_warned = false;
+  std::int64_t next_seq = 0;
+  std::int32_t epoch = 0;
+  std::int64_t last_t_us = std::numeric_limits<std::int64_t>::min();
+  std::int64_t first_event = 0, last_event = 0;
+  std::size_t skipped_messages = 0;
+};
+
+void take_samples(BenchState& st, const LcmLogEvent& ev) {
+  using Severity = Diagnostic::Severity;
+  const samples_t& m = ev.samples;
+  Recording& rec = st.log.recording;
+  ++st.log.sample_messages;
+  if (st.first_event == 0) st.first_event = ev.number;
+  st.last_event = ev.number;
+  if (m.bench != st.log.bench && !st.bench_field_warned) {
+    st.bench_field_warned = true;
+    st.reporter.warn(ev.number, fmt::format("message names bench {} but came on {}; the channel's bench is used",
+                                            printable(m.bench), ev.channel));
+  }
+  const auto q = quantity_from_samples_code(m.quantity);
+  if (!q) {
+    ++st.skipped_messages;
+    st.reporter.warn(ev.number, fmt::format("unknown quantity code {} ({} samples); message skipped", int(m.quantity),
+                                            m.n));
+    return;
+  }
+  if (!st.quantity_known) {
+    rec.quantity = *q;
+    st.quantity_known = true;
+  } else if (*q != rec.quantity) {
+    ++st.skipped_messages;
+    st.reporter.warn(ev.number, fmt::format("quantity changes from {} to {}; message ({} samples) skipped",
+                                            quantity_unit(rec.quantity), quantity_unit(*q), m.n));
+    return;
+  }
+
+  bool restart = st.have_epoch && m.clock_epoch != st.epoch;
+  if (st.have_seq && m.seq != st.next_seq) {
+    if (m.seq > st.next_seq) {
+      const std::int64_t lost = m.seq - st.next_seq;
+      st.log.samples_lost += lost;
+      st.reporter.warn(ev.number, fmt::format("{} samples lost: sequence number jumps from {} to {}", lost,
+                                              st.next_seq - 1, m.seq));
+    } else if (!restart && m.n > 0 && m.device_time_us[m.n - 1] <= st.last_t_us) {
+      ++st.skipped_messages;
+      st.reporter.warn(ev.number, fmt::format("samples {} to {} were already read (repeated message); skipped",
+                                              m.seq, m.seq + m.n - 1));
+      return;
+    } else {
+      st.reporter.report(Severity::note, ev.number,
+                         fmt::format("sequence number restarts from {} at {} (bridge restarted?)", st.next_seq, m.seq));
+      if (m.n > 0 && m.device_time_us[0] <= st.last_t_us) restart = true;
+    }
+  }
+  st.have_seq = true;
+  st.next_seq = m.seq + m.n;
+
+  if (restart) {
+    if (!rec.empty() && (rec.clock_restarts.empty() || rec.clock_restarts.back() != rec.size()))
+      rec.clock_restarts.push_back(rec.size());
+    st.reporter.report(Severity::note, ev.number,
+                       fmt::format("device clock restarted (clock epoch {} -> {}); a new timeline starts here and no "
+                                   "run spans it",
+                                   st.epoch, m.clock_epoch));
+    st.last_t_us = std::numeric_limits<std::int64_t>::min();
+  }
+  st.have_epoch = true;
+  st.epoch = m.clock_epoch;
+
+  for (std::int32_t i = 0; i < m.n; ++i) {
+    const std::int64_t t = m.device_time_us[i];
+    const double v = m.value[i];
+    if (!std::isfinite(v)) {
+      st.reporter.warn(ev.number, fmt::format("sample {}: value is NaN or infinite; skipped", m.seq + i));
+      continue;
+    }
+    if (t <= st.last_t_us) {
+      st.reporter.warn(ev.number, fmt::format("sample {}: device time {} µs does not advance (previous {} µs); "
+                                              "skipped",
+                                              m.seq + i, t, st.last_t_us));
+      continue;
+    }
+    rec.push(static_cast<double>(t) / 1e6, v);
+    st.last_t_us = t;
+  }
+}
+
+void take_config(BenchState& st, const LcmLogEvent& ev) {
+  const config_t& c = ev.config;
+  ++st.log.config_messages;
+  if (c.bench != st.log.bench)
+    st.reporter.warn(ev.number, fmt::format("config names bench {} but came on {}; the channel's bench is used",
+                                            printable(c.bench), ev.channel));
+  if (st.log.config && (st.log.config->inertia_kg_m2 != c.inertia_kg_m2 ||
+                        st.log.config->kb_v_s_per_rad != c.kb_v_s_per_rad)) {
+    st.reporter.report(Diagnostic::Severity::note, ev.number,
+                       fmt::format("bench parameters change: J {} -> {} kg·m², K_b {} -> {} V·s/rad; the latest is "
+                                   "used",
+                                   st.log.config->inertia_kg_m2, c.inertia_kg_m2, st.log.config->kb_v_s_per_rad,
+                                   c.kb_v_s_per_rad));
+  }
+  st.log.config = c;
+}
+
+}  // namespace
+
+LcmLogContents read_lcm_log(const std::string& path, const LcmLogOptions& options) {
+  LcmLogContents out;
+  out.path = path;
+  std::string why;
+  if (!options.is_valid(&why)) {
+    out.diagnostics.push_back({Diagnostic::Severity::error, path, 0, "invalid reader options: " + why});
+    return out;
+  }
+  LcmLogReader reader(path);
+  if (!reader.good()) {
+    out.diagnostics.push_back({Diagnostic::Severity::error, path, 0, reader.open_error()});
+    return out;
+  }
+  std::vector<std::unique_ptr<BenchState>> benches;
+  auto bench = [&](const std::string& id) -> BenchState& {
+    for (auto& b : benches)
+      if (b->log.bench == id) return *b;
+    benches.push_back(std::make_unique<BenchState>(id, path, options.max_event_reports));
+    return *benches.back();
+  };
+  std::size_t file_problems = 0;
+  LcmLogEvent ev;
+  while (reader.next(ev)) {
+    switch (ev.kind) {
+      case LcmLogEvent::Kind::samples: take_samples(bench(ev.bench), ev); break;
+      case LcmLogEvent::Kind::config: take_config(bench(ev.bench), ev); break;
+      case LcmLogEvent::Kind::other: ++out.other_channels[ev.channel]; break;
+      case LcmLogEvent::Kind::problem:
+        if (!ev.bench.empty() && ev.number > 0) {
+          BenchState& st = bench(ev.bench);
+          if (ev.channel.ends_with(".SAMPLE")) ++st.skipped_messages, ++st.log.sample_messages;
+          st.reporter.warn(ev.number, ev.problem);
+        } else if (++file_problems <= options.max_event_reports) {
+          out.diagnostics.push_back({Diagnostic::Severity::warning, path, ev.number, ev.problem});
+        }
+        break;
+    }
+  }
+  out.events = reader.events_read();
+  if (file_problems > options.max_event_reports)
+    out.diagnostics.push_back({Diagnostic::Severity::warning, path, 0,
+                               fmt::format("{} more damaged parts of the file not listed; {} in all",
+                                           file_problems - options.max_event_reports, file_problems)});
+
+  for (auto& b : benches) {
+    b->reporter.finish();
+    Recording& rec = b->log.recording;
+    rec.lines_read = static_cast<std::size_t>(b->log.sample_messages);
+    rec.lines_skipped = b->skipped_messages;
+    if (b->log.sample_messages == 0) {
+      rec.note(0, fmt::format("bench {}: {} config messages, no samples", b->log.bench, b->log.config_messages));
+    } else if (rec.empty()) {
+      rec.error(0, fmt::format("no samples: {} messages on {} (events {} to {}), none with a usable sample",
+                               b->log.sample_messages, rec.source.substr(path.size() + 1), b->first_event,
+                               b->last_event));
+    } else {
+      rec.note(0, fmt::format("{} samples ({}) from {} messages (events {} to {}){}{}", rec.size(),
+                              quantity_unit(rec.quantity), b->log.sample_messages, b->first_event, b->last_event,
+                              b->log.samples_lost ? fmt::format(", {} lost in sequence gaps", b->log.samples_lost)
+                                                  : std::string(),
+                              b->log.config ? std::string() : std::string(", no config message")));
+    }
+    out.benches.push_back(std::move(b->log));
+  }
+  return out;
+}
+
+}  // namespace spindown

@@ -1,0 +1,196 @@
+#include "spindown/read_recording.hpp"
+
+#include <cerrno>
+#include <cstring>
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "spindown/lab_line.hpp"
+#include "text_support.hpp"
+
+namespace spindown {
+
+std::string_view file_format_name(FileFormat format) {
+  switch (format) {
+    case FileFormat::automatic: return "auto";
+    case FileFormat::arduino_text: return "arduino";
+    case FileFormat::delimited_text: return "delimited";
+    case FileFormat::lcm_log: return "lcm";
+  }
+  return "?";
+}
+
+std::optional<FileFormat> parse_file_format(std::string_view name) {
+  if (name == "auto") return FileFormat::automatic;
+  if (name == "arduino" || name == "putty" || name == "lab") return FileFormat::arduino_text;
+  if (name == "delimited" || name == "csv" || name == "tsv" || name == "text") return FileFormat::delimited_text;
+  if (name == "lcm" || name == "lcm-log" || name == "log") return FileFormat::lcm_log;
+  return std::nullopt;
+}
+
+bool ReadOptions::is_valid(std::string* why) const {
+  std::string w;
+  if (!arduino.is_valid(&w)) {
+    if (why) *why = "Arduino text: " + w;
+    return false;
+  }
+  if (!delimited.is_valid(&w)) {
+    if (why) *why = "delimited text: " + w;
+    return false;
+  }
+  if (!lcm.is_valid(&w)) {
+    if (why) *why = "LCM log: " + w;
+    return false;
+  }
+  return true;
+}
+
+std::optional<std::string> read_file_bytes(const std::string& path, std::string* why, std::size_t max_bytes) {
+  auto fail = [&](std::string msg) -> std::optional<std::string> {
+    if (why) *why = std::move(msg);
+    return std::nullopt;
+  };
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return fail(fmt::format("cannot open {}: {}", path, std::strerror(errno)));
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) return fail(fmt::format("cannot read {}: {}", path, std::strerror(errno)));
+  if (S_ISDIR(st.st_mode)) return fail(fmt::format("cannot read {}: it is a directory", path));
+  if (S_ISREG(st.st_mode) && static_cast<std::size_t>(st.st_size) > max_bytes)
+    return fail(fmt::format("cannot read {}: {} bytes is more than the {} bytes a text recording may have", path,
+                            st.st_size, max_bytes));
+  std::string bytes;
+  bytes.resize(S_ISREG(st.st_mode) ? static_cast<std::size_t>(st.st_size) : 0);
+  std::size_t have = 0;
+  for (;;) {
+    if (have == bytes.size()) {
+      if (bytes.size() >= max_bytes)
+        return fail(fmt::format("cannot read {}: more than {} bytes", path, max_bytes));
+      bytes.resize(std::min(max_bytes, std::max<std::size_t>(bytes.size() * 2, 64 * 1024)));
+    }
+    const ssize_t n = ::read(fd, bytes.data() + have, bytes.size() - have);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      return fail(fmt::format("cannot read {}: {}", path, std::strerror(errno)));
+    }
+    if (n == 0) break;
+    have += static_cast<std::size_t>(n);
+  }
+  bytes.resize(have);
+  return bytes;
+}
+
+FileFormat detect_format(std::string_view head, const ReadOptions& options) {
+  if (head.size() >= 4) {
+    const auto* p = reinterpret_cast<const unsigned char*>(head.data());
+    const std::uint32_t word =
+        (std::uint32_t(p[0]) << 24) | (std::uint32_t(p[1]) << 16) | (std::uint32_t(p[2]) << 8) | p[3];
+    if (word == lcm_log_magic) return FileFormat::lcm_log;
+  }
+  if (options.format != FileFormat::automatic) return options.format;
+  if (options.delimited.names_columns()) return FileFormat::delimited_text;
+  // Arduino text when at least half of the first 200 lines with content are lab samples.
+  std::size_t content = 0, samples = 0;
+  text::for_each_line(head, [&](std::int64_t, std::string_view line) {
+    if (content >= 200 || line.starts_with("=~=~=~")) return;
+    const LabLine parsed = parse_lab_line(line);
+    if (parsed.kind == LabLine::Kind::blank) return;
+    ++content;
+    samples += parsed.kind == LabLine::Kind::sample;
+  });
+  if (content == 0 || samples * 2 >= content) return FileFormat::arduino_text;
+  return FileFormat::delimited_text;
+}
+
+namespace {
+
+Recording failed(const std::string& path, std::string message) {
+  Recording rec;
+  rec.source = path;
+  rec.error(0, std::move(message));
+  return rec;
+}
+
+}  // namespace
+
+std::vector<Recording> read_recordings(const std::string& path, const ReadOptions& options,
+                                       std::vector<RecordingInfo>* info) {
+  std::vector<Recording> out;
+  auto add = [&](Recording rec, RecordingInfo i) {
+    out.push_back(std::move(rec));
+    if (info) info->push_back(std::move(i));
+  };
+  if (info) info->clear();
+  std::string why;
+  if (!options.is_valid(&why)) {
+    add(failed(path, "invalid read options: " + why), {});
+    return out;
+  }
+
+  // An LCM log is streamed, never loaded whole: look at its first word only.
+  char head[4] = {};
+  std::size_t head_len = 0;
+  {
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) {
+      add(failed(path, fmt::format("cannot open {}: {}", path, std::strerror(errno))), {});
+      return out;
+    }
+    struct stat st {};
+    if (::fstat(fd, &st) == 0 && S_ISDIR(st.st_mode)) {
+      ::close(fd);
+      add(failed(path, fmt::format("cannot read {}: it is a directory", path)), {});
+      return out;
+    }
+    const ssize_t n = ::read(fd, head, sizeof head);
+    ::close(fd);
+    head_len = n > 0 ? static_cast<std::size_t>(n) : 0;
+  }
+
+  if (detect_format(std::string_view(head, head_len), options) == FileFormat::lcm_log ||
+      options.format == FileFormat::lcm_log) {
+    LcmLogContents log = read_lcm_log(path, options.lcm);
+    for (BenchLog& b : log.benches) {
+      if (b.sample_messages == 0) continue;
+      Recording rec = std::move(b.recording);
+      rec.diagnostics.insert(rec.diagnostics.begin(), log.diagnostics.begin(), log.diagnostics.end());
+      add(std::move(rec), {FileFormat::lcm_log, b.bench, std::move(b.config), b.samples_lost});
+    }
+    if (out.empty()) {
+      Recording rec;
+      rec.source = path;
+      rec.diagnostics = log.diagnostics;
+      if (!log.has_errors()) {
+        std::string channels;
+        for (const auto& [name, count] : log.other_channels)
+          if (channels.size() < 300) channels += fmt::format("{}{} ({})", channels.empty() ? "" : ", ", name, count);
+        for (const BenchLog& b : log.benches)
+          channels += fmt::format("{}SPINDOWN.{}.CONFIG ({})", channels.empty() ? "" : ", ", b.bench,
+                                  b.config_messages);
+        rec.error(0, fmt::format("no samples: {} events, none on SPINDOWN.<bench>.SAMPLE{}", log.events,
+                                 channels.empty() ? std::string() : " (channels: " + channels + ")"));
+      }
+      add(std::move(rec), {FileFormat::lcm_log, {}, {}, 0});
+    }
+    return out;
+  }
+
+  auto bytes = read_file_bytes(path, &why);
+  if (!bytes) {
+    add(failed(path, why), {});
+    return out;
+  }
+  const FileFormat format = detect_format(*bytes, options);
+  if (format == FileFormat::delimited_text)
+    add(read_delimited_text(*bytes, path, options.delimited), {FileFormat::delimited_text, {}, {}, 0});
+  else
+    add(read_arduino_text(*bytes, path, options.arduino), {FileFormat::arduino_text, {}, {}, 0});
+  return out;
+}
+
+}  // namespace spindown

@@ -1,0 +1,175 @@
+#include "text_support.hpp"
+
+#include <algorithm>
+#include <fmt/format.h>
+
+namespace spindown::text {
+
+bool looks_binary(std::string_view bytes, std::size_t* control_bytes, std::size_t* looked_at) {
+  const std::size_t n = std::min<std::size_t>(bytes.size(), 64 * 1024);
+  std::size_t control = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto c = static_cast<unsigned char>(bytes[i]);
+    if ((c < 0x20 && c != '\t' && c != '\r' && c != '\n') || c == 0x7F) ++control;
+  }
+  if (control_bytes) *control_bytes = control;
+  if (looked_at) *looked_at = n;
+  return n > 0 && control * 10 > n;
+}
+
+std::string quote_line(std::string_view line) {
+  constexpr std::size_t max_shown = 40;
+  std::string out = "\"";
+  for (std::size_t i = 0; i < line.size() && i < max_shown; ++i) {
+    const auto c = static_cast<unsigned char>(line[i]);
+    if (c == '\t') out += "\\t";
+    else if (c == '\r') out += "\\r";
+    else if (c == '\\') out += "\\\\";
+    else if (c == '"') out += "\\\"";
+    else if (c < 0x20 || c == 0x7F) out += fmt::format("\\x{:02x}", c);
+    else out += static_cast<char>(c);
+  }
+  out += '"';
+  if (line.size() > max_shown) out += fmt::format("… ({} bytes)", line.size());
+  return out;
+}
+
+void LineReporter::report(Diagnostic::Severity severity, std::int64_t line, std::string message) {
+  ++count_;
+  if (count_ <= max_) {
+    rec_.diagnostics.push_back({severity, rec_.source, line, std::move(message)});
+    return;
+  }
+  if (first_unlisted_ == 0) first_unlisted_ = line;
+  last_unlisted_ = line;
+}
+
+void LineReporter::finish() {
+  if (count_ <= max_) return;
+  rec_.warn(0, fmt::format("{} more problem lines not listed one by one (lines {} to {}); {} in all",
+                           count_ - max_, first_unlisted_, last_unlisted_, count_));
+}
+
+namespace {
+
+// Median of the positive steps between consecutive times in raw[from, from + count].
+double median_step(const std::vector<RawSample>& raw, std::size_t from, std::size_t count) {
+  double steps[64];
+  std::size_t n = 0;
+  for (std::size_t i = from + 1; i < raw.size() && i <= from + count && n < 64; ++i) {
+    const double d = raw[i].t - raw[i - 1].t;
+    if (d > 0) steps[n++] = d;
+  }
+  if (n == 0) return 0;
+  std::nth_element(steps, steps + n / 2, steps + n);
+  return steps[n / 2];
+}
+
+}  // namespace
+
+TimelineCounts build_timeline(const std::vector<RawSample>& raw, const TimelineRules& rules,
+                              Recording& rec, LineReporter& reporter) {
+  using Severity = Diagnostic::Severity;
+  TimelineCounts counts;
+  const double period = median_step(raw, 0, 64);
+  // A step larger than this is a gap in the data, or a garbled time if the next sample
+  // continues from the previous one.
+  const double jump = period > 0 ? std::max(20 * period, 0.5 * rules.units_per_s) : rules.units_per_s;
+  const auto u = rules.unit;
+
+  rec.t_s.reserve(rec.t_s.size() + raw.size());
+  rec.value.reserve(rec.value.size() + raw.size());
+
+  bool have_prev = false;
+  double offset = 0;   // wraps so far in this clock epoch, in file units
+  double prev_u = 0;   // unwrapped time of the last accepted sample
+  std::int64_t prev_line = 0;
+  double prev_value = 0;
+
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    const RawSample& s = raw[i];
+    const RawSample* next = i + 1 < raw.size() ? &raw[i + 1] : nullptr;
+
+    if (s.session_start && rules.drop_cut_first && i + 3 < raw.size()) {
+      const double local = median_step(raw, i + 1, 9);
+      const double d = raw[i + 1].t - s.t;
+      if (local > 0 && (d <= 0 || d > std::max(4 * local, local + 0.1 * rules.units_per_s))) {
+        ++counts.cut_first;
+        reporter.report(Severity::note, s.line,
+                        fmt::format("first sample {} looks cut short (logging started mid-line): its "
+                                    "time {} {} does not fit the next samples ({} {}, then every ~{} {}); "
+                                    "dropped",
+                                    quote_line(s.text), s.t, u, raw[i + 1].t, u, local, u));
+        continue;
+      }
+    }
+
+    double cur_u = s.t + offset;
+    if (have_prev) {
+      const double d = cur_u - prev_u;
+      const double next_u = next ? next->t + offset : 0;
+      if (d == 0) {
+        ++counts.duplicates;
+        reporter.warn(s.line, fmt::format("{}: time {} {} repeats line {}{}; skipped", quote_line(s.text), s.t,
+                                          u, prev_line, s.value == prev_value ? " (duplicate line)" : ""));
+        continue;
+      }
+      if (d > 0) {
+        if (d > jump && next && next_u > prev_u && next_u < cur_u && next_u - prev_u <= jump) {
+          ++counts.ahead;
+          reporter.warn(s.line, fmt::format("{}: time {} {} jumps ahead of its neighbours (line {} has {} {}, "
+                                            "the next sample {} {}); skipped",
+                                            quote_line(s.text), s.t, u, prev_line, prev_u - offset, u, next->t, u));
+          continue;
+        }
+        if (d > jump) {
+          ++counts.gaps;
+          reporter.report(Severity::note, s.line,
+                          fmt::format("no samples for {:.3g} s of device time (lines {} to {})",
+                                      d / rules.units_per_s, prev_line, s.line));
+        }
+      } else {  // time went back
+        const double prev_raw = prev_u - offset;
+        const double window = 600 * rules.units_per_s;
+        if (rules.wrap > 0 && prev_raw > rules.wrap - window && s.t < window && d + rules.wrap > 0 &&
+            d + rules.wrap <= std::max(jump, window)) {
+          ++counts.wraps;
+          offset += rules.wrap;
+          cur_u += rules.wrap;
+          reporter.report(Severity::note, s.line,
+                          fmt::format("device clock wrapped from {} {} to {} {} (counter overflow at {} {}); "
+                                      "unwrapped",
+                                      prev_raw, u, s.t, u, rules.wrap, u));
+        } else if (next && next_u > prev_u && next_u - prev_u <= jump) {
+          ++counts.backwards;
+          reporter.warn(s.line, fmt::format("{}: time goes back from {} {} (line {}) to {} {} and the next "
+                                            "sample continues from {} {}; skipped",
+                                            quote_line(s.text), prev_raw, u, prev_line, s.t, u, next->t, u));
+          continue;
+        } else if (-d >= rules.reset_min_back && next && next_u >= cur_u && next_u - cur_u <= jump) {
+          ++counts.restarts;
+          offset = 0;
+          cur_u = s.t;
+          rec.clock_restarts.push_back(rec.size());
+          reporter.report(Severity::note, s.line,
+                          fmt::format("device clock restarted (Arduino reset?): time goes back from {} {} "
+                                      "(line {}) to {} {}; a new timeline starts here and no run spans it",
+                                      prev_raw, u, prev_line, s.t, u));
+        } else {
+          ++counts.backwards;
+          reporter.warn(s.line, fmt::format("{}: time goes back from {} {} (line {}) to {} {}; skipped",
+                                            quote_line(s.text), prev_raw, u, prev_line, s.t, u));
+          continue;
+        }
+      }
+    }
+    rec.push(cur_u / rules.units_per_s, s.value);
+    have_prev = true;
+    prev_u = cur_u;
+    prev_line = s.line;
+    prev_value = s.value;
+  }
+  return counts;
+}
+
+}  // namespace spindown::text

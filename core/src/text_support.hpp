@@ -1,0 +1,94 @@
+#pragma once
+// Private to the text readers (Arduino/PuTTY and delimited text): splitting a buffer into
+// lines, reporting bad lines without flooding the output, and turning the samples' printed
+// device times into a Recording's timeline (cut first line, wrap, reset, outliers,
+// duplicates). Not installed; the public interfaces are arduino_text.hpp and
+// delimited_text.hpp.
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "spindown/recording.hpp"
+
+namespace spindown::text {
+
+// Calls on_line(line_number, line) for each line of text, without its terminator. LF, CR LF
+// and a lone CR (old Mac, some terminal programs) all end a line; a final line without a
+// terminator counts too. No allocation.
+template <class OnLine>
+std::int64_t for_each_line(std::string_view text, OnLine&& on_line) {
+  const char* p = text.data();
+  const char* const end = p + text.size();
+  std::int64_t number = 0;
+  while (p < end) {
+    const char* q = p;
+    while (q < end && *q != '\n' && *q != '\r') ++q;
+    on_line(++number, std::string_view(p, static_cast<std::size_t>(q - p)));
+    if (q == end) break;
+    p = q + 1;
+    if (*q == '\r' && p < end && *p == '\n') ++p;
+  }
+  return number;
+}
+
+// True when the bytes are not text: more than 10 % control characters (NUL included; tab,
+// CR, LF excepted) in the first 64 KiB. A few bytes of serial noise do not make a log binary.
+bool looks_binary(std::string_view bytes, std::size_t* control_bytes = nullptr,
+                  std::size_t* looked_at = nullptr);
+
+// A line for a message: quoted, control bytes escaped, cut to about 40 characters.
+std::string quote_line(std::string_view line);
+
+// Per-line problems go to the Recording one by one up to a limit, then only as a count, so
+// a file of garbage still gives readable output.
+class LineReporter {
+ public:
+  LineReporter(Recording& recording, std::size_t max_individual)
+      : rec_(recording), max_(max_individual) {}
+  void report(Diagnostic::Severity severity, std::int64_t line, std::string message);
+  void warn(std::int64_t line, std::string message) {
+    report(Diagnostic::Severity::warning, line, std::move(message));
+  }
+  // The summary of what was not listed; call once at the end.
+  void finish();
+  std::size_t count() const { return count_; }
+
+ private:
+  Recording& rec_;
+  std::size_t max_;
+  std::size_t count_ = 0;
+  std::int64_t first_unlisted_ = 0, last_unlisted_ = 0;
+};
+
+// One parsed sample before timeline repair; t in the file's own unit (ms for millis()).
+struct RawSample {
+  std::int64_t line = 0;
+  double t = 0;
+  double value = 0;
+  bool session_start = false;  // first sample of the file or after a PuTTY header
+  std::string_view text;       // the line, for messages
+};
+
+struct TimelineRules {
+  double units_per_s = 1000;      // 1000 for ms
+  std::string_view unit = "ms";   // for messages
+  double wrap = 0;                // counter modulus in file units (2^32 for millis()); 0 = none
+  double reset_min_back = 1000;   // a jump back larger than this, confirmed by the next
+                                  // sample, is a device restart (file units)
+  bool drop_cut_first = true;     // a session's first sample off the cadence was cut short
+};
+
+struct TimelineCounts {
+  std::size_t cut_first = 0, backwards = 0, ahead = 0, duplicates = 0, wraps = 0, restarts = 0,
+              gaps = 0;
+  std::size_t dropped() const { return cut_first + backwards + ahead + duplicates; }
+};
+
+// Appends the usable samples to rec (t_s = unwrapped t / units_per_s) and says what it did
+// about every sample it did not use and every wrap, restart and gap.
+TimelineCounts build_timeline(const std::vector<RawSample>& raw, const TimelineRules& rules,
+                              Recording& rec, LineReporter& reporter);
+
+}  // namespace spindown::text
