@@ -1,0 +1,41 @@
+#pragma once
+// A pseudo-terminal pair seen from the device side: we hold the master, a program (the bridge)
+// opens the slave path as if it were /dev/ttyACM0. The slave starts raw so bytes pass unchanged.
+// Used by the virtual bench and by tests in place of hardware.
+#include <chrono>
+#include <string>
+#include <string_view>
+
+namespace spindown {
+
+class PseudoTerminal {
+ public:
+  // Opens a new pty (throws std::runtime_error with errno text on failure).
+  PseudoTerminal();
+  ~PseudoTerminal();
+  PseudoTerminal(PseudoTerminal&& other) noexcept;
+  PseudoTerminal& operator=(PseudoTerminal&& other) noexcept;
+  PseudoTerminal(const PseudoTerminal&) = delete;
+  PseudoTerminal& operator=(const PseudoTerminal&) = delete;
+
+  const std::string& slave_path() const { return slave_path_; }
+  int master_fd() const { return master_; }
+
+  // True while some process has the slave open (the master sees no hangup).
+  bool reader_attached() const;
+  // Waits up to timeout for a reader; true when one is there.
+  bool wait_for_reader(std::chrono::milliseconds timeout) const;
+  // The baud rate the reader set on the slave (0 when unknown).
+  int reader_baud() const;
+  // Writes all of data within timeout; returns bytes written (fewer on timeout or hangup).
+  std::size_t write(std::string_view data, std::chrono::milliseconds timeout);
+  // Reads what the reader sent (non-blocking); empty when nothing.
+  std::string read_available();
+  void close();  // the "cable pulled": the reader sees a hangup
+
+ private:
+  int master_ = -1;
+  std::string slave_path_;
+};
+
+}  // namespace spindown

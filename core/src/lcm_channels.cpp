@@ -1,0 +1,68 @@
+#include "spindown/lcm_channels.hpp"
+
+#include <array>
+#include <fmt/format.h>
+#include <stdexcept>
+
+namespace spindown {
+
+namespace {
+constexpr std::array<std::pair<ChannelKind, std::string_view>, 6> kSuffixes{{
+    {ChannelKind::sample, "SAMPLE"},
+    {ChannelKind::config, "CONFIG"},
+    {ChannelKind::run, "RUN"},
+    {ChannelKind::fit, "FIT"},
+    {ChannelKind::explain, "EXPLAIN"},
+    {ChannelKind::status, "STATUS"},
+}};
+
+bool is_id_char(char c) {
+  return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' ||
+         c == '-';
+}
+}  // namespace
+
+bool is_valid_bench_id(std::string_view id, std::string* why) {
+  auto fail = [&](std::string reason) {
+    if (why) *why = std::move(reason);
+    return false;
+  };
+  if (id.empty()) return fail("bench id is empty (want 1-32 of A-Z a-z 0-9 _ -)");
+  if (id.size() > max_bench_id_length)
+    return fail(fmt::format("bench id is {} characters long (at most {})", id.size(), max_bench_id_length));
+  for (std::size_t i = 0; i < id.size(); ++i) {
+    if (!is_id_char(id[i])) {
+      const auto c = static_cast<unsigned char>(id[i]);
+      return fail(fmt::format("bench id has character 0x{:02x} at position {} (allowed: A-Z a-z 0-9 _ -)",
+                              c, i + 1));
+    }
+  }
+  return true;
+}
+
+std::string_view channel_suffix(ChannelKind kind) {
+  for (const auto& [k, s] : kSuffixes)
+    if (k == kind) return s;
+  return "UNKNOWN";
+}
+
+std::string channel_name(std::string_view bench, ChannelKind kind) {
+  std::string why;
+  if (!is_valid_bench_id(bench, &why)) throw std::invalid_argument(why);
+  return fmt::format("{}{}.{}", channel_prefix, bench, channel_suffix(kind));
+}
+
+std::optional<ParsedChannel> parse_channel(std::string_view channel) {
+  if (!channel.starts_with(channel_prefix)) return std::nullopt;
+  channel.remove_prefix(channel_prefix.size());
+  const auto dot = channel.rfind('.');
+  if (dot == std::string_view::npos) return std::nullopt;
+  const auto bench = channel.substr(0, dot);
+  const auto suffix = channel.substr(dot + 1);
+  if (!is_valid_bench_id(bench)) return std::nullopt;
+  for (const auto& [k, s] : kSuffixes)
+    if (s == suffix) return ParsedChannel{std::string(bench), k};
+  return std::nullopt;
+}
+
+}  // namespace spindown

@@ -1,0 +1,355 @@
+#include "spindown/serial_bridge.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include "spindown/lab_line.hpp"
+
+namespace spindown {
+
+namespace {
+
+std::int64_t steady_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
+
+// A line as it can be shown in a status message: at most max bytes, non-printables escaped.
+std::string printable(std::string_view text, std::size_t max = 60) {
+  std::string out;
+  for (std::size_t i = 0; i < text.size() && i < max; ++i) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    if (c == '\t') out += "\\t";
+    else if (c == '\\') out += "\\\\";
+    else if (c == '"') out += "\\\"";
+    else if (c < 0x20 || c >= 0x7f) out += fmt::format("\\x{:02x}", c);
+    else out += static_cast<char>(c);
+  }
+  if (text.size() > max) out += "...";
+  return out;
+}
+
+std::string host_name() {
+  char buf[256] = {};
+  if (::gethostname(buf, sizeof buf - 1) != 0) return "unknown";
+  return buf;
+}
+
+std::int8_t to_lcm_quantity(Quantity q) {
+  switch (q) {
+    case Quantity::back_emf_volts: return samples_t::QUANTITY_BACK_EMF_V;
+    case Quantity::rpm: return samples_t::QUANTITY_RPM;
+    case Quantity::rad_per_s: return samples_t::QUANTITY_RAD_S;
+  }
+  return samples_t::QUANTITY_BACK_EMF_V;
+}
+
+}  // namespace
+
+std::string_view wire_protocol_name(WireProtocol p) {
+  switch (p) {
+    case WireProtocol::unknown: return "unknown";
+    case WireProtocol::lab: return "lab-tsv";
+    case WireProtocol::spindown_v1: return spindown_protocol_name;
+  }
+  return "unknown";
+}
+
+SerialBridge::SerialBridge(BridgeSettings settings, BridgeSink& sink)
+    : s_(std::move(settings)), sink_(sink), splitter_(s_.max_line_bytes) {
+  if (s_.host.empty()) s_.host = host_name();
+  if (s_.pid == 0) s_.pid = static_cast<int>(::getpid());
+  batch_.bench = s_.bench;
+  batch_.n = 0;
+}
+
+void SerialBridge::start(std::int64_t now_us) {
+  start_us_ = now_us;
+  rate_window_start_us_ = now_us;
+  next_status_us_ = now_us;
+  next_config_us_ = now_us;
+  tick(now_us);
+}
+
+void SerialBridge::connected(std::int64_t now_us) {
+  if (ever_connected_) ++counters_.reconnects;
+  ever_connected_ = true;
+  connected_ = true;
+  state_ = "connected";
+  next_status_us_ = now_us;  // say so now, not at the next heartbeat
+  tick(now_us);
+}
+
+void SerialBridge::disconnected(std::int64_t now_us, std::string_view why) {
+  flush();
+  if (splitter_.reset() > 0) ++counters_.partial_lines;
+  if (connected_) ++counters_.disconnects;
+  connected_ = false;
+  state_ = "disconnected";
+  error(std::string(why), now_us);
+  next_status_us_ = now_us;
+  tick(now_us);
+}
+
+void SerialBridge::open_failed(std::int64_t now_us, std::string_view why) {
+  ++counters_.open_failures;
+  connected_ = false;
+  if (state_ != "disconnected") {
+    state_ = "disconnected";
+    next_status_us_ = now_us;
+  }
+  error(std::string(why), now_us);
+  tick(now_us);
+}
+
+void SerialBridge::error(std::string text, std::int64_t now_us) {
+  last_error_ = std::move(text);
+  last_error_utime_ = now_us;
+}
+
+void SerialBridge::feed(std::string_view bytes, std::int64_t now_us) {
+  feed_start_ns_ = steady_ns();
+  counters_.bytes += static_cast<std::int64_t>(bytes.size());
+  splitter_.feed(bytes, [&](const LineSplitter::Line& line) { on_line(line, now_us); });
+  flush();
+}
+
+void SerialBridge::on_line(const LineSplitter::Line& line, std::int64_t now_us) {
+  ++lines_seen_;
+  if (line.oversize) {
+    ++counters_.oversize_lines;
+    bad_line(line.text, fmt::format("line longer than {} bytes, discarded up to its newline", s_.max_line_bytes),
+             now_us);
+    return;
+  }
+  if (looks_like_spindown_line(line.text))
+    on_spindown_line(line.text, now_us);
+  else
+    on_lab_line(line.text, now_us);
+}
+
+void SerialBridge::bad_line(std::string_view text, std::string_view why, std::int64_t now_us) {
+  ++counters_.lines_bad;
+  error(fmt::format("{} line {}: {}: \"{}\"", s_.device, lines_seen_, why, printable(text)), now_us);
+}
+
+void SerialBridge::set_protocol(WireProtocol p, std::int64_t now_us) {
+  if (p == protocol_) return;
+  if (protocol_ != WireProtocol::unknown)
+    error(fmt::format("{}: protocol changed from {} to {}", s_.device, wire_protocol_name(protocol_),
+                      wire_protocol_name(p)),
+          now_us);
+  protocol_ = p;
+  flush();  // a batch holds one protocol's samples
+  clock_.set_tick_us(p == WireProtocol::lab ? 1000 : 1);  // millis() vs micros(); a new epoch
+  have_device_seq_ = false;
+  next_config_us_ = now_us;  // the config changed: publish it with the next tick
+}
+
+void SerialBridge::on_lab_line(std::string_view text, std::int64_t now_us) {
+  const LabLine l = parse_lab_line(text);
+  switch (l.kind) {
+    case LabLine::Kind::blank: ++counters_.lines_blank; return;
+    case LabLine::Kind::garbled: bad_line(text, l.why, now_us); return;
+    case LabLine::Kind::sample: break;
+  }
+  ++counters_.lines_good;
+  set_protocol(WireProtocol::lab, now_us);
+  const auto r = clock_.update(static_cast<std::uint64_t>(l.millis));
+  add_sample(r, now_us, l.value, -1);
+}
+
+void SerialBridge::on_spindown_line(std::string_view text, std::int64_t now_us) {
+  const SpindownLine l = parse_spindown_line(text);
+  switch (l.kind) {
+    case SpindownLine::Kind::blank: ++counters_.lines_blank; return;
+    case SpindownLine::Kind::garbled: bad_line(text, l.why, now_us); return;
+    case SpindownLine::Kind::note: ++counters_.lines_good; return;
+    case SpindownLine::Kind::banner:
+      ++counters_.lines_good;
+      set_protocol(WireProtocol::spindown_v1, now_us);
+      banner_ = l.banner;
+      banner_seen_ = true;
+      next_config_us_ = now_us;
+      tick(now_us);
+      return;
+    case SpindownLine::Kind::sample: break;
+  }
+  const int bits = banner_seen_ ? banner_.adc_bits : 10;
+  if (l.adc > (1 << bits) - 1) {
+    bad_line(text, "ADC count above the converter's range", now_us);
+    return;
+  }
+  ++counters_.lines_good;
+  set_protocol(WireProtocol::spindown_v1, now_us);
+  const auto r = clock_.update(l.time_us);
+  if (have_device_seq_ && !r.reset) {
+    const std::uint32_t expected = last_device_seq_ + 1;
+    if (l.seq != expected) {
+      const std::uint32_t ahead = l.seq - expected;  // modulo 2^32
+      const std::int64_t lost = ahead < 0x80000000u ? std::int64_t(ahead) : 1;
+      counters_.device_seq_gaps += lost;
+      error(fmt::format("{}: device sequence jumped from {} to {} ({} sample(s) lost on the wire)", s_.device,
+                        last_device_seq_, l.seq, lost),
+            now_us);
+    }
+  }
+  have_device_seq_ = true;
+  last_device_seq_ = l.seq;
+  const double vpc = banner_seen_ ? banner_.volts_per_count() : SpindownBanner{}.volts_per_count();
+  add_sample(r, now_us, l.adc * vpc, l.adc);
+}
+
+void SerialBridge::add_sample(const DeviceClock::Reading& r, std::int64_t host_us, double value, std::int32_t raw) {
+  if (r.reset) {
+    flush();  // one clock epoch per message
+    counters_.device_resets = r.epoch;
+    error(fmt::format("{}: device clock restarted (Arduino reset), clock epoch {}", s_.device, r.epoch), host_us);
+  }
+  if (batch_.n == 0) {
+    batch_.seq = next_seq_;
+    batch_.clock_epoch = r.epoch;
+    batch_.quantity = protocol_ == WireProtocol::spindown_v1 ? samples_t::QUANTITY_BACK_EMF_V
+                                                              : to_lcm_quantity(s_.quantity);
+  }
+  batch_.device_time_us.push_back(r.time_us);
+  batch_.host_time_us.push_back(host_us);
+  batch_.value.push_back(value);
+  batch_.raw_adc.push_back(raw);
+  ++batch_.n;
+  ++next_seq_;
+  batch_.utime = host_us;
+  if (static_cast<std::size_t>(batch_.n) >= s_.max_batch) flush();
+}
+
+void SerialBridge::flush() {
+  if (batch_.n == 0) return;
+  sink_.publish(batch_);
+  const std::int64_t took_ns = steady_ns() - feed_start_ns_;
+  latency_us_[latency_count_ % latency_us_.size()] = static_cast<float>(took_ns / 1000.0);
+  ++latency_count_;
+  counters_.samples += batch_.n;
+  rate_window_samples_ += batch_.n;
+  ++counters_.messages;
+  batch_.n = 0;
+  batch_.device_time_us.clear();
+  batch_.host_time_us.clear();
+  batch_.value.clear();
+  batch_.raw_adc.clear();
+}
+
+double SerialBridge::latency_quantile_us(double p) const {
+  const std::size_t n = std::min(latency_count_, latency_us_.size());
+  if (n == 0) return 0;
+  std::vector<float> v(latency_us_.begin(), latency_us_.begin() + static_cast<std::ptrdiff_t>(n));
+  const auto k = static_cast<std::size_t>(std::clamp(p, 0.0, 1.0) * double(n - 1) + 0.5);
+  std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+  return v[k];
+}
+
+void SerialBridge::tick(std::int64_t now_us) {
+  if (now_us >= next_config_us_) {
+    sink_.publish(make_config(now_us));
+    next_config_us_ = now_us + static_cast<std::int64_t>(s_.config_interval_s * 1e6);
+  }
+  if (now_us >= next_status_us_) {
+    const std::int64_t window = now_us - rate_window_start_us_;
+    if (window >= 200'000) {
+      rate_hz_ = double(rate_window_samples_) * 1e6 / double(window);
+      rate_window_start_us_ = now_us;
+      rate_window_samples_ = 0;
+    }
+    sink_.publish(make_status(now_us));
+    next_status_us_ = now_us + static_cast<std::int64_t>(s_.status_interval_s * 1e6);
+  }
+}
+
+void SerialBridge::stop(std::int64_t now_us) {
+  flush();
+  stopping_ = true;
+  state_ = "stopping";
+  sink_.publish(make_status(now_us));
+}
+
+config_t SerialBridge::make_config(std::int64_t now_us) const {
+  config_t c;
+  c.utime = now_us;
+  c.bench = s_.bench;
+  c.inertia_kg_m2 = s_.params.inertia_kg_m2;
+  c.inertia_source = s_.params.inertia_source;
+  c.kb_v_s_per_rad = s_.params.kb_v_s_per_rad;
+  c.kb_source = s_.params.kb_source;
+  c.protocol = std::string(wire_protocol_name(protocol_));
+  c.baud = s_.baud;
+  c.device = s_.device;
+  c.host = s_.host;
+  if (protocol_ == WireProtocol::spindown_v1) {
+    c.quantity = samples_t::QUANTITY_BACK_EMF_V;
+    const SpindownBanner b = banner_seen_ ? banner_ : SpindownBanner{};
+    c.adc_volts_per_count = b.volts_per_count();
+    c.adc_bits = b.adc_bits;
+    c.firmware = banner_seen_ ? fmt::format("{} {}", b.firmware, b.version) : "spindown-v1 (no banner seen yet)";
+    c.sample_period_s = banner_seen_ ? b.period_us * 1e-6 : 0.0;
+  } else {
+    c.quantity = to_lcm_quantity(s_.quantity);
+    // The lab sketch prints volts = counts·ref/(2^bits − 1), rounded to 2 decimals.
+    c.adc_volts_per_count = s_.adc_ref_v / double((1 << s_.adc_bits) - 1);
+    c.adc_bits = s_.adc_bits;
+    c.firmware = protocol_ == WireProtocol::lab ? "lab sketch" : "unknown (no valid line yet)";
+    c.sample_period_s = s_.lab_period_s;
+  }
+  return c;
+}
+
+status_t SerialBridge::make_status(std::int64_t now_us) const {
+  status_t st;
+  st.utime = now_us;
+  st.service = "bridge";
+  st.instance = s_.bench;
+  st.host = s_.host;
+  st.pid = s_.pid;
+  st.state = state_;
+  st.uptime_s = double(now_us - start_us_) * 1e-6;
+  const std::pair<const char*, std::int64_t> counters[] = {
+      {"lines_good", counters_.lines_good},
+      {"lines_bad", counters_.lines_bad},
+      {"lines_blank", counters_.lines_blank},
+      {"oversize_lines", counters_.oversize_lines},
+      {"samples", counters_.samples},
+      {"messages", counters_.messages},
+      {"seq", next_seq_},
+      {"bytes", counters_.bytes},
+      {"reconnects", counters_.reconnects},
+      {"disconnects", counters_.disconnects},
+      {"open_failures", counters_.open_failures},
+      {"device_resets", counters_.device_resets},
+      {"device_seq_gaps", counters_.device_seq_gaps},
+      {"partial_lines", counters_.partial_lines},
+  };
+  for (const auto& [name, value] : counters) {
+    st.counter_name.emplace_back(name);
+    st.counter_value.push_back(value);
+  }
+  st.ncounters = static_cast<std::int32_t>(st.counter_name.size());
+  const std::pair<const char*, double> gauges[] = {
+      {"connected", connected_ ? 1.0 : 0.0},
+      {"rate_hz", rate_hz_},
+      {"clock_epoch", double(clock_.epoch())},
+      {"buffered_bytes", double(splitter_.buffered())},
+      {"latency_p50_us", latency_quantile_us(0.50)},
+      {"latency_p99_us", latency_quantile_us(0.99)},
+      {"latency_max_us", latency_quantile_us(1.0)},
+  };
+  for (const auto& [name, value] : gauges) {
+    st.gauge_name.emplace_back(name);
+    st.gauge_value.push_back(value);
+  }
+  st.ngauges = static_cast<std::int32_t>(st.gauge_name.size());
+  st.last_error = last_error_;
+  st.last_error_utime = last_error_utime_;
+  return st;
+}
+
+}  // namespace spindown

@@ -1,0 +1,155 @@
+// spindown-bridge: reads a bench's Arduino over a serial port and publishes its samples,
+// config and heartbeat on LCM (SPINDOWN.<bench>.SAMPLE|CONFIG|STATUS). Survives unplugging,
+// resets, wrong baud rates and garbage; SIGINT/SIGTERM end it with exit code 0.
+#include <CLI/CLI.hpp>
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <fmt/format.h>
+#include <lcm/lcm-cpp.hpp>
+#include <thread>
+
+#include "spindown/bridge_settings.hpp"
+#include "spindown/lcm_channels.hpp"
+#include "spindown/serial_bridge.hpp"
+#include "spindown/serial_port.hpp"
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+extern "C" void on_signal(int) { g_stop = true; }
+
+std::int64_t wall_us() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+class LcmSink : public spindown::BridgeSink {
+ public:
+  LcmSink(lcm::LCM& lcm, const std::string& bench)
+      : lcm_(lcm),
+        sample_(spindown::channel_name(bench, spindown::ChannelKind::sample)),
+        config_(spindown::channel_name(bench, spindown::ChannelKind::config)),
+        status_(spindown::channel_name(bench, spindown::ChannelKind::status)) {}
+  void publish(const spindown::samples_t& m) override { check(lcm_.publish(sample_, &m), sample_); }
+  void publish(const spindown::config_t& m) override { check(lcm_.publish(config_, &m), config_); }
+  void publish(const spindown::status_t& m) override { check(lcm_.publish(status_, &m), status_); }
+
+ private:
+  void check(int rc, const std::string& channel) {
+    if (rc != 0 && ++failures_ % 100 == 1)
+      fmt::print(stderr, "spindown-bridge: publishing on {} failed ({} times so far)\n", channel, failures_);
+  }
+  lcm::LCM& lcm_;
+  std::string sample_, config_, status_;
+  long failures_ = 0;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"spindown-bridge: a bench's serial port -> LCM SPINDOWN.<bench>.SAMPLE|CONFIG|STATUS"};
+  spindown::BridgeSettings s;
+  std::string config_file, lcm_url;
+  bool exit_on_missing = false;
+  double retry_s = 0.25;
+  app.add_option("--device", s.device, "serial device, e.g. /dev/ttyACM0");
+  app.add_option("--bench", s.bench, "bench id [A-Za-z0-9_-]{1,32}");
+  auto* baud_opt = app.add_option("--baud", s.baud, "baud rate (lab sketch 9600, spindown firmware 115200)");
+  app.add_option("--lcm-url", lcm_url, "LCM URL (default: LCM_DEFAULT_URL or LCM's default)");
+  app.add_option("--config", config_file, "TOML file: bench J, K_b, quantity, ADC, serial (see README)")
+      ->check(CLI::ExistingFile);
+  bool retry_flag = false;
+  auto* retry = app.add_flag("--retry", retry_flag, "keep retrying a missing device every --retry-interval (default)");
+  app.add_flag("--exit-on-missing", exit_on_missing, "exit with code 1 when the device cannot be opened")
+      ->excludes(retry);
+  app.add_option("--retry-interval", retry_s, "seconds between attempts to open the device")
+      ->check(CLI::Range(0.01, 0.5));
+  CLI11_PARSE(app, argc, argv);
+
+  // CLI beats the file: remember what the command line said before reading the file.
+  const spindown::BridgeSettings cli = s;
+  if (!config_file.empty()) {
+    try {
+      spindown::load_bridge_settings(config_file, s);
+    } catch (const std::exception& e) {
+      fmt::print(stderr, "spindown-bridge: {}\n", e.what());
+      return 2;
+    }
+    if (!cli.bench.empty()) s.bench = cli.bench;
+    if (!cli.device.empty()) s.device = cli.device;
+    if (baud_opt->count() > 0) s.baud = cli.baud;
+  }
+  std::string why;
+  if (!s.is_valid(&why)) {
+    fmt::print(stderr, "spindown-bridge: {}\n", why);
+    return 2;
+  }
+
+  lcm::LCM lcm(lcm_url);
+  if (!lcm.good()) {
+    fmt::print(stderr, "spindown-bridge: cannot start LCM{}{}\n", lcm_url.empty() ? "" : " at ", lcm_url);
+    return 1;
+  }
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  std::signal(SIGPIPE, SIG_IGN);
+
+  LcmSink sink(lcm, s.bench);
+  spindown::SerialBridge bridge(s, sink);
+  bridge.start(wall_us());
+  fmt::print(stderr, "spindown-bridge: bench {} device {} at {} baud\n", s.bench, s.device, s.baud);
+
+  spindown::SerialPort port;
+  std::array<char, 4096> buf{};
+  const auto retry_every = std::chrono::microseconds(static_cast<long>(retry_s * 1e6));
+  auto next_try = std::chrono::steady_clock::now();
+  std::string last_open_error;
+  int rc = 0;
+  while (!g_stop) {
+    if (!port.is_open()) {
+      if (std::chrono::steady_clock::now() >= next_try) {
+        try {
+          port = spindown::SerialPort(s.device, s.baud);
+          bridge.connected(wall_us());
+          last_open_error.clear();
+          fmt::print(stderr, "spindown-bridge: connected to {}\n", s.device);
+        } catch (const std::exception& e) {
+          bridge.open_failed(wall_us(), e.what());
+          if (exit_on_missing) {
+            fmt::print(stderr, "spindown-bridge: {} (exiting: --exit-on-missing)\n", e.what());
+            rc = 1;
+            break;
+          }
+          if (last_open_error != e.what()) {
+            fmt::print(stderr, "spindown-bridge: {} (retrying every {:.2f} s)\n", e.what(), retry_s);
+            last_open_error = e.what();
+          }
+          next_try = std::chrono::steady_clock::now() + retry_every;
+        }
+      }
+      if (!port.is_open()) {
+        bridge.tick(wall_us());
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        continue;
+      }
+    }
+    try {
+      const std::size_t got = port.read_some(buf, std::chrono::milliseconds(100));
+      if (got > 0) bridge.feed(std::string_view(buf.data(), got), wall_us());
+    } catch (const spindown::SerialError& e) {
+      port.close();
+      bridge.disconnected(wall_us(), e.what());
+      fmt::print(stderr, "spindown-bridge: {}; reopening\n", e.what());
+      next_try = std::chrono::steady_clock::now();  // try at once, then every retry interval
+    }
+    bridge.tick(wall_us());
+  }
+  bridge.stop(wall_us());
+  const auto& c = bridge.counters();
+  fmt::print(stderr,
+             "spindown-bridge: stopped: {} samples, {} good / {} bad lines, {} reconnects, latency p99 {:.0f} us\n",
+             c.samples, c.lines_good, c.lines_bad, c.reconnects, bridge.latency_quantile_us(0.99));
+  return rc;
+}

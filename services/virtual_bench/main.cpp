@@ -1,0 +1,186 @@
+// spindown-virtual-bench: a simulated bench on a pseudo-terminal. Prints the pty's path (and
+// links it with --link), waits for a reader (as an Arduino boots when its port opens), then
+// writes the runs at the baud rate's pace, --speed times faster. Exits when all runs are sent.
+#include <CLI/CLI.hpp>
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fmt/format.h>
+#include <fstream>
+#include <thread>
+
+#include "spindown/pseudo_terminal.hpp"
+#include "spindown/virtual_bench.hpp"
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+extern "C" void on_signal(int) { g_stop = true; }
+
+using Clock = std::chrono::steady_clock;
+
+// Sleeps until t (or a signal), in short steps.
+void sleep_until(Clock::time_point t) {
+  for (int guard = 0; guard < 100'000'000 && !g_stop; ++guard) {
+    const auto now = Clock::now();
+    if (now >= t) return;
+    std::this_thread::sleep_for(std::min<Clock::duration>(t - now, std::chrono::milliseconds(50)));
+  }
+}
+
+void relink(const std::string& link, const std::string& target) {
+  if (link.empty()) return;
+  std::error_code ec;
+  std::filesystem::remove(link, ec);
+  std::filesystem::create_symlink(target, link);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"spindown-virtual-bench: a simulated spin-down bench on a pseudo-terminal"};
+  spindown::VirtualBenchOptions o;
+  auto& sp = o.spec;
+  std::string protocol = "lab", lead_in = "zeros", link, truth_file, sent_file;
+  double speed = 1.0, wait_reader_s = 30, linger_s = 1.0, period_ms = 20, jitter_ms = 0.5;
+  app.set_config("--config", "", "TOML file with any of these options (key = long option name)");
+  app.add_option("--protocol", protocol, "lab (millis<TAB>volts) or spindown-v1")
+      ->check(CLI::IsMember({"lab", "spindown-v1"}));
+  app.add_option("--baud", o.baud, "baud rate (default 9600 lab, 115200 spindown-v1)");
+  app.add_option("--speed", speed, "times faster than real time; 0 = as fast as possible")
+      ->check(CLI::Range(0.0, 1e6));
+  app.add_option("--runs", o.runs, "runs: spin up, steady, cut, coast, stop, tail");
+  app.add_option("--idle", o.idle_s, "seconds at rest between runs");
+  app.add_option("--period-ms", period_ms, "loop period (ms)");
+  app.add_option("--jitter-ms", jitter_ms, "uniform ± jitter of the period (ms)");
+  app.add_option("--e0", sp.e0_v, "back-EMF at the cut (V)");
+  app.add_option("--e0-step", o.e0_step_v, "added to e0 at each further run (V)");
+  app.add_option("--supply", sp.supply_v, "pin reading before the cut with --lead-in supply (V)");
+  app.add_option("--lead-in", lead_in, "what the pin reads before the cut")
+      ->check(CLI::IsMember({"zeros", "floating", "supply"}));
+  app.add_option("--lead-in-s", sp.lead_in_s, "seconds recorded before the cut");
+  app.add_option("--tail-s", sp.tail_s, "seconds recorded after the stop");
+  app.add_option("--max-coast-s", sp.max_coast_s, "longest coast simulated");
+  app.add_option("--inertia", sp.bench.inertia_kg_m2, "J (kg*m^2)");
+  app.add_option("--kb", sp.bench.kb_v_s_per_rad, "K_b (V*s/rad)");
+  app.add_option("--viscous", sp.friction.viscous, "c_v (N*m*s/rad)");
+  app.add_option("--coulomb", sp.friction.coulomb, "c_c (N*m)");
+  app.add_option("--stribeck-static", sp.friction.stribeck_static, "c_s (N*m)");
+  app.add_option("--stribeck-speed", sp.friction.stribeck_speed, "w_s (rad/s)");
+  app.add_option("--windage", sp.friction.windage, "c_w (N*m*s^2/rad^2)");
+  app.add_option("--offset", sp.offset_v, "sensor offset after the cut (V)");
+  app.add_option("--noise", sp.noise_v, "white noise (V)");
+  app.add_option("--ripple", sp.ripple, "relative commutator ripple");
+  app.add_option("--adc-bits", sp.adc_bits, "ADC bits (0 = no quantization)");
+  app.add_option("--decimals", sp.decimals, "decimals the lab sketch prints");
+  app.add_option("--seed", sp.seed, "random seed");
+  app.add_option("--firmware", o.firmware, "firmware name in the spindown-v1 banner");
+  app.add_option("--reset-at", o.reset_at_s, "bench seconds at which the Arduino resets (repeatable)");
+  app.add_option("--unplug-at", o.unplug_at_s, "bench seconds at which the cable is pulled");
+  app.add_option("--unplug-for", o.unplug_for_s, "seconds the cable stays out");
+  app.add_option("--garbage-every", o.garbage_every, "a garbage line after every N-th sample line");
+  app.add_option("--partial-every", o.partial_every, "every N-th sample line cut short");
+  app.add_option("--long-line-at", o.long_line_at_s, "bench seconds at which an over-long line is sent");
+  app.add_option("--long-line-bytes", o.long_line_bytes, "bytes of that line (no newline until its end)");
+  app.add_option("--link", link, "symlink to the pty's path (like /dev/ttyACM0)");
+  app.add_option("--truth", truth_file, "write parameters, cut/stop times and faults as JSON");
+  app.add_option("--sent", sent_file, "write every sample line sent (TSV: epoch device_time_us value raw_adc device_seq)");
+  app.add_option("--wait-reader", wait_reader_s, "seconds to wait for a reader to open the pty (0: do not wait)");
+  app.add_option("--linger", linger_s, "seconds to keep the pty open after the last line");
+  CLI11_PARSE(app, argc, argv);
+
+  o.protocol = protocol == "lab" ? spindown::BenchProtocol::lab : spindown::BenchProtocol::spindown_v1;
+  sp.lead_in = lead_in == "zeros" ? spindown::LeadIn::zeros
+               : lead_in == "supply" ? spindown::LeadIn::supply
+                                     : spindown::LeadIn::floating;
+  sp.period_s = period_ms / 1000.0;
+  sp.jitter_s = jitter_ms / 1000.0;
+  o.seed = sp.seed;
+
+  std::unique_ptr<spindown::VirtualBench> bench;
+  try {
+    bench = std::make_unique<spindown::VirtualBench>(o);
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "spindown-virtual-bench: {}\n", e.what());
+    return 2;
+  }
+  if (!truth_file.empty()) std::ofstream(truth_file) << bench->truth().dump(2) << "\n";
+  if (!sent_file.empty()) {
+    std::ofstream out(sent_file);
+    out << "epoch\tdevice_time_us\tvalue\traw_adc\tdevice_seq\n";
+    for (const auto& s : bench->sent())
+      out << fmt::format("{}\t{}\t{:.17g}\t{}\t{}\n", s.epoch, s.device_time_us, s.value, s.raw_adc, s.device_seq);
+  }
+
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  std::signal(SIGPIPE, SIG_IGN);
+  auto pty = std::make_unique<spindown::PseudoTerminal>();
+  relink(link, pty->slave_path());
+  fmt::print("{}\n", pty->slave_path());
+  std::fflush(stdout);
+
+  const auto wait_reader = [&]() {
+    if (wait_reader_s <= 0) return true;
+    const auto deadline = Clock::now() + std::chrono::milliseconds(long(wait_reader_s * 1000));
+    while (!g_stop && Clock::now() < deadline)
+      if (pty->wait_for_reader(std::chrono::milliseconds(100))) return true;
+    return false;
+  };
+  if (!wait_reader()) {
+    fmt::print(stderr, "spindown-virtual-bench: nobody opened {} within {} s\n", pty->slave_path(), wait_reader_s);
+    return g_stop ? 0 : 1;
+  }
+
+  const int baud = o.effective_baud();
+  std::uint64_t garble_state = o.seed;
+  auto anchor = Clock::now();  // bench time 0
+  auto at = [&](double bench_s) {
+    return anchor + std::chrono::microseconds(speed > 0 ? long(bench_s / speed * 1e6) : 0L);
+  };
+  long written = 0, dropped = 0, garbled = 0;
+  for (const auto& e : bench->emissions()) {
+    if (g_stop) break;
+    if (e.kind == spindown::BenchEmission::Kind::unplug) {
+      sleep_until(at(e.wire_s));
+      fmt::print(stderr, "spindown-virtual-bench: cable pulled for {} s\n", e.unplug_for_s);
+      pty.reset();
+      if (!link.empty()) std::filesystem::remove(link);
+      const auto back = Clock::now() + std::chrono::milliseconds(long(e.unplug_for_s * 1000 / (speed > 0 ? speed : 1e9)));
+      sleep_until(back);
+      pty = std::make_unique<spindown::PseudoTerminal>();
+      relink(link, pty->slave_path());
+      fmt::print("{}\n", pty->slave_path());
+      std::fflush(stdout);
+      const auto waited_from = Clock::now();
+      if (!wait_reader()) {
+        fmt::print(stderr, "spindown-virtual-bench: nobody reopened {} within {} s\n", pty->slave_path(), wait_reader_s);
+        return g_stop ? 0 : 1;
+      }
+      anchor += Clock::now() - waited_from;  // the board boots when the port opens
+      continue;
+    }
+    sleep_until(at(e.wire_s));
+    std::string_view bytes = e.bytes;
+    std::string garbage;
+    const int reader = pty->reader_baud();
+    if (reader > 0 && reader != baud) {  // a real UART at the wrong rate decodes framing garbage
+      garbage = spindown::garble_for_baud(bytes, baud, reader, garble_state);
+      bytes = garbage;
+      ++garbled;
+    }
+    const bool attached = pty->reader_attached();
+    const auto put = pty->write(bytes, std::chrono::milliseconds(attached ? 2000 : 0));
+    if (put < bytes.size()) ++dropped;
+    else ++written;
+  }
+  if (!g_stop) sleep_until(Clock::now() + std::chrono::milliseconds(long(linger_s * 1000)));
+  fmt::print(stderr, "spindown-virtual-bench: {} lines written, {} dropped (no reader), {} garbled (baud mismatch)\n",
+             written, dropped, garbled);
+  if (!link.empty()) {
+    std::error_code ec;
+    std::filesystem::remove(link, ec);
+  }
+  return 0;
+}
