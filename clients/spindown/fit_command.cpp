@@ -1,12 +1,14 @@
 #include "fit_command.hpp"
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <exception>
 #include <fmt/format.h>
 #include <iostream>
 #include <memory>
+#include <string>
 
 #include "exit_codes.hpp"
 #include "spindown/bench.hpp"
@@ -26,6 +28,26 @@ struct FitPlan {
   bool bench_from_user = false;  // J or K_b given on the command line: never taken from a log's config
   ReportOptions report;
 };
+
+// A finite number above (or, for non_negative, at least) zero; the message names no limits.
+CLI::Validator number_check(bool non_negative) {
+  return CLI::Validator(
+      [non_negative](std::string& text) -> std::string {
+        std::size_t used = 0;
+        double x = 0;
+        try {
+          x = std::stod(text, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used == 0 || used != text.size() || !std::isfinite(x) || x < 0 || (!non_negative && x == 0))
+          return fmt::format("'{}' is not a {} number", text, non_negative ? "non-negative" : "positive");
+        return {};
+      },
+      non_negative ? "NUMBER>=0" : "NUMBER>0");
+}
+const CLI::Validator positive = number_check(false);
+const CLI::Validator non_negative = number_check(true);
 
 [[noreturn]] void bad_usage(const std::string& why) { throw CLI::ValidationError(why); }
 
@@ -153,9 +175,16 @@ FileFit fit_file(const std::string& path, const FitPlan& plan) {
 
 // Problems go to stderr, naming the file (and line): warnings and errors always, notes with -v.
 void report_problems(const FileFit& file, const FitPlan& plan, bool verbose) {
+  // An error that made the file unusable is said once, by its "not used" line.
+  auto is_a_failure = [&](const Diagnostic& d) {
+    return d.severity == Diagnostic::Severity::error &&
+           std::any_of(file.failures.begin(), file.failures.end(), [&](const std::string& why) {
+             return why.size() >= d.message.size() && why.ends_with(d.message);
+           });
+  };
   std::vector<Diagnostic> shown;
   for (const auto& d : file.diagnostics)
-    if (verbose || d.severity != Diagnostic::Severity::note) shown.push_back(d);
+    if ((verbose || d.severity != Diagnostic::Severity::note) && !is_a_failure(d)) shown.push_back(d);
   for (const auto& line : summarize_diagnostics(shown, plan.report.max_diagnostics)) std::cerr << line << '\n';
   for (const auto& why : file.failures) std::cerr << file.file << ": error: not used: " << why << '\n';
   std::cerr.flush();
@@ -166,27 +195,28 @@ void report_problems(const FileFit& file, const FitPlan& plan, bool verbose) {
 void setup_fit(CLI::App& app) {
   auto opt = std::make_shared<FitCommandOptions>();
   CLI::App* sub = app.add_subcommand("fit", "Fit viscous, Coulomb and combined friction to each spin-down run");
+  sub->footer("Exit codes: 0 ok, 1 a file or run could not be used (the others are still reported), 2 bad usage.");
   sub->add_option("FILE", opt->files, "Arduino/PuTTY log, delimited text (CSV/TSV) or LCM log")->required();
-  sub->add_flag("--json", opt->json, "Print design §5's JSON object instead of tables");
+  sub->add_flag("--json", opt->json, "Print one JSON object {\"files\":[{\"runs\":[{\"models\":…}]}]} instead of tables");
   sub->add_option("--models", opt->models, "Models to fit, comma-separated: viscous,coulomb,combined (default all)")
       ->delimiter(',');
   sub->add_flag("--lab-units", opt->lab_units, "Also give the lab's units (g·cm², g·cm²·s⁻¹, g·cm²·rad·s⁻²)");
   sub->add_flag("-v,--verbose", opt->verbose, "Show every diagnostic, notes included");
 
   auto* inertia = sub->add_option("--inertia", opt->inertia_kg_m2, "Moment of inertia J (kg·m²)")
-                      ->check(CLI::PositiveNumber)
+                      ->check(positive)
                       ->group("Bench");
   auto* radius = sub->add_option("--flywheel-radius", opt->flywheel_radius_m, "Flywheel cylinder radius (m)")
-                     ->check(CLI::PositiveNumber)
+                     ->check(positive)
                      ->group("Bench");
   auto* height = sub->add_option("--flywheel-height", opt->flywheel_height_m, "Flywheel cylinder height (m)")
-                     ->check(CLI::PositiveNumber)
+                     ->check(positive)
                      ->group("Bench");
   auto* density = sub->add_option("--flywheel-density", opt->flywheel_density_kg_m3, "Flywheel density (kg/m³)")
-                      ->check(CLI::PositiveNumber)
+                      ->check(positive)
                       ->group("Bench");
   auto* rotor = sub->add_option("--rotor-inertia", opt->rotor_inertia_kg_m2, "Motor rotor inertia (kg·m²)")
-                    ->check(CLI::NonNegativeNumber)
+                    ->check(non_negative)
                     ->group("Bench");
   for (auto* o : {radius, height, density, rotor}) {
     o->excludes(inertia);
@@ -194,10 +224,10 @@ void setup_fit(CLI::App& app) {
       if (other != o) o->needs(other);
   }
   auto* kb = sub->add_option("--kb", opt->kb_v_s_per_rad, "Back-EMF constant K_b (V·s/rad)")
-                 ->check(CLI::PositiveNumber)
+                 ->check(positive)
                  ->group("Bench");
   auto* kv = sub->add_option("--speed-constant", opt->speed_constant_rpm_per_v, "Motor speed constant (rpm/V)")
-                 ->check(CLI::PositiveNumber)
+                 ->check(positive)
                  ->group("Bench");
   kb->excludes(kv);
 
