@@ -1,0 +1,138 @@
+#pragma once
+// The streaming run detector: fed one sample at a time (live fitter) or every sample of a
+// recording (find_runs), it finds each spin-down — the power cut, the coast, the stop — and
+// emits events as it decides. Memory is bounded: in the lead-in it keeps only a few seconds,
+// during a coast at most RunOptions::max_buffer samples.
+//
+// How it decides (all thresholds relative to the data's own level and noise):
+//  * a coast is confirmed when a trailing window (0.25 s or 1 s) shows a smooth, significant
+//    decline (slope t-statistic, roughness relative to the level);
+//  * the cut is then located by a two-segment least-squares split of the last seconds
+//    (constant lead-in | linear coast start), which finds both steps (zeros, floating pin,
+//    supply) and kinks (powered motor at steady speed); a reading pinned at its maximum
+//    (ADC top) is skipped: the coast starts where it leaves it;
+//  * the stop is the start of a stop_hold_s window that is flat (no significant slope) and low;
+//    the zero level and noise come from that standstill, the stop time from the approach line;
+//  * a coast that approaches standstill asymptotically (pure viscous) is not a stop.
+#include <cstddef>
+#include <deque>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "spindown/recording.hpp"
+#include "spindown/runs.hpp"
+
+namespace spindown {
+
+struct RunEvent {
+  enum class Kind {
+    cut,         // a coast started: run has number, cut_index, t_cut_s, lead_in
+    stop,        // standstill reached: run also has stop_index, t_stop_s, zero_level
+    complete,    // the run is final (tail collected, or closed without a stop)
+    ignored,     // a coast too short or otherwise unusable; diagnostic says why
+    diagnostic,  // a note or warning not tied to a finished run (clipping, bad samples…)
+  };
+  Kind kind = Kind::diagnostic;
+  Run run;                // valid for cut/stop/complete/ignored
+  Diagnostic diagnostic;  // valid for ignored/diagnostic (and notes on complete runs)
+  bool has_diagnostic = false;
+};
+
+class RunDetector {
+ public:
+  enum class State { idle, coasting, tail };
+
+  explicit RunDetector(RunOptions opt = {}, std::string source = {});
+
+  // One sample; its index is the number of push() calls before it. Non-finite samples are
+  // counted (reported by finish()) and otherwise ignored; time going backwards is taken as
+  // a clock restart.
+  void push(double t_s, double value);
+  // The device clock restarted before the next sample: an open run is closed there.
+  void clock_restart();
+  // End of the stream: an open coast is closed (never stopped), a tail is cut short.
+  void finish();
+
+  // Events since the last call, oldest first.
+  std::vector<RunEvent> take_events();
+  bool has_events() const { return !events_.empty(); }
+
+  State state() const { return state_; }
+  std::size_t samples_seen() const { return next_index_; }
+  std::size_t buffered() const { return bt_.size(); }
+
+ private:
+  // Least-squares line over a sliding time window of the buffer, O(1) per sample.
+  struct WindowFit {
+    double span_s = 1.0;
+    std::size_t first = 0, end = 0;  // absolute indices [first, end)
+    double t0 = 0;                   // time origin for the sums (precision)
+    double n = 0, st = 0, stt = 0, sv = 0, svv = 0, stv = 0;
+    unsigned updates = 0;
+    void clear(std::size_t at, double t_origin);
+    void add(double t, double v);
+    void remove(double t, double v);
+    double mean() const { return n > 0 ? sv / n : 0.0; }
+    double sxx() const { return stt - st * st / n; }
+    double slope() const;
+    double resid_sd() const;
+  };
+
+  double t(std::size_t i) const { return bt_[i - base_]; }
+  double v(std::size_t i) const { return bv_[i - base_]; }
+  void advance(WindowFit& w, std::size_t i);
+  void rebuild(WindowFit& w, std::size_t from, std::size_t to);
+  void reset_window(WindowFit& w, std::size_t lo, std::size_t end);
+  double duration(const WindowFit& w) const;
+  void trim_idle();
+  void idle_step(std::size_t i);
+  void coast_step(std::size_t i);
+  void coast_checks(std::size_t i);
+  void tail_step(std::size_t i);
+  bool confirms_decline(const WindowFit& w) const;
+  void start_coast(std::size_t i, const WindowFit& w);
+  void found_standstill(std::size_t i);
+  void tail_ends_by_time(std::size_t upto);
+  void close_unstopped(std::size_t end, const std::string& why);
+  void complete_run(std::size_t end);
+  void to_idle(std::size_t lo, bool need_quiet);
+  void emit_diag(Diagnostic::Severity sev, std::string msg);
+  double median_of(std::size_t from, std::size_t to);
+
+  RunOptions opt_;
+  std::string source_;
+  State state_ = State::idle;
+  std::deque<double> bt_, bv_;
+  std::size_t base_ = 0;        // absolute index of bt_[0]
+  std::size_t next_index_ = 0;  // absolute index of the next sample
+  std::size_t lo_ = 0;          // earliest index the current lead-in search may use
+  std::size_t stream_start_ = 0;  // first index after the stream start / last clock restart
+  bool need_quiet_ = false;     // after a closed coast: no new run until the decline pauses
+  bool have_last_t_ = false;
+  double last_t_ = 0;
+  std::size_t non_finite_ = 0;
+  std::size_t same_start_ = 0;  // first of the current run of identical readings
+  std::size_t plateau_start_ = 0, plateau_end_ = 0;  // last long positive plateau (clipping?)
+  bool have_plateau_ = false;
+  int accepted_ = 0;
+
+  WindowFit short_{0.25}, long_{1.0}, hold_{1.0};
+
+  // The open run.
+  Run run_;
+  double v0_ = 0;          // reading at the cut (start of the coast line)
+  double coast_sd_ = 0;    // coast noise near the cut
+  double level_min_ = 0;   // lowest hold-window mean seen in this coast
+  int rising_ = 0;         // consecutive samples far above level_min_ (power back?)
+  std::size_t rise_start_ = 0;
+  double depart_band_ = 0; // tail: how far from zero_level counts as leaving standstill
+  int departing_ = 0;
+  std::size_t depart_start_ = 0;
+  std::string run_note_;   // note attached to the completed run
+
+  std::vector<RunEvent> events_;
+  std::vector<double> scratch_;
+};
+
+}  // namespace spindown

@@ -1,0 +1,93 @@
+#include "spindown/runs.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+
+#include "spindown/run_detector.hpp"
+
+namespace spindown {
+
+bool RunOptions::is_valid(std::string* why) const {
+  auto fail = [&](std::string msg) {
+    if (why) *why = std::move(msg);
+    return false;
+  };
+  auto positive = [](double x) { return std::isfinite(x) && x > 0; };
+  if (!positive(stop_hold_s)) return fail(fmt::format("stop_hold_s must be > 0 (got {})", stop_hold_s));
+  if (!(std::isfinite(min_coast_s) && min_coast_s >= 0))
+    return fail(fmt::format("min_coast_s must be >= 0 (got {})", min_coast_s));
+  if (!positive(max_coast_s) || max_coast_s <= min_coast_s)
+    return fail(fmt::format("max_coast_s must be > min_coast_s (got {} and {})", max_coast_s, min_coast_s));
+  if (!(std::isfinite(tail_s) && tail_s >= 0)) return fail(fmt::format("tail_s must be >= 0 (got {})", tail_s));
+  if (max_buffer < 64) return fail(fmt::format("max_buffer must be at least 64 samples (got {})", max_buffer));
+  return true;
+}
+
+Segmentation find_runs(const Recording& rec, const RunOptions& opt) {
+  Segmentation seg;
+  auto diag = [&](Diagnostic::Severity sev, std::string msg) {
+    seg.diagnostics.push_back({sev, rec.source, 0, std::move(msg)});
+  };
+  std::string why;
+  if (!opt.is_valid(&why)) {
+    diag(Diagnostic::Severity::error, "run options: " + why);
+    return seg;
+  }
+  if (rec.t_s.size() != rec.value.size()) {
+    diag(Diagnostic::Severity::error, fmt::format("{} times but {} values: recording not segmented", rec.t_s.size(),
+                                                  rec.value.size()));
+    return seg;
+  }
+  if (rec.empty()) {
+    diag(Diagnostic::Severity::warning, "no samples: no runs");
+    return seg;
+  }
+
+  // The detector numbers only finite samples; map its indices back when some are not.
+  std::vector<std::size_t> index_of;
+  const bool all_finite = std::all_of(rec.t_s.begin(), rec.t_s.end(), [](double x) { return std::isfinite(x); }) &&
+                          std::all_of(rec.value.begin(), rec.value.end(), [](double x) { return std::isfinite(x); });
+  if (!all_finite) {
+    for (std::size_t i = 0; i < rec.size(); ++i)
+      if (std::isfinite(rec.t_s[i]) && std::isfinite(rec.value[i])) index_of.push_back(i);
+  }
+  auto map = [&](std::size_t k) {
+    if (all_finite) return k;
+    return k < index_of.size() ? index_of[k] : rec.size();
+  };
+
+  std::vector<std::size_t> restarts = rec.clock_restarts;
+  std::sort(restarts.begin(), restarts.end());
+  auto next_restart = restarts.begin();
+
+  RunDetector det(opt, rec.source);
+  auto collect = [&] {
+    for (RunEvent& e : det.take_events()) {
+      if (e.has_diagnostic) seg.diagnostics.push_back(e.diagnostic);
+      if (e.kind == RunEvent::Kind::complete) {
+        Run r = e.run;
+        r.cut_index = map(r.cut_index);
+        r.stop_index = map(r.stop_index);
+        r.end_index = map(r.end_index);
+        seg.runs.push_back(std::move(r));
+      }
+    }
+  };
+  for (std::size_t i = 0; i < rec.size(); ++i) {
+    while (next_restart != restarts.end() && *next_restart <= i) {
+      if (*next_restart == i && i > 0) det.clock_restart();
+      ++next_restart;
+    }
+    det.push(rec.t_s[i], rec.value[i]);
+    if (det.has_events()) collect();
+  }
+  det.finish();
+  collect();
+  if (seg.runs.empty())
+    diag(Diagnostic::Severity::warning,
+         fmt::format("no spin-down found in {} samples (no smooth decline after a cut)", rec.size()));
+  return seg;
+}
+
+}  // namespace spindown
