@@ -316,7 +316,8 @@ std::string format_file_fit(const FileFit& file, const ReportOptions& opt) {
   std::string out = fmt::format("== {}: {} samples from {} lines ({} skipped), {} run{} fitted", file.file,
                                 file.samples, file.lines_read, file.lines_skipped, file.runs.size(),
                                 file.runs.size() == 1 ? "" : "s");
-  if (errors + warnings > 0) out += fmt::format(", {} errors, {} warnings", errors, warnings);
+  auto count = [](std::size_t n, std::string_view what) { return fmt::format("{} {}{}", n, what, n == 1 ? "" : "s"); };
+  if (errors + warnings > 0) out += ", " + count(errors, "error") + ", " + count(warnings, "warning");
   out += '\n';
   if (opt.diagnostics_in_text) {
     for (const auto& line : summarize_diagnostics(file.diagnostics, opt.max_diagnostics)) out += "  " + line + '\n';
