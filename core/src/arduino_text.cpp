@@ -71,7 +71,7 @@ Recording read_arduino_text(std::string_view text, std::string source, const Ard
   const std::int64_t lines = text::for_each_line(text, [&](std::int64_t n, std::string_view line) {
     if (is_putty_header(line)) {
       ++headers;
-      rec.note(n, fmt::format("PuTTY log header skipped: {}", text::quote_line(line)));
+      rec.note(n, text::putty_header_note(line));
       session_start = first_content = true;
       return;
     }
@@ -113,6 +113,7 @@ Recording read_arduino_text(std::string_view text, std::string source, const Ard
   rules.drop_cut_first = options.drop_cut_first_line;
   const text::TimelineCounts timeline = text::build_timeline(raw, rules, rec, reporter);
   reporter.finish();
+  text::sort_by_line(rec);
 
   rec.lines_read = static_cast<std::size_t>(lines);
   rec.lines_skipped = rec.lines_read - rec.size();

@@ -271,7 +271,7 @@ Recording read_delimited_text(std::string_view text, std::string source, const D
     else if (t.front() == '#') ++comments;
     else if (t.starts_with("=~=~=~")) {
       ++headers;
-      rec.note(n, fmt::format("PuTTY log header skipped: {}", text::quote_line(line)));
+      rec.note(n, text::putty_header_note(line));
     } else content.push_back({n, line});
   });
   rec.lines_read = static_cast<std::size_t>(lines);
@@ -449,6 +449,7 @@ Recording read_delimited_text(std::string_view text, std::string source, const D
   rules.drop_cut_first = false;
   const text::TimelineCounts timeline = text::build_timeline(raw, rules, rec, reporter);
   reporter.finish();
+  text::sort_by_line(rec);
   rec.lines_skipped = rec.lines_read - rec.size();
 
   const std::string columns = fmt::format("time = column {} '{}' in {} ({}), value = column {} '{}' in {} ({}), "

@@ -65,7 +65,8 @@ std::optional<std::string> read_file_bytes(const std::string& path, std::string*
     return fail(fmt::format("cannot read {}: {} bytes is more than the {} bytes a text recording may have", path,
                             st.st_size, max_bytes));
   std::string bytes;
-  bytes.resize(S_ISREG(st.st_mode) ? static_cast<std::size_t>(st.st_size) : 0);
+  // One byte more than the size, so the read that sees the end needs no growth.
+  bytes.resize(S_ISREG(st.st_mode) ? static_cast<std::size_t>(st.st_size) + 1 : 0);
   std::size_t have = 0;
   for (;;) {
     if (have == bytes.size()) {
@@ -94,10 +95,10 @@ FileFormat detect_format(std::string_view head, const ReadOptions& options) {
   }
   if (options.format != FileFormat::automatic) return options.format;
   if (options.delimited.names_columns()) return FileFormat::delimited_text;
-  // Arduino text when at least half of the first 200 lines with content are lab samples.
+  // Arduino text when at least half of the first 50 lines with content are lab samples.
   std::size_t content = 0, samples = 0;
-  text::for_each_line(head, [&](std::int64_t, std::string_view line) {
-    if (content >= 200 || line.starts_with("=~=~=~")) return;
+  text::for_each_line(head.substr(0, 64 * 1024), [&](std::int64_t, std::string_view line) {
+    if (content >= 50 || line.starts_with("=~=~=~")) return;
     const LabLine parsed = parse_lab_line(line);
     if (parsed.kind == LabLine::Kind::blank) return;
     ++content;

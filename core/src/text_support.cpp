@@ -1,16 +1,18 @@
 #include "text_support.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <fmt/format.h>
 
 namespace spindown::text {
 
 bool looks_binary(std::string_view bytes, std::size_t* control_bytes, std::size_t* looked_at) {
-  const std::size_t n = std::min<std::size_t>(bytes.size(), 64 * 1024);
+  const std::size_t n = std::min<std::size_t>(bytes.size(), 8 * 1024);
   std::size_t control = 0;
+  const auto* p = reinterpret_cast<const unsigned char*>(bytes.data());
   for (std::size_t i = 0; i < n; ++i) {
-    const auto c = static_cast<unsigned char>(bytes[i]);
-    if ((c < 0x20 && c != '\t' && c != '\r' && c != '\n') || c == 0x7F) ++control;
+    const unsigned c = p[i];
+    control += (c < 0x20) + (c == 0x7F) - (c == '\t') - (c == '\n') - (c == '\r');
   }
   if (control_bytes) *control_bytes = control;
   if (looked_at) *looked_at = n;
@@ -48,6 +50,23 @@ void LineReporter::finish() {
   if (count_ <= max_) return;
   rec_.warn(0, fmt::format("{} more problem lines not listed one by one (lines {} to {}); {} in all",
                            count_ - max_, first_unlisted_, last_unlisted_, count_));
+}
+
+void sort_by_line(Recording& rec) {
+  auto key = [](const Diagnostic& d) { return d.line > 0 ? d.line : INT64_MAX; };
+  std::stable_sort(rec.diagnostics.begin(), rec.diagnostics.end(),
+                   [&](const Diagnostic& a, const Diagnostic& b) { return key(a) < key(b); });
+}
+
+std::string putty_header_note(std::string_view line) {
+  constexpr std::string_view tag = "PuTTY log ";
+  const std::size_t at = line.find(tag);
+  if (at != std::string_view::npos) {
+    std::string_view when = line.substr(at + tag.size());
+    when = when.substr(0, std::min(when.find(" ="), std::size_t{40}));
+    return fmt::format("PuTTY log header skipped (log started {})", when);
+  }
+  return fmt::format("PuTTY log header skipped: {}", quote_line(line));
 }
 
 namespace {

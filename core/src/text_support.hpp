@@ -6,6 +6,7 @@
 // delimited_text.hpp.
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -21,20 +22,25 @@ template <class OnLine>
 std::int64_t for_each_line(std::string_view text, OnLine&& on_line) {
   const char* p = text.data();
   const char* const end = p + text.size();
+  const char* nl = nullptr;  // next '\n' at or after p (or end); kept so CR-only text stays O(n)
   std::int64_t number = 0;
   while (p < end) {
-    const char* q = p;
-    while (q < end && *q != '\n' && *q != '\r') ++q;
-    on_line(++number, std::string_view(p, static_cast<std::size_t>(q - p)));
-    if (q == end) break;
-    p = q + 1;
-    if (*q == '\r' && p < end && *p == '\n') ++p;
+    if (nl == nullptr || nl < p) {
+      nl = static_cast<const char*>(std::memchr(p, '\n', static_cast<std::size_t>(end - p)));
+      if (!nl) nl = end;
+    }
+    const char* cr = static_cast<const char*>(std::memchr(p, '\r', static_cast<std::size_t>(nl - p)));
+    const char* stop = cr ? cr : nl;
+    on_line(++number, std::string_view(p, static_cast<std::size_t>(stop - p)));
+    if (stop == end) break;
+    p = stop + 1;
+    if (*stop == '\r' && p < end && *p == '\n') ++p;
   }
   return number;
 }
 
 // True when the bytes are not text: more than 10 % control characters (NUL included; tab,
-// CR, LF excepted) in the first 64 KiB. A few bytes of serial noise do not make a log binary.
+// CR, LF excepted) in the first 8 KiB. A few bytes of serial noise do not make a log binary.
 bool looks_binary(std::string_view bytes, std::size_t* control_bytes = nullptr,
                   std::size_t* looked_at = nullptr);
 
@@ -61,6 +67,12 @@ class LineReporter {
   std::size_t count_ = 0;
   std::int64_t first_unlisted_ = 0, last_unlisted_ = 0;
 };
+
+// Diagnostics in line order, those about the whole file (line 0) last; stable.
+void sort_by_line(Recording& rec);
+
+// "PuTTY log header skipped (log started 2023.09.14 10:21:33)" for a PuTTY header line.
+std::string putty_header_note(std::string_view line);
 
 // One parsed sample before timeline repair; t in the file's own unit (ms for millis()).
 struct RawSample {

@@ -1,0 +1,367 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "spindown/arduino_text.hpp"
+#include "spindown/synthetic_run.hpp"
+
+using namespace spindown;
+using Severity = Diagnostic::Severity;
+
+namespace {
+
+const std::string data_dir = SPINDOWN_SHARED_DATA;
+
+std::vector<const Diagnostic*> with(const Recording& r, Severity s) {
+  std::vector<const Diagnostic*> out;
+  for (const auto& d : r.diagnostics)
+    if (d.severity == s) out.push_back(&d);
+  return out;
+}
+
+const Diagnostic* at_line(const Recording& r, std::int64_t line) {
+  for (const auto& d : r.diagnostics)
+    if (d.line == line) return &d;
+  return nullptr;
+}
+
+bool mentions(const Recording& r, const std::string& text) {
+  return std::any_of(r.diagnostics.begin(), r.diagnostics.end(),
+                     [&](const Diagnostic& d) { return d.message.find(text) != std::string::npos; });
+}
+
+std::string all_diagnostics(const Recording& r) {
+  std::string out;
+  for (const auto& d : r.diagnostics) out += d.to_string() + "\n";
+  return out;
+}
+
+bool strictly_increasing(const std::vector<double>& t) {
+  return std::adjacent_find(t.begin(), t.end(), [](double a, double b) { return b <= a; }) == t.end();
+}
+
+// "t\tv\r\n" lines from (ms, volts) pairs.
+std::string lines(const std::vector<std::pair<long long, const char*>>& rows, const char* eol = "\r\n") {
+  std::string s;
+  for (const auto& [t, v] : rows) s += std::to_string(t) + "\t" + v + eol;
+  return s;
+}
+
+std::string cadence(long long from_ms, int count, int step_ms = 20, const char* v = "1.00") {
+  std::string s;
+  for (int i = 0; i < count; ++i) s += std::to_string(from_ms + i * step_ms) + "\t" + v + "\r\n";
+  return s;
+}
+
+}  // namespace
+
+TEST(ArduinoText, EverySampleFileReadsCleanly) {
+  int files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(data_dir)) {
+    if (entry.path().extension() != ".tsv") continue;
+    ++files;
+    const Recording r = read_arduino_text_file(entry.path().string());
+    SCOPED_TRACE(entry.path().filename().string() + "\n" + all_diagnostics(r));
+    EXPECT_FALSE(r.has_errors());
+    ASSERT_GT(r.size(), 1000u);
+    EXPECT_EQ(r.quantity, Quantity::back_emf_volts);
+    EXPECT_EQ(r.t_s.size(), r.value.size());
+    EXPECT_TRUE(strictly_increasing(r.t_s));
+    EXPECT_TRUE(r.clock_restarts.empty());
+    // Every file's first line is PuTTY's cut "3\t0.00": dropped, so the clock starts at 5.234 s.
+    EXPECT_DOUBLE_EQ(r.t_s.front(), 5.234);
+    EXPECT_TRUE(mentions(r, "cut short"));
+    EXPECT_EQ(r.lines_read, r.size() + r.lines_skipped);
+    for (double v : r.value) ASSERT_TRUE(std::isfinite(v) && v > -1 && v < 6);
+  }
+  EXPECT_EQ(files, 7);
+}
+
+TEST(ArduinoText, SupplyLeadInReportsItsThreeGarbledLines) {
+  const Recording r = read_arduino_text_file(data_dir + "/supply-leadin.tsv");
+  SCOPED_TRACE(all_diagnostics(r));
+  const auto warnings = with(r, Severity::warning);
+  ASSERT_EQ(warnings.size(), 3u);
+  EXPECT_EQ(warnings[0]->line, 47);
+  EXPECT_EQ(warnings[1]->line, 1077);
+  EXPECT_EQ(warnings[2]->line, 1614);
+  EXPECT_NE(warnings[0]->message.find("missing value"), std::string::npos);
+  EXPECT_NE(warnings[0]->to_string().find("supply-leadin.tsv:47: warning:"), std::string::npos);
+  // 1667 lines: header, cut first line, three garbled lines.
+  EXPECT_EQ(r.lines_read, 1667u);
+  EXPECT_EQ(r.size(), 1667u - 5u);
+  EXPECT_TRUE(mentions(r, "PuTTY log header"));
+  EXPECT_NE(at_line(r, 1), nullptr);
+  EXPECT_EQ(at_line(r, 1)->severity, Severity::note);
+  // Reads the supply (3 V) before the cut at 8234 ms, then the coast.
+  EXPECT_NEAR(r.value[0], 3.0, 0.05);
+  EXPECT_LT(r.value.back(), 0.05);
+}
+
+TEST(ArduinoText, SyntheticRunRoundTripsExactly) {
+  SyntheticRunSpec spec;
+  spec.lead_in = LeadIn::floating;
+  spec.seed = 7;
+  const SyntheticRun run = make_synthetic_run(spec);
+  for (bool header : {false, true}) {
+    const Recording r = read_arduino_text(to_arduino_text(run, 2, header), "synthetic");
+    SCOPED_TRACE(all_diagnostics(r));
+    EXPECT_TRUE(with(r, Severity::warning).empty());
+    ASSERT_EQ(r.size(), run.t_ms.size());
+    for (std::size_t i = 0; i < r.size(); ++i) {
+      ASSERT_DOUBLE_EQ(r.t_s[i], run.t_ms[i] / 1000.0) << i;
+      ASSERT_NEAR(r.value[i], run.volts[i], 1e-9) << i;
+    }
+  }
+}
+
+TEST(ArduinoText, EmptyFileIsAClearError) {
+  const Recording r = read_arduino_text("", "empty.tsv");
+  ASSERT_TRUE(r.has_errors());
+  EXPECT_TRUE(r.empty());
+  EXPECT_EQ(r.diagnostics.front().message, "no samples: the file is empty");
+}
+
+TEST(ArduinoText, BinaryJunkIsAClearErrorWithoutAFloodOfWarnings) {
+  std::mt19937 rng(3);
+  std::string junk(100'000, '\0');
+  for (auto& c : junk) c = static_cast<char>(rng());
+  const Recording r = read_arduino_text(junk, "junk.bin");
+  ASSERT_TRUE(r.has_errors());
+  EXPECT_TRUE(r.empty());
+  EXPECT_EQ(r.diagnostics.size(), 1u);
+  EXPECT_NE(r.diagnostics.front().message.find("no samples: binary data"), std::string::npos);
+
+  const Recording nuls = read_arduino_text(std::string(4096, '\0'), "zeros.bin");
+  ASSERT_TRUE(nuls.has_errors());
+  EXPECT_NE(nuls.diagnostics.front().message.find("binary"), std::string::npos);
+}
+
+TEST(ArduinoText, TextWithoutSamplesSaysWhy) {
+  const Recording r = read_arduino_text("hello world\r\nthis is not data 1 2 3\r\n", "notes.txt");
+  ASSERT_TRUE(r.has_errors());
+  EXPECT_NE(r.diagnostics.back().message.find("no samples: none of the 2 lines"), std::string::npos)
+      << all_diagnostics(r);
+}
+
+TEST(ArduinoText, OnlyZerosIsValidData) {
+  const Recording r = read_arduino_text(cadence(1000, 50, 20, "0.00"), "zeros.tsv");
+  EXPECT_FALSE(r.has_errors());
+  EXPECT_EQ(r.size(), 50u);
+  EXPECT_TRUE(std::all_of(r.value.begin(), r.value.end(), [](double v) { return v == 0; }));
+}
+
+TEST(ArduinoText, ThreeSamples) {
+  const Recording r = read_arduino_text("100\t2.00\n120\t1.90\n140\t1.80\n", "three.tsv");
+  EXPECT_FALSE(r.has_errors()) << all_diagnostics(r);
+  ASSERT_EQ(r.size(), 3u);
+  EXPECT_DOUBLE_EQ(r.t_s[2], 0.14);
+  EXPECT_DOUBLE_EQ(r.value[2], 1.8);
+}
+
+TEST(ArduinoText, NanAndInfLinesAreWarnedAndSkipped) {
+  std::string text = cadence(1000, 10);
+  text += "1200\tnan\r\n1220\tinf\r\n";
+  text += cadence(1240, 10);
+  const Recording r = read_arduino_text(text, "nan.tsv");
+  EXPECT_EQ(r.size(), 20u);
+  ASSERT_NE(at_line(r, 11), nullptr);
+  EXPECT_EQ(at_line(r, 11)->severity, Severity::warning);
+  EXPECT_NE(at_line(r, 11)->message.find("NaN or infinite"), std::string::npos);
+  ASSERT_NE(at_line(r, 12), nullptr);
+  for (double v : r.value) EXPECT_TRUE(std::isfinite(v));
+}
+
+TEST(ArduinoText, ASampleGoingBackInTimeIsSkipped) {
+  std::string text = cadence(1000, 10);   // lines 1-10: 1000 … 1180
+  text += "1150\t1.00\r\n";               // line 11: back 30 ms
+  text += cadence(1200, 10);              // lines 12-21
+  const Recording r = read_arduino_text(text, "back.tsv");
+  EXPECT_EQ(r.size(), 20u);
+  EXPECT_TRUE(strictly_increasing(r.t_s));
+  EXPECT_TRUE(r.clock_restarts.empty());
+  ASSERT_NE(at_line(r, 11), nullptr) << all_diagnostics(r);
+  EXPECT_EQ(at_line(r, 11)->severity, Severity::warning);
+  EXPECT_NE(at_line(r, 11)->message.find("goes back"), std::string::npos);
+}
+
+TEST(ArduinoText, AGarbledTimeFarBackIsAnOutlierNotAReset) {
+  // "27049" losing a digit: 2709 is far back, but the next line continues the old clock.
+  std::string text = cadence(27000, 10, 20, "0.70");
+  text += "2709\t0.70\r\n";  // line 11
+  text += cadence(27200, 10, 20, "0.70");
+  const Recording r = read_arduino_text(text, "digit.tsv");
+  EXPECT_EQ(r.size(), 20u);
+  EXPECT_TRUE(r.clock_restarts.empty());
+  ASSERT_NE(at_line(r, 11), nullptr);
+  EXPECT_EQ(at_line(r, 11)->severity, Severity::warning);
+}
+
+TEST(ArduinoText, AGarbledTimeFarAheadIsSkipped) {
+  std::string text = cadence(27000, 10, 20, "0.70");
+  text += "272000\t0.70\r\n";  // line 11: an extra digit
+  text += cadence(27200, 10, 20, "0.70");
+  const Recording r = read_arduino_text(text, "ahead.tsv");
+  EXPECT_EQ(r.size(), 20u);
+  EXPECT_TRUE(strictly_increasing(r.t_s));
+  ASSERT_NE(at_line(r, 11), nullptr);
+  EXPECT_NE(at_line(r, 11)->message.find("jumps ahead"), std::string::npos);
+}
+
+TEST(ArduinoText, ARealGapIsKeptAndNoted) {
+  std::string text = cadence(1000, 10);
+  text += cadence(60000, 10);  // the sketch paused for a minute
+  const Recording r = read_arduino_text(text, "gap.tsv");
+  EXPECT_EQ(r.size(), 20u);
+  EXPECT_TRUE(with(r, Severity::warning).empty()) << all_diagnostics(r);
+  EXPECT_TRUE(mentions(r, "no samples for"));
+}
+
+TEST(ArduinoText, DuplicateTimesAreSkipped) {
+  std::string text = cadence(1000, 10);
+  text += "1180\t1.00\r\n";  // line 11 repeats line 10
+  text += cadence(1200, 5);
+  const Recording r = read_arduino_text(text, "dup.tsv");
+  EXPECT_EQ(r.size(), 15u);
+  ASSERT_NE(at_line(r, 11), nullptr);
+  EXPECT_NE(at_line(r, 11)->message.find("repeats line 10"), std::string::npos);
+  EXPECT_TRUE(strictly_increasing(r.t_s));
+}
+
+TEST(ArduinoText, MillisWrapIsUnwrapped) {
+  const long long top = 4294967296LL;
+  std::string text = cadence(top - 200, 10);  // up to top - 20
+  text += cadence(0, 10);                     // wrapped
+  const Recording r = read_arduino_text(text, "wrap.tsv");
+  ASSERT_EQ(r.size(), 20u) << all_diagnostics(r);
+  EXPECT_TRUE(strictly_increasing(r.t_s));
+  EXPECT_TRUE(r.clock_restarts.empty());
+  EXPECT_DOUBLE_EQ(r.t_s[10], top / 1000.0);
+  EXPECT_NEAR(r.t_s[10] - r.t_s[9], 0.020, 1e-9);
+  EXPECT_TRUE(mentions(r, "wrapped"));
+}
+
+TEST(ArduinoText, ResetStartsANewTimeline) {
+  std::string text = cadence(30000, 20);  // lines 1-20
+  text += cadence(150, 20, 20, "0.50");   // lines 21-40: the Arduino rebooted
+  const Recording r = read_arduino_text(text, "reset.tsv");
+  ASSERT_EQ(r.size(), 40u);
+  ASSERT_EQ(r.clock_restarts.size(), 1u);
+  EXPECT_EQ(r.clock_restarts[0], 20u);
+  EXPECT_DOUBLE_EQ(r.t_s[20], 0.150);
+  ASSERT_NE(at_line(r, 21), nullptr);
+  EXPECT_EQ(at_line(r, 21)->severity, Severity::note);
+  EXPECT_NE(at_line(r, 21)->message.find("restarted"), std::string::npos);
+  EXPECT_TRUE(with(r, Severity::warning).empty()) << all_diagnostics(r);
+}
+
+TEST(ArduinoText, NewPuttySessionMidFileWithCutLineAndReset) {
+  std::string text = "=~=~=~=~ PuTTY log 2023.09.14 10:21:33 =~=~=~=~\r\n";
+  text += "3\t0.00\r\n" + cadence(5234, 30);
+  text += "=~=~=~=~ PuTTY log 2023.09.14 10:25:00 =~=~=~=~\r\n";  // line 33
+  text += "1\t0.00\r\n" + cadence(2011, 30, 20, "2.00");              // line 34 cut, reset
+  const Recording r = read_arduino_text(text, "sessions.tsv");
+  SCOPED_TRACE(all_diagnostics(r));
+  ASSERT_EQ(r.size(), 60u);
+  ASSERT_EQ(r.clock_restarts.size(), 1u);
+  EXPECT_EQ(r.clock_restarts[0], 30u);
+  EXPECT_DOUBLE_EQ(r.t_s[30], 2.011);
+  EXPECT_TRUE(with(r, Severity::warning).empty());
+  ASSERT_NE(at_line(r, 34), nullptr);
+  EXPECT_NE(at_line(r, 34)->message.find("cut short"), std::string::npos);
+}
+
+TEST(ArduinoText, AFirstLineThatFitsTheCadenceIsKept) {
+  const Recording r = read_arduino_text(cadence(3, 20), "starts-at-3.tsv");
+  EXPECT_EQ(r.size(), 20u);
+  EXPECT_DOUBLE_EQ(r.t_s[0], 0.003);
+  EXPECT_FALSE(mentions(r, "cut short"));
+}
+
+TEST(ArduinoText, GarbledFirstLineAndColumnHeaderAreNotes) {
+  const Recording cut = read_arduino_text(".00\r\n" + cadence(1000, 10), "cut.tsv");
+  EXPECT_EQ(cut.size(), 10u);
+  ASSERT_NE(at_line(cut, 1), nullptr);
+  EXPECT_EQ(at_line(cut, 1)->severity, Severity::note);
+
+  const Recording header = read_arduino_text("millis\tvolts\r\n" + cadence(1000, 10), "header.tsv");
+  EXPECT_EQ(header.size(), 10u);
+  EXPECT_TRUE(with(header, Severity::warning).empty());
+  EXPECT_TRUE(mentions(header, "column header"));
+}
+
+TEST(ArduinoText, LineEndingsLfCrLfAndCrOnlyGiveTheSameSamples) {
+  const std::vector<std::pair<long long, const char*>> rows{{1000, "2.00"}, {1020, "1.90"}, {1040, "1.80"},
+                                                            {1060, "1.70"}, {1080, "1.60"}};
+  const Recording crlf = read_arduino_text(lines(rows, "\r\n"), "crlf");
+  const Recording lf = read_arduino_text(lines(rows, "\n"), "lf");
+  const Recording cr = read_arduino_text(lines(rows, "\r"), "cr");
+  ASSERT_EQ(crlf.size(), 5u);
+  EXPECT_EQ(lf.t_s, crlf.t_s);
+  EXPECT_EQ(cr.t_s, crlf.t_s);
+  EXPECT_EQ(cr.value, crlf.value);
+  EXPECT_EQ(cr.lines_read, 5u);
+  // No terminator on the last line.
+  std::string no_eol = lines(rows, "\n");
+  no_eol.pop_back();
+  EXPECT_EQ(read_arduino_text(no_eol, "no-eol").size(), 5u);
+}
+
+TEST(ArduinoText, BlankLinesAreCounted) {
+  const Recording r = read_arduino_text("\r\n1000\t1.00\r\n\r\n\r\n1020\t1.00\r\n1040\t1.00\r\n", "blank.tsv");
+  EXPECT_EQ(r.size(), 3u);
+  EXPECT_EQ(r.lines_read, 6u);
+  EXPECT_EQ(r.lines_skipped, 3u);
+  EXPECT_TRUE(mentions(r, "3 blank"));
+}
+
+TEST(ArduinoText, ManyBadLinesAreSummarised) {
+  std::string text = cadence(1000, 5);
+  for (int i = 0; i < 500; ++i) text += "garbage line\r\n";
+  text += cadence(1100, 5);
+  const Recording r = read_arduino_text(text, "bad.tsv");
+  EXPECT_EQ(r.size(), 10u);
+  const auto warnings = with(r, Severity::warning);
+  ASSERT_EQ(warnings.size(), 21u);  // 20 listed + the summary
+  EXPECT_EQ(warnings[0]->line, 6);
+  EXPECT_EQ(warnings[20]->line, 0);
+  EXPECT_NE(warnings[20]->message.find("480 more problem lines"), std::string::npos) << warnings[20]->message;
+  EXPECT_NE(warnings[20]->message.find("lines 26 to 505"), std::string::npos) << warnings[20]->message;
+}
+
+TEST(ArduinoText, TenMegabyteLineWithoutNewline) {
+  const std::string huge(10'000'000, '5');
+  const Recording alone = read_arduino_text(huge, "huge.tsv");
+  ASSERT_TRUE(alone.has_errors());
+  EXPECT_TRUE(alone.empty());
+
+  const Recording mixed = read_arduino_text(cadence(1000, 10) + huge + "\r\n" + cadence(1200, 10), "mixed.tsv");
+  EXPECT_EQ(mixed.size(), 20u);
+  ASSERT_NE(at_line(mixed, 11), nullptr);
+  EXPECT_NE(at_line(mixed, 11)->message.find("too long"), std::string::npos);
+  EXPECT_LT(at_line(mixed, 11)->message.size(), 300u);  // the line is not copied into the message
+}
+
+TEST(ArduinoText, MissingFileNamesFileAndReason) {
+  const Recording r = read_arduino_text_file("/nonexistent/dir/run.tsv");
+  ASSERT_TRUE(r.has_errors());
+  EXPECT_NE(r.diagnostics[0].message.find("/nonexistent/dir/run.tsv"), std::string::npos);
+  EXPECT_NE(r.diagnostics[0].message.find("No such file or directory"), std::string::npos);
+}
+
+TEST(ArduinoText, OptionsValidate) {
+  ArduinoTextOptions o;
+  std::string why;
+  EXPECT_TRUE(o.is_valid(&why));
+  o.reset_min_back_s = -1;
+  EXPECT_FALSE(o.is_valid(&why));
+  EXPECT_NE(why.find("reset_min_back_s"), std::string::npos);
+  const Recording r = read_arduino_text(cadence(0, 5), "x", o);
+  EXPECT_TRUE(r.has_errors());
+}

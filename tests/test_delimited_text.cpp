@@ -1,0 +1,239 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+#include <string>
+
+#include "spindown/delimited_text.hpp"
+#include "spindown/synthetic_run.hpp"
+
+using namespace spindown;
+using Severity = Diagnostic::Severity;
+
+namespace {
+
+std::string all_diagnostics(const Recording& r) {
+  std::string out;
+  for (const auto& d : r.diagnostics) out += d.to_string() + "\n";
+  return out;
+}
+
+bool mentions(const Recording& r, const std::string& text) {
+  return std::any_of(r.diagnostics.begin(), r.diagnostics.end(),
+                     [&](const Diagnostic& d) { return d.message.find(text) != std::string::npos; });
+}
+
+const Diagnostic* at_line(const Recording& r, std::int64_t line) {
+  for (const auto& d : r.diagnostics)
+    if (d.line == line) return &d;
+  return nullptr;
+}
+
+std::size_t warnings(const Recording& r) {
+  return std::count_if(r.diagnostics.begin(), r.diagnostics.end(),
+                       [](const Diagnostic& d) { return d.severity == Severity::warning; });
+}
+
+// n rows of "t<sep>v" with t in seconds (printed with the given scale) and v = 3 - t.
+std::string rows(int n, const char* sep, double scale = 1.0, int decimals = 3) {
+  std::string s;
+  for (int i = 0; i < n; ++i) {
+    const double t = 0.02 * i;
+    s += fmt::format("{:.{}f}{}{:.3f}\n", t * scale, decimals, sep, 3.0 - t);
+  }
+  return s;
+}
+
+}  // namespace
+
+TEST(DelimitedText, CsvWithHeaderNamesAndUnits) {
+  const Recording r = read_delimited_text("time (s),volts\n" + rows(100, ","), "run.csv");
+  SCOPED_TRACE(all_diagnostics(r));
+  EXPECT_FALSE(r.has_errors());
+  ASSERT_EQ(r.size(), 100u);
+  EXPECT_EQ(r.quantity, Quantity::back_emf_volts);
+  EXPECT_NEAR(r.t_s[50], 1.0, 1e-12);
+  EXPECT_NEAR(r.value[50], 2.0, 1e-12);
+  EXPECT_EQ(warnings(r), 0u);
+  EXPECT_TRUE(mentions(r, "time = column 1 'time (s)' in s (from the header)"));
+}
+
+TEST(DelimitedText, TsvMillisAndRpm) {
+  std::string text = "millis\trpm\n";
+  for (int i = 0; i < 50; ++i) text += fmt::format("{}\t{}\n", 1000 + 20 * i, 3000 - 10 * i);
+  const Recording r = read_delimited_text(text, "run.tsv");
+  SCOPED_TRACE(all_diagnostics(r));
+  ASSERT_EQ(r.size(), 50u);
+  EXPECT_EQ(r.quantity, Quantity::rpm);
+  EXPECT_DOUBLE_EQ(r.t_s[1], 1.02);
+  EXPECT_DOUBLE_EQ(r.value[1], 2990);
+}
+
+TEST(DelimitedText, WhitespaceSeparatedWithSuffixUnitsAndExtraColumns) {
+  std::string text = "# bench 2, flywheel B\nindex  time_ms   omega_rad_s  current\n";
+  for (int i = 0; i < 30; ++i) text += fmt::format("{}  {}  {:.2f}  0.1\n", i, 20 * i, 300.0 - i);
+  DelimitedTextOptions o;
+  o.value_column = "3";
+  o.quantity = Quantity::rad_per_s;
+  const Recording r = read_delimited_text(text, "run.txt", o);
+  SCOPED_TRACE(all_diagnostics(r));
+  ASSERT_EQ(r.size(), 30u);
+  EXPECT_EQ(r.quantity, Quantity::rad_per_s);
+  EXPECT_DOUBLE_EQ(r.t_s[2], 0.04);
+  EXPECT_DOUBLE_EQ(r.value[2], 298.0);
+  EXPECT_TRUE(mentions(r, "'time_ms' in ms (from the header)"));
+}
+
+TEST(DelimitedText, SemicolonCsvWithDecimalComma) {
+  std::string text = "Zeit [s];U [V]\n";
+  for (int i = 0; i < 20; ++i) text += fmt::format("{},{:02d};2,{:02d}\n", i / 50, (i % 50) * 2, 99 - i);
+  DelimitedTextOptions o;
+  o.time_column = "1";
+  const Recording r = read_delimited_text(text, "excel.csv", o);
+  SCOPED_TRACE(all_diagnostics(r));
+  ASSERT_EQ(r.size(), 20u);
+  EXPECT_DOUBLE_EQ(r.t_s[3], 0.06);
+  EXPECT_DOUBLE_EQ(r.value[3], 2.96);
+  EXPECT_EQ(r.quantity, Quantity::back_emf_volts);
+}
+
+TEST(DelimitedText, NoHeaderTwoColumnsInfersUnits) {
+  const Recording ms = read_delimited_text(rows(40, ",", 1000, 0), "ms.csv");
+  SCOPED_TRACE(all_diagnostics(ms));
+  ASSERT_EQ(ms.size(), 40u);
+  EXPECT_NEAR(ms.t_s[10], 0.2, 1e-12);
+  EXPECT_TRUE(mentions(ms, "read as ms"));
+  EXPECT_EQ(ms.quantity, Quantity::back_emf_volts);
+
+  const Recording s = read_delimited_text(rows(40, " "), "s.txt");
+  EXPECT_NEAR(s.t_s[10], 0.2, 1e-12);
+  EXPECT_TRUE(mentions(s, "read as s"));
+
+  const Recording us = read_delimited_text(rows(40, "\t", 1e6, 0), "us.tsv");
+  EXPECT_NEAR(us.t_s[10], 0.2, 1e-12);
+  EXPECT_TRUE(mentions(us, "read as us"));
+
+  DelimitedTextOptions o;
+  o.time_unit = TimeUnit::ms;
+  const Recording given = read_delimited_text(rows(40, ","), "given.csv", o);  // 0.000, 0.020 … ms
+  EXPECT_NEAR(given.t_s[10], 0.0002, 1e-15);
+}
+
+TEST(DelimitedText, AmbiguousColumnsAreAClearError) {
+  const Recording r = read_delimited_text("time,millis,volts\n0,0,1\n1,1000,2\n", "two-times.csv");
+  ASSERT_TRUE(r.has_errors());
+  EXPECT_TRUE(mentions(r, "'time' and 'millis' could each be the time")) << all_diagnostics(r);
+
+  const Recording v = read_delimited_text("t,volts,rpm\n0,1,2\n1,1,2\n", "two-values.csv");
+  ASSERT_TRUE(v.has_errors());
+  EXPECT_TRUE(mentions(v, "could each be the value")) << all_diagnostics(v);
+
+  const Recording none = read_delimited_text("a,b,c\n0,1,2\n1,1,2\n", "abc.csv");
+  ASSERT_TRUE(none.has_errors());
+  EXPECT_TRUE(mentions(none, "cannot tell which of the 3 columns is the time")) << all_diagnostics(none);
+
+  const Recording unit = read_delimited_text("time,speed\n0,1\n1,2\n", "speed.csv");
+  ASSERT_TRUE(unit.has_errors());
+  EXPECT_TRUE(mentions(unit, "cannot tell the unit of value column 'speed'")) << all_diagnostics(unit);
+
+  const Recording three = read_delimited_text("0,1,2\n1,1,2\n", "noheader3.csv");
+  ASSERT_TRUE(three.has_errors());
+}
+
+TEST(DelimitedText, NamedColumnsResolveOrSayWhatExists) {
+  const std::string text = "Time (ms),Speed [rpm],Temp\n0,100,20\n20,99,20\n40,98,20\n";
+  DelimitedTextOptions o;
+  o.time_column = "time";
+  o.value_column = "speed";
+  const Recording r = read_delimited_text(text, "named.csv", o);
+  ASSERT_EQ(r.size(), 3u) << all_diagnostics(r);
+  EXPECT_EQ(r.quantity, Quantity::rpm);
+  EXPECT_DOUBLE_EQ(r.t_s[2], 0.04);
+
+  o.value_column = "volts";
+  const Recording bad = read_delimited_text(text, "named.csv", o);
+  ASSERT_TRUE(bad.has_errors());
+  EXPECT_TRUE(mentions(bad, "no column named 'volts' (columns: 1 'Time (ms)', 2 'Speed [rpm]', 3 'Temp')"))
+      << all_diagnostics(bad);
+
+  o.value_column = "7";
+  EXPECT_TRUE(mentions(read_delimited_text(text, "named.csv", o), "column 7 does not exist"));
+}
+
+TEST(DelimitedText, BadRowsAreReportedWithLineNumbers) {
+  std::string text = "t,v\n0,1\n0.02,1\n0.04,nan\n0.06\n0.08,abc\n0.10,inf\n,1\n0.12,1\n0.10,1\n0.14,1\n";
+  const Recording r = read_delimited_text(text, "bad.csv");
+  SCOPED_TRACE(all_diagnostics(r));
+  EXPECT_EQ(r.size(), 4u);
+  ASSERT_NE(at_line(r, 4), nullptr);
+  EXPECT_NE(at_line(r, 4)->message.find("NaN or infinite"), std::string::npos);
+  ASSERT_NE(at_line(r, 5), nullptr);
+  EXPECT_NE(at_line(r, 5)->message.find("column 2 is missing"), std::string::npos);
+  EXPECT_NE(at_line(r, 6)->message.find("not a number"), std::string::npos);
+  EXPECT_NE(at_line(r, 8)->message.find("empty"), std::string::npos);
+  ASSERT_NE(at_line(r, 10), nullptr);
+  EXPECT_NE(at_line(r, 10)->message.find("goes back"), std::string::npos);
+  EXPECT_EQ(r.lines_read, 11u);
+  EXPECT_EQ(r.lines_skipped, 7u);
+}
+
+TEST(DelimitedText, EmptyBinaryAndHeaderOnly) {
+  EXPECT_TRUE(mentions(read_delimited_text("", "e.csv"), "no samples: the file is empty"));
+  EXPECT_TRUE(mentions(read_delimited_text(std::string(1000, '\0'), "z.csv"), "binary"));
+  const Recording header_only = read_delimited_text("time,volts\n", "h.csv");
+  EXPECT_TRUE(header_only.has_errors());
+  EXPECT_TRUE(header_only.empty());
+}
+
+TEST(DelimitedText, SyntheticRunAsCsv) {
+  const SyntheticRun run = make_synthetic_run(SyntheticRunSpec{});
+  std::string csv = "time_s,emf_v\r\n";
+  for (std::size_t i = 0; i < run.t_ms.size(); ++i) csv += fmt::format("{:.3f},{:.2f}\r\n", run.t_ms[i] / 1000, run.volts[i]);
+  const Recording r = read_delimited_text(csv, "synthetic.csv");
+  ASSERT_EQ(r.size(), run.t_ms.size()) << all_diagnostics(r);
+  for (std::size_t i = 0; i < r.size(); ++i) {
+    ASSERT_NEAR(r.t_s[i], run.t_ms[i] / 1000, 1e-9);
+    ASSERT_NEAR(r.value[i], run.volts[i], 1e-9);
+  }
+}
+
+TEST(DelimitedText, LongLineAndManyBadRowsStayBounded) {
+  std::string text = "t,v\n0,1\n" + std::string(10'000'000, '9') + "\n0.02,1\n";
+  for (int i = 0; i < 300; ++i) text += "x,y\n";
+  text += "0.04,1\n";
+  const Recording r = read_delimited_text(text, "long.csv");
+  EXPECT_EQ(r.size(), 3u) << all_diagnostics(r);
+  EXPECT_EQ(warnings(r), 21u);
+  EXPECT_TRUE(mentions(r, "more problem lines"));
+  for (const auto& d : r.diagnostics) EXPECT_LT(d.message.size(), 400u);
+}
+
+TEST(DelimitedText, TimeUnitNames) {
+  EXPECT_EQ(parse_time_unit("ms"), TimeUnit::ms);
+  EXPECT_EQ(parse_time_unit("Seconds"), TimeUnit::s);
+  EXPECT_EQ(parse_time_unit("µs"), TimeUnit::us);
+  EXPECT_EQ(parse_time_unit("micros"), TimeUnit::us);
+  EXPECT_FALSE(parse_time_unit("min"));
+  EXPECT_EQ(time_unit_name(TimeUnit::us), "us");
+  EXPECT_DOUBLE_EQ(time_units_per_second(TimeUnit::ms), 1000);
+}
+
+TEST(DelimitedText, OptionsValidate) {
+  DelimitedTextOptions o;
+  std::string why;
+  EXPECT_TRUE(o.is_valid(&why));
+  EXPECT_FALSE(o.names_columns());
+  o.time_column = "0";
+  EXPECT_FALSE(o.is_valid(&why));
+  EXPECT_NE(why.find("between 1"), std::string::npos);
+  o.time_column = "v";
+  o.value_column = "V";
+  EXPECT_FALSE(o.is_valid(&why));
+  o = {};
+  o.delimiter = '|';
+  EXPECT_FALSE(o.is_valid(&why));
+  o = {};
+  o.quantity = Quantity::rpm;
+  EXPECT_TRUE(o.names_columns());
+}

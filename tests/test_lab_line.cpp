@@ -1,0 +1,90 @@
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "spindown/lab_line.hpp"
+
+using namespace spindown;
+using Kind = LabLine::Kind;
+
+TEST(LabLine, ParsesTheSketchsLine) {
+  const LabLine l = parse_lab_line("8245\t2.81");
+  ASSERT_EQ(l.kind, Kind::sample) << l.why;
+  EXPECT_EQ(l.millis, 8245);
+  EXPECT_DOUBLE_EQ(l.value, 2.81);
+}
+
+TEST(LabLine, ToleratesCarriageReturnAndOtherBlanks) {
+  for (const char* s : {"8245\t2.81\r", "8245 2.81", "  8245\t\t2.81  \r", "8245\t2.81\r\r"}) {
+    const LabLine l = parse_lab_line(s);
+    ASSERT_EQ(l.kind, Kind::sample) << s << ": " << l.why;
+    EXPECT_EQ(l.millis, 8245);
+    EXPECT_DOUBLE_EQ(l.value, 2.81);
+  }
+}
+
+TEST(LabLine, AcceptsNegativeAndZeroValuesAndTheLargestMillis) {
+  EXPECT_DOUBLE_EQ(parse_lab_line("0\t-0.01").value, -0.01);
+  EXPECT_EQ(parse_lab_line("0\t0.00").kind, Kind::sample);
+  const LabLine top = parse_lab_line("4294967295\t0.00");
+  ASSERT_EQ(top.kind, Kind::sample);
+  EXPECT_EQ(top.millis, 4294967295LL);
+  EXPECT_EQ(parse_lab_line("5234\t3").kind, Kind::sample);  // Serial.println(int)
+}
+
+TEST(LabLine, BlankLines) {
+  for (const char* s : {"", "\r", "  \t ", "\r\r"}) EXPECT_EQ(parse_lab_line(s).kind, Kind::blank) << '"' << s << '"';
+}
+
+struct Bad {
+  const char* line;
+  const char* why_contains;
+};
+
+class LabLineRejects : public ::testing::TestWithParam<Bad> {};
+
+TEST_P(LabLineRejects, WithAReason) {
+  const LabLine l = parse_lab_line(GetParam().line);
+  EXPECT_EQ(l.kind, Kind::garbled) << GetParam().line;
+  EXPECT_NE(std::string(l.why).find(GetParam().why_contains), std::string::npos)
+      << "line \"" << GetParam().line << "\" why: " << l.why;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Garbage, LabLineRejects,
+    ::testing::Values(Bad{"6", "missing value"}, Bad{"6\r", "missing value"}, Bad{"38017\t", "missing value"},
+                      Bad{"8245\t2.81\t7", "extra field"}, Bad{"8245 2.81 x", "extra field"},
+                      Bad{"abc\t2.81", "time is not a number"}, Bad{"8245\tabc", "value is not a number"},
+                      Bad{"8245\t2.8x", "value is not a number"}, Bad{"82a5\t2.81", "time is not a number"},
+                      Bad{"-5\t2.81", "negative time"}, Bad{"12.5\t2.81", "whole number"},
+                      Bad{"8245\tnan", "NaN or infinite"}, Bad{"8245\tinf", "NaN or infinite"},
+                      Bad{"8245\t-inf", "NaN or infinite"}, Bad{"8245\tovf", "value is not a number"},
+                      Bad{"4294967296\t1.00", "range of millis"}, Bad{"99999999999999999999999\t1", "range"},
+                      Bad{"8245\t1e300", "larger than an Arduino"}, Bad{"8245\t1e999", "out of range"},
+                      Bad{"8245,2.81", "time is not a number"}, Bad{"\t2.81", "whole number"},
+                      Bad{"=~=~=~=~ PuTTY log 2023.09.14 =~=~", "not a number"},
+                      Bad{"8245\t+2.81", "value is not a number"}));
+
+TEST(LabLine, NulBytesAreGarbage) {
+  const std::string with_nul("82\0" "45\t2.81", 8);
+  EXPECT_EQ(parse_lab_line(with_nul).kind, Kind::garbled);
+  const std::string value_nul("8245\t2.8\0" "1", 9);
+  EXPECT_EQ(parse_lab_line(value_nul).kind, Kind::garbled);
+}
+
+TEST(LabLine, AVeryLongLineIsRejectedWithoutReadingIt) {
+  const std::string digits(10'000'000, '7');
+  const LabLine l = parse_lab_line(digits);
+  EXPECT_EQ(l.kind, Kind::garbled);
+  EXPECT_NE(std::string(l.why).find("too long"), std::string::npos);
+}
+
+TEST(LabLine, WhyIsEmptyForSamplesAndStaticForGarbage) {
+  EXPECT_TRUE(parse_lab_line("1\t2").why.empty());
+  std::string_view why;
+  {
+    std::string temp = "1\tx";
+    why = parse_lab_line(temp).why;
+  }
+  EXPECT_EQ(why, "value is not a number");  // still valid after the input is gone
+}
