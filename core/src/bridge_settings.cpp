@@ -85,7 +85,7 @@ void load_bridge_settings(const std::string& path, BridgeSettings& s) {
   double d = 0;
   std::string t;
 
-  r.text("bench", s.bench);
+  r.text("bench_id", s.bench);
   r.text("serial.device", s.device);
   if (r.integer("serial.baud", i)) s.baud = int(i);
   if (r.integer("serial.max_line_bytes", i)) {

@@ -185,6 +185,14 @@ VirtualBench::VirtualBench(VirtualBenchOptions options) : o_(std::move(options))
     run_start_s += run.t_ms.empty() ? 0.0 : run.t_ms.back() / 1000.0 + spec.period_s + o_.idle_s;
   }
   truth_["samples"] = sent_.size();
+  std::size_t garbage = 0, partial = 0, long_lines = 0;
+  for (const auto& e : emissions_) {
+    garbage += e.kind == BenchEmission::Kind::garbage;
+    partial += e.kind == BenchEmission::Kind::partial;
+    long_lines += e.kind == BenchEmission::Kind::long_line;
+  }
+  truth_["faults"] = {{"garbage_lines", garbage}, {"partial_lines", partial}, {"long_lines", long_lines},
+                      {"resets", o_.reset_at_s.size()}, {"unplugs", o_.unplug_at_s >= 0 ? 1 : 0}};
   truth_["duration_s"] = duration_s();
 }
 

@@ -128,8 +128,13 @@ int main(int argc, char** argv) {
       if (pty->wait_for_reader(std::chrono::milliseconds(100))) return true;
     return false;
   };
+  const auto unlink = [&]() {
+    std::error_code ec;
+    if (!link.empty()) std::filesystem::remove(link, ec);
+  };
   if (!wait_reader()) {
     fmt::print(stderr, "spindown-virtual-bench: nobody opened {} within {} s\n", pty->slave_path(), wait_reader_s);
+    unlink();
     return g_stop ? 0 : 1;
   }
 
@@ -156,6 +161,7 @@ int main(int argc, char** argv) {
       const auto waited_from = Clock::now();
       if (!wait_reader()) {
         fmt::print(stderr, "spindown-virtual-bench: nobody reopened {} within {} s\n", pty->slave_path(), wait_reader_s);
+        unlink();
         return g_stop ? 0 : 1;
       }
       anchor += Clock::now() - waited_from;  // the board boots when the port opens
@@ -171,16 +177,14 @@ int main(int argc, char** argv) {
       ++garbled;
     }
     const bool attached = pty->reader_attached();
-    const auto put = pty->write(bytes, std::chrono::milliseconds(attached ? 2000 : 0));
+    const auto timeout = std::chrono::milliseconds(attached ? 2000 + long(bytes.size() / 1000) : 0);
+    const auto put = pty->write(bytes, timeout);
     if (put < bytes.size()) ++dropped;
     else ++written;
   }
   if (!g_stop) sleep_until(Clock::now() + std::chrono::milliseconds(long(linger_s * 1000)));
   fmt::print(stderr, "spindown-virtual-bench: {} lines written, {} dropped (no reader), {} garbled (baud mismatch)\n",
              written, dropped, garbled);
-  if (!link.empty()) {
-    std::error_code ec;
-    std::filesystem::remove(link, ec);
-  }
+  unlink();
   return 0;
 }

@@ -2,7 +2,7 @@
 // Everything spindown-bridge needs to know about its bench and port, with the lab's defaults,
 // and the TOML file that sets them (keys documented in services/bridge/README.md):
 //
-//   bench = "bench-3"                 # CLI --bench wins
+//   bench_id = "bench-3"              # CLI --bench wins
 //   [serial]  device = "/dev/ttyACM0"  baud = 9600  max_line_bytes = 1024
 //   [bench]   inertia_kg_m2 = 1.12687602e-5  inertia_source = "…"
 //             (or flywheel_radius_m, flywheel_height_m, flywheel_density_kg_m3, rotor_inertia_kg_m2)
