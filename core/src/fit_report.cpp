@@ -60,8 +60,13 @@ std::string render_table(const std::vector<std::vector<std::string>>& rows, std:
       for (const auto& l : r.back()) width[c] = std::max(width[c], display_width(l));
     }
   }
+  // Rows that span several lines are kept apart by a blank line.
+  bool tall_rows = false;
+  for (std::size_t ri = 1; ri < cells.size(); ++ri)
+    for (const auto& cell : cells[ri]) tall_rows = tall_rows || cell.size() > 1;
   std::string out;
   for (std::size_t ri = 0; ri < cells.size(); ++ri) {
+    if (tall_rows && ri > 1) out += '\n';
     std::size_t height = 0;
     for (const auto& cell : cells[ri]) height = std::max(height, cell.size());
     for (std::size_t li = 0; li < height; ++li) {
