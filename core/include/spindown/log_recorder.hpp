@@ -1,0 +1,83 @@
+#pragma once
+// spindown-logger's two halves: the LCM thread only copies each received event into a bounded
+// queue (offer), and a writer thread drains the queue into an EventLogWriter and flushes it on
+// a timer even when no event arrives, so a slow disk never stalls the socket and a killed
+// logger loses at most one flush interval. stop() drains everything queued before closing.
+//
+// Events beyond the queue's capacity are dropped and counted (never silently): they show in
+// the writer's status as queue_drops/drops.
+#include <atomic>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <mutex>
+#include <string>
+#include <string_view>
+#include <thread>
+#include <vector>
+
+#include <spindown/status_t.hpp>
+
+#include "spindown/event_log_writer.hpp"
+
+namespace spindown {
+
+struct LogRecorderOptions {
+  std::size_t queue_capacity = 10000;        // events waiting for the writer, at most
+  std::size_t queue_max_bytes = 256u << 20;  // and their payload bytes, at most
+  double flush_interval_s = 0.5;             // buffered events reach the kernel at least this often
+  double status_interval_s = 0.1;            // how often status() is refreshed by the writer thread
+
+  bool is_valid(std::string* why) const;
+};
+
+class LogRecorder {
+ public:
+  // writer must be open and must outlive the recorder; the recorder's thread owns it until stop().
+  LogRecorder(EventLogWriter& writer, LogRecorderOptions options);
+  ~LogRecorder();  // stop() if still running
+  LogRecorder(const LogRecorder&) = delete;
+  LogRecorder& operator=(const LogRecorder&) = delete;
+
+  void start();
+
+  // From the receiving thread: queue one event. False when the queue was full (counted).
+  bool offer(std::int64_t recv_utime, std::string_view channel, const void* data, std::int32_t size);
+
+  // Writes everything queued, closes the writer with state why and joins the thread.
+  void stop(std::string_view why = "stopped");
+
+  // The writer's latest status (refreshed by the writer thread), with utime set to now_us.
+  status_t status(std::int64_t now_us) const;
+
+  std::size_t queue_depth() const;
+  std::int64_t dropped() const { return dropped_.load(); }
+
+ private:
+  struct Event {
+    std::int64_t utime;
+    std::string channel;
+    std::vector<std::uint8_t> data;
+  };
+  void run();
+  void refresh_status(std::int64_t now_us);
+
+  EventLogWriter& writer_;
+  LogRecorderOptions o_;
+  mutable std::mutex queue_mutex_;
+  std::condition_variable wake_;
+  std::deque<Event> queue_;
+  std::size_t queue_bytes_ = 0;
+  bool stopping_ = false;
+  std::string stop_why_ = "stopped";
+  std::atomic<std::int64_t> dropped_{0};
+  std::int64_t dropped_reported_ = 0;
+
+  mutable std::mutex status_mutex_;
+  status_t status_;
+  std::int64_t next_status_us_ = 0;
+
+  std::thread thread_;
+};
+
+}  // namespace spindown

@@ -1,0 +1,315 @@
+#include "spindown/event_log_writer.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <lcm/eventlog.h>
+#include <unistd.h>
+
+#include <spindown/samples_t.hpp>
+
+#include "spindown/lcm_channels.hpp"
+
+namespace spindown {
+
+namespace {
+
+// magic, event number, timestamp, channel length, data length (lcm eventlog.c).
+constexpr std::int64_t kEventHeaderBytes = 4 + 8 + 8 + 4 + 4;
+
+std::string errno_text(int err) { return std::strerror(err); }
+
+std::string instance_name(const EventLogWriterOptions& o) {
+  if (!o.instance.empty()) return o.instance;
+  return o.bench.empty() ? o.prefix : o.bench;
+}
+
+}  // namespace
+
+bool EventLogWriterOptions::is_valid(std::string* why) const {
+  auto fail = [&](std::string reason) {
+    if (why) *why = std::move(reason);
+    return false;
+  };
+  if (dir.empty()) return fail("log directory is empty");
+  if (prefix.empty() || prefix.find('/') != std::string::npos)
+    return fail(fmt::format("file name prefix '{}' must be non-empty and contain no '/'", prefix));
+  std::string bench_why;
+  if (!bench.empty() && !is_valid_bench_id(bench, &bench_why)) return fail(bench_why);
+  if (!std::isfinite(rotate_size_mb) || rotate_size_mb < 0)
+    return fail(fmt::format("rotate size {} MB must be >= 0 (0 = never)", rotate_size_mb));
+  if (!std::isfinite(rotate_time_s) || rotate_time_s < 0)
+    return fail(fmt::format("rotate time {} s must be >= 0 (0 = never)", rotate_time_s));
+  if (status_channel.empty()) return fail("status channel is empty");
+  if (buffer_bytes < 4096) return fail(fmt::format("buffer of {} bytes is below 4096", buffer_bytes));
+  if (!std::isfinite(reopen_interval_s) || reopen_interval_s <= 0)
+    return fail(fmt::format("reopen interval {} s must be > 0", reopen_interval_s));
+  return true;
+}
+
+std::string event_log_file_name(std::string_view prefix, std::string_view bench, std::time_t unix_time,
+                                int suffix) {
+  std::tm local{};
+  localtime_r(&unix_time, &local);
+  char stamp[32] = {};
+  std::strftime(stamp, sizeof stamp, "%Y-%m-%d-%H%M%S", &local);
+  std::string name = fmt::format("{}-{}", prefix, stamp);
+  if (!bench.empty()) name += fmt::format("-{}", bench);
+  if (suffix > 0) name += fmt::format(".{}", suffix);
+  return name + ".lcm";
+}
+
+EventLogWriter::EventLogWriter(EventLogWriterOptions options, std::int64_t start_us)
+    : o_(std::move(options)), start_us_(start_us), status_("logger", instance_name(o_), start_us) {
+  std::string why;
+  if (!o_.is_valid(&why)) throw std::invalid_argument(why);
+  stdio_buffer_.resize(o_.buffer_bytes);
+}
+
+EventLogWriter::~EventLogWriter() {
+  if (log_) {
+    const auto now = std::chrono::duration_cast<std::chrono::microseconds>(
+                         std::chrono::system_clock::now().time_since_epoch())
+                         .count();
+    close(now, "stopped");
+  }
+}
+
+void EventLogWriter::open(std::int64_t now_us) {
+  if (!log_) open_new_file(now_us);
+}
+
+void EventLogWriter::open_new_file(std::int64_t now_us) {
+  const std::time_t t = static_cast<std::time_t>(now_us / 1000000);
+  std::string name;
+  // O_EXCL: never overwrite a log (a restart or a rotation within the same second).
+  for (int suffix = 0;; ++suffix) {
+    name = o_.dir + "/" + event_log_file_name(o_.prefix, o_.bench, t, suffix);
+    const int fd = ::open(name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    if (fd >= 0) {
+      ::close(fd);
+      break;
+    }
+    if (errno != EEXIST || suffix >= 999)
+      throw EventLogError(fmt::format("cannot create log file {}: {}", name, errno_text(errno)));
+  }
+  log_ = lcm_eventlog_create(name.c_str(), "w");
+  if (!log_) throw EventLogError(fmt::format("cannot open log file {}: {}", name, errno_text(errno)));
+  // Our own buffer, flushed only between events (see raw_write), so the kernel only ever sees
+  // whole events and a SIGKILL cannot leave half an event behind.
+  std::setvbuf(log_->f, stdio_buffer_.data(), _IOFBF, stdio_buffer_.size());
+  path_ = name;
+  files_.push_back(name);
+  ++counters_.files;
+  file_open_us_ = now_us;
+  file_bytes_ = 0;
+  file_events_ = 0;
+  pending_bytes_ = 0;
+  unflushed_events_ = 0;
+  write_status_event(now_us, "opened");
+}
+
+bool EventLogWriter::rotation_due(std::int64_t now_us, std::int64_t next_event_bytes) const {
+  if (!log_ || file_events_ == 0) return false;  // never leave a file with no events
+  if (o_.rotate_size_mb > 0 && double(file_bytes_ + next_event_bytes) > o_.rotate_size_mb * 1e6) return true;
+  if (o_.rotate_time_s > 0 && double(now_us - file_open_us_) >= o_.rotate_time_s * 1e6) return true;
+  return false;
+}
+
+bool EventLogWriter::write(std::int64_t recv_utime, std::string_view channel, const void* data,
+                           std::int32_t size, std::int64_t now_us) {
+  track_samples(channel, data, size);
+  if (!log_ && now_us >= next_reopen_us_) {
+    try {
+      open_new_file(now_us);
+    } catch (const EventLogError& e) {
+      fail_text(now_us, e.what());
+    }
+  }
+  if (!log_) {
+    ++counters_.events_lost;
+    return false;
+  }
+  const std::int64_t event_bytes = kEventHeaderBytes + std::int64_t(channel.size()) + size;
+  if (rotation_due(now_us, event_bytes)) {
+    rotate(now_us, "rotating");
+    if (!log_) {
+      ++counters_.events_lost;
+      return false;
+    }
+  }
+  if (!raw_write(recv_utime, channel, data, size, now_us)) {
+    ++counters_.events_lost;
+    return false;
+  }
+  ++counters_.events;
+  ++unflushed_events_;
+  ++file_events_;
+  return true;
+}
+
+bool EventLogWriter::raw_write(std::int64_t utime, std::string_view channel, const void* data,
+                               std::int32_t size, std::int64_t now_us) {
+  const std::int64_t event_bytes = kEventHeaderBytes + std::int64_t(channel.size()) + size;
+  // Hand the buffer to the kernel before it would fill up mid-event.
+  if (pending_bytes_ > 0 && pending_bytes_ + event_bytes > std::int64_t(stdio_buffer_.size()))
+    if (!fflush_pending(now_us)) return false;
+  std::string channel_z(channel);
+  lcm_eventlog_event_t ev{};
+  ev.timestamp = utime;
+  ev.channellen = static_cast<std::int32_t>(channel_z.size());
+  ev.datalen = size;
+  ev.channel = channel_z.data();
+  ev.data = const_cast<void*>(data);
+  errno = 0;
+  if (lcm_eventlog_write_event(log_, &ev) != 0) {
+    fail(now_us, "writing " + path_, errno ? errno : EIO);
+    return false;
+  }
+  pending_bytes_ += event_bytes;
+  file_bytes_ += event_bytes;
+  counters_.bytes += event_bytes;
+  return true;
+}
+
+bool EventLogWriter::fflush_pending(std::int64_t now_us) {
+  if (!log_) return false;
+  if (pending_bytes_ == 0) return true;
+  if (std::fflush(log_->f) != 0) {
+    fail(now_us, "writing " + path_, errno);
+    return false;
+  }
+  ++counters_.flushes;
+  pending_bytes_ = 0;
+  unflushed_events_ = 0;
+  return true;
+}
+
+bool EventLogWriter::sync(std::int64_t now_us) {
+  if (!log_) return false;
+  if (::fdatasync(fileno(log_->f)) != 0 && errno != EINVAL) {  // EINVAL: a special file
+    fail(now_us, "syncing " + path_, errno);
+    return false;
+  }
+  return true;
+}
+
+bool EventLogWriter::flush(std::int64_t now_us) {
+  const bool had_data = pending_bytes_ > 0;
+  if (!fflush_pending(now_us)) return false;
+  if (had_data && o_.sync_on_flush) return sync(now_us);
+  return true;
+}
+
+void EventLogWriter::tick(std::int64_t now_us) {
+  if (rotation_due(now_us, 0)) rotate(now_us, "rotating");
+}
+
+void EventLogWriter::rotate(std::int64_t now_us, std::string_view why) {
+  close_file(now_us, why);
+  try {
+    open_new_file(now_us);
+  } catch (const EventLogError& e) {
+    fail_text(now_us, e.what());
+  }
+}
+
+void EventLogWriter::close_file(std::int64_t now_us, std::string_view state) {
+  if (!log_) return;
+  write_status_event(now_us, state);
+  if (fflush_pending(now_us)) sync(now_us);
+  if (log_) {
+    lcm_eventlog_destroy(log_);
+    log_ = nullptr;
+  }
+}
+
+void EventLogWriter::close(std::int64_t now_us, std::string_view why) { close_file(now_us, why); }
+
+void EventLogWriter::write_status_event(std::int64_t now_us, std::string_view state) {
+  if (!log_) return;
+  status_t st = make_status(now_us);
+  st.state = std::string(state);
+  std::vector<std::uint8_t> buf(static_cast<std::size_t>(st.getEncodedSize()));
+  if (st.encode(buf.data(), 0, static_cast<int>(buf.size())) < 0) return;
+  if (raw_write(now_us, o_.status_channel, buf.data(), static_cast<std::int32_t>(buf.size()), now_us))
+    ++counters_.status_events;
+}
+
+void EventLogWriter::fail(std::int64_t now_us, std::string what, int err) {
+  fail_text(now_us, fmt::format("{}: {}", what, errno_text(err)));
+}
+
+void EventLogWriter::fail_text(std::int64_t now_us, std::string text) {
+  ++counters_.write_errors;
+  last_error_ = std::move(text);
+  last_error_utime_ = now_us;
+  // Whatever sat in the buffer may not have reached the file.
+  counters_.events_lost += unflushed_events_;
+  unflushed_events_ = 0;
+  pending_bytes_ = 0;
+  if (log_) {
+    lcm_eventlog_destroy(log_);  // fclose; its own flush attempt fails the same way
+    log_ = nullptr;
+  }
+  next_reopen_us_ = now_us + static_cast<std::int64_t>(o_.reopen_interval_s * 1e6);
+}
+
+void EventLogWriter::track_samples(std::string_view channel, const void* data, std::int32_t size) {
+  const auto parsed = parse_channel(channel);
+  if (!parsed || parsed->kind != ChannelKind::sample) return;
+  samples_t s;
+  if (size <= 0 || s.decode(data, 0, size) < 0) {
+    ++counters_.decode_errors;
+    return;
+  }
+  auto it = next_seq_.find(parsed->bench);
+  if (it == next_seq_.end()) {
+    if (next_seq_.size() >= o_.max_tracked_benches) {
+      ++counters_.benches_untracked;
+      return;
+    }
+    next_seq_.emplace(parsed->bench, s.seq + std::max<std::int32_t>(s.n, 0));
+    return;
+  }
+  if (s.seq > it->second) {
+    ++counters_.seq_gaps;
+    counters_.samples_missing += s.seq - it->second;
+  } else if (s.seq < it->second) {
+    ++counters_.seq_repeats;  // a restarted bridge or a duplicate: follow the new sequence
+  }
+  it->second = s.seq + std::max<std::int32_t>(s.n, 0);
+}
+
+status_t EventLogWriter::make_status(std::int64_t now_us) const {
+  status_.set_state(log_ ? "running" : (files_.empty() ? "starting" : "error"));
+  const std::pair<const char*, std::int64_t> counters[] = {
+      {"events", counters_.events},
+      {"bytes", counters_.bytes},
+      {"files", counters_.files},
+      {"drops", counters_.queue_drops + counters_.events_lost},
+      {"write_errors", counters_.write_errors},
+      {"flushes", counters_.flushes},
+      {"queue_drops", counters_.queue_drops},
+      {"events_lost", counters_.events_lost},
+      {"status_events", counters_.status_events},
+      {"decode_errors", counters_.decode_errors},
+      {"seq_gaps", counters_.seq_gaps},
+      {"samples_missing", counters_.samples_missing},
+      {"seq_repeats", counters_.seq_repeats},
+      {"benches_untracked", counters_.benches_untracked},
+  };
+  for (const auto& [name, value] : counters) status_.set_counter(name, value);
+  status_.set_gauge("queue_depth", queue_depth_);
+  status_.set_gauge("file_bytes", double(file_bytes_));
+  status_.set_gauge("unflushed_events", double(unflushed_events_));
+  status_.set_gauge("benches_tracked", double(next_seq_.size()));
+  status_.set_error(last_error_, last_error_utime_);
+  return status_.message(now_us);
+}
+
+}  // namespace spindown
