@@ -1,0 +1,246 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <lcm/lcm-cpp.hpp>
+#include <random>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+#include "spindown/read_recording.hpp"
+#include "spindown/synthetic_run.hpp"
+
+using namespace spindown;
+
+namespace {
+
+const std::string data_dir = SPINDOWN_SHARED_DATA;
+
+struct TempFile {
+  std::string path;
+  TempFile(const std::string& name, const std::string& content)
+      : path(::testing::TempDir() + "spindown_read_" + std::to_string(::getpid()) + "_" + name) {
+    std::ofstream(path, std::ios::binary) << content;
+  }
+  ~TempFile() { std::filesystem::remove(path); }
+};
+
+template <class M>
+void write_event(lcm::LogFile& log, const std::string& channel, const M& m, std::int64_t utime) {
+  std::vector<std::uint8_t> buf(static_cast<std::size_t>(m.getEncodedSize()));
+  m.encode(buf.data(), 0, static_cast<int>(buf.size()));
+  lcm::LogEvent e{0, utime, channel, static_cast<std::int32_t>(buf.size()), buf.data()};
+  ASSERT_EQ(log.writeEvent(&e), 0);
+}
+
+samples_t batch(const std::string& bench, std::int64_t seq, int n, std::int8_t quantity) {
+  samples_t m{};
+  m.bench = bench;
+  m.seq = seq;
+  m.quantity = quantity;
+  m.n = n;
+  for (int i = 0; i < n; ++i) {
+    m.device_time_us.push_back((seq + i) * 20000);
+    m.host_time_us.push_back(0);
+    m.value.push_back(100.0 - i);
+    m.raw_adc.push_back(-1);
+  }
+  return m;
+}
+
+bool mentions(const Recording& r, const std::string& text) {
+  return std::any_of(r.diagnostics.begin(), r.diagnostics.end(),
+                     [&](const Diagnostic& d) { return d.message.find(text) != std::string::npos; });
+}
+
+std::string all_diagnostics(const Recording& r) {
+  std::string out;
+  for (const auto& d : r.diagnostics) out += d.to_string() + "\n";
+  return out;
+}
+
+}  // namespace
+
+TEST(ReadRecording, SampleFilesAreArduinoText) {
+  for (const auto& entry : std::filesystem::directory_iterator(data_dir)) {
+    if (entry.path().extension() != ".tsv") continue;
+    std::vector<RecordingInfo> info;
+    const auto recs = read_recordings(entry.path().string(), {}, &info);
+    ASSERT_EQ(recs.size(), 1u) << entry.path();
+    ASSERT_EQ(info.size(), 1u);
+    EXPECT_EQ(info[0].format, FileFormat::arduino_text) << entry.path();
+    EXPECT_FALSE(recs[0].has_errors()) << all_diagnostics(recs[0]);
+    EXPECT_GT(recs[0].size(), 1000u);
+    EXPECT_EQ(recs[0].source, entry.path().string());
+  }
+}
+
+TEST(ReadRecording, CsvIsDelimitedText) {
+  TempFile f("run.csv", "time_s,rpm\n0.00,3000\n0.02,2990\n0.04,2980\n");
+  std::vector<RecordingInfo> info;
+  const auto recs = read_recordings(f.path, {}, &info);
+  ASSERT_EQ(recs.size(), 1u);
+  EXPECT_EQ(info[0].format, FileFormat::delimited_text);
+  EXPECT_EQ(recs[0].quantity, Quantity::rpm);
+  EXPECT_EQ(recs[0].size(), 3u) << all_diagnostics(recs[0]);
+}
+
+TEST(ReadRecording, NamingAColumnForcesDelimitedText) {
+  TempFile f("lab.tsv", "1000\t2.00\n1020\t1.99\n1040\t1.98\n");
+  ReadOptions o;
+  o.delimited.time_unit = TimeUnit::ms;
+  o.delimited.quantity = Quantity::rad_per_s;
+  std::vector<RecordingInfo> info;
+  const auto recs = read_recordings(f.path, o, &info);
+  EXPECT_EQ(info.at(0).format, FileFormat::delimited_text);
+  EXPECT_EQ(recs.at(0).quantity, Quantity::rad_per_s);
+  EXPECT_DOUBLE_EQ(recs.at(0).t_s.at(1), 1.02);
+}
+
+TEST(ReadRecording, LcmLogGivesOneRecordingPerBench) {
+  TempFile f("two.lcm", "");
+  {
+    lcm::LogFile log(f.path, "w");
+    ASSERT_TRUE(log.good());
+    config_t c{};
+    c.bench = "b";
+    c.inertia_kg_m2 = 2e-5;
+    c.kb_v_s_per_rad = 0.01;
+    write_event(log, "SPINDOWN.b.CONFIG", c, 1);
+    write_event(log, "SPINDOWN.a.SAMPLE", batch("a", 0, 10, samples_t::QUANTITY_BACK_EMF_V), 2);
+    write_event(log, "SPINDOWN.b.SAMPLE", batch("b", 0, 10, samples_t::QUANTITY_RPM), 3);
+    write_event(log, "SPINDOWN.a.SAMPLE", batch("a", 15, 10, samples_t::QUANTITY_BACK_EMF_V), 4);
+  }
+  std::vector<RecordingInfo> info;
+  const auto recs = read_recordings(f.path, {}, &info);
+  ASSERT_EQ(recs.size(), 2u);
+  ASSERT_EQ(info.size(), 2u);
+  // Benches come in order of first appearance: b's config is the first event.
+  EXPECT_EQ(info[0].format, FileFormat::lcm_log);
+  EXPECT_EQ(info[0].bench, "b");
+  ASSERT_TRUE(info[0].config);
+  EXPECT_DOUBLE_EQ(info[0].config->inertia_kg_m2, 2e-5);
+  EXPECT_EQ(recs[0].quantity, Quantity::rpm);
+  EXPECT_EQ(recs[0].size(), 10u);
+  EXPECT_EQ(info[1].bench, "a");
+  EXPECT_EQ(info[1].samples_lost, 5);
+  EXPECT_FALSE(info[1].config);
+  EXPECT_EQ(recs[1].size(), 20u);
+  EXPECT_NE(recs[1].source.find("SPINDOWN.a.SAMPLE"), std::string::npos);
+}
+
+TEST(ReadRecording, LcmLogWithoutSamplesIsAnError) {
+  TempFile f("config-only.lcm", "");
+  {
+    lcm::LogFile log(f.path, "w");
+    config_t c{};
+    c.bench = "b";
+    write_event(log, "SPINDOWN.b.CONFIG", c, 1);
+    write_event(log, "SPINDOWN.b.STATUS", c, 2);
+  }
+  const auto recs = read_recordings(f.path);
+  ASSERT_EQ(recs.size(), 1u);
+  ASSERT_TRUE(recs[0].has_errors());
+  EXPECT_TRUE(mentions(recs[0], "no samples: 2 events, none on SPINDOWN.<bench>.SAMPLE")) << all_diagnostics(recs[0]);
+  EXPECT_TRUE(mentions(recs[0], "SPINDOWN.b.STATUS (1)"));
+}
+
+TEST(ReadRecording, DamageInALogIsCopiedToEveryBench) {
+  TempFile f("damaged.lcm", "");
+  {
+    lcm::LogFile log(f.path, "w");
+    write_event(log, "SPINDOWN.a.SAMPLE", batch("a", 0, 10, 0), 1);
+    write_event(log, "SPINDOWN.b.SAMPLE", batch("b", 0, 10, 0), 2);
+  }
+  std::filesystem::resize_file(f.path, std::filesystem::file_size(f.path) - 7);
+  const auto recs = read_recordings(f.path);
+  ASSERT_EQ(recs.size(), 1u);  // bench b's only event is the truncated one
+  EXPECT_TRUE(mentions(recs[0], "truncated")) << all_diagnostics(recs[0]);
+  EXPECT_EQ(recs[0].size(), 10u);
+}
+
+TEST(ReadRecording, UnreadableInputsNameTheFileAndTheReason) {
+  auto only_error = [](const std::vector<Recording>& recs) {
+    EXPECT_EQ(recs.size(), 1u);
+    EXPECT_TRUE(recs.at(0).has_errors());
+    EXPECT_TRUE(recs.at(0).empty());
+    return recs.at(0).diagnostics.back().message;
+  };
+  const std::string missing = only_error(read_recordings("/nonexistent/run.tsv"));
+  EXPECT_NE(missing.find("/nonexistent/run.tsv"), std::string::npos);
+  EXPECT_NE(missing.find("No such file or directory"), std::string::npos);
+
+  EXPECT_NE(only_error(read_recordings(data_dir)).find("directory"), std::string::npos);
+
+  TempFile empty("empty.tsv", "");
+  EXPECT_EQ(only_error(read_recordings(empty.path)), "no samples: the file is empty");
+
+  std::mt19937 rng(5);
+  std::string junk(50'000, '\0');
+  for (auto& c : junk) c = static_cast<char>(rng());
+  TempFile bin("junk.bin", junk);
+  EXPECT_NE(only_error(read_recordings(bin.path)).find("binary"), std::string::npos);
+
+  TempFile zeros("zeros.bin", std::string(10'000, '\0'));
+  EXPECT_NE(only_error(read_recordings(zeros.path)).find("no samples"), std::string::npos);
+
+  if (::geteuid() != 0) {  // root reads anything
+    TempFile locked("locked.tsv", "1\t2\n");
+    std::filesystem::permissions(locked.path, std::filesystem::perms::none);
+    EXPECT_NE(only_error(read_recordings(locked.path)).find("Permission denied"), std::string::npos);
+  }
+}
+
+TEST(ReadRecording, SyntheticPuttyLogFromDisk) {
+  SyntheticRunSpec spec;
+  spec.lead_in = LeadIn::supply;
+  const SyntheticRun run = make_synthetic_run(spec);
+  TempFile f("synthetic.log", "=~=~=~ PuTTY log 2024.01.01 =~=~=~\r\n12\t3.00\r\n" + to_arduino_text(run));
+  const auto recs = read_recordings(f.path);
+  ASSERT_EQ(recs.size(), 1u);
+  EXPECT_EQ(recs[0].size(), run.t_ms.size()) << all_diagnostics(recs[0]);
+  EXPECT_TRUE(mentions(recs[0], "cut short"));
+}
+
+TEST(ReadRecording, DetectFormat) {
+  const std::string magic("\xED\xA1\xDA\x01", 4);
+  EXPECT_EQ(detect_format(magic + "rest"), FileFormat::lcm_log);
+  EXPECT_EQ(detect_format("8245\t2.81\r\n8265\t2.80\r\n"), FileFormat::arduino_text);
+  EXPECT_EQ(detect_format("=~=~=~ PuTTY log\r\n3\t0.00\r\n5234\t0.00\r\n"), FileFormat::arduino_text);
+  EXPECT_EQ(detect_format("t,v\n0.0,1\n0.02,1\n"), FileFormat::delimited_text);
+  EXPECT_EQ(detect_format("0.000 2.81\n0.020 2.80\n"), FileFormat::delimited_text);
+  EXPECT_EQ(detect_format(""), FileFormat::arduino_text);
+  ReadOptions o;
+  o.format = FileFormat::delimited_text;
+  EXPECT_EQ(detect_format("8245\t2.81\n", o), FileFormat::delimited_text);
+  EXPECT_EQ(detect_format(magic, o), FileFormat::lcm_log);  // the magic word wins
+  EXPECT_EQ(parse_file_format("csv"), FileFormat::delimited_text);
+  EXPECT_EQ(parse_file_format("lcm"), FileFormat::lcm_log);
+  EXPECT_FALSE(parse_file_format("xml"));
+  EXPECT_EQ(file_format_name(FileFormat::arduino_text), "arduino");
+}
+
+TEST(ReadRecording, InvalidOptionsAreReported) {
+  ReadOptions o;
+  o.delimited.delimiter = '|';
+  std::string why;
+  EXPECT_FALSE(o.is_valid(&why));
+  EXPECT_NE(why.find("delimited text"), std::string::npos);
+  const auto recs = read_recordings(data_dir + "/seed-3v-run1.tsv", o);
+  ASSERT_EQ(recs.size(), 1u);
+  EXPECT_TRUE(recs[0].has_errors());
+}
+
+TEST(ReadRecording, ReadFileBytes) {
+  TempFile f("bytes", std::string("a\0b", 3));
+  std::string why;
+  auto bytes = read_file_bytes(f.path, &why);
+  ASSERT_TRUE(bytes);
+  EXPECT_EQ(*bytes, std::string("a\0b", 3));
+  EXPECT_FALSE(read_file_bytes(f.path, &why, 2));
+  EXPECT_NE(why.find("more than"), std::string::npos);
+  EXPECT_FALSE(read_file_bytes("/nonexistent", &why));
+  EXPECT_NE(why.find("cannot open /nonexistent"), std::string::npos);
+}
