@@ -1,0 +1,160 @@
+#pragma once
+// The live fitter's logic without any I/O: raw LCM messages (channel, bytes, receive time) go
+// in, run events, fits, diagnostics and a heartbeat come out through a sink. spindown-fitter
+// wraps it with LCM; `spindown refit` feeds it the events of a log in log order; tests drive
+// it directly. The same input gives the same runs and the same numbers everywhere.
+//
+// Per bench: samples are checked like the log reader checks them (decode, quantity, sequence
+// gaps, repeated messages, clock epochs, NaN values, device time that does not advance), fed
+// one by one to a RunDetector, and each completed run is fitted with fit_run() using J and K_b
+// of the bench's latest CONFIG (or the configured default, said so in bench_source).
+//
+// Bounded: at most max_benches benches (the least recently active is evicted), per bench the
+// detector's buffer and a mirror of it (≤ RunOptions::max_buffer samples each), a sample-rate
+// cap per bench (flooding messages dropped and counted). Nothing in the input throws out of it.
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <memory>
+#include <optional>
+#include <regex>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <spindown/config_t.hpp>
+#include <spindown/run_t.hpp>
+#include <spindown/samples_t.hpp>
+#include <spindown/status_t.hpp>
+
+#include "spindown/bench.hpp"
+#include "spindown/fit.hpp"
+#include "spindown/recording.hpp"
+#include "spindown/run_detector.hpp"
+#include "spindown/runs.hpp"
+
+namespace spindown {
+
+struct FitterOptions {
+  RunOptions runs;                       // the same defaults as `spindown fit`
+  std::vector<ModelKind> models{all_models[0], all_models[1], all_models[2]};
+  BenchParams default_bench;             // J, K_b for a bench without (usable) CONFIG
+  bool ignore_config = false;            // always use default_bench (like `spindown fit --inertia`)
+  std::string bench_regex = ".*";        // benches handled (full match on the id)
+  std::size_t max_benches = 256;         // more: the least recently active bench is evicted
+  double max_rate_hz = 5000;             // samples per second per bench (host time); 0 = no cap
+  double burst_s = 2.0;                  // the cap's bucket holds this many seconds of samples
+  bool is_valid(std::string* why) const;
+};
+
+struct FitterCounters {
+  std::int64_t messages = 0;           // messages given to the core
+  std::int64_t sample_messages = 0;    // decoded samples_t
+  std::int64_t config_messages = 0;    // decoded config_t
+  std::int64_t samples = 0;            // samples given to a run detector
+  std::int64_t runs_started = 0;       // cut events
+  std::int64_t runs = 0;               // runs completed (fitted)
+  std::int64_t runs_ignored = 0;       // coasts too short / abandoned by the detector
+  std::int64_t fits = 0;               // fits published
+  std::int64_t fit_failures = 0;       // runs where no model converged (still published)
+  std::int64_t decode_errors = 0;      // wrong fingerprint, truncated, damaged
+  std::int64_t invalid_bench = 0;      // channel's bench id not [A-Za-z0-9_-]{1,32}
+  std::int64_t bench_mismatch = 0;     // message's bench field differs from the channel's
+  std::int64_t filtered = 0;           // bench not matching bench_regex
+  std::int64_t other_channels = 0;     // not SPINDOWN.<bench>.SAMPLE|CONFIG
+  std::int64_t seq_gaps = 0;           // gaps in samples_t.seq
+  std::int64_t samples_lost = 0;       // samples missing in those gaps
+  std::int64_t duplicates = 0;         // repeated messages skipped
+  std::int64_t seq_restarts = 0;       // sequence number went back (bridge restarted)
+  std::int64_t clock_restarts = 0;     // device clock epochs
+  std::int64_t nan_values = 0;         // non-finite values skipped
+  std::int64_t time_backwards = 0;     // samples whose device time does not advance, skipped
+  std::int64_t quantity_errors = 0;    // unknown or changing quantity: message skipped
+  std::int64_t bad_configs = 0;        // CONFIG with unusable J/K_b
+  std::int64_t dropped_benches = 0;    // benches evicted (max_benches)
+  std::int64_t flood_drops = 0;        // samples dropped by the rate cap
+  std::int64_t flood_messages = 0;     // messages dropped by the rate cap
+  std::int64_t internal_errors = 0;    // exceptions caught from the fit or detector
+};
+
+// One completed run's fit, as published.
+struct FitResult {
+  std::string bench;
+  RunFit fit;                      // indices as in the bench's sample stream
+  std::string bench_source;        // "config" or why the default J/K_b was used
+  std::int64_t first_seq = 0, last_seq = 0;
+  std::int64_t detected_utime = 0; // receive time of the message that completed the run
+  double fit_seconds = 0;          // CPU-clock time the fit took
+  std::span<const double> t_s;     // the run's samples [cut, end), valid during the call only
+  std::span<const double> value;
+};
+
+class FitterSink {
+ public:
+  virtual ~FitterSink() = default;
+  virtual void run_changed(const run_t& run) = 0;         // SPINDOWN.<bench>.RUN
+  virtual void fit_ready(const FitResult& result) = 0;    // SPINDOWN.<bench>.FIT (and EXPLAIN)
+  // Detector notes, skipped samples, … with the bench channel as source. Default: ignored.
+  virtual void diagnostic(const std::string& bench, const Diagnostic& d) {
+    (void)bench;
+    (void)d;
+  }
+};
+
+class FitterCore {
+ public:
+  // options must be valid (is_valid); sink must outlive the core.
+  FitterCore(FitterOptions options, FitterSink& sink);
+  ~FitterCore();
+  FitterCore(const FitterCore&) = delete;
+  FitterCore& operator=(const FitterCore&) = delete;
+
+  // A raw LCM message: SPINDOWN.<bench>.SAMPLE and .CONFIG are decoded and used, other
+  // channels counted. recv_utime is the host receive time (µs since the epoch; from the log
+  // when refitting) used by the rate cap and for latency.
+  void on_message(std::string_view channel, const void* data, std::int64_t size, std::int64_t recv_utime);
+  // Already decoded messages (tests, tools); bench is the channel's bench id.
+  void on_samples(std::string_view bench, const samples_t& msg, std::int64_t recv_utime);
+  void on_config(std::string_view bench, const config_t& msg, std::int64_t recv_utime);
+  // End of the stream (refit, shutdown): open coasts are closed and fitted as `spindown fit`
+  // does at the end of a file.
+  void finish(std::int64_t now_utime);
+
+  const FitterCounters& counters() const { return counters_; }
+  std::size_t bench_count() const { return benches_.size(); }
+  std::size_t buffered_samples() const;  // over all benches (detector + mirror)
+  const std::string& last_error() const { return last_error_; }
+  std::int64_t last_error_utime() const { return last_error_utime_; }
+  // Benches in order of first appearance (still held).
+  std::vector<std::string> benches() const;
+
+  // Heartbeat: every counter, gauges (benches, buffered samples, sample rate), last error.
+  status_t make_status(std::int64_t now_utime, std::string_view instance, std::string_view host, std::int32_t pid,
+                       std::string_view state, double uptime_s) const;
+
+ private:
+  struct Bench;
+  Bench* bench_for(std::string_view id, std::int64_t recv_utime, std::string_view kind);
+  void error(std::string text, std::int64_t utime);
+  void push_sample(Bench& b, std::int64_t seq, double t_s, double value, std::int64_t recv_utime);
+  void handle_events(Bench& b, std::int64_t recv_utime);
+  void restart_clock(Bench& b, std::int64_t recv_utime);
+  void fit_and_publish(Bench& b, const Run& run, std::int64_t recv_utime);
+  void publish_run(Bench& b, const Run& run, std::int8_t state, std::string note, std::int64_t utime);
+  void trim_mirror(Bench& b);
+
+  FitterOptions opt_;
+  FitterSink& sink_;
+  std::regex bench_filter_;
+  std::map<std::string, std::unique_ptr<Bench>, std::less<>> benches_;
+  std::uint64_t activity_ = 0;   // increases per message: least recently active = smallest
+  std::uint64_t arrivals_ = 0;   // order of first appearance
+  FitterCounters counters_;
+  std::string last_error_;
+  std::int64_t last_error_utime_ = 0;
+  std::vector<double> scratch_t_, scratch_v_;
+};
+
+}  // namespace spindown

@@ -1,0 +1,189 @@
+#include "spindown/fit_message.hpp"
+
+#include <cmath>
+#include <fmt/format.h>
+#include <limits>
+
+#include "spindown/quantity.hpp"
+
+namespace spindown {
+
+namespace {
+
+constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+
+bool fail(std::string* why, std::string text) {
+  if (why) *why = std::move(text);
+  return false;
+}
+
+}  // namespace
+
+fit_t to_fit_message(const RunFit& fit, const FitProvenance& about, std::int64_t utime) {
+  fit_t m;
+  m.utime = utime;
+  m.bench = about.bench;
+  m.run = fit.run.number;
+  m.t_cut_s = fit.run.t_cut_s;
+  m.t_stop_s = fit.run.stopped ? fit.run.t_stop_s : nan;
+  m.samples = static_cast<std::int32_t>(fit.run.end_index > fit.run.cut_index ? fit.run.end_index - fit.run.cut_index
+                                                                               : 0);
+  m.inertia_kg_m2 = fit.bench.inertia_kg_m2;
+  m.kb_v_s_per_rad = fit.bench.kb_v_s_per_rad;
+  m.bench_source = about.bench_source;
+  m.zero_level = fit.run.zero_level;
+  m.residual_unit = std::string(quantity_unit(fit.quantity));
+
+  m.nmodels = static_cast<std::int32_t>(fit.models.size());
+  m.nparams = 0;
+  for (std::size_t i = 0; i < fit.models.size(); ++i) {
+    const ModelFit& f = fit.models[i];
+    m.model.emplace_back(model_name(f.kind));
+    m.rmse.push_back(f.rmse);
+    m.r2.push_back(f.r2);
+    m.aic.push_back(f.aic);
+    m.bic.push_back(f.bic);
+    m.t_stop_pred_s.push_back(f.t_stop_pred_s);
+    m.converged.push_back(f.converged);
+    m.model_samples.push_back(static_cast<std::int32_t>(f.n));
+    m.model_message.push_back(f.message);
+    for (const Parameter& p : f.params) {
+      m.param_model.push_back(static_cast<std::int32_t>(i));
+      m.param_name.push_back(p.name);
+      m.param_value.push_back(p.value);
+      m.param_stderr.push_back(p.std_error);
+      m.param_unit.push_back(p.unit);
+      ++m.nparams;
+    }
+  }
+  m.best = fit.best;
+  m.best_reason = fit.best_reason;
+  m.verdict = "";  // no reference configured: the health verdict belongs to a later stage
+  m.verdict_reason = "";
+  m.latency_s = about.latency_s;
+  m.inertia_source = fit.bench.inertia_source;
+  m.kb_source = fit.bench.kb_source;
+  m.lead_in = fit.run.lead_in;
+  m.noise_level = fit.run.noise_level;
+  m.period_s = fit.run.period_s;
+  m.first_seq = about.first_seq;
+  m.last_seq = about.last_seq;
+  return m;
+}
+
+std::optional<RunFit> from_fit_message(const fit_t& m, std::string* why) {
+  const auto nm = static_cast<std::size_t>(std::max(m.nmodels, 0));
+  const auto np = static_cast<std::size_t>(std::max(m.nparams, 0));
+  if (m.nmodels < 0 || m.nparams < 0 || m.model.size() != nm || m.rmse.size() != nm || m.r2.size() != nm ||
+      m.aic.size() != nm || m.bic.size() != nm || m.t_stop_pred_s.size() != nm || m.converged.size() != nm ||
+      m.model_samples.size() != nm || m.model_message.size() != nm || m.param_model.size() != np ||
+      m.param_name.size() != np || m.param_value.size() != np || m.param_stderr.size() != np ||
+      m.param_unit.size() != np) {
+    fail(why, fmt::format("FIT of bench {} run {}: array sizes do not match nmodels {} / nparams {}", m.bench, m.run,
+                          m.nmodels, m.nparams));
+    return std::nullopt;
+  }
+  RunFit fit;
+  fit.run.number = m.run;
+  fit.run.t_cut_s = m.t_cut_s;
+  fit.run.stopped = std::isfinite(m.t_stop_s);
+  fit.run.t_stop_s = m.t_stop_s;
+  fit.run.cut_index = 0;
+  fit.run.end_index = static_cast<std::size_t>(std::max(m.samples, 0));
+  fit.run.stop_index = fit.run.end_index;
+  fit.run.zero_level = m.zero_level;
+  fit.run.noise_level = m.noise_level;
+  fit.run.lead_in = m.lead_in;
+  fit.run.period_s = m.period_s;
+  fit.bench.inertia_kg_m2 = m.inertia_kg_m2;
+  fit.bench.kb_v_s_per_rad = m.kb_v_s_per_rad;
+  fit.bench.inertia_source = m.inertia_source;
+  fit.bench.kb_source = m.kb_source;
+  const auto q = parse_quantity(m.residual_unit);
+  if (!q) {
+    fail(why, fmt::format("FIT of bench {} run {}: unknown residual unit '{}'", m.bench, m.run, m.residual_unit));
+    return std::nullopt;
+  }
+  fit.quantity = *q;
+  for (std::size_t i = 0; i < nm; ++i) {
+    const auto kind = parse_model(m.model[i]);
+    if (!kind) {
+      fail(why, fmt::format("FIT of bench {} run {}: unknown model '{}'", m.bench, m.run, m.model[i]));
+      return std::nullopt;
+    }
+    ModelFit f;
+    f.kind = *kind;
+    f.rmse = m.rmse[i];
+    f.r2 = m.r2[i];
+    f.aic = m.aic[i];
+    f.bic = m.bic[i];
+    f.t_stop_pred_s = m.t_stop_pred_s[i];
+    f.converged = m.converged[i];
+    f.n = static_cast<std::size_t>(std::max(m.model_samples[i], 0));
+    f.message = m.model_message[i];
+    fit.models.push_back(std::move(f));
+  }
+  for (std::size_t k = 0; k < np; ++k) {
+    const std::int32_t i = m.param_model[k];
+    if (i < 0 || static_cast<std::size_t>(i) >= nm) {
+      fail(why, fmt::format("FIT of bench {} run {}: parameter {} belongs to model {} of {}", m.bench, m.run,
+                            m.param_name[k], i, nm));
+      return std::nullopt;
+    }
+    ModelFit& f = fit.models[static_cast<std::size_t>(i)];
+    f.params.push_back({m.param_name[k], m.param_value[k], m.param_stderr[k], m.param_unit[k]});
+    if (m.param_name[k] == "omega0") f.omega0 = m.param_value[k];
+  }
+  fit.best = m.best;
+  fit.best_reason = m.best_reason;
+  return fit;
+}
+
+std::optional<Json> fit_message_json(const fit_t& msg, const ReportOptions& opt, std::string* why) {
+  auto fit = from_fit_message(msg, why);
+  if (!fit) return std::nullopt;
+  Json j = run_fit_json(*fit, opt);
+  j["bench"]["id"] = msg.bench;
+  j["first_seq"] = msg.first_seq;
+  j["last_seq"] = msg.last_seq;
+  return j;
+}
+
+run_t to_run_message(std::string_view bench, const Run& run, std::int8_t state, std::int64_t first_seq,
+                     std::int64_t last_seq, std::int32_t samples, std::string note, std::int64_t utime) {
+  run_t m;
+  m.utime = utime;
+  m.bench = std::string(bench);
+  m.run = run.number;
+  m.state = state;
+  m.t_cut_s = run.t_cut_s;
+  m.t_stop_s = run.stopped ? run.t_stop_s : nan;
+  m.first_seq = first_seq;
+  m.last_seq = last_seq;
+  m.samples = samples;
+  m.note = std::move(note);
+  return m;
+}
+
+std::string_view run_state_name(std::int8_t state) {
+  switch (state) {
+    case run_t::STATE_POWERED: return "powered";
+    case run_t::STATE_COASTING: return "coasting";
+    case run_t::STATE_STOPPED: return "stopped";
+    case run_t::STATE_ABANDONED: return "abandoned";
+    default: return "unknown";
+  }
+}
+
+Json without_timing_fields(Json j) {
+  if (j.is_object()) {
+    j.erase("latency_s");
+    j.erase("utime");
+    for (auto& [key, value] : j.items()) value = without_timing_fields(std::move(value));
+  } else if (j.is_array()) {
+    for (auto& value : j) value = without_timing_fields(std::move(value));
+  }
+  return j;
+}
+
+}  // namespace spindown

@@ -1,0 +1,201 @@
+#include "fitter_service.hpp"
+
+#include <chrono>
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <spindown/status_t.hpp>
+
+#include "spindown/fit_message.hpp"
+#include "spindown/lcm_channels.hpp"
+
+namespace spindown {
+
+namespace {
+
+std::int64_t wall_us() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+std::string host_name() {
+  char buf[256] = {};
+  if (::gethostname(buf, sizeof buf - 1) != 0) return "unknown";
+  return buf;
+}
+
+// SPINDOWN\.(<bench regex>)\.(SAMPLE|CONFIG): LCM anchors the channel regex at both ends.
+std::string subscription_regex(const std::string& bench_regex) {
+  return fmt::format("SPINDOWN\\.({})\\.(SAMPLE|CONFIG)", bench_regex);
+}
+
+}  // namespace
+
+FitterService::FitterService(FitterServiceOptions options)
+    : opt_(std::move(options)), lcm_(opt_.lcm_url), core_(opt_.core, *this), host_(host_name()) {}
+
+FitterService::~FitterService() {
+  {
+    std::lock_guard lock(mu_);
+    stopping_ = true;
+  }
+  cv_.notify_all();
+  if (worker_.joinable()) worker_.join();
+}
+
+void FitterService::on_lcm(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  const std::size_t size = rbuf->data_size > 0 ? rbuf->data_size : 0;
+  {
+    std::lock_guard lock(mu_);
+    if (queue_.size() >= opt_.max_queue_messages || queue_bytes_ + size > opt_.max_queue_bytes) {
+      ++queue_drops_;
+      return;
+    }
+    Message m;
+    m.channel = channel;
+    const auto* d = static_cast<const unsigned char*>(rbuf->data);
+    m.data.assign(d, d + size);
+    m.recv_utime = rbuf->recv_utime;
+    queue_bytes_ += size;
+    queue_.push_back(std::move(m));
+    queue_high_water_ = std::max(queue_high_water_, queue_.size());
+  }
+  cv_.notify_one();
+}
+
+void FitterService::run_changed(const run_t& run) {
+  const std::string channel = channel_name(run.bench, ChannelKind::run);
+  if (lcm_.publish(channel, &run) != 0) ++publish_failures_;
+  if (opt_.verbose)
+    fmt::print(stderr, "spindown-fitter: {} run {} {}: {}\n", run.bench, run.run, run_state_name(run.state), run.note);
+}
+
+void FitterService::fit_ready(const FitResult& r) {
+  FitProvenance about;
+  about.bench = r.bench;
+  about.bench_source = r.bench_source;
+  about.first_seq = r.first_seq;
+  about.last_seq = r.last_seq;
+  const std::int64_t now = wall_us();
+  about.latency_s = 1e-6 * double(now - r.detected_utime);
+  const fit_t msg = to_fit_message(r.fit, about, now);
+  if (lcm_.publish(channel_name(r.bench, ChannelKind::fit), &msg) != 0) ++publish_failures_;
+  last_latency_s_ = about.latency_s;
+  max_latency_s_ = std::max(max_latency_s_, about.latency_s);
+  last_fit_s_ = r.fit_seconds;
+  if (opt_.verbose)
+    fmt::print(stderr, "spindown-fitter: {} run {} fitted: best {} ({} samples, fit {:.1f} ms, latency {:.1f} ms)\n",
+               r.bench, r.fit.run.number, r.fit.best.empty() ? "none" : r.fit.best, msg.samples, 1e3 * r.fit_seconds,
+               1e3 * about.latency_s);
+  publish_explain(r);
+}
+
+// Hook for the discrepancy workflow (design §6): when core/include/spindown/explain.hpp
+// provides explain_run(...), run it here on r.t_s/r.value with r.fit as the starting point and
+// publish the explain_t on channel_name(r.bench, ChannelKind::explain). Until then: nothing.
+void FitterService::publish_explain(const FitResult& r) { (void)r; }
+
+void FitterService::diagnostic(const std::string& bench, const Diagnostic& d) {
+  if (opt_.verbose) fmt::print(stderr, "spindown-fitter: {}: {}\n", bench, d.to_string());
+}
+
+void FitterService::publish_status(std::int64_t now_us, const char* state) {
+  status_t s = core_.make_status(now_us, opt_.instance, host_, static_cast<std::int32_t>(::getpid()), state,
+                                 1e-6 * double(now_us - start_us_));
+  std::size_t depth = 0, high = 0;
+  std::int64_t drops = 0;
+  {
+    std::lock_guard lock(mu_);
+    depth = queue_.size();
+    high = queue_high_water_;
+    drops = queue_drops_;
+  }
+  const std::int64_t samples = core_.counters().samples;
+  if (last_rate_us_ > 0 && now_us > last_rate_us_)
+    rate_hz_ = double(samples - last_samples_) / (1e-6 * double(now_us - last_rate_us_));
+  last_rate_us_ = now_us;
+  last_samples_ = samples;
+  s.counter_name.emplace_back("queue_drops");
+  s.counter_value.push_back(drops);
+  s.counter_name.emplace_back("publish_failures");
+  s.counter_value.push_back(publish_failures_);
+  s.ncounters = static_cast<std::int32_t>(s.counter_name.size());
+  const std::pair<const char*, double> gauges[] = {
+      {"sample_rate_hz", rate_hz_},           {"queue_depth", double(depth)},
+      {"queue_high_water", double(high)},     {"last_latency_s", last_latency_s_},
+      {"max_latency_s", max_latency_s_},      {"last_fit_s", last_fit_s_},
+  };
+  for (const auto& [name, value] : gauges) {
+    s.gauge_name.emplace_back(name);
+    s.gauge_value.push_back(value);
+  }
+  s.ngauges = static_cast<std::int32_t>(s.gauge_name.size());
+  if (s.last_error.empty() && drops > 0) s.last_error = fmt::format("{} messages dropped: receive queue full", drops);
+  if (lcm_.publish(channel_name(opt_.instance, ChannelKind::status), &s) != 0) ++publish_failures_;
+}
+
+void FitterService::worker() {
+  const auto period = std::chrono::microseconds(static_cast<std::int64_t>(opt_.status_period_s * 1e6));
+  auto next_status = std::chrono::steady_clock::now();
+  std::deque<Message> batch;
+  for (;;) {
+    bool stop = false;
+    {
+      std::unique_lock lock(mu_);
+      cv_.wait_until(lock, next_status, [&] { return stopping_ || !queue_.empty(); });
+      batch.swap(queue_);
+      queue_bytes_ = 0;
+      stop = stopping_;
+    }
+    for (const Message& m : batch)
+      core_.on_message(m.channel, m.data.data(), static_cast<std::int64_t>(m.data.size()), m.recv_utime);
+    batch.clear();
+    if (std::chrono::steady_clock::now() >= next_status) {
+      publish_status(wall_us(), "running");
+      next_status += period;
+      if (next_status < std::chrono::steady_clock::now()) next_status = std::chrono::steady_clock::now() + period;
+    }
+    if (stop) break;
+  }
+}
+
+int FitterService::run(const std::atomic<bool>& stop_flag) {
+  start_us_ = wall_us();
+  lcm::Subscription* sub = lcm_.subscribe(subscription_regex(opt_.core.bench_regex), &FitterService::on_lcm, this);
+  // Our handler only copies into the service's queue, but LCM's own default of 30 queued
+  // messages drops silently in a burst (design §7).
+  sub->setQueueCapacity(100000);
+  worker_ = std::thread([this] { worker(); });
+  int failures = 0;
+  while (!stop_flag) {
+    if (lcm_.handleTimeout(100) >= 0) {
+      failures = 0;
+      continue;
+    }
+    if (stop_flag) break;  // a signal interrupted the wait
+    if (++failures > 50) {
+      fmt::print(stderr, "spindown-fitter: LCM keeps failing to receive; stopping\n");
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  lcm_.unsubscribe(sub);
+  {
+    std::lock_guard lock(mu_);
+    stopping_ = true;
+  }
+  cv_.notify_all();
+  worker_.join();
+  // Runs still open are left open (a restarted fitter finds them again from new samples);
+  // only the counters go out.
+  publish_status(wall_us(), "stopping");
+  const FitterCounters& c = core_.counters();
+  fmt::print(stderr,
+             "spindown-fitter: stopped: {} benches, {} samples, {} runs, {} fits, {} decode errors, {} sequence gaps, "
+             "{} duplicates, {} NaN values, {} time backwards, {} benches evicted, {} flood drops, {} queue drops\n",
+             core_.bench_count(), c.samples, c.runs, c.fits, c.decode_errors, c.seq_gaps, c.duplicates, c.nan_values,
+             c.time_backwards, c.dropped_benches, c.flood_drops, queue_drops_);
+  return 0;
+}
+
+}  // namespace spindown

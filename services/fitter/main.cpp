@@ -1,0 +1,83 @@
+// spindown-fitter: finds every bench's spin-down runs live and publishes their life on
+// SPINDOWN.<bench>.RUN, the friction fits on SPINDOWN.<bench>.FIT and its own heartbeat on
+// SPINDOWN.<instance>.STATUS. SIGINT/SIGTERM end it with exit code 0.
+#include <CLI/CLI.hpp>
+#include <atomic>
+#include <csignal>
+#include <fmt/format.h>
+
+#include "fitter_service.hpp"
+#include "spindown/bench.hpp"
+#include "spindown/fit.hpp"
+#include "spindown/lcm_channels.hpp"
+
+namespace {
+std::atomic<bool> g_stop{false};
+extern "C" void on_signal(int) { g_stop = true; }
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"spindown-fitter: SPINDOWN.<bench>.SAMPLE|CONFIG -> RUN, FIT and STATUS, live"};
+  spindown::FitterServiceOptions o;
+  std::vector<std::string> models;
+  double kv = 0;
+  app.add_option("--lcm-url", o.lcm_url, "LCM URL (default: LCM_DEFAULT_URL or LCM's default)");
+  app.add_option("--bench", o.core.bench_regex, "benches to fit: regex on the bench id (default all)");
+  app.add_option("--instance", o.instance, "instance name: heartbeat on SPINDOWN.<instance>.STATUS")
+      ->check([](const std::string& s) {
+        std::string why;
+        return spindown::is_valid_bench_id(s, &why) ? std::string() : why;
+      });
+  auto* j = app.add_option("--inertia", o.core.default_bench.inertia_kg_m2,
+                           "J (kg·m²) for benches without CONFIG (default: the lab's)")
+                ->check(CLI::PositiveNumber);
+  auto* kb = app.add_option("--kb", o.core.default_bench.kb_v_s_per_rad,
+                            "K_b (V·s/rad) for benches without CONFIG (default: the lab's)")
+                 ->check(CLI::PositiveNumber);
+  auto* kvo = app.add_option("--speed-constant", kv, "K_b from a speed constant (rpm/V), instead of --kb")
+                  ->check(CLI::PositiveNumber)
+                  ->excludes(kb);
+  app.add_flag("--ignore-config", o.core.ignore_config, "always use --inertia/--kb, never a bench's CONFIG");
+  app.add_option("--models", models, "models: viscous,coulomb,combined (default all)")->delimiter(',');
+  app.add_option("--max-benches", o.core.max_benches, "benches held at once; more evicts the least recently active");
+  app.add_option("--max-rate", o.core.max_rate_hz, "samples/s per bench before messages are dropped (0: no cap)");
+  app.add_option("--max-coast", o.core.runs.max_coast_s, "seconds before a coast that never stops is closed");
+  app.add_option("--max-buffer", o.core.runs.max_buffer, "samples buffered per bench at most");
+  app.add_option("--status-period", o.status_period_s, "seconds between heartbeats")->check(CLI::Range(0.05, 60.0));
+  app.add_flag("-v,--verbose", o.verbose, "one line per run event and fit on stderr");
+  CLI11_PARSE(app, argc, argv);
+
+  if (j->count()) o.core.default_bench.inertia_source = "--inertia";
+  if (kb->count()) o.core.default_bench.kb_source = "--kb";
+  if (kvo->count()) {
+    o.core.default_bench.kb_v_s_per_rad = spindown::kb_from_speed_constant(kv);
+    o.core.default_bench.kb_source = fmt::format("--speed-constant {} rpm/V", kv);
+  }
+  if (!models.empty()) {
+    o.core.models.clear();
+    for (const auto& name : models) {
+      const auto kind = spindown::parse_model(name);
+      if (!kind) {
+        fmt::print(stderr, "spindown-fitter: --models: unknown model '{}' (viscous, coulomb, combined)\n", name);
+        return 2;
+      }
+      o.core.models.push_back(*kind);
+    }
+  }
+  std::string why;
+  if (!o.core.is_valid(&why)) {
+    fmt::print(stderr, "spindown-fitter: {}\n", why);
+    return 2;
+  }
+
+  spindown::FitterService service(o);
+  if (!service.good()) {
+    fmt::print(stderr, "spindown-fitter: cannot start LCM{}{}\n", o.lcm_url.empty() ? "" : " at ", o.lcm_url);
+    return 1;
+  }
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  fmt::print(stderr, "spindown-fitter: fitting benches matching '{}'{}; heartbeat on SPINDOWN.{}.STATUS\n",
+             o.core.bench_regex, o.lcm_url.empty() ? "" : " on " + o.lcm_url, o.instance);
+  return service.run(g_stop);
+}
