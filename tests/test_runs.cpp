@@ -164,7 +164,8 @@ TEST(FindRuns, SyntheticGridOfLeadInsPeriodsAndNoise) {
         EXPECT_EQ(r.lead_in, lead == LeadIn::zeros ? "zeros" : lead == LeadIn::floating ? "floating" : "supply")
             << what;
         ASSERT_TRUE(r.stopped) << what;
-        EXPECT_NEAR(r.t_stop_s, tr.t_stop_s, 0.2 + 3 * period) << what;
+        // The stop blurs with noise: its decline at the end is ~0.1 V/s.
+        EXPECT_NEAR(r.t_stop_s, tr.t_stop_s, 0.2 + 3 * period + 5 * noise) << what;
         EXPECT_NEAR(r.zero_level, 0.0, 0.01) << what;
       }
     }
@@ -224,6 +225,7 @@ TEST(FindRuns, SeveralRunsInOneRecordingAreFoundSeparately) {
     spec.lead_in = leads[k];
     spec.t0_ms = t0_ms;
     spec.e0_v = 2.5 + 0.3 * k;
+    spec.supply_v = spec.e0_v + 0.25;
     spec.lead_in_s = 2.0 + k;
     spec.tail_s = 2.5;
     spec.noise_v = 0.004;

@@ -11,6 +11,8 @@ namespace {
 
 // Seconds of lead-in searched for the cut before the window that confirmed the coast.
 constexpr double back_search_s = 2.0;
+// Seconds of lead-in kept while idle.
+constexpr double idle_keep_s = 40.0;
 // Samples searched at least, for slow loops.
 constexpr std::size_t back_search_min_samples = 16;
 // A coast is confirmed by a decline this many standard errors strong …
@@ -24,10 +26,15 @@ constexpr double standstill_max_fraction = 0.3;
 // A real stop arrives with a finite slope: the last quarter of the amplitude is crossed at
 // least this fast relative to the coast's mean rate (Coulomb ≈ 1, lab's combined ≈ 0.8,
 // pure viscous ≈ 0.3–0.45, depending on the noise that decides "flat").
-constexpr double stop_min_end_rate = 0.6;
+constexpr double stop_min_end_rate = 0.5;
+// … or the last stop_hold_s before the stop still falls with this t-statistic (an exponential
+// that has become "flat" shows ~3–6 there, a Coulomb stop tens).
+constexpr double stop_min_approach_t = 10.0;
+// A 1 s hold window decides alone when its slope error is this fraction of the mean rate.
+constexpr double slope_resolution = 0.05;
 // In the tail, a hold-window mean this fraction of the amplitude below the zero level retracts
 // the stop.
-constexpr double retract_fraction = 0.02;
+constexpr double retract_fraction = 0.01;
 // Recompute sliding sums from scratch this often (rounding drift).
 constexpr unsigned refresh_every = 4096;
 
@@ -42,28 +49,6 @@ void RunDetector::WindowFit::clear(std::size_t at, double t_origin) {
   t0 = t_origin;
   n = st = stt = sv = svv = stv = 0;
   updates = 0;
-}
-
-void RunDetector::WindowFit::add(double t, double v) {
-  t -= t0;
-  n += 1;
-  st += t;
-  stt += t * t;
-  sv += v;
-  svv += v * v;
-  stv += t * v;
-  ++updates;
-}
-
-void RunDetector::WindowFit::remove(double t, double v) {
-  t -= t0;
-  n -= 1;
-  st -= t;
-  stt -= t * t;
-  sv -= v;
-  svv -= v * v;
-  stv -= t * v;
-  ++updates;
 }
 
 double RunDetector::WindowFit::slope() const {
@@ -122,6 +107,16 @@ void RunDetector::advance(WindowFit& w, std::size_t i) {
 
 RunDetector::RunDetector(RunOptions opt, std::string source) : opt_(std::move(opt)), source_(std::move(source)) {
   hold_.span_s = opt_.stop_hold_s;
+  hold_long_.span_s = 3.0 * opt_.stop_hold_s;
+}
+
+void RunDetector::grow_ring() {
+  // Keep [base_, next_index_) at the same positions modulo the new, doubled size.
+  std::vector<Sample> bigger(std::max<std::size_t>(64, 2 * ring_.size()));
+  const std::size_t mask = bigger.size() - 1;
+  for (std::size_t k = base_; k + 1 < next_index_; ++k) bigger[k & mask] = ring_[k & mask_];
+  ring_.swap(bigger);
+  mask_ = mask;
 }
 
 std::vector<RunEvent> RunDetector::take_events() {
@@ -163,8 +158,8 @@ void RunDetector::push(double t_s, double value) {
   have_last_t_ = true;
   last_t_ = t_s;
   const std::size_t i = next_index_++;
-  bt_.push_back(t_s);
-  bv_.push_back(value);
+  if (next_index_ - base_ > ring_.size()) grow_ring();
+  ring_[i & mask_] = {t_s, value};
   // Track readings pinned at one positive value (a clipped converter) so the lead-in before
   // a long clip is still buffered when the coast leaves it.
   if (i == base_ || v(i) != v(i - 1)) same_start_ = i;
@@ -183,10 +178,9 @@ void RunDetector::push(double t_s, double value) {
 void RunDetector::clock_restart() {
   if (state_ == State::coasting) close_unstopped(next_index_, "the device clock restarted mid-coast");
   else if (state_ == State::tail) complete_run(next_index_);
-  bt_.clear();
-  bv_.clear();
   base_ = next_index_;
   have_plateau_ = false;
+  need_rise_ = false;
   stream_start_ = next_index_;
   have_last_t_ = false;
   state_ = State::idle;
@@ -194,10 +188,15 @@ void RunDetector::clock_restart() {
   need_quiet_ = false;
   short_.clear(next_index_, 0.0);
   long_.clear(next_index_, 0.0);
+  vlong_.clear(next_index_, 0.0);
+  hold_long_.clear(next_index_, 0.0);
+  quiet_until_s_ = -std::numeric_limits<double>::infinity();
   hold_.clear(next_index_, 0.0);
 }
 
 void RunDetector::finish() {
+  // A recording that ends soon after the stop: the hold window alone decides.
+  if (state_ == State::coasting && next_index_ > base_) coast_checks(next_index_ - 1, true);
   if (state_ == State::coasting) close_unstopped(next_index_, "the recording ends mid-coast (never reached standstill)");
   else if (state_ == State::tail) complete_run(next_index_);
   if (state_ != State::idle) to_idle(next_index_, false);
@@ -209,39 +208,42 @@ void RunDetector::finish() {
 }
 
 void RunDetector::to_idle(std::size_t lo, bool need_quiet) {
+  // After a stop, a new coast must start above the standstill: a slow coast's last creep
+  // after a premature stop is not a new run.
+  need_rise_ = state_ == State::tail && run_.stopped;
+  rise_level_ = run_.zero_level + depart_band_;
   state_ = State::idle;
   lo_ = lo;
   need_quiet_ = need_quiet;
   rising_ = departing_ = 0;
   reset_window(short_, lo, next_index_);
   reset_window(long_, lo, next_index_);
+  reset_window(vlong_, lo, next_index_);
   trim_idle();
 }
 
 void RunDetector::trim_idle() {
-  if (bt_.empty()) return;
-  const double keep_s = long_.span_s + back_search_s + 0.5;
-  const double t_now = bt_.back();
+  if (next_index_ == base_) return;
+  // Enough for the longest window and a few doublings of the back-search.
+  const double keep_s = idle_keep_s;
+  const double t_now = t(next_index_ - 1);
   std::size_t keep_from = std::max(lo_, base_);
   while (keep_from < next_index_ && t_now - t(keep_from) > keep_s) ++keep_from;
   // Keep enough samples for a slow loop's back-search, and what the windows still use.
   const std::size_t min_keep = back_search_min_samples + 16;
   if (next_index_ - keep_from < min_keep) keep_from = next_index_ > min_keep ? next_index_ - min_keep : 0;
   keep_from = std::max(keep_from, base_);
-  keep_from = std::min({keep_from, short_.first, long_.first});
+  keep_from = std::min({keep_from, short_.first, long_.first, vlong_.first});
   if (have_plateau_ && plateau_end_ >= base_ && t_now - t(plateau_end_) <= keep_s)
     keep_from = std::min(keep_from, std::max(base_, plateau_start_ >= back_search_min_samples
                                                         ? plateau_start_ - back_search_min_samples
                                                         : std::size_t{0}));
   // Bounded memory whatever the timing.
   if (next_index_ - keep_from > opt_.max_buffer) keep_from = next_index_ - opt_.max_buffer;
-  while (base_ < keep_from) {
-    bt_.pop_front();
-    bv_.pop_front();
-    ++base_;
-  }
+  base_ = std::max(base_, keep_from);
   if (short_.first < base_) reset_window(short_, base_, next_index_);
   if (long_.first < base_) reset_window(long_, base_, next_index_);
+  if (vlong_.first < base_) reset_window(vlong_, base_, next_index_);
 }
 
 bool RunDetector::confirms_decline(const WindowFit& w) const {
@@ -260,6 +262,7 @@ bool RunDetector::confirms_decline(const WindowFit& w) const {
 void RunDetector::idle_step(std::size_t i) {
   advance(short_, i);
   advance(long_, i);
+  advance(vlong_, i);
   if (need_quiet_) {
     // After a coast closed without a stop the decline may go on: wait for it to pause.
     const bool full = long_.n >= 8 && duration(long_) >= 0.8 * long_.span_s;
@@ -272,24 +275,25 @@ void RunDetector::idle_step(std::size_t i) {
     trim_idle();
     return;
   }
-  if (confirms_decline(short_)) start_coast(i, short_);
-  else if (confirms_decline(long_)) start_coast(i, long_);
-  else trim_idle();
+  if (t(i) >= quiet_until_s_) {
+    bool tried = false;
+    for (const WindowFit* w : {&short_, &long_, &vlong_}) {
+      if (confirms_decline(*w)) {
+        tried = true;
+        if (try_start_coast(i, *w)) return;
+      }
+    }
+    if (tried) quiet_until_s_ = t(i) + 0.5 * short_.span_s;  // look again once the windows moved on
+  }
+  trim_idle();
 }
 
-void RunDetector::start_coast(std::size_t i, const WindowFit& w) {
-  const std::size_t b = i;
-  const std::size_t w0 = w.first;
+RunDetector::CutSplit RunDetector::split_at_cut(std::size_t a, std::size_t b, const WindowFit& w) {
   const std::size_t lower = std::max(lo_, base_);
-  std::size_t a = w0;
-  while (a > lower && t(w0) - t(a - 1) <= back_search_s) --a;
-  if (w0 - a < back_search_min_samples) a = w0 - std::min(w0 - lower, back_search_min_samples);
+  CutSplit sp;
+  sp.a = a;
 
-  run_ = Run{};
-  run_.number = accepted_ + 1;
-  run_note_.clear();
-
-  // A reading pinned at its maximum for 3+ samples and left without a step: ADC top.
+  // A reading pinned at its maximum and left without a step: the converter's top.
   double m = v(a);
   for (std::size_t k = a; k <= b; ++k) m = std::max(m, v(k));
   std::size_t p = b + 1;  // last pinned sample
@@ -299,13 +303,11 @@ void RunDetector::start_coast(std::size_t i, const WindowFit& w) {
       break;
     }
   }
-  bool clipped = false;
-  std::size_t q = 0;  // first pinned sample
   if (p < b) {
-    q = p;
+    std::size_t q = p;  // first pinned sample
     while (q > lower && v(q - 1) == m) --q;
-    // Longest stretch of equal readings in the coast after it: quantized data plateaus too,
-    // a clipped reading is pinned much longer than that.
+    // Quantized data plateaus too; a clipped reading is pinned much longer than the longest
+    // plateau of the coast after it.
     std::size_t longest = 1, cur = 1;
     for (std::size_t k = p + 2; k <= b; ++k) {
       cur = v(k) == v(k - 1) ? cur + 1 : 1;
@@ -314,34 +316,27 @@ void RunDetector::start_coast(std::size_t i, const WindowFit& w) {
     const std::size_t pinned = p - q + 1;
     const double leave = m - v(p + 1);
     if (q > lower && pinned >= 5 && pinned >= 3 * longest && leave > 0 &&
-        leave <= 0.02 * std::abs(m) + 3.0 * w.resid_sd())
-      clipped = true;
-    if (clipped) a = std::max(lower, std::min(a, q >= back_search_min_samples ? q - back_search_min_samples : 0));
+        leave <= 0.02 * std::abs(m) + 3.0 * w.resid_sd()) {
+      sp.clipped = true;
+      sp.pin_first = q;
+      sp.pin_last = p;
+      sp.pin_level = m;
+      sp.a = std::max(lower, std::min(a, q >= back_search_min_samples ? q - back_search_min_samples : 0));
+      sp.cut_index = p + 1;
+      sp.t_cut_s = 0.5 * (t(q - 1) + t(q));
+      sp.pre_end = q;
+      sp.v0 = m;
+      sp.sd_post = w.resid_sd();
+    }
   }
 
-  std::size_t pre_end = 0;  // the lead-in is [a, pre_end)
-  double v0 = 0, sd_post = 0;
-  if (clipped) {
-    run_.cut_index = p + 1;
-    run_.t_cut_s = 0.5 * (t(q - 1) + t(q));
-    pre_end = q;
-    v0 = m;
-    sd_post = w.resid_sd();
-    RunEvent e;
-    e.kind = RunEvent::Kind::diagnostic;
-    e.has_diagnostic = true;
-    e.diagnostic = {Diagnostic::Severity::warning, source_, 0,
-                    fmt::format("run {}: reading pinned at {:g} (converter's top?) from {} to {} ({} samples): "
-                                "the coast is taken from where it leaves it",
-                                run_.number, m, fmt_s(t(q)), fmt_s(t(p)), p - q + 1)};
-    events_.push_back(std::move(e));
-  } else {
+  if (!sp.clipped) {
     // Two-segment least squares over [a, b]: constant lead-in [a, c), linear coast [c, b].
     const std::size_t n = b - a + 1;
     scratch_.assign(6 * (n + 1), 0.0);
-    double* pv = scratch_.data();         // prefix Σv, Σv² of [a, a+k)
+    double* pv = scratch_.data();  // prefix Σv, Σv² of [a, a+k)
     double* pvv = pv + (n + 1);
-    double* ss = pvv + (n + 1);           // suffix sums of [a+k, b]: n, Σt, Σt², Σv, Σv², Σtv
+    double* ss = pvv + (n + 1);  // suffix Σt, Σt², Σv, Σtv of [a+k, b] (t relative to t(b))
     double* stt_ = ss + (n + 1);
     double* sv_ = stt_ + (n + 1);
     double* stv_ = sv_ + (n + 1);
@@ -351,7 +346,6 @@ void RunDetector::start_coast(std::size_t i, const WindowFit& w) {
       pvv[k + 1] = pvv[k] + x * x;
     }
     const double tr = t(b);
-    // suffix: Σt, Σt², Σv, Σtv; Σv² recovered from prefixes.
     for (std::size_t k = n; k-- > 0;) {
       const double tt = t(a + k) - tr, x = v(a + k);
       ss[k] = ss[k + 1] + tt;
@@ -360,13 +354,12 @@ void RunDetector::start_coast(std::size_t i, const WindowFit& w) {
       stv_[k] = stv_[k + 1] + tt * x;
     }
     const double svv_all = pvv[n];
-    double best = std::numeric_limits<double>::infinity();
     // The confirming window may straddle a small step (supply → back-EMF), so the split may
     // fall anywhere that leaves a few samples for the line.
-    std::size_t best_k = w0 - a;
+    double best = std::numeric_limits<double>::infinity();
+    std::size_t best_k = 0;
     for (std::size_t k = 0; k + 3 <= n; ++k) {
-      const double npre = double(k);
-      const double sse_pre = k > 0 ? pvv[k] - pv[k] * pv[k] / npre : 0.0;
+      const double sse_pre = k > 0 ? pvv[k] - pv[k] * pv[k] / double(k) : 0.0;
       const double np = double(n - k);
       const double sxx = stt_[k] - ss[k] * ss[k] / np;
       const double sxy = stv_[k] - ss[k] * sv_[k] / np;
@@ -386,36 +379,101 @@ void RunDetector::start_coast(std::size_t i, const WindowFit& w) {
     const double beta = sxx > 0 ? sxy / sxx : 0.0;
     const double tbar = ss[k] / np, vbar = sv_[k] / np;
     const std::size_t c = a + k;
-    v0 = vbar + beta * ((t(c) - tr) - tbar);
-    sd_post = np > 2 ? std::sqrt(std::max(syy - beta * sxy, 0.0) / (np - 2)) : 0.0;
-    run_.cut_index = c;
-    pre_end = c;
+    sp.v0 = vbar + beta * ((t(c) - tr) - tbar);
+    sp.post_slope = beta;
+    sp.sd_post = np > 2 ? std::sqrt(std::max(syy - beta * sxy, 0.0) / (np - 2)) : 0.0;
+    sp.cut_index = c;
+    sp.pre_end = c;
     const bool sample_before = c > base_ && c > stream_start_ && c - 1 >= lo_;
-    run_.t_cut_s = sample_before ? 0.5 * (t(c - 1) + t(c)) : t(c);
+    sp.t_cut_s = sample_before ? 0.5 * (t(c - 1) + t(c)) : t(c);
   }
 
-  // What the reading did before the cut.
-  const std::size_t npre = pre_end - a;
-  if (npre < 3) {
-    run_.lead_in = "none";
-  } else {
-    double mu = 0;
-    for (std::size_t k = a; k < pre_end; ++k) mu += v(k);
-    mu /= double(npre);
-    double var = 0;
-    for (std::size_t k = a; k < pre_end; ++k) var += (v(k) - mu) * (v(k) - mu);
-    const double sd_pre = std::sqrt(var / double(npre));
-    const double scale = std::abs(v0);
-    const double step = v0 - mu;
-    if (std::abs(step) <= std::max(5.0 * sd_post, 0.03 * scale)) run_.lead_in = "powered";
-    else if (step < 0) run_.lead_in = "supply";
-    else if (sd_pre > std::max(0.02 * scale, 3.0 * sd_post)) run_.lead_in = "floating";
-    else if (std::abs(mu) <= 0.1 * scale) run_.lead_in = "zeros";
-    else run_.lead_in = "floating";
+  // The lead-in [a, pre_end): level, roughness, maximum and trend.
+  sp.npre = sp.pre_end - sp.a;
+  if (sp.npre >= 3) {
+    WindowFit f;
+    f.clear(sp.a, t(sp.a));
+    sp.pre_max = v(sp.a);
+    for (std::size_t k = sp.a; k < sp.pre_end; ++k) {
+      f.add(t(k), v(k));
+      sp.pre_max = std::max(sp.pre_max, v(k));
+    }
+    sp.pre_mean = f.mean();
+    sp.pre_sd = std::sqrt(std::max(f.svv / f.n - sp.pre_mean * sp.pre_mean, 0.0));
+    // A lead-in falling at a good part of the coast's own rate is more coast: the cut lies
+    // further back.
+    const double s = f.slope(), sd = f.resid_sd();
+    const double s_err = f.sxx() > 0 ? sd / std::sqrt(f.sxx()) : 0.0;
+    sp.pre_declining = sp.npre >= 8 && s < 0 && -s > 3.0 * s_err &&
+                       (sp.clipped || sp.post_slope >= 0 || s <= 0.3 * sp.post_slope);
+    sp.pre_flat = sp.npre >= 8 && std::abs(s) + 2.0 * s_err <= 0.3 * std::abs(sp.post_slope);
+  }
+  return sp;
+}
+
+std::string RunDetector::classify_lead_in(const CutSplit& sp) const {
+  if (sp.npre < 3) return "none";
+  const double scale = std::abs(sp.v0);
+  const double step = sp.v0 - sp.pre_mean;
+  // No step beyond the noise of either side: a powered motor whose speed is the reading.
+  if (std::abs(step) <= std::max({3.0 * sp.sd_post, 4.0 * sp.pre_sd, 0.01 * scale})) return "powered";
+  if (step < 0) return "supply";
+  if (sp.pre_sd > std::max(0.02 * scale, 3.0 * sp.sd_post)) return "floating";
+  if (std::abs(sp.pre_mean) <= 0.1 * scale) return "zeros";
+  return "floating";
+}
+
+bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
+  const std::size_t b = i;
+  const std::size_t w0 = w.first;
+  const std::size_t lower = std::max(lo_, base_);
+  double span = std::max(back_search_s, 2.0 * w.span_s);
+  CutSplit sp;
+  std::string lead;
+  for (int attempt = 0;; ++attempt) {
+    std::size_t a = w0;
+    while (a > lower && t(w0) - t(a - 1) <= span) --a;
+    if (w0 - a < back_search_min_samples) a = w0 - std::min(w0 - lower, back_search_min_samples);
+    sp = split_at_cut(a, b, w);
+    lead = classify_lead_in(sp);
+    // Search further back when the lead-in seen is too short to judge, is itself part of the
+    // decline, or is a "plateau" not shown to be flatter than the coast.
+    const bool unsure = sp.npre < 8 || sp.pre_declining || (lead == "powered" && !sp.pre_flat);
+    if (unsure && a > lower && attempt < 5) {
+      span *= 2;
+      continue;
+    }
+    break;
   }
 
-  v0_ = v0;
-  coast_sd_ = sd_post;
+  // Whether this is a cut at all.
+  bool plausible = sp.v0 > 0;
+  const double scale = std::abs(sp.v0);
+  if (lead == "none") plausible = plausible && sp.a <= stream_start_;  // only a stream that starts mid-coast
+  if (lead == "powered" && sp.pre_sd > 0.05 * scale) plausible = false;  // a rough "plateau"
+  if ((lead == "zeros" || lead == "floating") && sp.v0 < 1.5 * sp.pre_max) plausible = false;
+  if (sp.pre_declining) plausible = false;  // a decline with no cut in reach
+  // A cut without a step (a kink, or a stream that starts mid-coast) rests on the slope alone:
+  // a quarter-second window of noise can fake it, so it needs a window of a second or more.
+  if ((lead == "powered" || lead == "none") && w.span_s < 1.0) plausible = false;
+  if (need_rise_ && sp.v0 < rise_level_) plausible = false;  // the last coast, still creeping down
+  if (!plausible) return false;
+
+  run_ = Run{};
+  run_.number = accepted_ + 1;
+  run_.cut_index = sp.cut_index;
+  run_.t_cut_s = sp.t_cut_s;
+  run_.lead_in = lead;
+  run_note_.clear();
+  if (sp.clipped) {
+    emit_diag(Diagnostic::Severity::warning,
+              fmt::format("run {}: reading pinned at {:g} (converter's top?) from {} to {} ({} samples): "
+                          "the coast is taken from where it leaves it",
+                          run_.number, sp.pin_level, fmt_s(t(sp.pin_first)), fmt_s(t(sp.pin_last)),
+                          sp.pin_last - sp.pin_first + 1));
+  }
+  v0_ = sp.v0;
+  coast_sd_ = sp.sd_post;
   level_min_ = std::numeric_limits<double>::infinity();
   rising_ = 0;
   state_ = State::coasting;
@@ -426,16 +484,19 @@ void RunDetector::start_coast(std::size_t i, const WindowFit& w) {
     events_.push_back(std::move(e));
   }
   reset_window(hold_, run_.cut_index, i + 1);
+  hold_long_live_ = false;  // built when the coast gets low (saves work on the way down)
   coast_checks(i);
+  return true;
 }
 
 void RunDetector::coast_step(std::size_t i) {
   advance(hold_, i);
+  if (hold_long_live_) advance(hold_long_, i);
   coast_checks(i);
 }
 
-void RunDetector::coast_checks(std::size_t i) {
-  if (bt_.size() > opt_.max_buffer) {
+void RunDetector::coast_checks(std::size_t i, bool at_end) {
+  if (buffered() > opt_.max_buffer) {
     RunEvent e;
     e.kind = RunEvent::Kind::ignored;
     e.run = run_;
@@ -456,7 +517,6 @@ void RunDetector::coast_checks(std::size_t i) {
   if (hold_.n < 3 || hold_.first < run_.cut_index) return;
   const double dur = duration(hold_);
   const double mu = hold_.mean();
-  const double sd = hold_.resid_sd();
 
   // Power back before standstill: the reading climbs well above the coast's lowest level.
   if (dur >= 0.5 * hold_.span_s) level_min_ = std::min(level_min_, mu);
@@ -473,14 +533,34 @@ void RunDetector::coast_checks(std::size_t i) {
     rising_ = 0;
   }
 
+  // Standstill: the hold window is flat and low, and either its slope is resolved well below
+  // the coast's mean rate or a four times longer window is flat too (noisy, slow coasts).
   if (dur < 0.9 * hold_.span_s) return;
-  const double s = hold_.slope();
-  const double scale = std::max(std::abs(v0_), std::abs(mu));
-  const double tiny = 1e-12 * (scale > 0 ? scale : 1.0);
-  const bool no_slope = std::abs(s) * std::sqrt(hold_.sxx()) <= flat_t_stat * sd + tiny;
-  const bool small_drop = std::abs(s) * dur <= std::max(3.0 * sd, 0.01 * std::abs(v0_)) + tiny;
-  const bool low = v0_ > 0 ? mu <= standstill_max_fraction * v0_ : true;
-  if (no_slope && small_drop && low) found_standstill(i);
+  if (v0_ > 0 && mu > standstill_max_fraction * v0_) return;  // still high: the usual case, cheap
+  const double mean_rate = (v0_ - mu) / std::max(t(i) - run_.t_cut_s, 1e-9);
+  auto flat = [&](const WindowFit& w, bool* resolved) {
+    if (w.n < 3 || w.first < run_.cut_index) return false;
+    const double d = duration(w);
+    if (d < 0.9 * w.span_s) return false;
+    const double m = w.mean(), s = w.slope(), e = w.resid_sd(), sxx = w.sxx();
+    const double scale = std::max(std::abs(v0_), std::abs(m));
+    const double tiny = 1e-12 * (scale > 0 ? scale : 1.0);
+    const bool no_slope = std::abs(s) * std::sqrt(sxx) <= flat_t_stat * e + tiny;
+    const bool small_drop = std::abs(s) * d <= std::max(3.0 * e, 0.01 * std::abs(v0_)) + tiny;
+    const bool low = v0_ > 0 ? m <= standstill_max_fraction * v0_ : true;
+    if (resolved) *resolved = sxx > 0 && e / std::sqrt(sxx) <= slope_resolution * mean_rate;
+    return no_slope && small_drop && low;
+  };
+  bool resolved = at_end;
+  if (!flat(hold_, at_end ? nullptr : &resolved)) return;
+  if (!resolved) {
+    if (!hold_long_live_) {
+      reset_window(hold_long_, run_.cut_index, i + 1);
+      hold_long_live_ = true;
+    }
+    if (!flat(hold_long_, nullptr)) return;
+  }
+  found_standstill(i);
 }
 
 void RunDetector::found_standstill(std::size_t i) {
@@ -545,7 +625,20 @@ void RunDetector::found_standstill(std::size_t i) {
 
   run_.zero_level = z;
   run_.noise_level = sd_z;
-  if (end_rate >= stop_min_end_rate || amp <= 0) {
+  // … and right before it the reading still falls clearly (an exponential has flattened).
+  double approach_t = std::numeric_limits<double>::infinity();
+  {
+    std::size_t from = stop;
+    while (from > run_.cut_index && t_stop - t(from - 1) <= opt_.stop_hold_s) --from;
+    if (stop >= from + 3) {
+      WindowFit f;
+      f.clear(from, t(from));
+      for (std::size_t j = from; j < stop; ++j) f.add(t(j), v(j));
+      const double e = f.resid_sd();
+      approach_t = e > 0 ? -f.slope() * std::sqrt(f.sxx()) / e : (f.slope() < 0 ? approach_t : 0.0);
+    }
+  }
+  if (end_rate >= stop_min_end_rate || approach_t >= stop_min_approach_t || amp <= 0) {
     run_.stopped = true;
     run_.stop_index = stop;
     run_.t_stop_s = t_stop;
@@ -580,7 +673,7 @@ void RunDetector::tail_ends_by_time(std::size_t upto) {
 }
 
 void RunDetector::tail_step(std::size_t i) {
-  if (bt_.size() > opt_.max_buffer) {
+  if (buffered() > opt_.max_buffer) {
     complete_run(i);
     to_idle(i, false);
     return;
@@ -588,6 +681,7 @@ void RunDetector::tail_step(std::size_t i) {
   // Still falling: the "standstill" was a noisy stretch of a slow coast. Retract the stop and
   // keep coasting (the stop event was provisional; only complete runs are final).
   advance(hold_, i);
+  if (hold_long_live_) advance(hold_long_, i);
   if (hold_.n >= 3 && hold_.first >= run_.stop_index) {
     const double drop = run_.zero_level - hold_.mean();
     if (drop > std::max(4.0 * run_.noise_level / std::sqrt(hold_.n), retract_fraction * (v0_ - run_.zero_level))) {

@@ -15,7 +15,6 @@
 //    the zero level and noise come from that standstill, the stop time from the approach line;
 //  * a coast that approaches standstill asymptotically (pure viscous) is not a stop.
 #include <cstddef>
-#include <deque>
 #include <limits>
 #include <string>
 #include <vector>
@@ -60,7 +59,7 @@ class RunDetector {
 
   State state() const { return state_; }
   std::size_t samples_seen() const { return next_index_; }
-  std::size_t buffered() const { return bt_.size(); }
+  std::size_t buffered() const { return next_index_ - base_; }
 
  private:
   // Least-squares line over a sliding time window of the buffer, O(1) per sample.
@@ -71,16 +70,39 @@ class RunDetector {
     double n = 0, st = 0, stt = 0, sv = 0, svv = 0, stv = 0;
     unsigned updates = 0;
     void clear(std::size_t at, double t_origin);
-    void add(double t, double v);
-    void remove(double t, double v);
+    void add(double t, double v) {
+      t -= t0;
+      n += 1;
+      st += t;
+      stt += t * t;
+      sv += v;
+      svv += v * v;
+      stv += t * v;
+      ++updates;
+    }
+    void remove(double t, double v) {
+      t -= t0;
+      n -= 1;
+      st -= t;
+      stt -= t * t;
+      sv -= v;
+      svv -= v * v;
+      stv -= t * v;
+      ++updates;
+    }
     double mean() const { return n > 0 ? sv / n : 0.0; }
     double sxx() const { return stt - st * st / n; }
     double slope() const;
     double resid_sd() const;
   };
 
-  double t(std::size_t i) const { return bt_[i - base_]; }
-  double v(std::size_t i) const { return bv_[i - base_]; }
+  // The buffer: a ring indexed by absolute sample index, holding [base_, next_index_).
+  struct Sample {
+    double t = 0, v = 0;
+  };
+  double t(std::size_t i) const { return ring_[i & mask_].t; }
+  double v(std::size_t i) const { return ring_[i & mask_].v; }
+  void grow_ring();
   void advance(WindowFit& w, std::size_t i);
   void rebuild(WindowFit& w, std::size_t from, std::size_t to);
   void reset_window(WindowFit& w, std::size_t lo, std::size_t end);
@@ -88,10 +110,23 @@ class RunDetector {
   void trim_idle();
   void idle_step(std::size_t i);
   void coast_step(std::size_t i);
-  void coast_checks(std::size_t i);
+  void coast_checks(std::size_t i, bool at_end = false);
   void tail_step(std::size_t i);
   bool confirms_decline(const WindowFit& w) const;
-  void start_coast(std::size_t i, const WindowFit& w);
+  // Where the cut lies in [a, b] (b = newest sample), and what came before it.
+  struct CutSplit {
+    std::size_t a = 0, cut_index = 0, pre_end = 0, npre = 0;
+    double t_cut_s = 0, v0 = 0, sd_post = 0, post_slope = 0;
+    double pre_mean = 0, pre_sd = 0, pre_max = 0;
+    bool pre_declining = false;
+    bool pre_flat = false;  // lead-in slope shown to be well below the coast's
+    bool clipped = false;
+    std::size_t pin_first = 0, pin_last = 0;
+    double pin_level = 0;
+  };
+  CutSplit split_at_cut(std::size_t a, std::size_t b, const WindowFit& w);
+  std::string classify_lead_in(const CutSplit& sp) const;
+  bool try_start_coast(std::size_t i, const WindowFit& w);
   void found_standstill(std::size_t i);
   void tail_ends_by_time(std::size_t upto);
   void close_unstopped(std::size_t end, const std::string& why);
@@ -103,12 +138,15 @@ class RunDetector {
   RunOptions opt_;
   std::string source_;
   State state_ = State::idle;
-  std::deque<double> bt_, bv_;
-  std::size_t base_ = 0;        // absolute index of bt_[0]
+  std::vector<Sample> ring_;
+  std::size_t mask_ = 0;
+  std::size_t base_ = 0;        // absolute index of the oldest buffered sample
   std::size_t next_index_ = 0;  // absolute index of the next sample
   std::size_t lo_ = 0;          // earliest index the current lead-in search may use
   std::size_t stream_start_ = 0;  // first index after the stream start / last clock restart
   bool need_quiet_ = false;     // after a closed coast: no new run until the decline pauses
+  bool need_rise_ = false;      // after a stop: a new coast must start above rise_level_
+  double rise_level_ = 0;
   bool have_last_t_ = false;
   double last_t_ = 0;
   std::size_t non_finite_ = 0;
@@ -117,7 +155,10 @@ class RunDetector {
   bool have_plateau_ = false;
   int accepted_ = 0;
 
-  WindowFit short_{0.25}, long_{1.0}, hold_{1.0};
+  WindowFit short_{0.25}, long_{1.0}, vlong_{4.0};  // confirm a decline
+  WindowFit hold_{1.0}, hold_long_{3.0};            // confirm a standstill
+  bool hold_long_live_ = false;
+  double quiet_until_s_ = -std::numeric_limits<double>::infinity();  // after a rejected cut
 
   // The open run.
   Run run_;
