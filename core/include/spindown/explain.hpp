@@ -1,0 +1,103 @@
+#pragma once
+// The discrepancy workflow (design §6): fit the base model (the user's belief), find where its
+// simulation and the measurement disagree beyond the noise, try every candidate effect from
+// the library, name the one that explains the disagreement, add it, and repeat until nothing
+// significant remains. A run that needs nothing more comes back with nothing added.
+//
+// Judging "significant" robustly (ripple, quantization and aliasing make residuals
+// correlated): residuals are binned (~0.5 s); the noise of a bin mean is estimated from the
+// data itself (bin-to-bin differences of the residual, never below the white-noise value
+// from second differences); the information criterion uses an effective sample size
+// n_eff = n·σ²_white/(m·σ²_bin) so correlated noise cannot buy an effect.
+#include <cstddef>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "spindown/bench.hpp"
+#include "spindown/effect_fit.hpp"
+#include "spindown/effects.hpp"
+#include "spindown/recording.hpp"
+#include "spindown/runs.hpp"
+
+namespace spindown {
+
+struct ExplainOptions {
+  BenchParams bench;
+  std::vector<const Effect*> base{find_effect("viscous")};  // the lab's belief
+  std::vector<const Effect*> candidates;  // empty = the whole library
+  double min_delta_bic = 10;    // evidence (effective-sample BIC) needed to add an effect
+  double bin_s = 0.5;           // residual bin width for locating the disagreement
+  double systematic_z = 4;      // a bin mean this many noise SEs from 0 is systematic
+  int max_steps = 4;            // effects added at most
+  bool is_valid(std::string* why) const;
+};
+
+// A time (and speed) range where the residual is systematic.
+struct Disagreement {
+  double t_from_s = 0, t_to_s = 0;      // device time (s), the file's clock
+  double tau_from_s = 0, tau_to_s = 0;  // seconds after the cut
+  double omega_from = 0, omega_to = 0;  // model speed (rad/s) at the ends
+  double mean_residual = 0;             // measurement − model, reading unit
+  double peak_residual = 0;             // largest bin mean (signed)
+  double z = 0;                         // peak bin mean / its noise SE
+};
+
+// One candidate tried at a step.
+struct CandidateTrial {
+  std::string effect;
+  EffectFit fit;
+  double delta_bic = 0;       // effective-sample BIC improvement over the current model (> 0 better)
+  double systematic_after = 0;  // share of the systematic bins left (sum of z² beyond threshold)
+  std::string verdict;        // "added", or why it was rejected
+};
+
+struct ExplainStep {
+  std::string added;
+  double rmse_before = 0, rmse_after = 0;
+  std::vector<Disagreement> where;  // before the step
+  std::vector<CandidateTrial> trials;
+  std::string why;
+  EffectFit fit;  // the model after the step
+};
+
+struct ExplainResult {
+  Run run;
+  BenchParams bench;
+  Quantity quantity = Quantity::back_emf_volts;
+  std::string unit;                 // the reading's unit
+  std::vector<double> tau, y;       // samples used: seconds after the cut, raw readings
+  double noise_level = 0;           // white noise of a reading (second differences)
+  double bin_noise = 0;             // noise SE of a bin mean in the base residual
+  std::size_t bin_samples = 0;
+  EffectFit base;
+  std::vector<ExplainStep> steps;
+  EffectFit final_fit;
+  std::vector<CandidateTrial> final_trials;  // the last round, when every candidate was rejected
+  std::vector<Disagreement> remaining;  // systematic ranges left after the last step
+  std::string conclusion;               // why the workflow stopped
+  bool ok = false;
+  std::string message;                  // why the run could not be explained
+
+  double rmse_base() const { return base.rmse; }
+  double rmse_final() const { return final_fit.rmse; }
+};
+
+ExplainResult explain_run(const Recording& rec, const Run& run, const ExplainOptions& opt);
+// The same on raw arrays (t in seconds on the recording's clock), for the live fitter.
+ExplainResult explain_run(std::span<const double> t_s, std::span<const double> value, Quantity q, const Run& run,
+                          const ExplainOptions& opt);
+
+// Residual analysis used by the workflow (exposed for tests and reports).
+struct ResidualBins {
+  std::size_t m = 0;                 // samples per bin
+  std::vector<std::size_t> first;    // first sample of each bin
+  std::vector<double> mean;          // mean residual per bin
+  double white = 0;                  // white-noise σ of one reading
+  double bin_se = 0;                 // noise SE of a bin mean
+};
+ResidualBins bin_residuals(std::span<const double> residual, std::size_t m, double white_sigma);
+// White noise of the readings from second differences over [0, n) (robust to smooth signal).
+double white_noise(std::span<const double> y);
+
+}  // namespace spindown

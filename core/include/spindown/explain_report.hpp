@@ -1,0 +1,43 @@
+#pragma once
+// Reporting the discrepancy workflow: the story in words, design §5's `explain --json`
+// object, and an SVG figure (measurement, base and final simulation; residuals before and
+// after). Shared by `spindown explain` and the live fitter.
+#include <cstddef>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "spindown/explain.hpp"
+#include "spindown/recording.hpp"
+
+namespace spindown {
+
+// Everything `spindown explain` learnt about one input file.
+struct FileExplain {
+  std::string file;
+  std::size_t samples = 0;
+  std::vector<Diagnostic> diagnostics;
+  std::vector<ExplainResult> runs;
+  std::vector<std::string> failures;  // non-empty means exit code 1
+  bool usable() const { return failures.empty(); }
+};
+
+using ExplainJson = nlohmann::ordered_json;
+
+// {"run":1,"base":[…],"steps":[{"added":…,"rmse_before":…,"rmse_after":…,"where":[{"t_from_s":…,
+// "t_to_s":…,"mean_residual":…}],"why":…}],"final":[…],"rmse_base":…,"rmse_final":…} plus extra
+// fields (units, parameters, candidates, noise, conclusion). Non-finite numbers become null.
+ExplainJson explain_run_json(const ExplainResult& r);
+ExplainJson explain_report_json(std::span<const FileExplain> files);
+
+// The story, step by step, for people.
+std::string format_explain(const ExplainResult& r);
+// The same for every run of a file, headed by the file name.
+std::string format_file_explain(const FileExplain& file);
+
+// One SVG document; one figure (two panels) per run, stacked. Titles name file and run.
+std::string explain_svg(std::span<const FileExplain> files);
+
+}  // namespace spindown

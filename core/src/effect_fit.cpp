@@ -1,0 +1,540 @@
+#include "spindown/effect_fit.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <exception>
+#include <fmt/format.h>
+#include <limits>
+#include <nlopt.hpp>
+
+#include "spindown/effect_simulator.hpp"
+
+namespace spindown {
+namespace {
+
+constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+
+// Bounds, typical sizes and a simulator for one combination on one run.
+struct Setup {
+  const std::vector<const Effect*>& effects;
+  const EffectFitData& data;
+  RunScale scale;
+  EffectSimulator sim;
+  std::vector<double> lo, hi, typical;
+
+  Setup(const std::vector<const Effect*>& e, const EffectFitData& d)
+      : effects(e), data(d), scale(run_scale(d)), sim(e, d.k) {
+    const int P = sim.size();
+    lo.assign(P, 0.0);
+    hi.assign(P, 0.0);
+    typical.assign(P, 0.0);
+    lo[0] = 1e-6 * scale.omega0;
+    hi[0] = 10.0 * scale.omega0 + 1.0;
+    typical[0] = scale.omega0;
+    for (std::size_t i = 0; i < e.size(); ++i)
+      for (int j = 0; j < e[i]->size(); ++j) {
+        const EffectParam& p = e[i]->params[j];
+        const int at = sim.first_param(i) + j;
+        lo[at] = p.lower(scale);
+        hi[at] = p.upper(scale);
+        typical[at] = p.typical(scale);
+      }
+  }
+  void clamp(std::vector<double>& th) const {
+    for (std::size_t j = 0; j < th.size(); ++j) th[j] = std::clamp(th[j], lo[j], hi[j]);
+  }
+};
+
+double sse_of(const Setup& s, const std::vector<double>& th, std::vector<double>& model) {
+  model.resize(s.data.tau.size());
+  s.sim.simulate(th, s.data.tau, model);
+  double sse = 0;
+  for (std::size_t i = 0; i < model.size(); ++i) {
+    const double r = s.data.y[i] - model[i];
+    sse += r * r;
+  }
+  return std::isfinite(sse) ? sse : std::numeric_limits<double>::infinity();
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+// Starting point from the integral form, linear in the amplitudes:
+//   ω̂(τ_i) = ω̂(τ_0) − Σ_e a_e·∫_{τ_0}^{τ_i} shape_e(ω̂) dτ,  ω̂ = (y − offset)/k,
+// over the samples before the detected stop; no derivative of noisy data is taken. Shape
+// parameters (Stribeck speed) are tried on a small grid; negative amplitudes are dropped
+// (active set) so the start is feasible.
+std::vector<double> integral_start(const Setup& s) {
+  const auto& d = s.data;
+  std::vector<double> th(s.typical);
+  th[0] = s.scale.omega0;
+  double offset = 0;
+  for (std::size_t e = 0; e < s.effects.size(); ++e) {
+    if (s.effects[e]->kind != EffectKind::sensor) continue;
+    // The library's sensor effects are additive in their first parameter: start it at the
+    // reading at standstill when the run shows one.
+    const std::size_t tail = d.tau.size() - std::min(d.moving, d.tau.size());
+    const double v = tail >= 5 ? median(std::vector<double>(d.y.begin() + static_cast<std::ptrdiff_t>(d.moving), d.y.end())) : 0.0;
+    th[s.sim.first_param(e)] = v;
+    offset += v;
+  }
+  const std::size_t m = std::min(d.moving, d.tau.size());
+  std::vector<int> torque;  // effect indices with an amplitude to regress
+  for (std::size_t e = 0; e < s.effects.size(); ++e)
+    if (s.effects[e]->kind == EffectKind::torque && s.effects[e]->shape) torque.push_back(static_cast<int>(e));
+  if (m < torque.size() + 3) return th;
+
+  std::vector<double> w(m);
+  for (std::size_t i = 0; i < m; ++i) w[i] = (d.y[i] - offset) / d.k;
+
+  // Grid over the shape parameters (at most one shaped effect varies at a time: the grid of
+  // the first shaped effect, others at their typical value).
+  std::vector<std::vector<double>> shape_par(s.effects.size());
+  int gridded = -1;
+  for (int e : torque) {
+    const Effect* ef = s.effects[e];
+    shape_par[e].assign(th.begin() + s.sim.first_param(e), th.begin() + s.sim.first_param(e) + ef->size());
+    if (ef->shape_starts && gridded < 0) gridded = e;
+  }
+  std::vector<double> grid{0.0};
+  if (gridded >= 0) grid = s.effects[gridded]->shape_starts(s.scale);
+
+  double best_sse = std::numeric_limits<double>::infinity();
+  std::vector<double> best_th = th;
+  const int q = static_cast<int>(torque.size());
+  Eigen::MatrixXd a(static_cast<Eigen::Index>(m), q + 1);
+  Eigen::VectorXd b(static_cast<Eigen::Index>(m));
+  for (double g : grid) {
+    if (gridded >= 0 && shape_par[gridded].size() > 1) shape_par[gridded][1] = g;
+    for (int c = 0; c < q; ++c) {
+      const int e = torque[c];
+      double integral = 0, prev = s.effects[e]->shape(shape_par[e].data(), std::max(w[0], 0.0));
+      a(0, c + 1) = 0;
+      for (std::size_t i = 1; i < m; ++i) {
+        const double cur = s.effects[e]->shape(shape_par[e].data(), std::max(w[i], 0.0));
+        integral += 0.5 * (prev + cur) * (d.tau[i] - d.tau[i - 1]);
+        prev = cur;
+        a(static_cast<Eigen::Index>(i), c + 1) = -integral;
+      }
+    }
+    for (std::size_t i = 0; i < m; ++i) {
+      a(static_cast<Eigen::Index>(i), 0) = 1.0;
+      b[static_cast<Eigen::Index>(i)] = w[i];
+    }
+    // Non-negative amplitudes by an active set: drop the most negative, solve again.
+    std::vector<bool> active(q, true);
+    Eigen::VectorXd sol = Eigen::VectorXd::Zero(q + 1);
+    for (int round = 0; round <= q; ++round) {
+      std::vector<Eigen::Index> cols{0};
+      for (int c = 0; c < q; ++c)
+        if (active[c]) cols.push_back(c + 1);
+      Eigen::MatrixXd sub(a.rows(), static_cast<Eigen::Index>(cols.size()));
+      for (std::size_t c = 0; c < cols.size(); ++c) sub.col(static_cast<Eigen::Index>(c)) = a.col(cols[c]);
+      const Eigen::LDLT<Eigen::MatrixXd> ldlt(sub.transpose() * sub);
+      if (ldlt.info() != Eigen::Success) break;
+      const Eigen::VectorXd x = ldlt.solve(sub.transpose() * b);
+      if (!x.allFinite()) break;
+      sol.setZero();
+      for (std::size_t c = 0; c < cols.size(); ++c) sol[cols[c]] = x[static_cast<Eigen::Index>(c)];
+      int worst = -1;
+      for (int c = 0; c < q; ++c)
+        if (active[c] && sol[c + 1] < 0 && (worst < 0 || sol[c + 1] < sol[worst + 1])) worst = c;
+      if (worst < 0) break;
+      active[worst] = false;
+    }
+    const double sse = (a * sol - b).squaredNorm();
+    if (!(sse < best_sse)) continue;
+    best_sse = sse;
+    best_th = th;
+    // ω at the cut: back from the first sample with the fitted deceleration.
+    double r0 = 0;
+    for (int c = 0; c < q; ++c) {
+      const int e = torque[c];
+      const int at = s.sim.first_param(e);
+      for (std::size_t j = 1; j < shape_par[e].size(); ++j) best_th[at + j] = shape_par[e][j];
+      // A small floor keeps the shape parameters' sensitivities alive.
+      best_th[at] = std::max(sol[c + 1], 0.02 * s.typical[at]);
+      r0 += best_th[at] * s.effects[e]->shape(shape_par[e].data(), std::max(sol[0], 0.0));
+    }
+    best_th[0] = sol[0] + r0 * std::max(d.tau[0], 0.0);
+  }
+  s.clamp(best_th);
+  return best_th;
+}
+
+// Levenberg–Marquardt on the simulator's exact sensitivities, bounds by projection.
+struct LmResult {
+  std::vector<double> theta;
+  double sse = 0;
+  int evals = 0;
+  bool converged = false;
+};
+
+LmResult levenberg_marquardt(const Setup& s, std::vector<double> th) {
+  const std::size_t n = s.data.tau.size();
+  const int P = s.sim.size();
+  LmResult out;
+  std::vector<double> model(n), jac(n * P), model_try(n);
+  auto assemble = [&](const std::vector<double>& t, Eigen::MatrixXd& jtj, Eigen::VectorXd& jtr) {
+    s.sim.simulate(t, s.data.tau, model, jac);
+    jtj.setZero(P, P);
+    jtr.setZero(P);
+    double sse = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double r = s.data.y[i] - model[i];
+      sse += r * r;
+      const double* g = &jac[i * P];
+      for (int a = 0; a < P; ++a) {
+        jtr[a] += g[a] * r;
+        for (int b = 0; b <= a; ++b) jtj(a, b) += g[a] * g[b];
+      }
+    }
+    for (int a = 0; a < P; ++a)
+      for (int b = a + 1; b < P; ++b) jtj(a, b) = jtj(b, a);
+    return std::isfinite(sse) ? sse : std::numeric_limits<double>::infinity();
+  };
+  Eigen::MatrixXd jtj, jtj_try;
+  Eigen::VectorXd jtr, jtr_try;
+  double sse = assemble(th, jtj, jtr);
+  out.evals = 1;
+  double lambda = 1e-3;
+  for (int it = 0; it < 100 && out.evals < 150; ++it) {
+    Eigen::MatrixXd a = jtj;
+    Eigen::VectorXd rhs = jtr;
+    const double floor = 1e-12 * (jtj.diagonal().maxCoeff() + 1e-300);
+    for (int j = 0; j < P; ++j) {
+      a(j, j) = jtj(j, j) * (1.0 + lambda) + lambda * floor;
+      // A parameter on its bound that the descent direction pushes outward stays there
+      // (active set); otherwise projection would make LM stall on rejected steps.
+      const bool at_lo = th[j] <= s.lo[j] && jtr[j] <= 0;
+      const bool at_hi = th[j] >= s.hi[j] && jtr[j] >= 0;
+      if (at_lo || at_hi) {
+        a.row(j).setZero();
+        a.col(j).setZero();
+        a(j, j) = 1;
+        rhs[j] = 0;
+      }
+    }
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(a);
+    if (ldlt.info() != Eigen::Success) break;
+    const Eigen::VectorXd step = ldlt.solve(rhs);
+    if (!step.allFinite()) break;
+    std::vector<double> trial(th);
+    for (int j = 0; j < P; ++j) trial[j] += step[j];
+    s.clamp(trial);
+    const double sse_try = assemble(trial, jtj_try, jtr_try);
+    ++out.evals;
+    if (sse_try < sse) {
+      const double gain = sse - sse_try;
+      bool small = true;
+      for (int j = 0; j < P; ++j)
+        if (std::abs(trial[j] - th[j]) > 1e-7 * std::max(std::abs(th[j]), 1e-6 * s.typical[j])) small = false;
+      th = trial;
+      jtj = jtj_try;
+      jtr = jtr_try;
+      sse = sse_try;
+      lambda = std::max(lambda / 10, 1e-12);
+      if (small || gain <= 1e-10 * sse) {
+        out.converged = true;
+        break;
+      }
+    } else {
+      lambda *= 10;
+      if (lambda > 1e10) {
+        out.converged = true;  // no step improves: at a (bounded) minimum
+        break;
+      }
+    }
+  }
+  out.theta = th;
+  out.sse = sse;
+  return out;
+}
+
+// NLopt: bounded L-BFGS on θ_j / scale_j with the sensitivity gradient. Never lets an
+// exception cross the C callback (design §7).
+struct NloptProblem {
+  const Setup* s;
+  std::vector<double> scale;
+  double sse0 = 1;
+  int evals = 0;
+  std::vector<double> model, jac, th;
+  std::exception_ptr error;
+};
+
+double nlopt_objective(unsigned n, const double* x, double* grad, void* data) {
+  auto* pb = static_cast<NloptProblem*>(data);
+  try {
+    ++pb->evals;
+    const Setup& s = *pb->s;
+    const std::size_t m = s.data.tau.size();
+    for (unsigned j = 0; j < n; ++j) pb->th[j] = x[j] * pb->scale[j];
+    pb->model.resize(m);
+    pb->jac.resize(grad ? m * n : 0);
+    s.sim.simulate(pb->th, s.data.tau, pb->model, grad ? std::span<double>(pb->jac) : std::span<double>());
+    double sse = 0;
+    if (grad) std::fill(grad, grad + n, 0.0);
+    for (std::size_t i = 0; i < m; ++i) {
+      const double r = s.data.y[i] - pb->model[i];
+      sse += r * r;
+      if (grad)
+        for (unsigned j = 0; j < n; ++j) grad[j] -= 2 * r * pb->jac[i * n + j];
+    }
+    if (grad)
+      for (unsigned j = 0; j < n; ++j) grad[j] *= pb->scale[j] / pb->sse0;
+    return sse / pb->sse0;
+  } catch (...) {
+    pb->error = std::current_exception();
+    throw nlopt::forced_stop();
+  }
+}
+
+// Returns "" on success or why it failed; th becomes the best point found.
+std::string refine_with_nlopt(const Setup& s, std::vector<double>& th, int max_evals, int& evals) {
+  const int P = s.sim.size();
+  NloptProblem pb{&s, std::vector<double>(P), 1.0, 0, {}, {}, th, nullptr};
+  std::vector<double> x(P), lb(P), ub(P);
+  for (int j = 0; j < P; ++j) {
+    pb.scale[j] = std::max(std::abs(th[j]), std::abs(s.typical[j]) * 1e-3) + 1e-300;
+    x[j] = th[j] / pb.scale[j];
+    lb[j] = s.lo[j] / pb.scale[j];
+    ub[j] = s.hi[j] / pb.scale[j];
+    x[j] = std::clamp(x[j], lb[j], ub[j]);
+  }
+  std::vector<double> model;
+  pb.sse0 = std::max(sse_of(s, th, model), 1e-300);
+  std::string why;
+  double fmin = 0;
+  try {
+    nlopt::opt opt(nlopt::LD_LBFGS, static_cast<unsigned>(P));
+    opt.set_lower_bounds(lb);
+    opt.set_upper_bounds(ub);
+    opt.set_min_objective(nlopt_objective, &pb);
+    // After LM the polish only has to confirm the optimum: a loose tolerance ends it in a
+    // few evaluations; as the full refinement it runs to 1e-12.
+    opt.set_ftol_rel(max_evals <= 10 ? 1e-9 : 1e-12);
+    opt.set_xtol_rel(max_evals <= 10 ? 1e-7 : 1e-10);
+    opt.set_maxeval(max_evals);
+    const nlopt::result res = opt.optimize(x, fmin);
+    if (res == nlopt::MAXEVAL_REACHED) why = fmt::format("no convergence within {} evaluations", max_evals);
+  } catch (const nlopt::roundoff_limited&) {
+    // at the optimum to machine precision: accept
+  } catch (const nlopt::forced_stop&) {
+    why = "the objective failed";
+    if (pb.error) {
+      try {
+        std::rethrow_exception(pb.error);
+      } catch (const std::exception& e) {
+        why = fmt::format("the objective failed: {}", e.what());
+      }
+    }
+  } catch (const std::exception& e) {
+    why = fmt::format("NLopt: {}", e.what());
+  }
+  evals += pb.evals;
+  std::vector<double> cand(P);
+  for (int j = 0; j < P; ++j) cand[j] = x[j] * pb.scale[j];
+  s.clamp(cand);
+  // NLopt returns its best point; keep it only when it is no worse.
+  if (sse_of(s, cand, model) <= sse_of(s, th, model)) th = cand;
+  return why;
+}
+
+// Covariance of θ from the Jacobian: classic s²(JᵀJ)⁻¹ widened per parameter to the
+// Newey–West (HAC) variance when residuals are correlated (ripple, quantization), as fit.cpp.
+// Parameters with no influence (a shape parameter whose amplitude is 0) get NaN.
+Eigen::MatrixXd covariance(const Setup& s, const std::vector<double>& th, bool& ok) {
+  const std::size_t n = s.data.tau.size();
+  const int P = s.sim.size();
+  std::vector<double> model(n), jacv(n * P);
+  s.sim.simulate(th, s.data.tau, model, jacv);
+  Eigen::MatrixXd cov = Eigen::MatrixXd::Constant(P, P, nan);
+  std::vector<int> keep;
+  for (int j = 0; j < P; ++j) {
+    double norm = 0;
+    for (std::size_t i = 0; i < n; ++i) norm += jacv[i * P + j] * jacv[i * P + j];
+    if (norm > 0 && std::isfinite(norm)) keep.push_back(j);
+  }
+  const int p = static_cast<int>(keep.size());
+  const auto N = static_cast<Eigen::Index>(n);
+  Eigen::MatrixXd jac(N, p);
+  Eigen::VectorXd res(N);
+  for (Eigen::Index i = 0; i < N; ++i) {
+    res[i] = s.data.y[static_cast<std::size_t>(i)] - model[static_cast<std::size_t>(i)];
+    for (int c = 0; c < p; ++c) jac(i, c) = jacv[static_cast<std::size_t>(i) * P + keep[c]];
+  }
+  ok = false;
+  if (p == 0 || N <= p) return cov;
+  // Column scaling for conditioning.
+  Eigen::VectorXd cs = jac.colwise().norm().transpose();
+  const Eigen::MatrixXd js = jac * cs.cwiseInverse().asDiagonal();
+  const Eigen::MatrixXd jtj = js.transpose() * js;
+  const Eigen::LDLT<Eigen::MatrixXd> ldlt(jtj);
+  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return cov;
+  Eigen::MatrixXd inv = ldlt.solve(Eigen::MatrixXd::Identity(p, p));
+  if (!inv.allFinite() || inv.diagonal().maxCoeff() > 1e12) return cov;
+  const double s2 = res.squaredNorm() / static_cast<double>(N - p);
+  const Eigen::MatrixXd classic = s2 * inv;
+  const int lags = static_cast<int>(std::ceil(4.0 * std::pow(static_cast<double>(N) / 100.0, 2.0 / 9.0)));
+  const Eigen::MatrixXd score = js.array().colwise() * res.array();
+  Eigen::MatrixXd meat = score.transpose() * score;
+  for (int l = 1; l <= lags && l < N; ++l) {
+    const double wgt = 1.0 - l / (lags + 1.0);
+    const Eigen::MatrixXd gamma = score.topRows(N - l).transpose() * score.bottomRows(N - l);
+    meat += wgt * (gamma + gamma.transpose());
+  }
+  const Eigen::MatrixXd hac = (static_cast<double>(N) / static_cast<double>(N - p)) * inv * meat * inv;
+  Eigen::VectorXd widen(p);
+  for (int j = 0; j < p; ++j) widen[j] = std::sqrt(std::max(1.0, hac(j, j) / classic(j, j)));
+  Eigen::MatrixXd c = widen.asDiagonal() * classic * widen.asDiagonal();
+  c = cs.cwiseInverse().asDiagonal() * c * cs.cwiseInverse().asDiagonal();
+  for (int a = 0; a < p; ++a)
+    for (int b = 0; b < p; ++b) cov(keep[a], keep[b]) = c(a, b);
+  ok = c.allFinite() && p == P;
+  return cov;
+}
+
+}  // namespace
+
+std::vector<std::string> EffectFit::names() const {
+  std::vector<std::string> out;
+  for (const Effect* e : effects) out.emplace_back(e->name);
+  return out;
+}
+
+std::string EffectFit::label() const {
+  std::string out;
+  for (const Effect* e : effects) out += (out.empty() ? "" : "+") + std::string(e->name);
+  return out.empty() ? "none" : out;
+}
+
+const Parameter* EffectFit::param(std::string_view name) const {
+  for (const auto& p : params)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
+RunScale run_scale(const EffectFitData& d) {
+  RunScale s;
+  const std::size_t n = d.tau.size();
+  if (n == 0) return s;
+  double first = 0, ymax = 0;
+  for (std::size_t i = 0; i < std::min<std::size_t>(n, 5); ++i) first = std::max(first, d.y[i]);
+  for (std::size_t i = 0; i < n; ++i) ymax = std::max(ymax, std::abs(d.y[i]));
+  s.omega0 = std::max(first / d.k, 1e-3);
+  const std::size_t m = std::clamp<std::size_t>(d.moving, 1, n);
+  s.duration_s = std::max(d.tau[m - 1], 0.1);
+  s.reading_max = std::max(ymax, 1e-9);
+  return s;
+}
+
+EffectFit fit_effects(const std::vector<const Effect*>& effects, const EffectFitData& data, const EffectFit* warm) {
+  EffectFit out;
+  out.effects = effects;
+  out.n = data.tau.size();
+  const Setup s(effects, data);
+  const int P = s.sim.size();
+  const std::size_t n = data.tau.size();
+  if (n < static_cast<std::size_t>(P) + 3 || std::min(data.moving, n) < static_cast<std::size_t>(P) + 2) {
+    out.message = fmt::format("{} samples while moving: too few to fit {} parameters", data.moving, P);
+    out.theta.assign(P, nan);
+    out.sse = out.rmse = out.aic = out.bic = nan;
+    return out;
+  }
+
+  std::vector<double> model;
+  std::vector<double> th = integral_start(s);
+  double sse_start = sse_of(s, th, model);
+  std::vector<double> th_nested;  // the warm fit's model exactly, new amplitudes ~0
+  if (warm && !warm->theta.empty() && std::isfinite(warm->sse)) {
+    th_nested = th;
+    th_nested[0] = warm->theta[0];
+    std::vector<double> th_warm = th;
+    th_warm[0] = warm->theta[0];
+    for (std::size_t e = 0; e < effects.size(); ++e) {
+      const int at = s.sim.first_param(e);
+      bool found = false;
+      for (std::size_t w = 0; w < warm->effects.size(); ++w)
+        if (warm->effects[w] == effects[e]) {
+          EffectSimulator ws(warm->effects, data.k);
+          for (int j = 0; j < effects[e]->size(); ++j) {
+            th_warm[at + j] = warm->theta[ws.first_param(w) + j];
+            th_nested[at + j] = th_warm[at + j];
+          }
+          found = true;
+        }
+      if (!found) th_nested[at] = effects[e]->kind == EffectKind::sensor ? 0.0 : s.lo[at] + 1e-6 * s.typical[at];
+    }
+    s.clamp(th_warm);
+    s.clamp(th_nested);
+    const double sse_warm = sse_of(s, th_warm, model);
+    if (sse_warm < sse_start) {
+      th = th_warm;
+      sse_start = sse_warm;
+    }
+  }
+
+  LmResult lm = levenberg_marquardt(s, th);
+  out.evaluations = lm.evals;
+  if (!th_nested.empty() && lm.sse > warm->sse * (1 + 1e-9)) {
+    // Nested models can only fit better: restart from the smaller model's optimum.
+    LmResult again = levenberg_marquardt(s, th_nested);
+    out.evaluations += again.evals;
+    if (again.sse < lm.sse) lm = again;
+  }
+  th = lm.theta;
+  // NLopt under bounds: a short polish after LM, the full refinement when LM did not converge.
+  const std::string why = refine_with_nlopt(s, th, lm.converged ? 5 : 300, out.evaluations);
+  const bool solved = lm.converged || why.empty();
+
+  out.theta = th;
+  out.sse = sse_of(s, th, out.simulated);
+  const double dn = static_cast<double>(n);
+  out.rmse = std::sqrt(out.sse / dn);
+  const double ll = dn * std::log(std::max(out.sse / dn, 1e-300));
+  out.aic = ll + 2.0 * P;
+  out.bic = ll + P * std::log(dn);
+  out.omega0 = th[0];
+  out.t_stop_pred_s = s.sim.stop_time(th);
+
+  bool cov_ok = false;
+  const Eigen::MatrixXd cov = covariance(s, th, cov_ok);
+  out.converged = solved;
+  if (!solved)
+    out.message = why;
+  else if (!cov_ok)
+    out.message = "some parameters are not identifiable from this run (no influence or singular Jacobian)";
+
+  const double J = data.inertia_kg_m2;
+  auto se = [&](int j, double factor) {
+    const double v = cov(j, j);
+    return std::isfinite(v) && v >= 0 ? std::sqrt(v) * std::abs(factor) : nan;
+  };
+  int stribeck_at = -1, coulomb_at = -1;
+  for (std::size_t e = 0; e < effects.size(); ++e) {
+    const int at = s.sim.first_param(e);
+    if (effects[e]->name == "stribeck") stribeck_at = at;
+    if (effects[e]->name == "coulomb") coulomb_at = at;
+    for (int j = 0; j < effects[e]->size(); ++j) {
+      const EffectParam& p = effects[e]->params[j];
+      const double f = p.per_inertia ? J : 1.0;
+      out.params.push_back({std::string(p.name), th[at + j] * f, se(at + j, f),
+                            p.unit == "reading" ? data.unit : std::string(p.unit)});
+    }
+  }
+  out.params.push_back({"omega0", th[0], se(0, 1.0), "rad/s"});
+  if (stribeck_at >= 0 && coulomb_at >= 0) {
+    // Derived: the static friction c_s = c_c + (c_s − c_c).
+    const double var = cov(coulomb_at, coulomb_at) + cov(stribeck_at, stribeck_at) + 2 * cov(coulomb_at, stribeck_at);
+    out.params.push_back({"c_s", (th[coulomb_at] + th[stribeck_at]) * J,
+                          std::isfinite(var) && var >= 0 ? std::sqrt(var) * J : nan, "N*m"});
+  }
+  return out;
+}
+
+}  // namespace spindown

@@ -1,0 +1,323 @@
+#include "spindown/explain.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+#include <limits>
+
+#include "spindown/effect_simulator.hpp"
+
+namespace spindown {
+namespace {
+
+constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+
+double median_of(std::vector<double> v) {
+  if (v.empty()) return 0;
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+std::vector<double> residual_of(std::span<const double> y, const EffectFit& f) {
+  std::vector<double> r(y.size());
+  for (std::size_t i = 0; i < y.size(); ++i) r[i] = y[i] - f.simulated[i];
+  return r;
+}
+
+// How much systematic disagreement a residual carries: Σ z² over the bins beyond what noise
+// alone gives (K bins → K), judged with a fixed bin noise so models compare fairly.
+double systematic_mass(const ResidualBins& b, double bin_se) {
+  double s = 0;
+  for (double m : b.mean) s += (m / bin_se) * (m / bin_se);
+  return std::max(0.0, s - static_cast<double>(b.mean.size()));
+}
+
+// A chi-square excess beyond 3 standard deviations (2K variance) is not noise.
+bool mass_significant(double mass, std::size_t bins) { return mass > 3.0 * std::sqrt(2.0 * static_cast<double>(bins)); }
+
+// Model speed (rad/s) at each sample, sensor terms removed.
+std::vector<double> model_speed(const EffectFit& f, std::span<const double> tau, double k) {
+  if (f.theta.empty() || !std::isfinite(f.theta[0])) return std::vector<double>(tau.size(), nan);
+  const EffectSimulator sim(f.effects, k);
+  return sim.omega(f.theta, tau);
+}
+
+std::vector<Disagreement> locate(const ResidualBins& b, double bin_se, double z_thr, std::span<const double> tau,
+                                 std::span<const double> residual, const std::vector<double>& speed, double t_cut) {
+  std::vector<Disagreement> out;
+  const std::size_t nb = b.mean.size();
+  std::size_t k = 0;
+  while (k < nb) {
+    const double z = b.mean[k] / bin_se;
+    if (std::abs(z) <= z_thr) {
+      ++k;
+      continue;
+    }
+    std::size_t e = k + 1;
+    while (e < nb && std::abs(b.mean[e] / bin_se) > z_thr && (b.mean[e] > 0) == (z > 0)) ++e;
+    const std::size_t i0 = b.first[k];
+    const std::size_t i1 = e < nb ? b.first[e] : tau.size();  // one past the last sample
+    Disagreement d;
+    d.tau_from_s = tau[i0];
+    d.tau_to_s = tau[i1 - 1];
+    d.t_from_s = d.tau_from_s + t_cut;
+    d.t_to_s = d.tau_to_s + t_cut;
+    d.omega_from = speed[i0];
+    d.omega_to = speed[i1 - 1];
+    double sum = 0;
+    for (std::size_t i = i0; i < i1; ++i) sum += residual[i];
+    d.mean_residual = sum / static_cast<double>(i1 - i0);
+    for (std::size_t j = k; j < e; ++j)
+      if (std::abs(b.mean[j]) > std::abs(d.peak_residual)) d.peak_residual = b.mean[j];
+    d.z = d.peak_residual / bin_se;
+    out.push_back(d);
+    k = e;
+  }
+  // Keep the few that carry most of the disagreement, in time order.
+  constexpr std::size_t keep = 6;
+  if (out.size() > keep) {
+    auto weight = [](const Disagreement& d) { return std::abs(d.mean_residual) * (d.tau_to_s - d.tau_from_s + 1e-3); };
+    std::vector<Disagreement> sorted = out;
+    std::sort(sorted.begin(), sorted.end(), [&](const auto& a, const auto& c) { return weight(a) > weight(c); });
+    sorted.resize(keep);
+    std::sort(sorted.begin(), sorted.end(), [](const auto& a, const auto& c) { return a.tau_from_s < c.tau_from_s; });
+    out = sorted;
+  }
+  return out;
+}
+
+bool contains(const std::vector<const Effect*>& v, const Effect* e) {
+  return std::find(v.begin(), v.end(), e) != v.end();
+}
+
+// The model plus one effect, in library order (so names and parameters read the same way).
+std::vector<const Effect*> with_effect(const std::vector<const Effect*>& model, const Effect* e) {
+  std::vector<const Effect*> out;
+  for (const Effect& lib : effect_library())
+    if (&lib == e || contains(model, &lib)) out.push_back(&lib);
+  return out;
+}
+
+}  // namespace
+
+bool ExplainOptions::is_valid(std::string* why) const {
+  if (!bench.is_valid(why)) return false;
+  auto fail = [&](std::string m) {
+    if (why) *why = std::move(m);
+    return false;
+  };
+  if (base.empty()) return fail("the base model needs at least one effect");
+  bool torque = false;
+  for (const Effect* e : base) {
+    if (!e) return fail("unknown effect in the base model");
+    torque = torque || e->kind == EffectKind::torque;
+  }
+  if (!torque) return fail("the base model needs a friction term (viscous, coulomb, …)");
+  for (const Effect* e : candidates)
+    if (!e) return fail("unknown candidate effect");
+  if (!(min_delta_bic >= 0) || !(bin_s > 0) || !(systematic_z > 0) || max_steps < 0)
+    return fail("thresholds must be positive");
+  return true;
+}
+
+double white_noise(std::span<const double> y) {
+  if (y.size() < 3) return 0;
+  double s = 0;
+  for (std::size_t i = 1; i + 1 < y.size(); ++i) {
+    const double d2 = y[i + 1] - 2 * y[i] + y[i - 1];
+    s += d2 * d2;
+  }
+  return std::sqrt(s / (6.0 * static_cast<double>(y.size() - 2)));
+}
+
+ResidualBins bin_residuals(std::span<const double> r, std::size_t m, double white_sigma) {
+  ResidualBins b;
+  b.m = std::max<std::size_t>(m, 1);
+  b.white = white_sigma;
+  const std::size_t n = r.size();
+  for (std::size_t i = 0; i < n; i += b.m) {
+    // A short last bin joins the one before it.
+    if (i > 0 && n - i < b.m / 2) break;
+    b.first.push_back(i);
+  }
+  for (std::size_t k = 0; k < b.first.size(); ++k) {
+    const std::size_t i0 = b.first[k];
+    const std::size_t i1 = k + 1 < b.first.size() ? b.first[k + 1] : n;
+    double s = 0;
+    for (std::size_t i = i0; i < i1; ++i) s += r[i];
+    b.mean.push_back(s / static_cast<double>(i1 - i0));
+  }
+  // Noise of a bin mean from the data: bin-to-bin jumps (a smooth misfit barely changes from
+  // one bin to the next; correlated noise does), never below the white-noise value.
+  std::vector<double> jumps;
+  for (std::size_t k = 1; k < b.mean.size(); ++k) jumps.push_back(std::abs(b.mean[k] - b.mean[k - 1]));
+  const double from_jumps = jumps.size() >= 4 ? 1.4826 * median_of(jumps) / std::sqrt(2.0) : 0.0;
+  b.bin_se = std::max({white_sigma / std::sqrt(static_cast<double>(b.m)), from_jumps, 1e-15});
+  return b;
+}
+
+ExplainResult explain_run(std::span<const double> t_s, std::span<const double> value, Quantity q, const Run& run,
+                          const ExplainOptions& opt) {
+  ExplainResult out;
+  out.run = run;
+  out.bench = opt.bench;
+  out.quantity = q;
+  out.unit = std::string(quantity_unit(q));
+  std::string why;
+  if (!opt.is_valid(&why)) {
+    out.message = why;
+    return out;
+  }
+  const std::size_t begin = std::min(run.cut_index, t_s.size());
+  const std::size_t end = std::clamp(run.end_index, begin, std::min(t_s.size(), value.size()));
+  const std::size_t stop = std::clamp(run.stop_index, begin, end);
+  for (std::size_t i = begin; i < end; ++i) {
+    if (!std::isfinite(t_s[i]) || !std::isfinite(value[i])) continue;
+    out.tau.push_back(t_s[i] - run.t_cut_s);
+    out.y.push_back(value[i]);
+  }
+  const double k = value_per_rad_per_s(q, opt.bench.kb_v_s_per_rad);
+  EffectFitData data;
+  data.tau = out.tau;
+  data.y = out.y;
+  data.moving = std::min((run.stopped ? stop : end) - begin, out.tau.size());
+  data.k = k;
+  data.inertia_kg_m2 = opt.bench.inertia_kg_m2;
+  data.unit = out.unit;
+  const std::size_t n = out.tau.size();
+
+  std::vector<const Effect*> model;
+  for (const Effect& lib : effect_library())
+    if (contains(opt.base, &lib)) model.push_back(&lib);
+  out.base = fit_effects(model, data);
+  out.final_fit = out.base;
+  if (!std::isfinite(out.base.sse)) {
+    out.message = fmt::format("the base model ({}) could not be fitted: {}", out.base.label(), out.base.message);
+    return out;
+  }
+  out.ok = true;
+
+  // Noise and bins: the period from the samples, bins of ~bin_s.
+  const double span_s = n > 1 ? out.tau.back() - out.tau.front() : 0.0;
+  const double period = n > 1 ? span_s / static_cast<double>(n - 1) : 0.02;
+  const std::size_t m = std::max<std::size_t>(5, static_cast<std::size_t>(std::lround(opt.bin_s / std::max(period, 1e-6))));
+  out.bin_samples = m;
+  out.noise_level = white_noise(std::span<const double>(out.y).first(std::max<std::size_t>(data.moving, std::min<std::size_t>(n, 3))));
+  out.noise_level = std::max(out.noise_level, 1e-12);
+
+  std::vector<const Effect*> pool = opt.candidates;
+  if (pool.empty())
+    for (const Effect& lib : effect_library()) pool.push_back(&lib);
+
+  EffectFit current = out.base;
+  for (int step = 0;; ++step) {
+    const std::vector<double> res = residual_of(out.y, current);
+    const ResidualBins bins = bin_residuals(res, m, out.noise_level);
+    if (step == 0) out.bin_noise = bins.bin_se;
+    const std::vector<double> speed = model_speed(current, out.tau, k);
+    std::vector<Disagreement> where = locate(bins, bins.bin_se, opt.systematic_z, out.tau, res, speed, run.t_cut_s);
+    const double mass = systematic_mass(bins, bins.bin_se);
+    if (where.empty() && mass_significant(mass, bins.mean.size()))
+      // Spread out rather than concentrated: show where it is largest at a lower threshold.
+      where = locate(bins, bins.bin_se, 0.6 * opt.systematic_z, out.tau, res, speed, run.t_cut_s);
+    if (where.empty() && !mass_significant(mass, bins.mean.size())) {
+      out.remaining = where;
+      out.conclusion = fmt::format(
+          "nothing significant remains: no {:.2g}-s stretch of the residual is beyond {:.0f}x its noise ({:.2g} {}), "
+          "and the bins together are consistent with noise",
+          opt.bin_s, opt.systematic_z, bins.bin_se, out.unit);
+      break;
+    }
+    if (step >= opt.max_steps) {
+      out.remaining = where;
+      out.conclusion = fmt::format("stopped after {} added effects; disagreement remains", step);
+      break;
+    }
+
+    ExplainStep st;
+    st.rmse_before = current.rmse;
+    st.where = where;
+    for (const Effect* c : pool) {
+      if (contains(current.effects, c)) continue;
+      CandidateTrial t;
+      t.effect = std::string(c->name);
+      t.fit = fit_effects(with_effect(current.effects, c), data, &current);
+      st.trials.push_back(std::move(t));
+    }
+    if (st.trials.empty()) {
+      out.remaining = where;
+      out.conclusion = "disagreement remains, but every candidate effect is already in the model";
+      break;
+    }
+    // Effective sample size from the best-fitting candidate's residual: correlated noise
+    // (ripple, aliasing, quantization) inflates the variance of a bin mean beyond σ²/m.
+    const CandidateTrial* lowest = nullptr;
+    for (const auto& t : st.trials)
+      if (std::isfinite(t.fit.sse) && (!lowest || t.fit.sse < lowest->fit.sse)) lowest = &t;
+    double n_eff = static_cast<double>(n);
+    if (lowest) {
+      const ResidualBins lb = bin_residuals(residual_of(out.y, lowest->fit), m, out.noise_level);
+      const double inflation = static_cast<double>(m) * lb.bin_se * lb.bin_se / (out.noise_level * out.noise_level);
+      n_eff = std::clamp(static_cast<double>(n) / std::max(inflation, 1.0), 2.0, static_cast<double>(n));
+    }
+    CandidateTrial* best = nullptr;
+    for (auto& t : st.trials) {
+      if (!std::isfinite(t.fit.sse) || t.fit.sse <= 0) {
+        t.delta_bic = nan;
+        t.verdict = fmt::format("could not be fitted ({})", t.fit.message);
+        continue;
+      }
+      const int extra = static_cast<int>(t.fit.theta.size()) - static_cast<int>(current.theta.size());
+      t.delta_bic = n_eff * std::log(current.sse / t.fit.sse) - extra * std::log(n_eff);
+      const ResidualBins tb = bin_residuals(residual_of(out.y, t.fit), m, out.noise_level);
+      t.systematic_after = mass > 0 ? systematic_mass(tb, bins.bin_se) / mass : 0.0;
+      if (!best || t.delta_bic > best->delta_bic) best = &t;
+    }
+    const bool enough = best && best->delta_bic > opt.min_delta_bic && best->systematic_after < 0.8;
+    for (auto& t : st.trials) {
+      if (!t.verdict.empty()) continue;
+      if (&t == best && enough) {
+        t.verdict = "added";
+        continue;
+      }
+      if (t.delta_bic <= opt.min_delta_bic)
+        t.verdict = t.delta_bic <= 0 ? fmt::format("no real improvement (RMSE {:.4g} {}, dBIC {:.1f})", t.fit.rmse,
+                                                   out.unit, t.delta_bic)
+                                     : fmt::format("too little evidence (dBIC {:.1f} < {:.0f}, RMSE {:.4g} {})",
+                                                   t.delta_bic, opt.min_delta_bic, t.fit.rmse, out.unit);
+      else if (t.systematic_after >= 0.8)
+        t.verdict = fmt::format("fits the noise, not the disagreement ({:.0f}% of it left, dBIC {:.1f})",
+                                100 * t.systematic_after, t.delta_bic);
+      else
+        t.verdict = fmt::format("explains less (dBIC {:.1f} vs {:.1f}, RMSE {:.4g} {}, {:.0f}% of the disagreement left)",
+                                t.delta_bic, best->delta_bic, t.fit.rmse, out.unit, 100 * t.systematic_after);
+    }
+    if (!enough) {
+      out.remaining = where;
+      out.conclusion = best ? fmt::format("no candidate explains what remains (best: {}, dBIC {:.1f}, {:.0f}% of the "
+                                          "disagreement left); nothing added",
+                                          best->effect, best->delta_bic, 100 * best->systematic_after)
+                            : "no candidate could be fitted; nothing added";
+      out.final_trials = std::move(st.trials);  // kept for the story: what was tried and why not
+      break;
+    }
+    st.added = best->effect;
+    st.rmse_after = best->fit.rmse;
+    st.fit = best->fit;
+    st.why = fmt::format("{}: dBIC {:.1f} (n_eff {:.0f}), RMSE {:.4g} -> {:.4g} {} ({:.2g}x smaller), {:.0f}% of "
+                         "the systematic disagreement left",
+                         best->effect, best->delta_bic, n_eff, current.rmse, best->fit.rmse, out.unit,
+                         current.rmse / best->fit.rmse, 100 * best->systematic_after);
+    current = st.fit;
+    out.steps.push_back(std::move(st));
+  }
+  out.final_fit = current;
+  return out;
+}
+
+ExplainResult explain_run(const Recording& rec, const Run& run, const ExplainOptions& opt) {
+  return explain_run(rec.t_s, rec.value, rec.quantity, run, opt);
+}
+
+}  // namespace spindown

@@ -1,0 +1,365 @@
+#include "spindown/explain_report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fmt/format.h>
+
+#include "spindown/fit_report.hpp"
+
+namespace spindown {
+namespace {
+
+ExplainJson number(double x) { return std::isfinite(x) ? ExplainJson(x) : ExplainJson(nullptr); }
+
+ExplainJson params_json(const EffectFit& f) {
+  ExplainJson p = ExplainJson::object();
+  for (const auto& q : f.params)
+    p[q.name] = ExplainJson{{"value", number(q.value)}, {"stderr", number(q.std_error)}, {"unit", q.unit}};
+  return p;
+}
+
+ExplainJson where_json(const std::vector<Disagreement>& where) {
+  ExplainJson a = ExplainJson::array();
+  for (const auto& d : where)
+    a.push_back({{"t_from_s", number(d.t_from_s)},
+                 {"t_to_s", number(d.t_to_s)},
+                 {"mean_residual", number(d.mean_residual)},
+                 {"tau_from_s", number(d.tau_from_s)},
+                 {"tau_to_s", number(d.tau_to_s)},
+                 {"omega_from_rad_s", number(d.omega_from)},
+                 {"omega_to_rad_s", number(d.omega_to)},
+                 {"peak_residual", number(d.peak_residual)},
+                 {"z", number(d.z)}});
+  return a;
+}
+
+ExplainJson trials_json(const std::vector<CandidateTrial>& trials) {
+  ExplainJson a = ExplainJson::array();
+  for (const auto& t : trials)
+    a.push_back({{"effect", t.effect},
+                 {"rmse", number(t.fit.rmse)},
+                 {"delta_bic", number(t.delta_bic)},
+                 {"systematic_left", number(t.systematic_after)},
+                 {"verdict", t.verdict}});
+  return a;
+}
+
+std::string ratio_text(double before, double after) {
+  if (!(after > 0) || !std::isfinite(before / after)) return "";
+  const double r = before / after;
+  return r >= 1.05 ? fmt::format("{:.3g}x smaller", r) : r > 0.95 ? "about the same" : fmt::format("{:.3g}x larger", 1 / r);
+}
+
+std::string with_unit(const std::string& v, const std::string& unit) { return unit.empty() ? v : v + " " + unit; }
+
+std::string params_text(const EffectFit& f, std::string_view indent) {
+  std::string out;
+  for (const auto& p : f.params)
+    out += fmt::format("{}{} = {}\n", indent, p.name, with_unit(format_value_error(p.value, p.std_error), p.unit));
+  return out;
+}
+
+std::string where_text(const std::vector<Disagreement>& where, const std::string& unit, std::string_view indent) {
+  std::string out;
+  for (const auto& d : where)
+    out += fmt::format("{}{:.2f}-{:.2f} s after the cut (speed {:.0f}->{:.0f} rad/s): data {} the model by {:.3g} {} "
+                       "on average (peak {:.3g} {}, {:.0f}x the noise of a bin)\n",
+                       indent, d.tau_from_s, d.tau_to_s, d.omega_from, d.omega_to,
+                       d.mean_residual > 0 ? "above" : "below", std::abs(d.mean_residual), unit,
+                       std::abs(d.peak_residual), unit, std::abs(d.z));
+  return out;
+}
+
+}  // namespace
+
+ExplainJson explain_run_json(const ExplainResult& r) {
+  ExplainJson j;
+  j["run"] = r.run.number;
+  j["base"] = r.base.names();
+  ExplainJson steps = ExplainJson::array();
+  for (const auto& s : r.steps)
+    steps.push_back({{"added", s.added},
+                     {"rmse_before", number(s.rmse_before)},
+                     {"rmse_after", number(s.rmse_after)},
+                     {"where", where_json(s.where)},
+                     {"why", s.why},
+                     {"candidates", trials_json(s.trials)},
+                     {"params", params_json(s.fit)}});
+  j["steps"] = steps;
+  j["final"] = r.final_fit.names();
+  j["rmse_base"] = number(r.rmse_base());
+  j["rmse_final"] = number(r.rmse_final());
+  // Extras (the contract allows more fields, never fewer).
+  j["ok"] = r.ok;
+  if (!r.message.empty()) j["message"] = r.message;
+  j["residual_unit"] = r.unit;
+  j["t_cut_s"] = number(r.run.t_cut_s);
+  j["t_stop_s"] = number(r.run.t_stop_s);
+  j["samples"] = r.tau.size();
+  j["noise_level"] = number(r.noise_level);
+  j["bin_noise"] = number(r.bin_noise);
+  j["base_params"] = params_json(r.base);
+  j["final_params"] = params_json(r.final_fit);
+  j["t_stop_pred_s"] = number(r.final_fit.t_stop_pred_s);
+  j["remaining"] = where_json(r.remaining);
+  j["rejected_last"] = trials_json(r.final_trials);
+  j["conclusion"] = r.conclusion;
+  j["inertia_kg_m2"] = number(r.bench.inertia_kg_m2);
+  j["kb_v_s_per_rad"] = number(r.bench.kb_v_s_per_rad);
+  return j;
+}
+
+ExplainJson explain_report_json(std::span<const FileExplain> files) {
+  ExplainJson out;
+  ExplainJson arr = ExplainJson::array();
+  for (const auto& f : files) {
+    ExplainJson fj;
+    fj["file"] = f.file;
+    ExplainJson runs = ExplainJson::array();
+    for (const auto& r : f.runs) runs.push_back(explain_run_json(r));
+    fj["runs"] = runs;
+    fj["samples"] = f.samples;
+    fj["failures"] = f.failures;
+    arr.push_back(fj);
+  }
+  out["files"] = arr;
+  return out;
+}
+
+std::string format_explain(const ExplainResult& r) {
+  const std::string& u = r.unit;
+  std::string out = fmt::format("run {}: cut at {:.3f} s, {} samples, noise {:.2g} {} per reading ({:.2g} {} per "
+                                "{}-sample bin)\n",
+                                r.run.number, r.run.t_cut_s, r.tau.size(), r.noise_level, u, r.bin_noise, u,
+                                r.bin_samples);
+  if (!r.ok) return out + fmt::format("  could not be explained: {}\n", r.message);
+  out += fmt::format("  base model: {}   RMSE {:.4g} {}\n", r.base.label(), r.base.rmse, u);
+  out += params_text(r.base, "    ");
+  int number = 0;
+  for (const auto& s : r.steps) {
+    ++number;
+    out += fmt::format("\n  step {}: where the model and the data disagree\n", number);
+    out += where_text(s.where, u, "    ");
+    const Effect* e = find_effect(s.added);
+    out += fmt::format("  missing effect: {}", s.added);
+    if (e) out += fmt::format(" - {} ({})\n    its signature: {}\n", e->meaning, e->term, e->signature);
+    else out += "\n";
+    out += fmt::format("    why: {}\n", s.why);
+    for (const auto& t : s.trials)
+      if (t.verdict != "added") out += fmt::format("    rejected {}: {}\n", t.effect, t.verdict);
+    out += fmt::format("    model now: {}\n", s.fit.label());
+    out += params_text(s.fit, "      ");
+    out += fmt::format("    gap: RMSE {:.4g} {} -> {:.4g} {} ({})\n", s.rmse_before, u, s.rmse_after, u,
+                       ratio_text(s.rmse_before, s.rmse_after));
+  }
+  out += fmt::format("\n  {}\n", r.conclusion.empty() ? "done" : r.conclusion);
+  if (!r.final_trials.empty()) {
+    for (const auto& t : r.final_trials) out += fmt::format("    {}: {}\n", t.effect, t.verdict);
+    if (!r.remaining.empty()) {
+      out += "    still visible:\n";
+      out += where_text(r.remaining, u, "      ");
+    }
+  }
+  if (r.steps.empty())
+    out += fmt::format("  final model: {} (nothing added), RMSE {:.4g} {}\n", r.final_fit.label(), r.final_fit.rmse, u);
+  else
+    out += fmt::format("  final model: {}, RMSE {:.4g} {} (base {:.4g} {}: {})\n", r.final_fit.label(),
+                       r.final_fit.rmse, u, r.base.rmse, u, ratio_text(r.base.rmse, r.final_fit.rmse));
+  return out;
+}
+
+std::string format_file_explain(const FileExplain& file) {
+  std::string out = fmt::format("{}\n", file.file);
+  for (const auto& r : file.runs) out += format_explain(r) + "\n";
+  return out;
+}
+
+namespace {
+
+// "Nice" axis ticks covering [lo, hi].
+std::vector<double> ticks(double lo, double hi, int target = 6) {
+  std::vector<double> out;
+  if (!(hi > lo)) return {lo};
+  const double raw = (hi - lo) / target;
+  const double mag = std::pow(10.0, std::floor(std::log10(raw)));
+  double step = mag;
+  for (double m : {1.0, 2.0, 2.5, 5.0, 10.0})
+    if (m * mag >= raw) {
+      step = m * mag;
+      break;
+    }
+  for (double t = std::ceil(lo / step) * step; t <= hi + 1e-9 * step && out.size() < 50; t += step)
+    out.push_back(std::abs(t) < 1e-12 * step ? 0.0 : t);
+  return out;
+}
+
+struct Panel {
+  double x, y, w, h;          // pixels
+  double x0, x1, y0, y1;      // data range
+  double px(double v) const { return x + (v - x0) / (x1 - x0) * w; }
+  double py(double v) const { return y + h - (v - y0) / (y1 - y0) * h; }
+};
+
+std::string polyline(const Panel& p, std::span<const double> xs, std::span<const double> ys, const char* style) {
+  std::string pts;
+  pts.reserve(xs.size() * 14);
+  for (std::size_t i = 0; i < xs.size(); ++i) {
+    if (!std::isfinite(ys[i])) continue;
+    pts += fmt::format("{:.1f},{:.1f} ", p.px(xs[i]), p.py(std::clamp(ys[i], p.y0, p.y1)));
+  }
+  return fmt::format("<polyline fill=\"none\" {} points=\"{}\"/>\n", style, pts);
+}
+
+std::string axes(const Panel& p, const std::string& xlabel, const std::string& ylabel) {
+  std::string s = fmt::format("<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"{:.1f}\" height=\"{:.1f}\" fill=\"none\" "
+                              "stroke=\"#444\"/>\n",
+                              p.x, p.y, p.w, p.h);
+  for (double t : ticks(p.x0, p.x1)) {
+    const double x = p.px(t);
+    s += fmt::format("<line x1=\"{0:.1f}\" y1=\"{1:.1f}\" x2=\"{0:.1f}\" y2=\"{2:.1f}\" stroke=\"#ddd\"/>\n", x, p.y,
+                     p.y + p.h);
+    s += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\">{:g}</text>\n", x, p.y + p.h + 16, t);
+  }
+  for (double t : ticks(p.y0, p.y1)) {
+    const double y = p.py(t);
+    s += fmt::format("<line x1=\"{0:.1f}\" y1=\"{1:.1f}\" x2=\"{2:.1f}\" y2=\"{1:.1f}\" stroke=\"#ddd\"/>\n", p.x, y,
+                     p.x + p.w);
+    s += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"end\">{:g}</text>\n", p.x - 6, y + 4, t);
+  }
+  s += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\">{}</text>\n", p.x + p.w / 2,
+                   p.y + p.h + 34, xlabel);
+  s += fmt::format("<text transform=\"translate({:.1f},{:.1f}) rotate(-90)\" text-anchor=\"middle\">{}</text>\n",
+                   p.x - 52, p.y + p.h / 2, ylabel);
+  return s;
+}
+
+std::string legend(double x, double y, const std::vector<std::pair<std::string, std::string>>& items) {
+  std::string s = fmt::format("<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"300\" height=\"{}\" fill=\"white\" "
+                              "fill-opacity=\"0.85\" stroke=\"#999\"/>\n",
+                              x, y, 8 + 18 * items.size());
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    const double yy = y + 16 + 18.0 * static_cast<double>(i);
+    s += fmt::format("<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" {}/>\n", x + 8, yy - 4, x + 38,
+                     yy - 4, items[i].second);
+    s += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\">{}</text>\n", x + 46, yy, items[i].first);
+  }
+  return s;
+}
+
+std::string xml_escape(const std::string& in) {
+  std::string out;
+  for (char c : in) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+// Bin means of a residual, for a readable line through noisy points.
+void binned(std::span<const double> x, std::span<const double> r, std::size_t m, std::vector<double>& bx,
+            std::vector<double>& by) {
+  m = std::max<std::size_t>(m, 1);
+  for (std::size_t i = 0; i < x.size(); i += m) {
+    const std::size_t e = std::min(i + m, x.size());
+    double sx = 0, sy = 0;
+    for (std::size_t j = i; j < e; ++j) sx += x[j], sy += r[j];
+    bx.push_back(sx / static_cast<double>(e - i));
+    by.push_back(sy / static_cast<double>(e - i));
+  }
+}
+
+constexpr double fig_w = 960, fig_h = 700;
+
+std::string run_figure(const std::string& file, const ExplainResult& r, double top) {
+  const std::string& u = r.unit;
+  const std::size_t n = r.tau.size();
+  std::string s;
+  const std::string title = fmt::format("{} - run {}: base {} (RMSE {:.3g} {}) -> {} (RMSE {:.3g} {})", file,
+                                        r.run.number, r.base.label(), r.base.rmse, u, r.final_fit.label(),
+                                        r.final_fit.rmse, u);
+  s += fmt::format("<text x=\"{}\" y=\"{:.1f}\" text-anchor=\"middle\" font-size=\"15\" font-weight=\"bold\">{}</text>\n",
+                   fig_w / 2, top + 22, xml_escape(title));
+  if (n == 0 || !r.ok) return s;
+  double ymin = 0, ymax = 0;
+  for (double v : r.y) ymin = std::min(ymin, v), ymax = std::max(ymax, v);
+  const double tmax = r.tau.back();
+  Panel top_p{80, top + 40, fig_w - 110, 330, 0, tmax, ymin, ymax + 0.05 * (ymax - ymin) + 1e-9};
+  std::vector<double> rb(n), rf(n);
+  double rmax = 1e-12;
+  for (std::size_t i = 0; i < n; ++i) {
+    rb[i] = r.y[i] - r.base.simulated[i];
+    rf[i] = r.y[i] - r.final_fit.simulated[i];
+  }
+  std::vector<double> bx, bb, fx, fb;
+  binned(r.tau, rb, r.bin_samples, bx, bb);
+  binned(r.tau, rf, r.bin_samples, fx, fb);
+  for (double v : bb) rmax = std::max(rmax, std::abs(v));
+  for (double v : rf) rmax = std::max(rmax, std::abs(v));
+  rmax *= 1.1;
+  Panel bot_p{80, top + 430, fig_w - 110, 200, 0, tmax, -rmax, rmax};
+
+  // Top: measurement, base and final simulations.
+  s += axes(top_p, "time after the cut (s)", fmt::format("reading ({})", u));
+  const std::size_t stride = std::max<std::size_t>(1, n / 2500);
+  for (std::size_t i = 0; i < n; i += stride)
+    s += fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"1.6\" fill=\"#777\"/>\n", top_p.px(r.tau[i]),
+                     top_p.py(r.y[i]));
+  const char* base_style = "stroke=\"#d62728\" stroke-width=\"2\" stroke-dasharray=\"7,4\"";
+  const char* final_style = "stroke=\"#1f77b4\" stroke-width=\"2\"";
+  s += polyline(top_p, r.tau, r.base.simulated, base_style);
+  s += polyline(top_p, r.tau, r.final_fit.simulated, final_style);
+  s += legend(top_p.x + top_p.w - 310, top_p.y + 10,
+              {{"measurement", "stroke=\"#777\" stroke-width=\"4\" stroke-dasharray=\"2,4\""},
+               {fmt::format("base model: {}", r.base.label()), base_style},
+               {fmt::format("final model: {}", r.final_fit.label()), final_style}});
+
+  // Bottom: residuals before (binned) and after (every sample, then binned).
+  for (const auto& step : r.steps)
+    for (const auto& d : step.where) {
+      if (&step != &r.steps.front()) break;
+      s += fmt::format("<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"{:.1f}\" height=\"{:.1f}\" fill=\"#ffbf00\" "
+                       "fill-opacity=\"0.18\"/>\n",
+                       bot_p.px(d.tau_from_s), bot_p.y, std::max(1.0, bot_p.px(d.tau_to_s) - bot_p.px(d.tau_from_s)),
+                       bot_p.h);
+    }
+  s += axes(bot_p, "time after the cut (s)", fmt::format("measurement - model ({})", u));
+  for (std::size_t i = 0; i < n; i += stride)
+    s += fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"1.2\" fill=\"#9ecae1\"/>\n", bot_p.px(r.tau[i]),
+                     bot_p.py(std::clamp(rf[i], -rmax, rmax)));
+  s += polyline(bot_p, bx, bb, "stroke=\"#d62728\" stroke-width=\"2\"");
+  s += polyline(bot_p, fx, fb, "stroke=\"#1f77b4\" stroke-width=\"2\"");
+  s += legend(bot_p.x + bot_p.w - 310, bot_p.y + 8,
+              {{fmt::format("before: {} ({}-sample means)", r.base.label(), r.bin_samples),
+                "stroke=\"#d62728\" stroke-width=\"2\""},
+               {fmt::format("after: {} (means; dots: samples)", r.final_fit.label()),
+                "stroke=\"#1f77b4\" stroke-width=\"2\""},
+               {"where the base model disagrees", "stroke=\"#ffbf00\" stroke-opacity=\"0.5\" stroke-width=\"10\""}});
+  return s;
+}
+
+}  // namespace
+
+std::string explain_svg(std::span<const FileExplain> files) {
+  std::size_t runs = 0;
+  for (const auto& f : files) runs += f.runs.size();
+  const double height = fig_h * static_cast<double>(std::max<std::size_t>(runs, 1));
+  std::string s = fmt::format("<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{}\" height=\"{}\" viewBox=\"0 0 {} {}\" "
+                              "font-family=\"sans-serif\" font-size=\"12\">\n<rect width=\"100%\" height=\"100%\" "
+                              "fill=\"white\"/>\n",
+                              fig_w, height, fig_w, height);
+  double top = 0;
+  for (const auto& f : files)
+    for (const auto& r : f.runs) {
+      s += run_figure(f.file, r, top);
+      top += fig_h;
+    }
+  s += "</svg>\n";
+  return s;
+}
+
+}  // namespace spindown
