@@ -28,6 +28,9 @@ run_case() {  # run_case NAME BRIDGE-ARGS -- BENCH-ARGS
   [[ $(last_status "$name" lines_bad) == 0 ]] || fail "$name: lines_bad should be 0"
   [[ $(last_status "$name" samples) == "$n" ]] || fail "$name: status samples != $n"
   [[ $(last_status "$name" state) == stopping ]] || fail "$name: last status is not 'stopping'"
+  # The bridge's own line->publish latency over real LCM UDP multicast (reported, not asserted).
+  echo "$name: line->publish latency p50 $(last_status "$name" latency_p50_us) us," \
+       "p99 $(last_status "$name" latency_p99_us) us, max $(last_status "$name" latency_max_us) us"
 }
 
 run_case lab --baud 9600 -- --protocol lab --speed 25 --runs 2 --lead-in supply --seed 3
