@@ -354,34 +354,66 @@ RunDetector::CutSplit RunDetector::split_at_cut(std::size_t a, std::size_t b, co
       stv_[k] = stv_[k + 1] + tt * x;
     }
     const double svv_all = pvv[n];
-    // The confirming window may straddle a small step (supply → back-EMF), so the split may
-    // fall anywhere that leaves a few samples for the line.
-    double best = std::numeric_limits<double>::infinity();
-    std::size_t best_k = 0;
-    for (std::size_t k = 0; k + 3 <= n; ++k) {
-      const double sse_pre = k > 0 ? pvv[k] - pv[k] * pv[k] / double(k) : 0.0;
+    struct Line {
+      double v0 = 0, slope = 0, sd = 0;
+    };
+    auto post_line = [&](std::size_t k) {
       const double np = double(n - k);
       const double sxx = stt_[k] - ss[k] * ss[k] / np;
       const double sxy = stv_[k] - ss[k] * sv_[k] / np;
       const double syy = (svv_all - pvv[k]) - sv_[k] * sv_[k] / np;
-      const double sse_post = sxx > 0 ? syy - sxy * sxy / sxx : syy;
-      const double sse = std::max(sse_pre, 0.0) + std::max(sse_post, 0.0);
-      if (sse < best) {
-        best = sse;
-        best_k = k;
+      Line l;
+      l.slope = sxx > 0 ? sxy / sxx : 0.0;
+      l.v0 = sv_[k] / np + l.slope * ((t(a + k) - tr) - ss[k] / np);
+      l.sd = np > 2 ? std::sqrt(std::max(syy - l.slope * sxy, 0.0) / (np - 2)) : 0.0;
+      return l;
+    };
+    // Best split with the lead-in starting at kb. The confirming window may straddle a small
+    // step (supply → back-EMF), so the split may fall anywhere that leaves a few samples for
+    // the line.
+    auto best_split = [&](std::size_t kb) {
+      double best = std::numeric_limits<double>::infinity();
+      std::size_t best_k = kb;
+      for (std::size_t k = kb; k + 3 <= n; ++k) {
+        const double m = double(k - kb);
+        const double sp_ = pv[k] - pv[kb];
+        const double sse_pre = k > kb ? (pvv[k] - pvv[kb]) - sp_ * sp_ / m : 0.0;
+        const double np = double(n - k);
+        const double sxx = stt_[k] - ss[k] * ss[k] / np;
+        const double sxy = stv_[k] - ss[k] * sv_[k] / np;
+        const double syy = (svv_all - pvv[k]) - sv_[k] * sv_[k] / np;
+        const double sse_post = sxx > 0 ? syy - sxy * sxy / sxx : syy;
+        const double sse = std::max(sse_pre, 0.0) + std::max(sse_post, 0.0);
+        if (sse < best) {
+          best = sse;
+          best_k = k;
+        }
       }
+      return best_k;
+    };
+    std::size_t kb = 0;
+    std::size_t k = best_split(0);
+    // Two steps in reach (zeros → supply → back-EMF): the coast follows the later one, taken
+    // when it splits a flat plateau from the coast by a clear step.
+    for (int again = 0; again < 3; ++again) {
+      const std::size_t k2 = best_split(k);
+      if (k2 < k + 3) break;
+      const double m = double(k2 - k);
+      const double mean = (pv[k2] - pv[k]) / m;
+      const double sd = std::sqrt(std::max((pvv[k2] - pvv[k]) / m - mean * mean, 0.0));
+      const Line l = post_line(k2);
+      const double scale = std::abs(l.v0);
+      if (std::abs(l.v0 - mean) <= std::max(5.0 * l.sd, 0.03 * scale) || sd > std::max(3.0 * l.sd, 0.02 * scale))
+        break;
+      kb = k;
+      k = k2;
     }
-    const std::size_t k = best_k;
-    const double np = double(n - k);
-    const double sxx = stt_[k] - ss[k] * ss[k] / np;
-    const double sxy = stv_[k] - ss[k] * sv_[k] / np;
-    const double syy = (svv_all - pvv[k]) - sv_[k] * sv_[k] / np;
-    const double beta = sxx > 0 ? sxy / sxx : 0.0;
-    const double tbar = ss[k] / np, vbar = sv_[k] / np;
+    const Line l = post_line(k);
     const std::size_t c = a + k;
-    sp.v0 = vbar + beta * ((t(c) - tr) - tbar);
-    sp.post_slope = beta;
-    sp.sd_post = np > 2 ? std::sqrt(std::max(syy - beta * sxy, 0.0) / (np - 2)) : 0.0;
+    sp.a = a + kb;
+    sp.v0 = l.v0;
+    sp.post_slope = l.slope;
+    sp.sd_post = l.sd;
     sp.cut_index = c;
     sp.pre_end = c;
     const bool sample_before = c > base_ && c > stream_start_ && c - 1 >= lo_;

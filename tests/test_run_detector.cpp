@@ -1,0 +1,244 @@
+// The streaming run detector: fed sample by sample it finds the same runs as find_runs,
+// announces cut and stop as they happen, and keeps its memory bounded.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "spindown/run_detector.hpp"
+#include "spindown/runs.hpp"
+#include "spindown/synthetic_run.hpp"
+
+using namespace spindown;
+
+namespace {
+
+struct Truth {
+  double t_cut_s, t_stop_s;
+};
+
+// Several runs with increasing device times (each: lead-in, cut, coast, stop, tail).
+Recording multi_run_recording(std::vector<Truth>* truths, double noise = 0.004) {
+  Recording rec;
+  rec.source = "multi";
+  double t0_ms = 1000;
+  const LeadIn leads[] = {LeadIn::zeros, LeadIn::floating, LeadIn::supply, LeadIn::zeros, LeadIn::supply};
+  for (int k = 0; k < 5; ++k) {
+    SyntheticRunSpec spec;
+    spec.lead_in = leads[k];
+    spec.t0_ms = t0_ms;
+    spec.e0_v = 2.4 + 0.3 * k;
+    spec.supply_v = spec.e0_v + 0.25;
+    spec.lead_in_s = 1.5 + 0.5 * k;
+    spec.tail_s = 2.0 + 0.5 * k;
+    spec.noise_v = noise;
+    spec.ripple = 0.01;
+    spec.period_s = k == 3 ? 0.030 : 0.020;
+    spec.seed = 300 + k;
+    const SyntheticRun s = make_synthetic_run(spec);
+    for (std::size_t i = 0; i < s.t_ms.size(); ++i) rec.push(s.t_ms[i] / 1000.0, s.volts[i]);
+    if (truths) truths->push_back({s.t_cut_ms / 1000.0, s.t_cut_ms / 1000.0 + s.t_stop_s});
+    t0_ms = s.t_ms.back() + 20;
+  }
+  return rec;
+}
+
+void expect_same_run(const spindown::Run& a, const spindown::Run& b) {
+  EXPECT_EQ(a.number, b.number);
+  EXPECT_EQ(a.cut_index, b.cut_index);
+  EXPECT_EQ(a.stop_index, b.stop_index);
+  EXPECT_EQ(a.end_index, b.end_index);
+  EXPECT_DOUBLE_EQ(a.t_cut_s, b.t_cut_s);
+  EXPECT_EQ(a.stopped, b.stopped);
+  if (a.stopped) {
+    EXPECT_DOUBLE_EQ(a.t_stop_s, b.t_stop_s);
+  }
+  EXPECT_DOUBLE_EQ(a.zero_level, b.zero_level);
+  EXPECT_DOUBLE_EQ(a.noise_level, b.noise_level);
+  EXPECT_EQ(a.lead_in, b.lead_in);
+  EXPECT_DOUBLE_EQ(a.period_s, b.period_s);
+}
+
+}  // namespace
+
+TEST(RunDetector, SampleBySampleFindsTheSameRunsAsFindRuns) {
+  std::vector<Truth> truths;
+  const Recording rec = multi_run_recording(&truths);
+  const Segmentation offline = find_runs(rec);
+  ASSERT_EQ(offline.runs.size(), 5u);
+
+  RunDetector live;
+  std::vector<spindown::Run> runs;
+  for (std::size_t i = 0; i < rec.size(); ++i) {
+    live.push(rec.t_s[i], rec.value[i]);
+    for (const RunEvent& e : live.take_events())
+      if (e.kind == RunEvent::Kind::complete) runs.push_back(e.run);
+  }
+  live.finish();
+  for (const RunEvent& e : live.take_events())
+    if (e.kind == RunEvent::Kind::complete) runs.push_back(e.run);
+
+  ASSERT_EQ(runs.size(), offline.runs.size());
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    SCOPED_TRACE("run " + std::to_string(k + 1));
+    expect_same_run(runs[k], offline.runs[k]);
+    EXPECT_NEAR(runs[k].t_cut_s, truths[k].t_cut_s, runs[k].period_s * 1.05);
+    EXPECT_NEAR(runs[k].t_stop_s, truths[k].t_stop_s, 0.15);
+  }
+}
+
+TEST(RunDetector, AnnouncesCutThenStopThenCompleteSoonAfterTheFacts) {
+  std::vector<Truth> truths;
+  const Recording rec = multi_run_recording(&truths);
+  const RunOptions opt;
+  RunDetector live(opt, "live");
+  std::vector<std::pair<RunEvent::Kind, double>> seen;  // kind, device time of the sample that triggered it
+  std::vector<spindown::Run> cuts;
+  for (std::size_t i = 0; i < rec.size(); ++i) {
+    live.push(rec.t_s[i], rec.value[i]);
+    for (const RunEvent& e : live.take_events()) {
+      if (e.kind == RunEvent::Kind::diagnostic) continue;
+      seen.emplace_back(e.kind, rec.t_s[i]);
+      if (e.kind == RunEvent::Kind::cut) cuts.push_back(e.run);
+    }
+  }
+  live.finish();
+  ASSERT_EQ(seen.size(), 3 * truths.size());
+  for (std::size_t k = 0; k < truths.size(); ++k) {
+    SCOPED_TRACE("run " + std::to_string(k + 1));
+    EXPECT_EQ(seen[3 * k].first, RunEvent::Kind::cut);
+    EXPECT_EQ(seen[3 * k + 1].first, RunEvent::Kind::stop);
+    EXPECT_EQ(seen[3 * k + 2].first, RunEvent::Kind::complete);
+    // The cut is announced within a second or so (a quarter-second window confirms the decline).
+    EXPECT_GT(seen[3 * k].second, truths[k].t_cut_s);
+    EXPECT_LT(seen[3 * k].second, truths[k].t_cut_s + 1.5);
+    // The stop within about stop_hold_s, the run once the tail is in.
+    EXPECT_GT(seen[3 * k + 1].second, truths[k].t_stop_s);
+    EXPECT_LT(seen[3 * k + 1].second, truths[k].t_stop_s + opt.stop_hold_s + 0.5);
+    EXPECT_NEAR(seen[3 * k + 2].second, truths[k].t_stop_s + opt.tail_s, 0.5);
+    EXPECT_EQ(cuts[k].number, int(k + 1));
+    EXPECT_NEAR(cuts[k].t_cut_s, truths[k].t_cut_s, 0.031);
+  }
+  EXPECT_EQ(cuts[1].lead_in, "floating");
+  EXPECT_EQ(cuts[2].lead_in, "supply");
+}
+
+TEST(RunDetector, MemoryStaysBoundedOverALongIdleStream) {
+  RunDetector live;
+  std::size_t most = 0;
+  // Ten minutes of a floating pin at 50 Hz: nothing to find, little to keep.
+  double x = 0.2;
+  for (int i = 0; i < 30000; ++i) {
+    x = std::clamp(0.85 * x + 0.04 + 0.1 * std::sin(0.37 * i) * std::cos(0.011 * i), 0.0, 0.7);
+    live.push(0.02 * i, std::round(x * 100) / 100);
+    most = std::max(most, live.buffered());
+    for (const RunEvent& e : live.take_events()) EXPECT_NE(e.kind, RunEvent::Kind::complete);
+  }
+  EXPECT_LT(most, 2500u);  // ~40 s of lead-in, not the whole stream
+  EXPECT_EQ(live.state(), RunDetector::State::idle);
+}
+
+TEST(RunDetector, ACoastLongerThanMaxBufferIsAbandonedNotGrown) {
+  RunOptions opt;
+  opt.max_buffer = 500;  // 10 s at 50 Hz, the coast lasts ~27 s
+  SyntheticRunSpec spec;
+  const SyntheticRun s = make_synthetic_run(spec);
+  RunDetector live(opt, "small");
+  std::size_t most = 0;
+  bool abandoned = false, completed = false;
+  for (std::size_t i = 0; i < s.t_ms.size(); ++i) {
+    live.push(s.t_ms[i] / 1000.0, s.volts[i]);
+    most = std::max(most, live.buffered());
+    for (const RunEvent& e : live.take_events()) {
+      if (e.kind == RunEvent::Kind::ignored) {
+        abandoned = true;
+        EXPECT_NE(e.diagnostic.message.find("max_buffer"), std::string::npos);
+      }
+      completed = completed || e.kind == RunEvent::Kind::complete;
+    }
+  }
+  live.finish();
+  EXPECT_TRUE(abandoned);
+  EXPECT_FALSE(completed);
+  EXPECT_LE(most, opt.max_buffer + 1);
+}
+
+TEST(RunDetector, MaxCoastClosesARunAsNeverStoppedAndTheRestOfTheDecayIsNoNewRun) {
+  RunOptions opt;
+  opt.max_coast_s = 8.0;
+  SyntheticRunSpec spec;
+  const SyntheticRun s = make_synthetic_run(spec);
+  Recording rec;
+  for (std::size_t i = 0; i < s.t_ms.size(); ++i) rec.push(s.t_ms[i] / 1000.0, s.volts[i]);
+  const Segmentation seg = find_runs(rec, opt);
+  ASSERT_EQ(seg.runs.size(), 1u);
+  EXPECT_FALSE(seg.runs[0].stopped);
+  EXPECT_NEAR(rec.t_s[seg.runs[0].end_index - 1] - seg.runs[0].t_cut_s, 8.0, 0.05);
+  const bool noted = std::any_of(seg.diagnostics.begin(), seg.diagnostics.end(), [](const Diagnostic& d) {
+    return d.message.find("max_coast_s") != std::string::npos;
+  });
+  EXPECT_TRUE(noted);
+}
+
+TEST(RunDetector, PowerRestoredMidCoastClosesTheRunAndTheNextCutStartsANewOne) {
+  // Coast for 6 s, then the supply returns (3.0 V) for 3 s, then a second cut.
+  SyntheticRunSpec first;
+  first.lead_in_s = 2.0;
+  const SyntheticRun a = make_synthetic_run(first);
+  Recording rec;
+  const double t_cut_a = a.t_cut_ms / 1000.0;
+  std::size_t i = 0;
+  for (; i < a.t_ms.size() && a.t_ms[i] / 1000.0 < t_cut_a + 6.0; ++i) rec.push(a.t_ms[i] / 1000.0, a.volts[i]);
+  const double t_back = rec.t_s.back() + 0.02;
+  for (int k = 0; k < 150; ++k) rec.push(t_back + 0.02 * k, 3.0);
+  SyntheticRunSpec second;
+  second.lead_in = LeadIn::supply;
+  second.lead_in_s = 0.5;
+  second.e0_v = 2.75;
+  second.t0_ms = (rec.t_s.back() + 0.02) * 1000.0;
+  second.seed = 9;
+  const SyntheticRun b = make_synthetic_run(second);
+  for (std::size_t k = 0; k < b.t_ms.size(); ++k) rec.push(b.t_ms[k] / 1000.0, b.volts[k]);
+
+  const Segmentation seg = find_runs(rec);
+  ASSERT_EQ(seg.runs.size(), 2u);
+  EXPECT_FALSE(seg.runs[0].stopped);
+  EXPECT_NEAR(rec.t_s[seg.runs[0].end_index], t_back, 0.05);
+  EXPECT_TRUE(seg.runs[1].stopped);
+  EXPECT_NEAR(seg.runs[1].t_cut_s, b.t_cut_ms / 1000.0, 0.021);
+  EXPECT_EQ(seg.runs[1].lead_in, "supply");
+}
+
+TEST(RunDetector, TimeGoingBackIsAClockRestartAndNonFiniteSamplesAreCounted) {
+  SyntheticRunSpec spec;
+  spec.t0_ms = 100;
+  const SyntheticRun s = make_synthetic_run(spec);
+  RunDetector live;
+  std::vector<spindown::Run> runs;
+  std::vector<std::string> notes;
+  auto drain = [&] {
+    for (const RunEvent& e : live.take_events()) {
+      if (e.kind == RunEvent::Kind::complete) runs.push_back(e.run);
+      if (e.has_diagnostic) notes.push_back(e.diagnostic.message);
+    }
+  };
+  // Half the coast, then the device resets (time back to 0.1 s) and a whole run follows.
+  const std::size_t half = s.t_ms.size() / 2;
+  for (std::size_t i = 0; i < half; ++i) live.push(s.t_ms[i] / 1000.0, s.volts[i]);
+  drain();
+  live.push(std::nan(""), 1.0);
+  for (std::size_t i = 0; i < s.t_ms.size(); ++i) live.push(s.t_ms[i] / 1000.0, s.volts[i]);
+  live.finish();
+  drain();
+  ASSERT_EQ(runs.size(), 2u);
+  EXPECT_FALSE(runs[0].stopped);
+  EXPECT_EQ(runs[0].end_index, half);
+  EXPECT_TRUE(runs[1].stopped);
+  EXPECT_GE(runs[1].cut_index, half);
+  auto has = [&](const std::string& what) {
+    return std::any_of(notes.begin(), notes.end(), [&](const std::string& m) { return m.find(what) != std::string::npos; });
+  };
+  EXPECT_TRUE(has("clock restart"));
+  EXPECT_TRUE(has("1 non-finite"));
+}
