@@ -156,10 +156,12 @@ int main(int argc, char** argv) {
     if (beat.due(now)) heartbeat(now, nullptr);
   }
 
-  // Drain what LCM has already received (bounded), then everything queued for the writer.
+  // Drain what has reached this host: LCM's receive thread may still hold packets from the
+  // socket, so dispatch until 50 ms pass with nothing new (at most 2 s under continuous
+  // traffic); then the writer writes everything queued.
   const auto drain_until = std::chrono::steady_clock::now() + std::chrono::seconds(2);
-  for (int i = 0; i < 1000000 && std::chrono::steady_clock::now() < drain_until; ++i)
-    if (lcm.handleTimeout(0) <= 0) break;
+  for (int i = 0; i < 10000000 && std::chrono::steady_clock::now() < drain_until; ++i)
+    if (lcm.handleTimeout(50) <= 0) break;
   lcm.unsubscribe(sub);
   recorder.stop("stopped");
   heartbeat(wall_us(), "stopped");

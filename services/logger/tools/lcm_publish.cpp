@@ -98,6 +98,16 @@ spindown::fit_t make_fit(const std::string& bench, std::int64_t now) {
   f.verdict = "";
   f.verdict_reason = "no reference configured";
   f.latency_s = 0.004;
+  f.inertia_source = "lab default";
+  f.kb_source = "speed constant 1180 rpm/V";
+  f.lead_in = "zeros";
+  f.noise_level = 0.011;
+  f.period_s = 0.02;
+  // Every per-model array must have nmodels entries or the encoder reads past the end.
+  f.model_samples.assign(f.nmodels, f.samples);
+  f.model_message.assign(f.nmodels, "");
+  f.first_seq = 0;
+  f.last_seq = 1861;
   return f;
 }
 

@@ -1,9 +1,11 @@
-// spindown-log-summary: reads LCM event logs in the order given (rotated files of one session
-// continue each other) and prints one JSON object: events per file and channel, problems (a
+// spindown-log-summary: reads LCM event logs in the order of their first event's time (rotated
+// files of one session continue each other; a name suffix .1, .2 does not sort by time) and prints one JSON object: events per file and channel, problems (a
 // truncated tail, garbage), per bench the SAMPLE sequence (messages, gaps, missing samples,
 // repeats, last publish time) and the last status event of spindown-logger in each file.
 // Exit code 0 when every file opened, 1 otherwise.
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cstdint>
 #include <fmt/format.h>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -35,6 +37,24 @@ int main(int argc, char** argv) {
   std::vector<std::string> files;
   app.add_option("FILE", files, "LCM logs, in order")->required();
   CLI11_PARSE(app, argc, argv);
+  {
+    std::vector<std::pair<std::int64_t, std::string>> by_time;
+    spindown::LcmLogEvent first;
+    for (const auto& path : files) {
+      spindown::LcmLogReader reader(path);
+      std::int64_t t = INT64_MAX;
+      while (reader.good() && reader.next(first))
+        if (first.kind != spindown::LcmLogEvent::Kind::problem) {
+          t = first.log_utime;
+          break;
+        }
+      by_time.emplace_back(t, path);
+    }
+    std::stable_sort(by_time.begin(), by_time.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    files.clear();
+    for (auto& [t, path] : by_time) files.push_back(path);
+  }
 
   nlohmann::json out;
   out["files"] = nlohmann::json::array();
