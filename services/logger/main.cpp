@@ -64,9 +64,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--bench", w.bench, "bench id: in the file names, and the default channels");
   app.add_option("--rotate-size", w.rotate_size_mb, "start a new file past this many MB (1e6 bytes); 0 = never")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0.0, 1e6));
   app.add_option("--rotate-time", w.rotate_time_s, "start a new file after this many seconds; 0 = never")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0.0, 1e9));
   app.add_option("--flush-interval", r.flush_interval_s, "seconds between flushes to the kernel (data a kill -9 can lose)")
       ->capture_default_str()
       ->check(CLI::Range(0.001, 3600.0));
@@ -80,7 +80,11 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--name", w.instance, "status_t.instance (default: the bench, else the prefix)");
   app.add_flag("-q,--quiet", quiet, "only errors on stderr");
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;  // --help is 0; any bad usage is 2 (design §5)
+  }
 
   if (channels.empty()) channels = w.bench.empty() ? "SPINDOWN\\..*" : "SPINDOWN\\." + w.bench + "\\..*";
   std::string why;
