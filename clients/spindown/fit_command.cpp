@@ -238,12 +238,11 @@ void setup_fit(CLI::App& app) {
   sub->add_option("--value-unit", opt->value_unit, "Value unit: V, rpm or rad/s")->group(text);
   sub->add_option("--delimiter", opt->delimiter, "Column delimiter: , ; tab space")->group(text);
 
-  sub->callback([opt, sub, inertia, radius, kb, kv]() {
+  sub->callback([opt, inertia, radius, kb, kv]() {
     opt->inertia_given = inertia->count() > 0;
     opt->flywheel_given = radius->count() > 0;
     opt->kb_given = kb->count() > 0;
     opt->speed_constant_given = kv->count() > 0;
-    (void)sub;
     const int code = run_fit(*opt);
     if (code != exit_ok) throw CLI::RuntimeError(code);
   });
