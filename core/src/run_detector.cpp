@@ -283,7 +283,7 @@ void RunDetector::idle_step(std::size_t i) {
         if (try_start_coast(i, *w)) return;
       }
     }
-    if (tried) quiet_until_s_ = t(i) + 0.5 * short_.span_s;  // look again once the windows moved on
+    if (tried) quiet_until_s_ = t(i) + 2.0 * short_.span_s;  // look again once the windows moved on
   }
   trim_idle();
 }
@@ -517,6 +517,7 @@ bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
   }
   reset_window(hold_, run_.cut_index, i + 1);
   hold_long_live_ = false;  // built when the coast gets low (saves work on the way down)
+  creeping_ = false;
   coast_checks(i);
   return true;
 }
@@ -585,6 +586,7 @@ void RunDetector::coast_checks(std::size_t i, bool at_end) {
   };
   bool resolved = at_end;
   if (!flat(hold_, at_end ? nullptr : &resolved)) return;
+  if (creeping_ && !at_end) resolved = false;  // an asymptotic coast ends when the long window is flat
   if (!resolved) {
     if (!hold_long_live_) {
       reset_window(hold_long_, run_.cut_index, i + 1);
@@ -592,10 +594,10 @@ void RunDetector::coast_checks(std::size_t i, bool at_end) {
     }
     if (!flat(hold_long_, nullptr)) return;
   }
-  found_standstill(i);
+  found_standstill(i, at_end);
 }
 
-void RunDetector::found_standstill(std::size_t i) {
+void RunDetector::found_standstill(std::size_t i, bool at_end) {
   const std::size_t h0 = hold_.first;
   const double z = median_of(h0, i + 1);
   double var = 0;
@@ -682,6 +684,10 @@ void RunDetector::found_standstill(std::size_t i) {
     e.run = run_;
     events_.push_back(std::move(e));
     tail_ends_by_time(i);
+  } else if (!creeping_ && !at_end) {
+    // Keep the coast until the decay is lost in the noise even over the long window: the
+    // exponential's tail still carries information for the fit.
+    creeping_ = true;
   } else {
     run_note_ = fmt::format(
         "run cut at {}: the coast approaches its floor ({:g}) asymptotically (last quarter {:.2f}x slower than "

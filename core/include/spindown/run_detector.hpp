@@ -127,7 +127,7 @@ class RunDetector {
   CutSplit split_at_cut(std::size_t a, std::size_t b, const WindowFit& w);
   std::string classify_lead_in(const CutSplit& sp) const;
   bool try_start_coast(std::size_t i, const WindowFit& w);
-  void found_standstill(std::size_t i);
+  void found_standstill(std::size_t i, bool at_end);
   void tail_ends_by_time(std::size_t upto);
   void close_unstopped(std::size_t end, const std::string& why);
   void complete_run(std::size_t end);
@@ -158,6 +158,7 @@ class RunDetector {
   WindowFit short_{0.25}, long_{1.0}, vlong_{4.0};  // confirm a decline
   WindowFit hold_{1.0}, hold_long_{3.0};            // confirm a standstill
   bool hold_long_live_ = false;
+  bool creeping_ = false;  // the coast was seen approaching standstill asymptotically
   double quiet_until_s_ = -std::numeric_limits<double>::infinity();  // after a rejected cut
 
   // The open run.
