@@ -5,12 +5,18 @@
 #include <iostream>
 
 #include "exit_codes.hpp"
+#include "explain_command.hpp"
 #include "fit_command.hpp"
+#include "refit_command.hpp"
+#include "export_command.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"spindown: fit friction models to DC-motor spin-down recordings"};
   app.require_subcommand(1);
   spindown::cli::setup_fit(app);
+  spindown::cli::setup_explain(app);
+  spindown::cli::setup_refit(app);
+  spindown::cli::setup_export(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {  // a subcommand finished with a non-zero exit code

@@ -154,6 +154,7 @@ FitterCore::FitterCore(FitterOptions options, FitterSink& sink)
 FitterCore::~FitterCore() = default;
 
 void FitterCore::error(std::string text, std::int64_t utime) {
+  sink_.problem(text);
   last_error_ = std::move(text);
   last_error_utime_ = utime;
 }

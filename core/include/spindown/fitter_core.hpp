@@ -96,7 +96,10 @@ class FitterSink {
   virtual ~FitterSink() = default;
   virtual void run_changed(const run_t& run) = 0;         // SPINDOWN.<bench>.RUN
   virtual void fit_ready(const FitResult& result) = 0;    // SPINDOWN.<bench>.FIT (and EXPLAIN)
-  // Detector notes, skipped samples, … with the bench channel as source. Default: ignored.
+  // A message or sample that could not be used, in words naming the channel (also kept as
+  // last_error for the heartbeat). Default: ignored.
+  virtual void problem(const std::string& text) { (void)text; }
+  // Detector notes (runs ignored, clock restarts, …) with the bench channel as source. Default: ignored.
   virtual void diagnostic(const std::string& bench, const Diagnostic& d) {
     (void)bench;
     (void)d;

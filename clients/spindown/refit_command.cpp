@@ -1,0 +1,349 @@
+#include "refit_command.hpp"
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <exception>
+#include <fmt/format.h>
+#include <iostream>
+#include <map>
+#include <memory>
+#include <regex>
+
+#include "exit_codes.hpp"
+#include "spindown/bench.hpp"
+#include "spindown/fit_message.hpp"
+
+namespace spindown::cli {
+
+namespace {
+
+constexpr std::size_t max_problems_listed = 20;  // per file, then counted
+
+class RefitSink final : public FitterSink {
+ public:
+  RefitSink(LogRefit& out, const std::string& path) : out_(out), path_(path) {}
+  void run_changed(const run_t&) override {}
+  void fit_ready(const FitResult& r) override {
+    out_.runs.push_back({r.bench, r.fit, r.bench_source, r.first_seq, r.last_seq});
+  }
+  void problem(const std::string& text) override {
+    if (++problems_ <= max_problems_listed)
+      out_.file.diagnostics.push_back({Diagnostic::Severity::warning, path_, 0, text});
+  }
+  void diagnostic(const std::string&, const Diagnostic& d) override {
+    Diagnostic copy = d;
+    copy.source = path_ + " " + d.source;
+    out_.file.diagnostics.push_back(std::move(copy));
+  }
+  std::size_t problems() const { return problems_; }
+
+ private:
+  LogRefit& out_;
+  const std::string& path_;
+  std::size_t problems_ = 0;
+};
+
+// The first place two JSON values differ ("" when equal).
+std::string first_difference(const Json& a, const Json& b, const std::string& path) {
+  if (a.type() != b.type()) return fmt::format("{}: {} vs {}", path, a.dump(), b.dump());
+  if (a.is_object()) {
+    for (const auto& [key, value] : a.items()) {
+      if (!b.contains(key)) return fmt::format("{}.{}: only in the refit", path, key);
+      if (auto d = first_difference(value, b.at(key), path + "." + key); !d.empty()) return d;
+    }
+    for (const auto& [key, value] : b.items())
+      if (!a.contains(key)) return fmt::format("{}.{}: only in the live result", path, key);
+    return {};
+  }
+  if (a.is_array()) {
+    if (a.size() != b.size()) return fmt::format("{}: {} vs {} elements", path, a.size(), b.size());
+    for (std::size_t i = 0; i < a.size(); ++i)
+      if (auto d = first_difference(a[i], b[i], fmt::format("{}[{}]", path, i)); !d.empty()) return d;
+    return {};
+  }
+  return a == b ? std::string() : fmt::format("{}: {} vs {}", path, a.dump(), b.dump());
+}
+
+FitterOptions fitter_options(const RefitCommandOptions& o) {
+  FitterOptions f;
+  f.bench_regex = o.bench_regex;
+  f.ignore_config = o.ignore_config;
+  f.max_rate_hz = 0;  // a log is read as fast as the disk allows; live caps were applied live
+  if (o.inertia_given) {
+    f.default_bench.inertia_kg_m2 = o.inertia_kg_m2;
+    f.default_bench.inertia_source = "--inertia";
+  }
+  if (o.kb_given) {
+    f.default_bench.kb_v_s_per_rad = o.kb_v_s_per_rad;
+    f.default_bench.kb_source = "--kb";
+  } else if (o.speed_constant_given) {
+    f.default_bench.kb_v_s_per_rad = kb_from_speed_constant(o.speed_constant_rpm_per_v);
+    f.default_bench.kb_source = fmt::format("--speed-constant {} rpm/V", o.speed_constant_rpm_per_v);
+  }
+  if (!o.models.empty()) {
+    f.models.clear();
+    for (const auto& name : o.models) {
+      auto kind = parse_model(name);
+      if (!kind) throw CLI::ValidationError(fmt::format("--models: unknown model '{}' (viscous, coulomb, combined)", name));
+      f.models.push_back(*kind);
+    }
+  }
+  std::string why;
+  if (!f.is_valid(&why)) throw CLI::ValidationError(why);
+  return f;
+}
+
+std::string run_key(const std::string& bench, int run) { return fmt::format("{}#{:09d}", bench, run); }
+
+}  // namespace
+
+LogRefit refit_log(const std::string& path, const FitterOptions& options, bool keep_live_fits,
+                   const std::function<void(const LcmLogEvent&)>& each_event) {
+  LogRefit out;
+  out.file.file = path;
+  LcmLogReader reader(path);
+  if (!reader.good()) {
+    out.file.failures.push_back(reader.open_error());
+    return out;
+  }
+  RefitSink sink(out, path);
+  FitterCore core(options, sink);
+  std::map<std::string, std::size_t, std::less<>> order;
+  std::int64_t last_utime = 0;
+  std::size_t file_problems = 0;
+  LcmLogEvent ev;
+  while (reader.next(ev)) {
+    if (each_event) each_event(ev);
+    if (ev.number > 0) last_utime = ev.log_utime;
+    if (!ev.bench.empty() && (ev.channel.ends_with(".SAMPLE") || ev.channel.ends_with(".CONFIG")) &&
+        !order.contains(ev.bench)) {
+      order.emplace(ev.bench, order.size());
+      out.bench_order.push_back(ev.bench);
+    }
+    switch (ev.kind) {
+      case LcmLogEvent::Kind::samples:
+      case LcmLogEvent::Kind::config:
+        core.on_message(ev.channel, ev.data, ev.data_size, ev.log_utime);
+        break;
+      case LcmLogEvent::Kind::problem:
+        if (ev.number > 0 && ev.data) {  // a message that does not decode: the core counts it
+          core.on_message(ev.channel, ev.data, ev.data_size, ev.log_utime);
+        } else if (++file_problems <= max_problems_listed) {
+          out.file.diagnostics.push_back({Diagnostic::Severity::warning, path, ev.number, ev.problem});
+        }
+        break;
+      case LcmLogEvent::Kind::other:
+        if (keep_live_fits && ev.channel.starts_with("SPINDOWN.") && ev.channel.ends_with(".FIT")) {
+          fit_t m;
+          try {
+            if (m.decode(ev.data, 0, ev.data_size) >= 0) {
+              out.live.push_back(std::move(m));
+              break;
+            }
+          } catch (const std::exception&) {
+          }
+          out.file.diagnostics.push_back({Diagnostic::Severity::warning, path, ev.number,
+                                          fmt::format("event {} on {}: not a decodable fit_t; skipped", ev.number,
+                                                      ev.channel)});
+        }
+        break;
+    }
+  }
+  core.finish(last_utime);
+  out.counters = core.counters();
+  const FitterCounters& c = out.counters;
+  if (file_problems > max_problems_listed)
+    out.file.diagnostics.push_back({Diagnostic::Severity::warning, path, 0,
+                                    fmt::format("{} damaged parts of the file in all", file_problems)});
+  if (sink.problems() > max_problems_listed)
+    out.file.diagnostics.push_back({Diagnostic::Severity::warning, path, 0,
+                                    fmt::format("{} unusable messages or samples in all (first {} listed)",
+                                                sink.problems(), max_problems_listed)});
+  out.file.diagnostics.push_back(
+      {Diagnostic::Severity::note, path, 0,
+       fmt::format("{} events: {} sample messages, {} config messages, {} samples used; {} decode errors, {} sequence "
+                   "gaps ({} samples lost), {} repeated messages, {} NaN values, {} samples with time going back, "
+                   "{} clock restarts",
+                   reader.events_read(), c.sample_messages, c.config_messages, c.samples, c.decode_errors, c.seq_gaps,
+                   c.samples_lost, c.duplicates, c.nan_values, c.time_backwards, c.clock_restarts)});
+
+  // Runs in the order `spindown fit` lists them: by bench (first appearance), then number.
+  auto rank = [&](const std::string& bench) {
+    auto it = order.find(bench);
+    return it == order.end() ? order.size() : it->second;
+  };
+  std::stable_sort(out.runs.begin(), out.runs.end(), [&](const RefitRun& a, const RefitRun& b) {
+    const auto ra = rank(a.bench), rb = rank(b.bench);
+    return ra != rb ? ra < rb : a.fit.run.number < b.fit.run.number;
+  });
+  out.file.samples = static_cast<std::size_t>(c.samples);
+  out.file.lines_read = static_cast<std::size_t>(c.sample_messages);
+  out.file.lines_skipped = static_cast<std::size_t>(c.decode_errors + c.duplicates + c.quantity_errors);
+  for (const RefitRun& r : out.runs) {
+    out.file.runs.push_back(r.fit);
+    if (r.fit.best.empty())
+      out.file.failures.push_back(fmt::format("SPINDOWN.{}.SAMPLE: run {}: no model converged", r.bench,
+                                              r.fit.run.number));
+  }
+  if (out.runs.empty())
+    out.file.failures.push_back(c.samples > 0 ? fmt::format("no spin-down run found in {} samples", c.samples)
+                                              : std::string("no samples on SPINDOWN.<bench>.SAMPLE channels"));
+  return out;
+}
+
+Json refit_file_json(const LogRefit& refit, const ReportOptions& opt) {
+  Json j = file_fit_json(refit.file, opt);
+  Json& runs = j["runs"];
+  for (std::size_t i = 0; i < refit.runs.size() && i < runs.size(); ++i) {
+    runs[i]["bench"]["id"] = refit.runs[i].bench;
+    runs[i]["first_seq"] = refit.runs[i].first_seq;
+    runs[i]["last_seq"] = refit.runs[i].last_seq;
+  }
+  return j;
+}
+
+void setup_refit(CLI::App& app) {
+  auto opt = std::make_shared<RefitCommandOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "refit", "Refit LCM logs exactly as spindown-fitter did live (same runs, same numbers); --compare checks it");
+  sub->footer(
+      "Reads each log with lcm::LogFile in its own order (never file:// replay). Runs are listed by bench, then run "
+      "number; in JSON each run also has bench.id, first_seq and last_seq.\n"
+      "Exit codes: 0 ok, 1 a log or run could not be used or --compare found a difference, 2 bad usage.");
+  sub->add_option("LOG", opt->logs, "LCM event log(s) (spindown-logger, lcm-logger)")->required();
+  sub->add_flag("--json", opt->json, "Print one JSON object {\"files\":[{\"runs\":[…]}]} instead of tables");
+  sub->add_option("--bench", opt->bench_regex, "Only benches whose id matches this regex (default all)");
+  sub->add_option("--models", opt->models, "Models to fit: viscous,coulomb,combined (default all)")->delimiter(',');
+  sub->add_flag("--lab-units", opt->lab_units, "Also give the lab's units");
+  sub->add_flag("-v,--verbose", opt->verbose, "Show every diagnostic, notes included");
+  auto* live = sub->add_flag("--live", opt->live, "Print the FIT messages recorded in the log instead of refitting");
+  sub->add_flag("--compare", opt->compare,
+                "Refit and compare with the recorded FIT messages, timing fields aside (exit 1 on a difference)")
+      ->excludes(live);
+  auto* j = sub->add_option("--inertia", opt->inertia_kg_m2, "J (kg·m²) for benches without CONFIG")
+                ->check(CLI::PositiveNumber)
+                ->group("Bench");
+  auto* kb = sub->add_option("--kb", opt->kb_v_s_per_rad, "K_b (V·s/rad) for benches without CONFIG")
+                 ->check(CLI::PositiveNumber)
+                 ->group("Bench");
+  auto* kv = sub->add_option("--speed-constant", opt->speed_constant_rpm_per_v, "K_b from a speed constant (rpm/V)")
+                 ->check(CLI::PositiveNumber)
+                 ->excludes(kb)
+                 ->group("Bench");
+  sub->add_flag("--ignore-config", opt->ignore_config, "Use --inertia/--kb (or the lab's) even where CONFIG says otherwise")
+      ->group("Bench");
+  sub->callback([opt, j, kb, kv]() {
+    opt->inertia_given = j->count() > 0;
+    opt->kb_given = kb->count() > 0;
+    opt->speed_constant_given = kv->count() > 0;
+    const int code = run_refit(*opt);
+    if (code != exit_ok) throw CLI::RuntimeError(code);
+  });
+}
+
+int run_refit(const RefitCommandOptions& o) {
+  const FitterOptions fopt = fitter_options(o);
+  ReportOptions report;
+  report.lab_units = o.lab_units;
+  report.max_diagnostics = o.verbose ? 0 : 8;
+  report.diagnostics_in_text = false;
+  bool ok = true;
+  Json files = Json::array();
+  for (const auto& path : o.logs) {
+    LogRefit r = refit_log(path, fopt, o.live || o.compare);
+    // Problems on stderr, as `spindown fit` does.
+    std::vector<Diagnostic> shown;
+    for (const auto& d : r.file.diagnostics)
+      if (o.verbose || d.severity != Diagnostic::Severity::note) shown.push_back(d);
+    for (const auto& line : summarize_diagnostics(shown, report.max_diagnostics)) std::cerr << line << '\n';
+
+    if (o.live || o.compare) {
+      // Recorded results, keyed by bench and run; the refit's likewise.
+      std::multimap<std::string, Json> live;
+      const std::regex wanted(o.bench_regex);
+      for (const fit_t& m : r.live) {
+        if (!std::regex_match(m.bench, wanted)) continue;
+        std::string why;
+        if (auto jf = fit_message_json(m, report, &why))
+          live.emplace(run_key(m.bench, m.run), without_timing_fields(std::move(*jf)));
+        else
+          std::cerr << path << ": warning: " << why << '\n';
+      }
+      if (o.live) {
+        if (live.empty()) {
+          std::cerr << path << ": error: no SPINDOWN.<bench>.FIT messages recorded in this log\n";
+          ok = false;
+        }
+        Json runs = Json::array();
+        for (auto& [key, jr] : live) runs.push_back(jr);
+        if (o.json) {
+          files.push_back(Json{{"file", path}, {"runs", std::move(runs)}});
+        } else {
+          std::cout << fmt::format("== {}: {} FIT messages recorded\n", path, live.size());
+          for (const fit_t& m : r.live)
+            if (auto f = from_fit_message(m))
+              std::cout << fmt::format("\n-- bench {} (live, latency {:.1f} ms, J/K_b: {})\n", m.bench,
+                                       1e3 * m.latency_s, m.bench_source)
+                        << format_run_fit(*f, report);
+        }
+        continue;
+      }
+      // --compare
+      const Json refit = refit_file_json(r, report);
+      std::size_t same = 0, differ = 0, missing_live = 0, missing_refit = 0;
+      std::map<std::string, Json> ours;
+      for (std::size_t i = 0; i < r.runs.size(); ++i)
+        ours.emplace(run_key(r.runs[i].bench, r.runs[i].fit.run.number),
+                     without_timing_fields(refit["runs"][i]));
+      for (const auto& [key, jr] : ours) {
+        auto [lo, hi] = live.equal_range(key);
+        if (lo == hi) {
+          ++missing_live;
+          std::cout << fmt::format("{}: {}: refit found it, no live FIT recorded\n", path, key);
+          continue;
+        }
+        for (auto it = lo; it != hi; ++it) {
+          const std::string d = first_difference(jr, it->second, "run");
+          if (d.empty()) {
+            ++same;
+          } else {
+            ++differ;
+            std::cout << fmt::format("{}: {}: differs: {}\n", path, key, d);
+          }
+        }
+      }
+      for (const auto& [key, jr] : live)
+        if (!ours.contains(key)) {
+          ++missing_refit;
+          std::cout << fmt::format("{}: {}: live FIT recorded, the refit did not find this run\n", path, key);
+        }
+      std::cout << fmt::format("{}: {} runs refitted, {} live FIT messages: {} identical, {} different, {} only "
+                               "refitted, {} only live\n",
+                               path, r.runs.size(), live.size(), same, differ, missing_live, missing_refit);
+      if (differ || missing_live || missing_refit || live.empty()) ok = false;
+      continue;
+    }
+
+    for (const auto& why : r.file.failures) std::cerr << path << ": error: not used: " << why << '\n';
+    ok = ok && r.file.usable();
+    if (o.json) {
+      files.push_back(refit_file_json(r, report));
+    } else {
+      std::size_t benches = 0;
+      std::string last;
+      for (const auto& run : r.runs)
+        if (run.bench != last) ++benches, last = run.bench;
+      std::cout << fmt::format("== {}: {} samples from {} messages ({} skipped), {} run{} fitted on {} bench{}\n",
+                               path, r.file.samples, r.file.lines_read, r.file.lines_skipped, r.runs.size(),
+                               r.runs.size() == 1 ? "" : "s", benches, benches == 1 ? "" : "es");
+      for (const auto& run : r.runs)
+        std::cout << fmt::format("\n-- bench {} (J/K_b: {})\n", run.bench, run.bench_source)
+                  << format_run_fit(run.fit, report);
+      std::cout.flush();
+    }
+  }
+  if (o.json && !o.compare) std::cout << Json{{"files", std::move(files)}}.dump(2) << std::endl;
+  return ok ? exit_ok : exit_unusable;
+}
+
+}  // namespace spindown::cli

@@ -1,0 +1,68 @@
+#pragma once
+// `spindown refit LOG...`: stream an LCM log (lcm::LogFile, the log's own order and receive
+// times) through the live fitter's FitterCore, so every bench's runs and numbers are exactly
+// what spindown-fitter gave for that traffic; print them as `spindown fit` does (text or §5
+// JSON, each run tagged with its bench id and sequence numbers). --live prints the FIT
+// messages recorded in the log instead; --compare checks the refit against them.
+// Memory is bounded by the per-bench state, not by the log's length.
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <spindown/fit_t.hpp>
+
+#include "spindown/fit_report.hpp"
+#include "spindown/fitter_core.hpp"
+#include "spindown/lcm_log_reader.hpp"
+
+namespace CLI {
+class App;
+}
+
+namespace spindown::cli {
+
+// One run as the live fitter would have published it.
+struct RefitRun {
+  std::string bench;
+  RunFit fit;
+  std::string bench_source;
+  std::int64_t first_seq = 0, last_seq = 0;
+};
+
+struct LogRefit {
+  FileFit file;                 // runs ordered by bench (first appearance), then run number
+  std::vector<RefitRun> runs;   // the same runs, with their bench ids
+  std::vector<fit_t> live;      // SPINDOWN.<bench>.FIT messages recorded in the log (when asked)
+  FitterCounters counters;
+  std::vector<std::string> bench_order;  // benches in order of first appearance
+};
+
+// Streams one log through a FitterCore (each event in log order, its receive time from the
+// log). each_event, when given, sees every event first (export writes samples from it).
+LogRefit refit_log(const std::string& path, const FitterOptions& options, bool keep_live_fits,
+                   const std::function<void(const LcmLogEvent&)>& each_event = {});
+
+// file_fit_json() with each run tagged as fit_message_json() tags a live FIT: bench.id,
+// first_seq, last_seq.
+Json refit_file_json(const LogRefit& refit, const ReportOptions& opt);
+
+struct RefitCommandOptions {
+  std::vector<std::string> logs;
+  bool json = false;
+  bool lab_units = false;
+  bool verbose = false;
+  bool live = false;     // print the recorded FIT messages, not a refit
+  bool compare = false;  // refit and compare with the recorded FIT messages (exit 1 on a difference)
+  std::string bench_regex = ".*";
+  std::vector<std::string> models;
+  double inertia_kg_m2 = 0, kb_v_s_per_rad = 0, speed_constant_rpm_per_v = 0;
+  bool inertia_given = false, kb_given = false, speed_constant_given = false;
+  bool ignore_config = false;
+};
+
+void setup_refit(CLI::App& app);
+int run_refit(const RefitCommandOptions& options);
+
+}  // namespace spindown::cli
