@@ -481,7 +481,10 @@ EffectFit fit_effects(const std::vector<const Effect*>& effects, const EffectFit
 
   LmResult lm = levenberg_marquardt(s, th);
   out.evaluations = lm.evals;
-  if (!th_nested.empty() && lm.sse > warm->sse * (1 + 1e-9)) {
+  bool warm_is_subset = warm != nullptr;
+  if (warm)
+    for (const Effect* we : warm->effects) warm_is_subset = warm_is_subset && std::find(effects.begin(), effects.end(), we) != effects.end();
+  if (!th_nested.empty() && warm_is_subset && lm.sse > warm->sse * (1 + 1e-9)) {
     // Nested models can only fit better: restart from the smaller model's optimum.
     LmResult again = levenberg_marquardt(s, th_nested);
     out.evaluations += again.evals;

@@ -87,6 +87,31 @@ std::vector<Disagreement> locate(const ResidualBins& b, double bin_se, double z_
   return out;
 }
 
+// The reading's resolution: the smallest step between distinct values (2-decimal prints:
+// 0.01 V). Near it, rounding is a deterministic, speed-dependent distortion no effect explains.
+double reading_quantum(std::span<const double> y) {
+  std::vector<double> v(y.begin(), y.end());
+  std::sort(v.begin(), v.end());
+  double q = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 1; i < v.size(); ++i) {
+    const double d = v[i] - v[i - 1];
+    if (d > 1e-9 * (std::abs(v[i]) + 1e-12)) q = std::min(q, d);
+  }
+  return std::isfinite(q) ? q : 0.0;
+}
+
+// Largest change (bin means) a candidate makes to the current model's simulation.
+double largest_change(const EffectFit& a, const EffectFit& b, std::size_t m) {
+  double worst = 0;
+  for (std::size_t i = 0; i < a.simulated.size(); i += m) {
+    const std::size_t e = std::min(i + m, a.simulated.size());
+    double s = 0;
+    for (std::size_t j = i; j < e; ++j) s += b.simulated[j] - a.simulated[j];
+    worst = std::max(worst, std::abs(s) / static_cast<double>(e - i));
+  }
+  return worst;
+}
+
 bool contains(const std::vector<const Effect*>& v, const Effect* e) {
   return std::find(v.begin(), v.end(), e) != v.end();
 }
@@ -210,6 +235,11 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
   if (pool.empty())
     for (const Effect& lib : effect_library()) pool.push_back(&lib);
 
+  // A named effect must remove at least half of the systematic disagreement (chi-square excess
+  // of the binned residual), not just shave the noise.
+  constexpr double max_left = 0.5;
+  // ... and move the model by at least half a reading step somewhere (else it fits rounding).
+  const double quantum = reading_quantum(out.y);
   EffectFit current = out.base;
   for (int step = 0;; ++step) {
     const std::vector<double> res = residual_of(out.y, current);
@@ -272,9 +302,16 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
       t.delta_bic = n_eff * std::log(current.sse / t.fit.sse) - extra * std::log(n_eff);
       const ResidualBins tb = bin_residuals(residual_of(out.y, t.fit), m, out.noise_level);
       t.systematic_after = mass > 0 ? systematic_mass(tb, bins.bin_se) / mass : 0.0;
+      t.change = largest_change(current, t.fit, m);
       if (!best || t.delta_bic > best->delta_bic) best = &t;
     }
-    const bool enough = best && best->delta_bic > opt.min_delta_bic && best->systematic_after < 0.8;
+    // Evidence that cannot separate two effects (within 3 in BIC) goes to the simpler one.
+    for (auto& t : st.trials)
+      if (best && &t != best && std::isfinite(t.delta_bic) && t.delta_bic > best->delta_bic - 3 &&
+          t.fit.theta.size() < best->fit.theta.size() && t.systematic_after <= best->systematic_after + 0.05)
+        best = &t;
+    const bool enough = best && best->delta_bic > opt.min_delta_bic && best->systematic_after < max_left &&
+                        best->change >= 0.5 * quantum;
     for (auto& t : st.trials) {
       if (!t.verdict.empty()) continue;
       if (&t == best && enough) {
@@ -286,12 +323,19 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
                                                    out.unit, t.delta_bic)
                                      : fmt::format("too little evidence (dBIC {:.1f} < {:.0f}, RMSE {:.4g} {})",
                                                    t.delta_bic, opt.min_delta_bic, t.fit.rmse, out.unit);
-      else if (t.systematic_after >= 0.8)
+      else if (t.change < 0.5 * quantum)
+        t.verdict = fmt::format("changes the model by {:.2g} {} at most, less than half the reading's resolution {:.2g} {} "
+                                "(dBIC {:.1f})",
+                                t.change, out.unit, quantum, out.unit, t.delta_bic);
+      else if (t.systematic_after >= max_left)
         t.verdict = fmt::format("fits the noise, not the disagreement ({:.0f}% of it left, dBIC {:.1f})",
                                 100 * t.systematic_after, t.delta_bic);
       else
-        t.verdict = fmt::format("explains less (dBIC {:.1f} vs {:.1f}, RMSE {:.4g} {}, {:.0f}% of the disagreement left)",
-                                t.delta_bic, best->delta_bic, t.fit.rmse, out.unit, 100 * t.systematic_after);
+        t.verdict = t.delta_bic > best->delta_bic
+                        ? fmt::format("as good but not simpler (dBIC {:.1f} vs {:.1f} with fewer parameters, RMSE {:.4g} {})",
+                                      t.delta_bic, best->delta_bic, t.fit.rmse, out.unit)
+                        : fmt::format("explains less (dBIC {:.1f} vs {:.1f}, RMSE {:.4g} {}, {:.0f}% of the disagreement left)",
+                                      t.delta_bic, best->delta_bic, t.fit.rmse, out.unit, 100 * t.systematic_after);
     }
     if (!enough) {
       out.remaining = where;
@@ -310,6 +354,29 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
                          best->effect, best->delta_bic, n_eff, current.rmse, best->fit.rmse, out.unit,
                          current.rmse / best->fit.rmse, 100 * best->systematic_after);
     current = st.fit;
+    // Backward check: an effect added at an earlier step may only have stood in for the one
+    // just found (greedy order); drop it when the model does as well without it.
+    for (bool dropped = true; dropped;) {
+      dropped = false;
+      for (const Effect* e : current.effects) {
+        if (contains(opt.base, e) || e->name == st.added) continue;
+        std::vector<const Effect*> reduced;
+        for (const Effect* k2 : current.effects)
+          if (k2 != e) reduced.push_back(k2);
+        EffectFit r = fit_effects(reduced, data, &current);
+        if (!std::isfinite(r.sse) || r.sse <= 0) continue;
+        const double cost = n_eff * std::log(r.sse / current.sse) - e->size() * std::log(n_eff);
+        if (cost < opt.min_delta_bic) {
+          st.removed.emplace_back(e->name);
+          st.why += fmt::format("; {} removed (dBIC {:.1f} without it: {} covers it)", e->name, cost, st.added);
+          current = std::move(r);
+          st.fit = current;
+          st.rmse_after = current.rmse;
+          dropped = true;
+          break;
+        }
+      }
+    }
     out.steps.push_back(std::move(st));
   }
   out.final_fit = current;

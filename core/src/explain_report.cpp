@@ -83,6 +83,7 @@ ExplainJson explain_run_json(const ExplainResult& r) {
                      {"rmse_after", number(s.rmse_after)},
                      {"where", where_json(s.where)},
                      {"why", s.why},
+                     {"removed", s.removed},
                      {"candidates", trials_json(s.trials)},
                      {"params", params_json(s.fit)}});
   j["steps"] = steps;

@@ -48,7 +48,8 @@ struct CandidateTrial {
   std::string effect;
   EffectFit fit;
   double delta_bic = 0;       // effective-sample BIC improvement over the current model (> 0 better)
-  double systematic_after = 0;  // share of the systematic bins left (sum of z² beyond threshold)
+  double systematic_after = 0;  // share of the systematic disagreement left (binned chi-square excess)
+  double change = 0;            // largest change it makes to the model (bin means, reading unit)
   std::string verdict;        // "added", or why it was rejected
 };
 
@@ -58,6 +59,8 @@ struct ExplainStep {
   std::vector<Disagreement> where;  // before the step
   std::vector<CandidateTrial> trials;
   std::string why;
+  // Effects added earlier that the new one made unnecessary (backward check after each step).
+  std::vector<std::string> removed;
   EffectFit fit;  // the model after the step
 };
 
