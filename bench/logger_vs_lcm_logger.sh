@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# spindown-logger beside Debian's lcm-logger 1.3.1 on the same traffic (design §7), in a private
+# network namespace over real UDP multicast:
+#   A  burst: 4 benches × N messages as fast as the publisher sends, then SIGTERM at once
+#   B  quiet tail: 200 messages at 100 Hz, 2 s of silence, then SIGKILL
+#   C  load: 100 benches at 50 Hz for 10 s (5000 msg/s): CPU of each logger, drops
+# Usage: bench/logger_vs_lcm_logger.sh [BIN_DIR]   (default build/bin)
+set -euo pipefail
+ROOT=$(cd "$(dirname "$0")/.." && pwd)
+BIN=${1:-${SPINDOWN_BIN_DIR:-$ROOT/build/bin}}
+for p in spindown-logger spindown-lcm-publish spindown-log-summary; do
+  [[ -x $BIN/$p ]] || { echo "missing $BIN/$p (build it first)" >&2; exit 2; }
+done
+command -v lcm-logger >/dev/null || { echo "lcm-logger not installed" >&2; exit 2; }
+if [[ -z "${SPINDOWN_IN_NETNS:-}" ]]; then exec env SPINDOWN_IN_NETNS=1 unshare -n bash "$0" "$BIN"; fi
+ip link set lo up
+ip route add 224.0.0.0/4 dev lo
+URL='udpm://239.255.76.67:7667?ttl=0'
+WORK=$(mktemp -d /tmp/spindown-logger-bench.XXXXXX)
+PIDS=()
+trap 'for p in "${PIDS[@]}"; do kill -KILL "$p" 2>/dev/null || true; done; rm -rf "$WORK"' EXIT
+
+count() {  # count FILE...: SAMPLE messages in LCM logs
+  "$BIN/spindown-log-summary" "$@" | python3 -c 'import json,sys; print(json.load(sys.stdin)["sample_messages"])'
+}
+cpu_ticks() { awk '{print $14 + $15}' "/proc/$1/stat"; }
+start_both() {  # start_both DIR
+  mkdir -p "$1/ours" "$1/theirs"
+  "$BIN/spindown-logger" --lcm-url "$URL" --dir "$1/ours" -q 2>"$1/ours.err" &
+  OURS=$!
+  lcm-logger -q --lcm-url="$URL" -c 'SPINDOWN\..*' "$1/theirs/lcmlog.lcm" 2>"$1/theirs.err" &
+  THEIRS=$!
+  PIDS+=("$OURS" "$THEIRS")
+  sleep 1
+}
+stop_both() {  # stop_both SIGNAL
+  kill "-$1" "$OURS" "$THEIRS"
+  wait "$OURS" 2>/dev/null || true
+  wait "$THEIRS" 2>/dev/null || true
+}
+
+N=${BURST:-20000}
+echo "A  burst of $((4 * N)) messages (4 benches, publisher at full speed), SIGTERM right after"
+start_both "$WORK/a"
+"$BIN/spindown-lcm-publish" --lcm-url "$URL" --benches 4 --count "$N" --rate 0 >/dev/null
+stop_both TERM
+printf '   %-16s %8s of %d\n' spindown-logger "$(count "$WORK"/a/ours/*.lcm)" $((4 * N))
+printf '   %-16s %8s of %d\n' lcm-logger "$(count "$WORK"/a/theirs/*)" $((4 * N))
+
+echo "B  200 messages at 100 Hz, 2 s of silence, then SIGKILL"
+start_both "$WORK/b"
+"$BIN/spindown-lcm-publish" --lcm-url "$URL" --bench quiet --count 200 --rate 100 >/dev/null
+sleep 2
+stop_both KILL
+printf '   %-16s %8s of 200\n' spindown-logger "$(count "$WORK"/b/ours/*.lcm)"
+printf '   %-16s %8s of 200\n' lcm-logger "$(count "$WORK"/b/theirs/*)"
+
+echo "C  100 benches at 50 Hz for 10 s, SIGTERM after"
+start_both "$WORK/c"
+o0=$(cpu_ticks "$OURS"); t0=$(cpu_ticks "$THEIRS")
+"$BIN/spindown-lcm-publish" --lcm-url "$URL" --benches 100 --count 500 --rate 50 >"$WORK/c/pub.json"
+o1=$(cpu_ticks "$OURS"); t1=$(cpu_ticks "$THEIRS")
+stop_both TERM
+hz=$(getconf CLK_TCK)
+sent=$(python3 -c "import json; print(json.load(open('$WORK/c/pub.json'))['sample_messages'])")
+secs=10
+printf '   %-16s %8s of %s messages, CPU %.1f %% of one core\n' spindown-logger "$(count "$WORK"/c/ours/*.lcm)" "$sent" \
+  "$(awk "BEGIN{print 100 * ($o1 - $o0) / $hz / $secs}")"
+printf '   %-16s %8s of %s messages, CPU %.1f %% of one core\n' lcm-logger "$(count "$WORK"/c/theirs/*)" "$sent" \
+  "$(awk "BEGIN{print 100 * ($t1 - $t0) / $hz / $secs}")"
