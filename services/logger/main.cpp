@@ -9,7 +9,10 @@
 #include <cstdlib>
 #include <fmt/format.h>
 #include <lcm/lcm-cpp.hpp>
+#include <cstdio>
+#include <cstring>
 #include <pthread.h>
+#include <sstream>
 
 #include "spindown/event_log_writer.hpp"
 #include "spindown/lcm_status.hpp"
@@ -34,6 +37,26 @@ std::string with_receive_buffer(std::string url, long bytes) {
   }
   if (bytes <= 0 || url.rfind("udpm://", 0) != 0 || url.find("recv_buf_size") != std::string::npos) return url;
   return url + (url.find('?') == std::string::npos ? "?" : "&") + fmt::format("recv_buf_size={}", bytes);
+}
+
+// Datagrams the kernel dropped because a UDP receive buffer was full, in this network
+// namespace (all sockets, not only ours): the part of LCM's loss that can be seen at all.
+long udp_receive_buffer_errors() {
+  std::FILE* f = std::fopen("/proc/net/snmp", "r");
+  if (!f) return -1;
+  char header[1024], values[1024];
+  long result = -1;
+  while (std::fgets(header, sizeof header, f) && std::fgets(values, sizeof values, f)) {
+    if (std::strncmp(header, "Udp:", 4) != 0) continue;
+    std::istringstream names(header + 4), numbers(values + 4);
+    std::string name;
+    long value = 0;
+    while (names >> name && numbers >> value)
+      if (name == "RcvbufErrors") result = value;
+    break;
+  }
+  std::fclose(f);
+  return result;
 }
 
 class Receiver {
@@ -144,9 +167,15 @@ int main(int argc, char** argv) {
 
   spindown::StatusHeartbeat beat("logger", "", start);  // only its schedule is used
   std::string reported_error;
+  const long rcvbuf_errors_at_start = udp_receive_buffer_errors();
   auto heartbeat = [&](std::int64_t now, const char* state) {
     spindown::status_t st = recorder.status(now);
     if (state) st.state = state;
+    if (rcvbuf_errors_at_start >= 0) {
+      st.gauge_name.emplace_back("udp_rcvbuf_errors_netns");
+      st.gauge_value.push_back(double(udp_receive_buffer_errors() - rcvbuf_errors_at_start));
+      st.ngauges = static_cast<std::int32_t>(st.gauge_name.size());
+    }
     lcm.publish(w.status_channel, &st);
     beat.mark_sent(now);
     if (st.last_error != reported_error) {
@@ -172,8 +201,11 @@ int main(int argc, char** argv) {
 
   const auto& c = writer.counters();
   if (!quiet) {
-    fmt::print(stderr, "spindown-logger: stopped: {} events, {} bytes in {} files, {} drops, {} write errors\n",
-               c.events, c.bytes, c.files, c.queue_drops + c.events_lost, c.write_errors);
+    fmt::print(stderr,
+               "spindown-logger: stopped: {} events, {} bytes in {} files, {} drops, {} write errors, "
+               "{} samples missing by sequence number, {} datagrams dropped by the kernel in this network namespace\n",
+               c.events, c.bytes, c.files, c.queue_drops + c.events_lost, c.write_errors, c.samples_missing,
+               rcvbuf_errors_at_start >= 0 ? udp_receive_buffer_errors() - rcvbuf_errors_at_start : -1);
     for (const auto& f : writer.files()) fmt::print(stderr, "spindown-logger: wrote {}\n", f);
   }
   if (c.write_errors > 0) {
