@@ -119,9 +119,12 @@ int main(int argc, char** argv) {
     return 1;
   }
   using spindown::ChannelKind;
-  lcm.subscribe(spindown::channel_name(bench, ChannelKind::sample), &Tap::on_samples, &tap);
-  lcm.subscribe(spindown::channel_name(bench, ChannelKind::status), &Tap::on_status, &tap);
-  lcm.subscribe(spindown::channel_name(bench, ChannelKind::config), &Tap::on_config, &tap);
+  // LCM drops messages silently past a subscription's queue capacity (default 30): a test
+  // tool on a busy machine must not, so let the queues grow.
+  for (auto* sub : {lcm.subscribe(spindown::channel_name(bench, ChannelKind::sample), &Tap::on_samples, &tap),
+                    lcm.subscribe(spindown::channel_name(bench, ChannelKind::status), &Tap::on_status, &tap),
+                    lcm.subscribe(spindown::channel_name(bench, ChannelKind::config), &Tap::on_config, &tap)})
+    sub->setQueueCapacity(1'000'000);
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   if (!ready_file.empty()) File(std::fopen(ready_file.c_str(), "w"));

@@ -149,6 +149,9 @@ int main(int argc, char** argv) {
     if (g_stop) break;
     if (e.kind == spindown::BenchEmission::Kind::unplug) {
       sleep_until(at(e.wire_s));
+      // What was sent before the pull reached the host (the reader may be a little behind):
+      // let it drain, so "sent" means "delivered" and tests can compare sample for sample.
+      sleep_until(Clock::now() + std::chrono::milliseconds(200));
       fmt::print(stderr, "spindown-virtual-bench: cable pulled for {} s\n", e.unplug_for_s);
       pty.reset();
       if (!link.empty()) std::filesystem::remove(link);

@@ -14,6 +14,8 @@ fi
 ip link set lo up
 ip route add 224.0.0.0/4 dev lo
 export LCM_URL='udpm://239.255.76.67:7667?ttl=0'
+# The tap may be starved of CPU on a busy machine: give its socket room (capped by rmem_max).
+TAP_URL="$LCM_URL&recv_buf_size=4194304"
 
 BIN=${SPINDOWN_BIN_DIR:?SPINDOWN_BIN_DIR not set}
 WORK=$(mktemp -d /tmp/spindown-bridge-test.XXXXXX)
@@ -37,6 +39,13 @@ wait_for() {
   done
 }
 
+# wait_samples PREFIX N SECONDS: waits until the tap holds N samples (no failure: the comparison
+# that follows says what is missing).
+wait_samples() {
+  local deadline=$((SECONDS + $3))
+  while (( $(wc -l < "$WORK/$1.samples.tsv") < $2 && SECONDS < deadline )); do sleep 0.05; done
+}
+
 # wait_pid PID SECONDS: waits for a child to exit, returns its exit code.
 wait_pid() {
   local pid=$1 deadline=$((SECONDS + $2))
@@ -50,7 +59,7 @@ wait_pid() {
 }
 
 start_tap() {  # start_tap BENCH PREFIX
-  "$BIN/spindown-bridge-tap" --bench "$1" --lcm-url "$LCM_URL" --samples "$WORK/$2.samples.tsv" \
+  "$BIN/spindown-bridge-tap" --bench "$1" --lcm-url "$TAP_URL" --samples "$WORK/$2.samples.tsv" \
     --status "$WORK/$2.status.jsonl" --config "$WORK/$2.config.jsonl" --ready "$WORK/$2.ready" \
     --timeout 250 2>"$WORK/$2.tap.log" &
   PIDS+=($!)

@@ -21,7 +21,7 @@ for proto in lab spindown-v1; do
   bridge=$!; PIDS+=($bridge)
   wait_pid "$bench" 150 || fail "$name: virtual bench failed: $(cat "$WORK/$name.bench.log")"
   n=$(truth "$name" "t['samples']")
-  wait_for "[[ \$(wc -l < '$WORK/$name.samples.tsv') -ge $n ]]" 10 "$name: $n samples"
+  wait_samples "$name" "$n" 10
   sleep 1.2
   kill -0 "$bridge" 2>/dev/null || fail "$name: the bridge stopped"
   grep -q '"state":"disconnected"' "$WORK/$name.status.jsonl" || fail "$name: no status said disconnected"

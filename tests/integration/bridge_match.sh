@@ -20,7 +20,7 @@ run_case() {  # run_case NAME BRIDGE-ARGS -- BENCH-ARGS
   local bridge=$!; PIDS+=($bridge)
   wait_pid "$bench" 120 || fail "$name: virtual bench failed: $(cat "$WORK/$name.bench.log")"
   local n; n=$(truth "$name" "t['samples']")
-  wait_for "[[ \$(wc -l < '$WORK/$name.samples.tsv') -ge $n ]]" 10 "$name: $n samples"
+  wait_samples "$name" "$n" 10
   sleep 1.2  # one more heartbeat
   kill -TERM "$bridge"
   wait_pid "$bridge" 5 || fail "$name: bridge exited with $? on SIGTERM (want 0)"

@@ -23,7 +23,7 @@ last_status late last_error | grep -q "No such file or directory" || fail "late:
 bench=$!; PIDS+=($bench)
 wait_pid "$bench" 60 || fail "late: the bridge did not open the device once it appeared: $(cat "$WORK/late.bench.log")"
 n=$(truth late "t['samples']")
-wait_for "[[ \$(wc -l < '$WORK/late.samples.tsv') -ge $n ]]" 10 "late: $n samples"
+wait_samples "late" "$n" 10
 compare_samples late || fail "late: samples differ"
 kill -TERM "$bridge"; wait_pid "$bridge" 5 || fail "late: bridge exit code $? on SIGTERM"
 
