@@ -1,0 +1,97 @@
+// fit_t and run_t from the fitter's results: a fit survives RunFit -> fit_t -> wire -> fit_t ->
+// RunFit with run_fit_json() unchanged, and inconsistent messages are refused with a reason.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "spindown/fit_message.hpp"
+#include "spindown/runs.hpp"
+#include "spindown/synthetic_run.hpp"
+
+namespace spindown {
+namespace {
+
+RunFit sample_fit() {
+  SyntheticRunSpec spec;
+  spec.seed = 42;
+  const SyntheticRun run = make_synthetic_run(spec);
+  Recording rec;
+  for (std::size_t i = 0; i < run.t_ms.size(); ++i) rec.push(run.t_ms[i] / 1000.0, run.volts[i]);
+  const Segmentation seg = find_runs(rec);
+  EXPECT_EQ(seg.runs.size(), 1u);
+  FitOptions fo;
+  fo.bench.inertia_source = "geometry";
+  return fit_run(rec, seg.runs.at(0), fo);
+}
+
+TEST(FitMessage, RoundTripKeepsTheReport) {
+  const RunFit fit = sample_fit();
+  FitProvenance about{"lab-3", "config", 100, 1500, 0.004};
+  const fit_t msg = to_fit_message(fit, about, 123);
+  EXPECT_EQ(msg.nmodels, 3);
+  EXPECT_EQ(msg.nparams, static_cast<std::int32_t>(msg.param_name.size()));
+  EXPECT_EQ(msg.best, fit.best);
+  EXPECT_EQ(msg.residual_unit, "V");
+  EXPECT_DOUBLE_EQ(msg.latency_s, 0.004);
+
+  // Over the wire.
+  std::vector<unsigned char> buf(static_cast<std::size_t>(msg.getEncodedSize()));
+  ASSERT_GT(msg.encode(buf.data(), 0, static_cast<int>(buf.size())), 0);
+  fit_t back;
+  ASSERT_GT(back.decode(buf.data(), 0, static_cast<int>(buf.size())), 0);
+
+  std::string why;
+  const auto again = from_fit_message(back, &why);
+  ASSERT_TRUE(again) << why;
+  Json expected = run_fit_json(fit);
+  EXPECT_EQ(run_fit_json(*again).dump(), expected.dump());
+
+  const auto j = fit_message_json(back, {}, &why);
+  ASSERT_TRUE(j) << why;
+  EXPECT_EQ((*j)["bench"]["id"], "lab-3");
+  EXPECT_EQ((*j)["first_seq"], 100);
+  EXPECT_EQ((*j)["last_seq"], 1500);
+  EXPECT_EQ((*j)["bench"]["J_source"], "geometry");
+}
+
+TEST(FitMessage, InconsistentArraysAreRefused) {
+  fit_t msg = to_fit_message(sample_fit(), {"b", "config", 0, 0, 0}, 0);
+  fit_t bad = msg;
+  bad.nmodels = 5;
+  std::string why;
+  EXPECT_FALSE(from_fit_message(bad, &why));
+  EXPECT_NE(why.find("nmodels"), std::string::npos);
+  bad = msg;
+  bad.param_model[0] = 9;
+  EXPECT_FALSE(from_fit_message(bad, &why));
+  bad = msg;
+  bad.model[1] = "magic";
+  EXPECT_FALSE(from_fit_message(bad, &why));
+  EXPECT_NE(why.find("magic"), std::string::npos);
+}
+
+TEST(FitMessage, NeverStoppedRunHasNanStop) {
+  RunFit fit = sample_fit();
+  fit.run.stopped = false;
+  const fit_t msg = to_fit_message(fit, {"b", "config", 0, 0, 0}, 0);
+  EXPECT_TRUE(std::isnan(msg.t_stop_s));
+  const auto back = from_fit_message(msg);
+  ASSERT_TRUE(back);
+  EXPECT_FALSE(back->run.stopped);
+}
+
+TEST(FitMessage, RunMessageAndTimingFields) {
+  spindown::Run r;
+  r.number = 2;
+  r.t_cut_s = 1.5;
+  const run_t m = to_run_message("b", r, run_t::STATE_COASTING, 10, 20, 11, "cut", 5);
+  EXPECT_EQ(m.run, 2);
+  EXPECT_TRUE(std::isnan(m.t_stop_s));
+  EXPECT_EQ(run_state_name(m.state), "coasting");
+  Json j = {{"a", 1}, {"latency_s", 0.2}, {"x", {{"utime", 5}, {"b", 2}}}};
+  EXPECT_EQ(without_timing_fields(j).dump(), R"({"a":1,"x":{"b":2}})");
+}
+
+}  // namespace
+}  // namespace spindown

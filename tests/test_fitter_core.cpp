@@ -1,0 +1,291 @@
+// FitterCore: generated runs fed as samples_t batches give one fit per run with the bench's
+// CONFIG (or the flagged default); caps and malformed input are counted and never touch the
+// other benches' results; the same input gives the same numbers as find_runs + fit_run.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "spindown/fit_message.hpp"
+#include "spindown/fitter_core.hpp"
+#include "spindown/runs.hpp"
+#include "spindown/synthetic_run.hpp"
+
+namespace spindown {
+namespace {
+
+struct CollectingSink : FitterSink {
+  std::vector<FitResult> fits;          // spans cleared: only valid during the call
+  std::vector<run_t> runs;
+  std::vector<std::string> problems;
+  void run_changed(const run_t& r) override { runs.push_back(r); }
+  void fit_ready(const FitResult& r) override {
+    FitResult copy = r;
+    copy.t_s = {};
+    copy.value = {};
+    fits.push_back(std::move(copy));
+  }
+  void problem(const std::string& text) override { problems.push_back(text); }
+  std::vector<const FitResult*> of(const std::string& bench) const {
+    std::vector<const FitResult*> out;
+    for (const auto& f : fits)
+      if (f.bench == bench) out.push_back(&f);
+    return out;
+  }
+};
+
+// Two runs back to back on one device clock, as (t_us, volts).
+struct Stream {
+  std::vector<std::int64_t> t_us;
+  std::vector<double> v;
+};
+Stream make_stream(int runs, std::uint64_t seed, double e0 = 2.8) {
+  Stream s;
+  double t0_ms = 1000;
+  for (int r = 0; r < runs; ++r) {
+    SyntheticRunSpec spec;
+    spec.seed = seed + r;
+    spec.e0_v = e0 + 0.2 * r;
+    spec.t0_ms = t0_ms;
+    const SyntheticRun run = make_synthetic_run(spec);
+    for (std::size_t i = 0; i < run.t_ms.size(); ++i) {
+      s.t_us.push_back(std::llround(run.t_ms[i] * 1000));
+      s.v.push_back(run.volts[i]);
+    }
+    t0_ms = run.t_ms.back() + 20;
+  }
+  return s;
+}
+
+samples_t batch(const std::string& bench, const Stream& s, std::size_t from, std::size_t n, std::int64_t seq) {
+  samples_t m;
+  m.bench = bench;
+  m.seq = seq;
+  m.quantity = samples_t::QUANTITY_BACK_EMF_V;
+  for (std::size_t i = from; i < from + n && i < s.t_us.size(); ++i) {
+    m.device_time_us.push_back(s.t_us[i]);
+    m.host_time_us.push_back(0);
+    m.value.push_back(s.v[i]);
+    m.raw_adc.push_back(-1);
+  }
+  m.n = static_cast<std::int32_t>(m.value.size());
+  return m;
+}
+
+config_t config(const std::string& bench, double j) {
+  config_t c;
+  c.bench = bench;
+  c.inertia_kg_m2 = j;
+  c.inertia_source = "test geometry";
+  c.kb_v_s_per_rad = 1.0 / 123.569311;
+  c.kb_source = "test";
+  c.quantity = samples_t::QUANTITY_BACK_EMF_V;
+  return c;
+}
+
+std::vector<unsigned char> encode(const samples_t& m) {
+  std::vector<unsigned char> buf(static_cast<std::size_t>(m.getEncodedSize()));
+  m.encode(buf.data(), 0, static_cast<int>(buf.size()));
+  return buf;
+}
+
+// Feeds a whole stream in batches of `per` samples through on_message (the service's path).
+void feed(FitterCore& core, const std::string& bench, const Stream& s, std::size_t per, std::int64_t& utime) {
+  std::int64_t seq = 0;
+  for (std::size_t i = 0; i < s.t_us.size(); i += per) {
+    const auto bytes = encode(batch(bench, s, i, per, seq));
+    seq += static_cast<std::int64_t>(std::min(per, s.t_us.size() - i));
+    utime += 20000 * static_cast<std::int64_t>(per);
+    core.on_message("SPINDOWN." + bench + ".SAMPLE", bytes.data(), static_cast<std::int64_t>(bytes.size()), utime);
+  }
+}
+
+TEST(FitterCore, OneFitPerRunWithTheBenchsConfigAndTheDefaultFlagged) {
+  CollectingSink sink;
+  FitterCore core({}, sink);
+  const Stream s = make_stream(2, 7);
+  core.on_config("withcfg", config("withcfg", 2.0e-5), 1);
+  std::int64_t utime = 10;
+  feed(core, "withcfg", s, 5, utime);
+  feed(core, "nocfg", s, 5, utime);
+  core.finish(utime);
+
+  const auto a = sink.of("withcfg"), b = sink.of("nocfg");
+  ASSERT_EQ(a.size(), 2u);
+  ASSERT_EQ(b.size(), 2u);
+  EXPECT_EQ(a[0]->bench_source, "config");
+  EXPECT_DOUBLE_EQ(a[0]->fit.bench.inertia_kg_m2, 2.0e-5);
+  EXPECT_EQ(a[0]->fit.bench.inertia_source, "test geometry");
+  EXPECT_NE(b[0]->bench_source.find("no CONFIG"), std::string::npos) << b[0]->bench_source;
+  EXPECT_DOUBLE_EQ(b[0]->fit.bench.inertia_kg_m2, BenchParams{}.inertia_kg_m2);
+  EXPECT_EQ(a[0]->fit.run.number, 1);
+  EXPECT_EQ(a[1]->fit.run.number, 2);
+  EXPECT_EQ(a[1]->first_seq, static_cast<std::int64_t>(a[1]->fit.run.cut_index));
+  for (const auto* f : a) EXPECT_EQ(f->fit.best, "combined");
+  // Friction scales with J: the same data with a larger J gives larger coefficients.
+  const double c4a = a[0]->fit.model(ModelKind::combined)->param("c4")->value;
+  const double c4b = b[0]->fit.model(ModelKind::combined)->param("c4")->value;
+  EXPECT_NEAR(c4a / c4b, 2.0e-5 / BenchParams{}.inertia_kg_m2, 1e-6);
+  EXPECT_EQ(core.counters().fits, 4);
+  EXPECT_EQ(core.counters().decode_errors, 0);
+
+  // The run's life: coasting, stopped, stopped (complete) per run.
+  int coasting = 0, stopped = 0;
+  for (const auto& r : sink.runs)
+    if (r.bench == "withcfg") (r.state == run_t::STATE_COASTING ? coasting : stopped) += 1;
+  EXPECT_EQ(coasting, 2);
+  EXPECT_EQ(stopped, 4);
+}
+
+TEST(FitterCore, SameNumbersAsFindRunsAndFitRun) {
+  const Stream s = make_stream(2, 11);
+  Recording rec;
+  for (std::size_t i = 0; i < s.t_us.size(); ++i) rec.push(double(s.t_us[i]) / 1e6, s.v[i]);
+  const Segmentation seg = find_runs(rec);
+  ASSERT_EQ(seg.runs.size(), 2u);
+
+  CollectingSink sink;
+  FitterCore core({}, sink);
+  std::int64_t utime = 0;
+  feed(core, "b", s, 3, utime);
+  core.finish(utime);
+  ASSERT_EQ(sink.fits.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    FitOptions fo;
+    const RunFit offline = fit_run(rec, seg.runs[k], fo);
+    const RunFit& live = sink.fits[k].fit;
+    EXPECT_EQ(run_fit_json(offline).dump(), run_fit_json(live).dump()) << "run " << k + 1;
+  }
+}
+
+TEST(FitterCore, MalformedMessagesAreCountedAndOtherBenchesUnaffected) {
+  const Stream s = make_stream(1, 3);
+  CollectingSink clean_sink;
+  {
+    FitterCore clean({}, clean_sink);
+    std::int64_t utime = 0;
+    feed(clean, "good", s, 4, utime);
+    clean.finish(utime);
+  }
+  ASSERT_EQ(clean_sink.fits.size(), 1u);
+
+  CollectingSink sink;
+  FitterCore core({}, sink);
+  std::int64_t utime = 0, seq = 0;
+  for (std::size_t i = 0; i < s.t_us.size(); i += 4) {
+    const auto good = encode(batch("good", s, i, 4, std::int64_t(i)));
+    utime += 80000;
+    core.on_message("SPINDOWN.good.SAMPLE", good.data(), std::int64_t(good.size()), utime);
+    // The bad bench interleaved: every kind of damage.
+    samples_t m = batch("bad", s, i, 4, seq);
+    seq += m.n;
+    const std::size_t k = i / 4;
+    if (k % 7 == 1) m.value[0] = std::nan("");
+    if (k % 11 == 2) m.device_time_us[1] = m.device_time_us[0] - 1000;
+    auto bytes = encode(m);
+    core.on_message("SPINDOWN.bad.SAMPLE", bytes.data(), std::int64_t(bytes.size()), utime);
+    if (k % 13 == 3) core.on_message("SPINDOWN.bad.SAMPLE", bytes.data(), std::int64_t(bytes.size()), utime);  // dup
+    if (k % 17 == 4) seq += 3;  // gap
+    if (k % 19 == 5) {
+      const std::string junk = "not an lcm message at all";
+      core.on_message("SPINDOWN.bad.SAMPLE", junk.data(), std::int64_t(junk.size()), utime);
+    }
+    if (k % 23 == 6) core.on_message("SPINDOWN.bad.SAMPLE", bytes.data(), std::int64_t(bytes.size() / 2), utime);
+    if (k % 29 == 7) {
+      std::vector<unsigned char> huge_n = bytes;
+      // n sits after hash(8) utime(8) bench(4+len+1) seq(8) epoch(4) quantity(1)
+      const std::size_t at = 8 + 8 + 4 + 4 + 8 + 4 + 1;
+      huge_n[at] = 0x7f;
+      core.on_message("SPINDOWN.bad.SAMPLE", huge_n.data(), std::int64_t(huge_n.size()), utime);
+    }
+    if (k % 31 == 8) core.on_message("SPINDOWN.bad bench!.SAMPLE", bytes.data(), std::int64_t(bytes.size()), utime);
+  }
+  core.finish(utime);
+  const FitterCounters& c = core.counters();
+  EXPECT_GT(c.nan_values, 0);
+  EXPECT_GT(c.time_backwards, 0);
+  EXPECT_GT(c.duplicates, 0);
+  EXPECT_GT(c.seq_gaps, 0);
+  EXPECT_GE(c.decode_errors, 3);
+  EXPECT_GT(c.invalid_bench, 0);
+  EXPECT_FALSE(core.last_error().empty());
+  const auto good = sink.of("good");
+  ASSERT_EQ(good.size(), 1u);
+  EXPECT_EQ(run_fit_json(good[0]->fit).dump(), run_fit_json(clean_sink.fits[0].fit).dump());
+  EXPECT_EQ(sink.of("bad").size(), 1u);  // damaged, yet its run is still found and fitted
+  const status_t st = core.make_status(utime, "fitter", "host", 1, "running", 1.0);
+  EXPECT_EQ(st.ncounters, static_cast<std::int32_t>(st.counter_name.size()));
+  EXPECT_FALSE(st.last_error.empty());
+}
+
+TEST(FitterCore, BenchesAreCappedAndTheLeastRecentlyActiveEvicted) {
+  CollectingSink sink;
+  FitterOptions o;
+  o.max_benches = 4;
+  FitterCore core(o, sink);
+  const Stream s = make_stream(1, 5);
+  // A bench id new every message.
+  for (int i = 0; i < 100; ++i) {
+    const samples_t m = batch("stray" + std::to_string(i), s, 0, 2, 0);
+    core.on_samples(m.bench, m, i);
+  }
+  EXPECT_LE(core.bench_count(), 4u);
+  EXPECT_EQ(core.counters().dropped_benches, 96);
+  EXPECT_NE(core.last_error().find("evicted"), std::string::npos);
+}
+
+TEST(FitterCore, AFloodingBenchIsCappedAndCounted) {
+  CollectingSink sink;
+  FitterOptions o;
+  o.max_rate_hz = 100;
+  o.burst_s = 1.0;
+  FitterCore core(o, sink);
+  const Stream s = make_stream(1, 5);
+  // 1000 samples within 0.1 s of host time: the bucket holds 100.
+  for (int i = 0; i < 100; ++i) {
+    const samples_t m = batch("flood", s, std::size_t(i) * 10, 10, i * 10);
+    core.on_samples("flood", m, 1000 * i);
+  }
+  EXPECT_GT(core.counters().flood_drops, 800);
+  EXPECT_LT(core.counters().samples, 200);
+}
+
+TEST(FitterCore, ARunThatNeverStopsIsClosedWithinMaxCoast) {
+  CollectingSink sink;
+  FitterOptions o;
+  o.runs.max_coast_s = 5.0;
+  FitterCore core(o, sink);
+  // A slow linear decline that would take minutes to stop.
+  samples_t m;
+  m.quantity = samples_t::QUANTITY_BACK_EMF_V;
+  m.bench = "slow";
+  std::int64_t seq = 0;
+  for (int i = 0; i < 3000; ++i) {
+    m = batch("slow", Stream{{std::int64_t(i) * 20000}, {i < 150 ? 0.0 : 3.0 - 0.002 * (i - 150)}}, 0, 1, seq++);
+    core.on_samples("slow", m, i);
+  }
+  EXPECT_LE(core.buffered_samples(), 2 * 3000u);
+  bool abandoned = false;
+  for (const auto& r : sink.runs) abandoned |= r.state == run_t::STATE_ABANDONED;
+  EXPECT_TRUE(abandoned);
+  ASSERT_GE(sink.fits.size(), 1u);
+  EXPECT_FALSE(sink.fits[0].fit.run.stopped);
+}
+
+TEST(FitterCore, OptionsSayWhatIsWrong) {
+  FitterOptions o;
+  std::string why;
+  EXPECT_TRUE(o.is_valid(&why));
+  o.bench_regex = "(";
+  EXPECT_FALSE(o.is_valid(&why));
+  EXPECT_NE(why.find("regex"), std::string::npos);
+  o = {};
+  o.max_benches = 0;
+  EXPECT_FALSE(o.is_valid(&why));
+}
+
+}  // namespace
+}  // namespace spindown
