@@ -68,6 +68,7 @@ FitterOptions fitter_options(const RefitCommandOptions& o) {
   FitterOptions f;
   f.bench_regex = o.bench_regex;
   f.ignore_config = o.ignore_config;
+  f.max_benches = o.max_benches;
   f.max_rate_hz = 0;  // a log is read as fast as the disk allows; live caps were applied live
   if (o.inertia_given) {
     f.default_bench.inertia_kg_m2 = o.inertia_kg_m2;
@@ -230,6 +231,9 @@ void setup_refit(CLI::App& app) {
                  ->check(CLI::PositiveNumber)
                  ->excludes(kb)
                  ->group("Bench");
+  sub->add_option("--max-benches", opt->max_benches,
+                  "Benches held at once, as the live spindown-fitter --max-benches (evictions are replayed too)")
+      ->check(CLI::PositiveNumber);
   sub->add_flag("--ignore-config", opt->ignore_config, "Use --inertia/--kb (or the lab's) even where CONFIG says otherwise")
       ->group("Bench");
   sub->callback([opt, j, kb, kv]() {

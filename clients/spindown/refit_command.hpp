@@ -60,6 +60,7 @@ struct RefitCommandOptions {
   double inertia_kg_m2 = 0, kb_v_s_per_rad = 0, speed_constant_rpm_per_v = 0;
   bool inertia_given = false, kb_given = false, speed_constant_given = false;
   bool ignore_config = false;
+  std::size_t max_benches = FitterOptions{}.max_benches;  // as spindown-fitter --max-benches
 };
 
 void setup_refit(CLI::App& app);
