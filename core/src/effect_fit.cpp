@@ -203,7 +203,7 @@ LmResult levenberg_marquardt(const Setup& s, std::vector<double> th) {
   double sse = assemble(th, jtj, jtr);
   out.evals = 1;
   double lambda = 1e-3;
-  for (int it = 0; it < 100 && out.evals < 150; ++it) {
+  for (int it = 0; it < 60 && out.evals < 80; ++it) {
     Eigen::MatrixXd a = jtj;
     Eigen::VectorXd rhs = jtr;
     const double floor = 1e-12 * (jtj.diagonal().maxCoeff() + 1e-300);
@@ -492,7 +492,7 @@ EffectFit fit_effects(const std::vector<const Effect*>& effects, const EffectFit
   }
   th = lm.theta;
   // NLopt under bounds: a short polish after LM, the full refinement when LM did not converge.
-  const std::string why = refine_with_nlopt(s, th, lm.converged ? 5 : 300, out.evaluations);
+  const std::string why = refine_with_nlopt(s, th, lm.converged ? 4 : 300, out.evaluations);
   const bool solved = lm.converged || why.empty();
 
   out.theta = th;

@@ -235,7 +235,7 @@ std::string axes(const Panel& p, const std::string& xlabel, const std::string& y
 }
 
 std::string legend(double x, double y, const std::vector<std::pair<std::string, std::string>>& items) {
-  std::string s = fmt::format("<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"300\" height=\"{}\" fill=\"white\" "
+  std::string s = fmt::format("<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"370\" height=\"{}\" fill=\"white\" "
                               "fill-opacity=\"0.85\" stroke=\"#999\"/>\n",
                               x, y, 8 + 18 * items.size());
   for (std::size_t i = 0; i < items.size(); ++i) {
@@ -280,7 +280,8 @@ std::string run_figure(const std::string& file, const ExplainResult& r, double t
   const std::string& u = r.unit;
   const std::size_t n = r.tau.size();
   std::string s;
-  const std::string title = fmt::format("{} - run {}: base {} (RMSE {:.3g} {}) -> {} (RMSE {:.3g} {})", file,
+  const std::string name = file.substr(file.find_last_of('/') == std::string::npos ? 0 : file.find_last_of('/') + 1);
+  const std::string title = fmt::format("{} - run {}: base {} (RMSE {:.3g} {}) -> {} (RMSE {:.3g} {})", name,
                                         r.run.number, r.base.label(), r.base.rmse, u, r.final_fit.label(),
                                         r.final_fit.rmse, u);
   s += fmt::format("<text x=\"{}\" y=\"{:.1f}\" text-anchor=\"middle\" font-size=\"15\" font-weight=\"bold\">{}</text>\n",
@@ -314,7 +315,7 @@ std::string run_figure(const std::string& file, const ExplainResult& r, double t
   const char* final_style = "stroke=\"#1f77b4\" stroke-width=\"2\"";
   s += polyline(top_p, r.tau, r.base.simulated, base_style);
   s += polyline(top_p, r.tau, r.final_fit.simulated, final_style);
-  s += legend(top_p.x + top_p.w - 310, top_p.y + 10,
+  s += legend(top_p.x + top_p.w - 380, top_p.y + 10,
               {{"measurement", "stroke=\"#777\" stroke-width=\"4\" stroke-dasharray=\"2,4\""},
                {fmt::format("base model: {}", r.base.label()), base_style},
                {fmt::format("final model: {}", r.final_fit.label()), final_style}});
@@ -334,7 +335,7 @@ std::string run_figure(const std::string& file, const ExplainResult& r, double t
                      bot_p.py(std::clamp(rf[i], -rmax, rmax)));
   s += polyline(bot_p, bx, bb, "stroke=\"#d62728\" stroke-width=\"2\"");
   s += polyline(bot_p, fx, fb, "stroke=\"#1f77b4\" stroke-width=\"2\"");
-  s += legend(bot_p.x + bot_p.w - 310, bot_p.y + 8,
+  s += legend(bot_p.x + bot_p.w - 380, bot_p.y + 8,
               {{fmt::format("before: {} ({}-sample means)", r.base.label(), r.bin_samples),
                 "stroke=\"#d62728\" stroke-width=\"2\""},
                {fmt::format("after: {} (means; dots: samples)", r.final_fit.label()),
