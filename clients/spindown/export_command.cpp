@@ -55,7 +55,12 @@ struct Output {
   }
 };
 
-std::string number(double x) { return std::isfinite(x) ? fmt::format("{:.10g}", x) : std::string("NaN"); }
+// MATLAB's readtable and pandas read NaN, Inf and -Inf.
+std::string number(double x) {
+  if (std::isnan(x)) return "NaN";
+  if (std::isinf(x)) return x > 0 ? "Inf" : "-Inf";
+  return fmt::format("{:.10g}", x);
+}
 
 // Quote a CSV field only when it needs it.
 std::string field(const std::string& s) {
