@@ -92,7 +92,7 @@ start_logger "$REPLAY_URL" "$T/replay" replay; LOGGER2=$STARTED
 "$B/spindown-fitter" --lcm-url "$REPLAY_URL" --instance replay -v 2>"$T/fitter2.err" &
 FITTER2=$!; PIDS+=($FITTER2)
 sleep 0.5
-lcm-logplayer --lcm-url="$REPLAY_URL" --speed=2 --regexp='SPINDOWN\..*\.(SAMPLE|CONFIG)' "$LOG" \
+lcm-logplayer --lcm-url="$REPLAY_URL" --speed=1 --regexp='SPINDOWN\..*\.(SAMPLE|CONFIG)' "$LOG" \
   >"$T/player.err" 2>&1 || fail "lcm-logplayer"
 for _ in $(seq 100); do
   [ "$(grep -c ' fitted: ' "$T/fitter2.err" || true)" -ge 6 ] && break; sleep 0.1
