@@ -58,6 +58,19 @@ for what in "decode errors" "sequence gaps" "duplicates" "NaN values" "time back
   [ "${n:-0}" -gt 0 ] || fail "fitter did not count $what"
 done
 
+# The heartbeat is in the log, with its counters and a last error naming a channel.
+python3 - "$LOG" <<'EOF' || fail "heartbeat"
+import sys
+data = open(sys.argv[1], "rb").read()
+n = data.count(b"SPINDOWN.fitter.STATUS")
+assert n >= 3, f"{n} heartbeats"
+for counter in (b"decode_errors", b"seq_gaps", b"duplicates", b"nan_values", b"time_backwards", b"dropped_benches",
+                b"flood_drops"):
+    assert counter in data, counter
+assert b"skipped" in data or b"evicted" in data, "last_error text"
+print(f"heartbeat: {n} STATUS messages with every counter")
+EOF
+
 # Refit equals the live fits, damage and all (the logger saw the same traffic, so the same
 # benches are evicted at the same moments: a bench that lost its CONFIG that way is fitted with
 # the default J in both).
