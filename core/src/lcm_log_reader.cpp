@@ -239,26 +239,15 @@ bool LcmLogReader::next(LcmLogEvent& event) {
                                more ? fmt::format("; skipped to the next event at offset {}", resume)
                                     : std::string("; it is the last one and is lost")));
   }
-  // lcm_eventlog rejects (and loses) an event that is not followed by another event or the
-  // end of the file; say so rather than lose it silently.
-  bool followed_ok = true;
-  if (end + 4 <= size_) {
-    unsigned char m[4];
-    fseeko(f, end, SEEK_SET);
-    followed_ok = std::fread(m, 1, 4, f) == 4 && be32(m) == lcm_log_magic;
-  }
   fseeko(f, at, SEEK_SET);
   const lcm::LogEvent* e = log_->readNextEvent();
   if (!e) {
-    if (ftello(f) <= at) fseeko(f, at + 1, SEEK_SET);
-    if (!followed_ok) {
-      fseeko(f, end, SEEK_SET);
-      return problem(fmt::format("event {} at offset {} (channel {}) is followed by bytes that are not an event; "
-                                 "lcm::LogFile rejects it, so it is lost",
-                                 events_ + 1, at, printable(channel)));
-    }
-    return problem(fmt::format("lcm::LogFile could not read the event at offset {} (channel {})", at,
-                               printable(channel)));
+    // The header was sound, so lcm_eventlog rejected (and lost) an event that is not followed
+    // by another event or the end of the file; say so rather than lose it silently.
+    fseeko(f, end, SEEK_SET);
+    return problem(fmt::format("event {} at offset {} (channel {}) is followed by bytes that are not an event; "
+                               "lcm::LogFile rejects it, so it is lost",
+                               events_ + 1, at, printable(channel)));
   }
   ++events_;
   event.number = events_;
