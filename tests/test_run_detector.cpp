@@ -137,6 +137,17 @@ TEST(RunDetector, MemoryStaysBoundedOverALongIdleStream) {
   }
   EXPECT_LT(most, 2500u);  // ~40 s of lead-in, not the whole stream
   EXPECT_EQ(live.state(), RunDetector::State::idle);
+
+  // Ten minutes of a pin reading the supply, exactly 3.00 (a pinned value is kept a while in
+  // case it is a clip the coast has yet to leave, but not forever).
+  RunDetector supply;
+  most = 0;
+  for (int i = 0; i < 30000; ++i) {
+    supply.push(0.02 * i, 3.0);
+    most = std::max(most, supply.buffered());
+  }
+  EXPECT_LT(most, 2500u);
+  EXPECT_FALSE(supply.has_events());
 }
 
 TEST(RunDetector, ACoastLongerThanMaxBufferIsAbandonedNotGrown) {

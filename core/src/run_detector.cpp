@@ -179,6 +179,7 @@ void RunDetector::clock_restart() {
   if (state_ == State::coasting) close_unstopped(next_index_, "the device clock restarted mid-coast");
   else if (state_ == State::tail) complete_run(next_index_);
   base_ = next_index_;
+  time_cursor_ = next_index_;
   have_plateau_ = false;
   need_rise_ = false;
   stream_start_ = next_index_;
@@ -227,14 +228,18 @@ void RunDetector::trim_idle() {
   // Enough for the longest window and a few doublings of the back-search.
   const double keep_s = idle_keep_s;
   const double t_now = t(next_index_ - 1);
-  std::size_t keep_from = std::max(lo_, base_);
-  while (keep_from < next_index_ && t_now - t(keep_from) > keep_s) ++keep_from;
+  // The first sample within keep_s only moves forward: amortized O(1) per sample.
+  time_cursor_ = std::max({time_cursor_, lo_, base_});
+  while (time_cursor_ + 1 < next_index_ && t_now - t(time_cursor_) > keep_s) ++time_cursor_;
+  std::size_t keep_from = time_cursor_;
   // Keep enough samples for a slow loop's back-search, and what the windows still use.
   const std::size_t min_keep = back_search_min_samples + 16;
   if (next_index_ - keep_from < min_keep) keep_from = next_index_ > min_keep ? next_index_ - min_keep : 0;
   keep_from = std::max(keep_from, base_);
   keep_from = std::min({keep_from, short_.first, long_.first, vlong_.first});
-  if (have_plateau_ && plateau_end_ >= base_ && t_now - t(plateau_end_) <= keep_s)
+  // A recent pinned stretch shorter than keep_s may be a clip the coast has yet to leave.
+  if (have_plateau_ && plateau_end_ >= base_ && plateau_start_ >= base_ && t_now - t(plateau_end_) <= keep_s &&
+      t(plateau_end_) - t(plateau_start_) <= keep_s)
     keep_from = std::min(keep_from, std::max(base_, plateau_start_ >= back_search_min_samples
                                                         ? plateau_start_ - back_search_min_samples
                                                         : std::size_t{0}));
@@ -436,7 +441,8 @@ RunDetector::CutSplit RunDetector::split_at_cut(std::size_t a, std::size_t b, co
     // further back.
     const double s = f.slope(), sd = f.resid_sd();
     const double s_err = f.sxx() > 0 ? sd / std::sqrt(f.sxx()) : 0.0;
-    sp.pre_declining = sp.npre >= 8 && s < 0 && -s > 3.0 * s_err &&
+    const bool smooth = sd <= std::max(3.0 * sp.sd_post, 0.02 * std::abs(sp.v0));  // not a wandering pin
+    sp.pre_declining = sp.npre >= 8 && smooth && s < 0 && -s > 3.0 * s_err &&
                        (sp.clipped || sp.post_slope >= 0 || s <= 0.3 * sp.post_slope);
     sp.pre_flat = sp.npre >= 8 && std::abs(s) + 2.0 * s_err <= 0.3 * std::abs(sp.post_slope);
   }
@@ -567,7 +573,7 @@ void RunDetector::coast_checks(std::size_t i, bool at_end) {
   }
 
   // Standstill: the hold window is flat and low, and either its slope is resolved well below
-  // the coast's mean rate or a four times longer window is flat too (noisy, slow coasts).
+  // the coast's mean rate or a three times longer window is flat too (noisy, slow coasts).
   if (dur < 0.9 * hold_.span_s) return;
   if (v0_ > 0 && mu > standstill_max_fraction * v0_) return;  // still high: the usual case, cheap
   const double mean_rate = (v0_ - mu) / std::max(t(i) - run_.t_cut_s, 1e-9);
@@ -606,7 +612,6 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
   const double amp = v0_ - z;
   const double band = std::max(3.0 * sd_z, 1e-9 * std::max(std::abs(amp), 1e-300));
 
-  // First sample of the standstill run that contains the hold window.
   // First sample of the standstill that contains the hold window (an isolated sample outside
   // the band is noise; two in a row are the coast).
   std::size_t first_in = i + 1;

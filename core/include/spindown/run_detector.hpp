@@ -142,6 +142,7 @@ class RunDetector {
   std::size_t mask_ = 0;
   std::size_t base_ = 0;        // absolute index of the oldest buffered sample
   std::size_t next_index_ = 0;  // absolute index of the next sample
+  std::size_t time_cursor_ = 0;  // first buffered sample within the idle keep time
   std::size_t lo_ = 0;          // earliest index the current lead-in search may use
   std::size_t stream_start_ = 0;  // first index after the stream start / last clock restart
   bool need_quiet_ = false;     // after a closed coast: no new run until the decline pauses
