@@ -9,6 +9,7 @@
 #include "fit_command.hpp"
 #include "refit_command.hpp"
 #include "export_command.hpp"
+#include "watch_command.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"spindown: fit friction models to DC-motor spin-down recordings"};
@@ -17,6 +18,7 @@ int main(int argc, char** argv) {
   spindown::cli::setup_explain(app);
   spindown::cli::setup_refit(app);
   spindown::cli::setup_export(app);
+  spindown::cli::setup_watch(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {  // a subcommand finished with a non-zero exit code

@@ -1,0 +1,144 @@
+#pragma once
+// The state behind `spindown watch`: one row per bench (its run's state from RUN, its last fit
+// from FIT, its bridge's health from STATUS, sequence gaps seen on SAMPLE, the age of its last
+// message) and one row per service (fitter, logger: state and key counters). Fed decoded
+// messages with the host time they arrived; renders a plain-text table and short event lines
+// ("bench-a: run 2 fit: combined …"), so it is testable without a terminal or LCM.
+//
+// Bounded: at most max_benches benches and max_services services (the least recently heard
+// is forgotten, and counted), a fixed number of recent events.
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <spindown/config_t.hpp>
+#include <spindown/fit_t.hpp>
+#include <spindown/run_t.hpp>
+#include <spindown/samples_t.hpp>
+#include <spindown/status_t.hpp>
+
+namespace spindown {
+
+struct LabTableOptions {
+  bool lab_units = false;          // coefficients in the lab's g·cm² units (SI otherwise)
+  double stale_s = 5.0;            // a row whose last message is older is marked stale ("!")
+  std::size_t max_benches = 64;    // rows kept; more forgets the least recently heard
+  std::size_t max_services = 16;
+  std::size_t max_events = 200;    // events not yet taken; older ones are dropped (and counted)
+  double gap_event_every_s = 10.0; // sequence-gap events at most this often per bench
+};
+
+// What the table knows about one bench.
+struct LabBenchRow {
+  std::string bench;
+  std::int64_t last_message_us = 0;  // host time of the bench's last message (any channel)
+
+  // From SPINDOWN.<bench>.RUN.
+  bool has_run = false;
+  std::int32_t run = 0;
+  std::int8_t run_state = run_t::STATE_POWERED;
+  double t_cut_s = 0, t_stop_s = 0;
+  std::int32_t run_samples = 0;
+
+  // From SPINDOWN.<bench>.FIT: the latest fit.
+  bool has_fit = false;
+  std::int32_t fit_run = 0;
+  std::int32_t fits = 0;             // FIT messages seen
+  std::string best;                  // best model ("" when none converged)
+  std::string coefficients;          // the best model's friction coefficients ± error (no units)
+  double rmse = 0;
+  std::string residual_unit;
+  std::string bench_source;          // "config" or why a default J/K_b was used
+
+  // From the bridge's SPINDOWN.<bench>.STATUS.
+  bool has_bridge = false;
+  std::string bridge_state;          // "connected", "disconnected", …
+  std::int64_t lines_good = 0, lines_bad = 0;
+  double rate_hz = 0;
+  std::string bridge_error;
+
+  // From SPINDOWN.<bench>.SAMPLE, as this listener saw it.
+  bool has_samples = false;
+  std::int64_t next_seq = 0;         // expected seq of the next message
+  std::int64_t samples = 0;
+  std::int64_t sample_messages = 0;
+  std::int64_t seq_gaps = 0;         // gaps in samples_t.seq
+  std::int64_t samples_missing = 0;  // samples in those gaps
+  std::int64_t seq_restarts = 0;     // seq went back (bridge restarted)
+  std::int64_t last_gap_event_us = 0;
+  std::int64_t gaps_at_last_event = 0;
+
+  bool has_config = false;
+};
+
+// A service's heartbeat (fitter, logger, …), keyed by service and instance.
+struct LabServiceRow {
+  std::string service, instance, host, state, last_error;
+  std::int32_t pid = 0;
+  double uptime_s = 0;
+  std::vector<std::pair<std::string, std::int64_t>> counters;  // the ones worth showing
+  std::int64_t last_message_us = 0;
+};
+
+class LabTable {
+ public:
+  explicit LabTable(LabTableOptions options = {});
+
+  // Decoded messages; bench is the bench id of the channel they came on, now_us the host
+  // time they arrived (µs since the epoch).
+  void on_samples(std::string_view bench, const samples_t& msg, std::int64_t now_us);
+  void on_config(std::string_view bench, const config_t& msg, std::int64_t now_us);
+  void on_run(std::string_view bench, const run_t& msg, std::int64_t now_us);
+  void on_fit(std::string_view bench, const fit_t& msg, std::int64_t now_us);
+  // A bridge's status (service "bridge") goes to its bench's row, any other to a service row.
+  void on_status(std::string_view channel_id, const status_t& msg, std::int64_t now_us);
+  // A message that could not be decoded (counted, the text kept for the footer).
+  void on_bad_message(std::string text, std::int64_t now_us);
+
+  // The table at now_us. width > 0 cuts lines to that many characters (a terminal's width).
+  std::string render(std::int64_t now_us, std::size_t width = 0) const;
+  // Events since the last call, oldest first, without time stamps ("bench-a: run 2 coasting…").
+  std::vector<std::string> take_events();
+
+  // True when something shown changed since clear_changed() (plain output prints only then).
+  bool changed() const { return changed_; }
+  void clear_changed() { changed_ = false; }
+
+  const LabBenchRow* bench(std::string_view id) const;
+  std::vector<std::string> bench_ids() const;  // sorted
+  std::size_t bench_count() const { return benches_.size(); }
+  const LabServiceRow* service(std::string_view service, std::string_view instance) const;
+  std::size_t service_count() const { return services_.size(); }
+  std::int64_t bad_messages() const { return bad_messages_; }
+  std::int64_t forgotten_rows() const { return forgotten_rows_; }
+  std::int64_t dropped_events() const { return dropped_events_; }
+
+ private:
+  LabBenchRow& row(std::string_view bench, std::int64_t now_us);
+  void event(std::string text);
+
+  LabTableOptions opt_;
+  std::map<std::string, LabBenchRow, std::less<>> benches_;
+  std::map<std::string, LabServiceRow, std::less<>> services_;  // "service/instance"
+  std::deque<std::string> events_;
+  std::int64_t bad_messages_ = 0;
+  std::string last_bad_message_;
+  std::int64_t forgotten_rows_ = 0;
+  std::int64_t dropped_events_ = 0;
+  bool changed_ = false;
+};
+
+// The best model's friction coefficients of a fit message, "c3 = 1.822 ± 0.011 g·cm²·s⁻¹, …"
+// (lab units) or in SI, units left out when with_units is false; "" when the message names no
+// usable best model.
+std::string fit_coefficients_text(const fit_t& msg, bool lab_units, bool with_units = true);
+
+// Code points of a UTF-8 string (the columns it takes for the text this table prints).
+std::size_t display_width(std::string_view utf8);
+
+}  // namespace spindown

@@ -1,0 +1,395 @@
+#include "spindown/lab_table.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <ctime>
+#include <fmt/format.h>
+#include <limits>
+
+#include "spindown/fit_message.hpp"
+#include "spindown/fit_report.hpp"
+#include "spindown/lab_units.hpp"
+#include "spindown/lcm_status.hpp"
+
+namespace spindown {
+
+namespace {
+
+// Counters worth a column per service; any other service shows its first few.
+constexpr std::array<std::string_view, 7> fitter_counters{"samples", "runs", "fits", "fit_failures",
+                                                          "seq_gaps", "samples_lost", "decode_errors"};
+constexpr std::array<std::string_view, 6> logger_counters{"events", "files", "drops", "write_errors",
+                                                          "seq_gaps", "samples_missing"};
+constexpr std::size_t other_counters_shown = 5;
+
+bool is_friction_coefficient(std::string_view name) {
+  return name.size() == 2 && name[0] == 'c' && name[1] >= '1' && name[1] <= '9';
+}
+
+std::string seconds_text(double s) {
+  if (!std::isfinite(s)) return "-";
+  if (s < 10) return fmt::format("{:.1f} s", s);
+  if (s < 600) return fmt::format("{:.0f} s", s);
+  return fmt::format("{:.0f} min", s / 60);
+}
+
+std::string age_text(std::int64_t last_us, std::int64_t now_us, double stale_s) {
+  if (last_us <= 0) return "-";
+  const double age = std::max(0.0, 1e-6 * double(now_us - last_us));
+  return seconds_text(age) + (age > stale_s ? " !" : "");
+}
+
+std::string run_state_text(const LabBenchRow& r) {
+  if (!r.has_run) return r.has_samples ? "-" : "no data";
+  return fmt::format("{} {}", r.run, run_state_name(r.run_state));
+}
+
+std::string fit_text(const LabBenchRow& r) {
+  if (!r.has_fit) return "-";
+  if (r.best.empty()) return fmt::format("run {}: no model converged", r.fit_run);
+  std::string s = fmt::format("run {} {}", r.fit_run, r.best);
+  if (!r.coefficients.empty()) s += ": " + r.coefficients;
+  if (r.bench_source != "config" && !r.bench_source.empty()) s += " (default J/K_b)";
+  return s;
+}
+
+std::string rmse_text(const LabBenchRow& r) {
+  if (!r.has_fit || r.best.empty() || !std::isfinite(r.rmse)) return "-";
+  return fmt::format("{:.3g} {}", r.rmse, r.residual_unit);
+}
+
+std::string bridge_text(const LabBenchRow& r) {
+  if (!r.has_bridge) return "no bridge status";
+  return fmt::format("{} {}/{} {:.0f} Hz", r.bridge_state, r.lines_good, r.lines_bad, r.rate_hz);
+}
+
+std::string gaps_text(const LabBenchRow& r) {
+  if (!r.has_samples) return "-";
+  if (r.seq_gaps == 0) return "0";
+  return fmt::format("{} ({} lost)", r.seq_gaps, r.samples_missing);
+}
+
+std::string counters_text(const LabServiceRow& s) {
+  std::string out;
+  for (const auto& [name, value] : s.counters) {
+    if (!out.empty()) out += ", ";
+    out += fmt::format("{} {}", name, value);
+  }
+  return out.empty() ? "-" : out;
+}
+
+// Cuts a UTF-8 line to width code points (never inside a character).
+std::string cut_to_width(const std::string& line, std::size_t width) {
+  if (width == 0) return line;
+  std::size_t points = 0;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    if ((static_cast<unsigned char>(line[i]) & 0xC0) == 0x80) continue;
+    if (points == width) return line.substr(0, i);
+    ++points;
+  }
+  return line;
+}
+
+// Columns padded to their widest cell; the last column is not padded.
+std::string format_columns(const std::vector<std::vector<std::string>>& rows, std::size_t width) {
+  std::vector<std::size_t> widths;
+  for (const auto& row : rows) {
+    if (widths.size() < row.size()) widths.resize(row.size(), 0);
+    for (std::size_t i = 0; i < row.size(); ++i) widths[i] = std::max(widths[i], display_width(row[i]));
+  }
+  std::string out;
+  for (const auto& row : rows) {
+    std::string line;
+    for (std::size_t i = 0; i < row.size(); ++i) {
+      line += row[i];
+      if (i + 1 < row.size()) line.append(widths[i] - display_width(row[i]) + 2, ' ');
+    }
+    out += cut_to_width(line, width) + '\n';
+  }
+  return out;
+}
+
+}  // namespace
+
+std::size_t display_width(std::string_view utf8) {
+  std::size_t n = 0;
+  for (unsigned char c : utf8)
+    if ((c & 0xC0) != 0x80) ++n;
+  return n;
+}
+
+std::string fit_coefficients_text(const fit_t& msg, bool lab_units, bool with_units) {
+  if (msg.best.empty()) return {};
+  const auto models = static_cast<std::size_t>(std::max(0, msg.nmodels));
+  std::size_t best = models;
+  for (std::size_t i = 0; i < models && i < msg.model.size(); ++i)
+    if (msg.model[i] == msg.best) best = i;
+  if (best == models) return {};
+  std::string out;
+  const auto params = static_cast<std::size_t>(std::max(0, msg.nparams));
+  for (std::size_t k = 0; k < params && k < msg.param_name.size() && k < msg.param_model.size() &&
+                          k < msg.param_value.size() && k < msg.param_stderr.size() && k < msg.param_unit.size();
+       ++k) {
+    if (msg.param_model[k] != static_cast<std::int32_t>(best) || !is_friction_coefficient(msg.param_name[k])) continue;
+    double value = msg.param_value[k], err = msg.param_stderr[k];
+    std::string_view unit = pretty_unit(msg.param_unit[k]);
+    if (lab_units)
+      if (auto lab = lab_unit_for(msg.param_unit[k])) {
+        value *= lab->per_si;
+        err *= lab->per_si;
+        unit = lab->pretty;
+      }
+    if (!out.empty()) out += ", ";
+    out += fmt::format("{} = {}", msg.param_name[k], format_value_error(value, err));
+    if (with_units) out += fmt::format(" {}", unit);
+  }
+  return out;
+}
+
+LabTable::LabTable(LabTableOptions options) : opt_(options) {}
+
+LabBenchRow& LabTable::row(std::string_view bench, std::int64_t now_us) {
+  auto it = benches_.find(bench);
+  if (it == benches_.end()) {
+    if (opt_.max_benches > 0 && benches_.size() >= opt_.max_benches) {
+      auto oldest = std::min_element(benches_.begin(), benches_.end(), [](const auto& a, const auto& b) {
+        return a.second.last_message_us < b.second.last_message_us;
+      });
+      event(fmt::format("{}: forgotten (more than {} benches; heard last)", oldest->first, opt_.max_benches));
+      benches_.erase(oldest);
+      ++forgotten_rows_;
+    }
+    it = benches_.emplace(std::string(bench), LabBenchRow{}).first;
+    it->second.bench = std::string(bench);
+  }
+  it->second.last_message_us = std::max(it->second.last_message_us, now_us);
+  changed_ = true;
+  return it->second;
+}
+
+void LabTable::event(std::string text) {
+  events_.push_back(std::move(text));
+  while (opt_.max_events > 0 && events_.size() > opt_.max_events) {
+    events_.pop_front();
+    ++dropped_events_;
+  }
+}
+
+std::vector<std::string> LabTable::take_events() {
+  std::vector<std::string> out(std::make_move_iterator(events_.begin()), std::make_move_iterator(events_.end()));
+  events_.clear();
+  return out;
+}
+
+void LabTable::on_samples(std::string_view bench, const samples_t& msg, std::int64_t now_us) {
+  LabBenchRow& r = row(bench, now_us);
+  const std::int64_t n = std::max<std::int32_t>(0, msg.n);
+  if (r.has_samples && r.sample_messages > 0) {
+    if (msg.seq > r.next_seq) {
+      ++r.seq_gaps;
+      r.samples_missing += msg.seq - r.next_seq;
+    } else if (msg.seq < r.next_seq) {
+      // Back before what we saw: a repeat (ignored) or a restarted bridge (seq from 0 again).
+      if (msg.seq + n <= r.next_seq && msg.seq != 0) return;
+      if (msg.seq == 0) {
+        ++r.seq_restarts;
+        event(fmt::format("{}: sample sequence restarted (bridge restarted?)", r.bench));
+      }
+    }
+  }
+  r.has_samples = true;
+  ++r.sample_messages;
+  r.samples += n;
+  r.next_seq = msg.seq + n;
+  const double since = 1e-6 * double(now_us - r.last_gap_event_us);
+  if (r.seq_gaps > r.gaps_at_last_event && (r.last_gap_event_us == 0 || since >= opt_.gap_event_every_s)) {
+    event(fmt::format("{}: sequence gaps: {} so far, {} samples lost on the way to this listener", r.bench,
+                      r.seq_gaps, r.samples_missing));
+    r.last_gap_event_us = now_us;
+    r.gaps_at_last_event = r.seq_gaps;
+  }
+}
+
+void LabTable::on_config(std::string_view bench, const config_t&, std::int64_t now_us) {
+  row(bench, now_us).has_config = true;
+}
+
+void LabTable::on_run(std::string_view bench, const run_t& msg, std::int64_t now_us) {
+  LabBenchRow& r = row(bench, now_us);
+  const bool news = !r.has_run || r.run != msg.run || r.run_state != msg.state;
+  r.has_run = true;
+  r.run = msg.run;
+  r.run_state = msg.state;
+  r.t_cut_s = msg.t_cut_s;
+  r.t_stop_s = msg.t_stop_s;
+  r.run_samples = msg.samples;
+  if (!news) return;
+  std::string text = fmt::format("{}: run {} {}", r.bench, msg.run, run_state_name(msg.state));
+  switch (msg.state) {
+    case run_t::STATE_COASTING:
+      if (std::isfinite(msg.t_cut_s)) text += fmt::format(" (cut at t = {:.2f} s)", msg.t_cut_s);
+      break;
+    case run_t::STATE_STOPPED:
+      if (std::isfinite(msg.t_stop_s) && std::isfinite(msg.t_cut_s))
+        text += fmt::format(" (stop at t = {:.2f} s, {:.2f} s after the cut, {} samples)", msg.t_stop_s,
+                            msg.t_stop_s - msg.t_cut_s, msg.samples);
+      break;
+    case run_t::STATE_ABANDONED:
+      if (!msg.note.empty()) text += ": " + msg.note;
+      break;
+    default:
+      break;
+  }
+  event(std::move(text));
+}
+
+void LabTable::on_fit(std::string_view bench, const fit_t& msg, std::int64_t now_us) {
+  LabBenchRow& r = row(bench, now_us);
+  r.has_fit = true;
+  ++r.fits;
+  r.fit_run = msg.run;
+  r.best = msg.best;
+  r.coefficients = fit_coefficients_text(msg, opt_.lab_units, false);
+  const std::string with_units = fit_coefficients_text(msg, opt_.lab_units, true);
+  r.rmse = std::numeric_limits<double>::quiet_NaN();
+  for (std::size_t i = 0; i < msg.model.size() && i < msg.rmse.size(); ++i)
+    if (msg.model[i] == msg.best) r.rmse = msg.rmse[i];
+  r.residual_unit = msg.residual_unit;
+  r.bench_source = msg.bench_source;
+  std::string text;
+  if (msg.best.empty()) {
+    text = fmt::format("{}: run {} fit: no model converged", r.bench, msg.run);
+  } else {
+    text = fmt::format("{}: run {} fit: best {}", r.bench, msg.run, msg.best);
+    if (!with_units.empty()) text += ": " + with_units;
+    if (std::isfinite(r.rmse)) text += fmt::format(", RMSE {:.3g} {}", r.rmse, r.residual_unit);
+  }
+  if (!msg.bench_source.empty() && msg.bench_source != "config") text += fmt::format(" [J/K_b: {}]", msg.bench_source);
+  event(std::move(text));
+}
+
+void LabTable::on_status(std::string_view channel_id, const status_t& msg, std::int64_t now_us) {
+  if (msg.service == "bridge") {
+    LabBenchRow& r = row(channel_id, now_us);
+    const std::string before = r.bridge_state;
+    r.has_bridge = true;
+    r.bridge_state = msg.state;
+    r.lines_good = find_counter(msg, "lines_good").value_or(0);
+    r.lines_bad = find_counter(msg, "lines_bad").value_or(0);
+    r.rate_hz = find_gauge(msg, "rate_hz").value_or(0);
+    if (!msg.last_error.empty() && msg.last_error != r.bridge_error)
+      event(fmt::format("{}: bridge: {}", r.bench, msg.last_error));
+    r.bridge_error = msg.last_error;
+    if (before != msg.state) event(fmt::format("{}: bridge {}", r.bench, msg.state));
+    return;
+  }
+  const std::string key = fmt::format("{}/{}", msg.service, msg.instance.empty() ? channel_id : msg.instance);
+  auto it = services_.find(key);
+  if (it == services_.end()) {
+    if (opt_.max_services > 0 && services_.size() >= opt_.max_services) {
+      auto oldest = std::min_element(services_.begin(), services_.end(), [](const auto& a, const auto& b) {
+        return a.second.last_message_us < b.second.last_message_us;
+      });
+      services_.erase(oldest);
+      ++forgotten_rows_;
+    }
+    it = services_.emplace(key, LabServiceRow{}).first;
+    event(fmt::format("{} {} on {} (pid {}): {}", msg.service, msg.instance, msg.host, msg.pid, msg.state));
+  }
+  LabServiceRow& s = it->second;
+  if (!s.state.empty() && s.state != msg.state)
+    event(fmt::format("{} {}: {}", msg.service, msg.instance, msg.state));
+  if (!msg.last_error.empty() && msg.last_error != s.last_error)
+    event(fmt::format("{} {}: {}", msg.service, msg.instance, msg.last_error));
+  s.service = msg.service;
+  s.instance = msg.instance.empty() ? std::string(channel_id) : msg.instance;
+  s.host = msg.host;
+  s.pid = msg.pid;
+  s.state = msg.state;
+  s.uptime_s = msg.uptime_s;
+  s.last_error = msg.last_error;
+  s.last_message_us = std::max(s.last_message_us, now_us);
+  s.counters.clear();
+  auto pick = [&](auto names) {
+    for (std::string_view name : names)
+      if (auto v = find_counter(msg, name)) s.counters.emplace_back(std::string(name), *v);
+  };
+  if (msg.service == "fitter") {
+    pick(fitter_counters);
+  } else if (msg.service == "logger") {
+    pick(logger_counters);
+  } else {
+    for (std::size_t i = 0; i < msg.counter_name.size() && i < msg.counter_value.size() && i < other_counters_shown;
+         ++i)
+      s.counters.emplace_back(msg.counter_name[i], msg.counter_value[i]);
+  }
+  changed_ = true;
+}
+
+void LabTable::on_bad_message(std::string text, std::int64_t) {
+  ++bad_messages_;
+  if (bad_messages_ == 1) event(text);
+  last_bad_message_ = std::move(text);
+  changed_ = true;
+}
+
+std::string LabTable::render(std::int64_t now_us, std::size_t width) const {
+  std::string out;
+  const std::time_t now_s = static_cast<std::time_t>(now_us / 1000000);
+  std::tm local{};
+  ::localtime_r(&now_s, &local);
+  out += cut_to_width(fmt::format("spindown watch  {:02}:{:02}:{:02}  {} bench{}, {} service{}", local.tm_hour,
+                                  local.tm_min, local.tm_sec, benches_.size(), benches_.size() == 1 ? "" : "es",
+                                  services_.size(), services_.size() == 1 ? "" : "s"),
+                      width) +
+         '\n';
+  std::vector<std::vector<std::string>> rows;
+  // Health first, the long fit last: a narrow terminal cuts only the end of the coefficients.
+  rows.push_back({"BENCH", "RUN", "AGE", "BRIDGE (lines ok/bad, rate)", "SEQ GAPS", "RMSE", "LAST FIT (best model)"});
+  for (const auto& [id, r] : benches_)
+    rows.push_back({id, run_state_text(r), age_text(r.last_message_us, now_us, opt_.stale_s), bridge_text(r),
+                    gaps_text(r), rmse_text(r), fit_text(r)});
+  if (benches_.empty()) rows.push_back({"(no bench heard yet)"});
+  out += format_columns(rows, width);
+  if (!benches_.empty())
+    out += cut_to_width(opt_.lab_units ? "coefficients in g·cm²·s⁻¹ (c1, c3) and g·cm²·rad·s⁻² (c2, c4)"
+                                       : "coefficients in N·m·s/rad (c1, c3) and N·m (c2, c4)",
+                        width) +
+           '\n';
+  if (!services_.empty()) {
+    std::vector<std::vector<std::string>> srows;
+    srows.push_back({"SERVICE", "STATE", "HOST/PID", "COUNTERS", "AGE"});
+    for (const auto& [key, s] : services_)
+      srows.push_back({s.service + " " + s.instance, s.state, fmt::format("{}/{}", s.host, s.pid), counters_text(s),
+                       age_text(s.last_message_us, now_us, opt_.stale_s)});
+    out += '\n' + format_columns(srows, width);
+    for (const auto& [key, s] : services_)
+      if (!s.last_error.empty())
+        out += cut_to_width(fmt::format("  {} {}: last error: {}", s.service, s.instance, s.last_error), width) + '\n';
+  }
+  if (bad_messages_ > 0)
+    out += cut_to_width(fmt::format("{} undecodable message{}; last: {}", bad_messages_, bad_messages_ == 1 ? "" : "s",
+                                    last_bad_message_),
+                        width) +
+           '\n';
+  return out;
+}
+
+const LabBenchRow* LabTable::bench(std::string_view id) const {
+  auto it = benches_.find(id);
+  return it == benches_.end() ? nullptr : &it->second;
+}
+
+std::vector<std::string> LabTable::bench_ids() const {
+  std::vector<std::string> ids;
+  for (const auto& [id, r] : benches_) ids.push_back(id);
+  return ids;
+}
+
+const LabServiceRow* LabTable::service(std::string_view service, std::string_view instance) const {
+  auto it = services_.find(fmt::format("{}/{}", service, instance));
+  return it == services_.end() ? nullptr : &it->second;
+}
+
+}  // namespace spindown

@@ -1,0 +1,306 @@
+// LabTable: the state and text behind `spindown watch`, fed decoded messages.
+#include <gtest/gtest.h>
+
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "spindown/lab_table.hpp"
+
+namespace spindown {
+namespace {
+
+constexpr std::int64_t t0 = 1'700'000'000'000'000;  // µs since the epoch
+constexpr std::int64_t sec = 1'000'000;
+
+run_t run_msg(const std::string& bench, int run, std::int8_t state, double cut = 1.5, double stop = 9.25) {
+  run_t m{};
+  m.bench = bench;
+  m.run = run;
+  m.state = state;
+  m.t_cut_s = cut;
+  m.t_stop_s = stop;
+  m.samples = 388;
+  return m;
+}
+
+// A combined-model fit as spindown-fitter publishes it (flat arrays; model 2 is the best).
+fit_t fit_msg(const std::string& bench, int run, const std::string& best = "combined") {
+  fit_t m{};
+  m.bench = bench;
+  m.run = run;
+  m.residual_unit = "V";
+  m.bench_source = "config";
+  m.model = {"viscous", "coulomb", "combined"};
+  m.nmodels = 3;
+  m.rmse = {0.05, 0.02, 0.0123};
+  m.r2 = {0.9, 0.99, 0.999};
+  m.aic = m.bic = {1, 2, 3};
+  m.t_stop_pred_s = {1e9, 8, 7.7};
+  m.converged = {true, true, true};
+  m.model_samples = {388, 388, 388};
+  m.model_message = {"", "", ""};
+  m.param_model = {0, 1, 2, 2, 2, 2};
+  m.param_name = {"c1", "c2", "c3", "c4", "omega0", "A"};
+  m.param_value = {1.4e-6, 1.38e-4, 1.822e-7, 1.139e-4, 450, -5.06};
+  m.param_stderr = {1e-8, 1e-6, 1.1e-9, 2e-7, 0.5, 0.01};
+  m.param_unit = {"N*m*s/rad", "N*m", "N*m*s/rad", "N*m", "rad/s", "V"};
+  m.nparams = static_cast<std::int32_t>(m.param_name.size());
+  m.best = best;
+  return m;
+}
+
+samples_t samples_msg(const std::string& bench, std::int64_t seq, int n) {
+  samples_t m{};
+  m.bench = bench;
+  m.seq = seq;
+  m.n = n;
+  for (int i = 0; i < n; ++i) {
+    m.device_time_us.push_back(20000 * (seq + i));
+    m.host_time_us.push_back(t0);
+    m.value.push_back(3.0);
+    m.raw_adc.push_back(-1);
+  }
+  return m;
+}
+
+status_t status_msg(const std::string& service, const std::string& instance, const std::string& state,
+                    std::vector<std::pair<std::string, std::int64_t>> counters,
+                    std::vector<std::pair<std::string, double>> gauges = {}) {
+  status_t s{};
+  s.service = service;
+  s.instance = instance;
+  s.host = "labhost";
+  s.pid = 42;
+  s.state = state;
+  for (auto& [k, v] : counters) {
+    s.counter_name.push_back(k);
+    s.counter_value.push_back(v);
+  }
+  s.ncounters = static_cast<std::int32_t>(s.counter_name.size());
+  for (auto& [k, v] : gauges) {
+    s.gauge_name.push_back(k);
+    s.gauge_value.push_back(v);
+  }
+  s.ngauges = static_cast<std::int32_t>(s.gauge_name.size());
+  return s;
+}
+
+bool contains(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
+
+std::string joined(const std::vector<std::string>& lines) {
+  std::string out;
+  for (const auto& l : lines) out += l + '\n';
+  return out;
+}
+
+TEST(LabTable, RunLifeBecomesStateAndEvents) {
+  LabTable table;
+  table.on_run("bench-a", run_msg("bench-a", 1, run_t::STATE_POWERED), t0);
+  table.on_run("bench-a", run_msg("bench-a", 1, run_t::STATE_COASTING), t0 + sec);
+  table.on_run("bench-a", run_msg("bench-a", 1, run_t::STATE_COASTING), t0 + sec);  // repeat: no event
+  table.on_run("bench-a", run_msg("bench-a", 1, run_t::STATE_STOPPED), t0 + 2 * sec);
+  const auto* row = table.bench("bench-a");
+  ASSERT_NE(row, nullptr);
+  EXPECT_EQ(row->run, 1);
+  EXPECT_EQ(row->run_state, static_cast<std::int8_t>(run_t::STATE_STOPPED));
+  const auto events = table.take_events();
+  ASSERT_EQ(events.size(), 3u) << joined(events);
+  EXPECT_EQ(events[0], "bench-a: run 1 powered");
+  EXPECT_EQ(events[1], "bench-a: run 1 coasting (cut at t = 1.50 s)");
+  EXPECT_EQ(events[2], "bench-a: run 1 stopped (stop at t = 9.25 s, 7.75 s after the cut, 388 samples)");
+  EXPECT_TRUE(table.take_events().empty());
+  EXPECT_TRUE(contains(table.render(t0 + 2 * sec), "1 stopped"));
+}
+
+TEST(LabTable, FitShowsBestModelCoefficientsAndRmse) {
+  LabTable table;
+  table.on_fit("bench-a", fit_msg("bench-a", 2), t0);
+  const auto* row = table.bench("bench-a");
+  ASSERT_NE(row, nullptr);
+  EXPECT_EQ(row->best, "combined");
+  EXPECT_EQ(row->fit_run, 2);
+  EXPECT_DOUBLE_EQ(row->rmse, 0.0123);
+  // Only the best model's friction coefficients, not ω0 or curve constants, nor other models'.
+  EXPECT_TRUE(contains(row->coefficients, "c3 = ")) << row->coefficients;
+  EXPECT_TRUE(contains(row->coefficients, "c4 = ")) << row->coefficients;
+  EXPECT_FALSE(contains(row->coefficients, "c1")) << row->coefficients;
+  EXPECT_FALSE(contains(row->coefficients, "omega0")) << row->coefficients;
+  EXPECT_TRUE(contains(row->coefficients, "±")) << row->coefficients;
+  EXPECT_FALSE(contains(row->coefficients, "N·m")) << row->coefficients;  // units: once, under the table
+  const std::string text = table.render(t0);
+  EXPECT_TRUE(contains(text, "run 2 combined: c3 = (1.822 ± 0.011)e-07, c4 = ")) << text;
+  EXPECT_TRUE(contains(text, "coefficients in N·m·s/rad (c1, c3) and N·m (c2, c4)")) << text;
+  EXPECT_TRUE(contains(text, "0.0123 V")) << text;
+  const auto events = table.take_events();
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_TRUE(contains(events[0], "bench-a: run 2 fit: best combined: c3 = (1.822 ± 0.011)e-07 N·m·s/rad, c4 = "))
+      << events[0];
+  EXPECT_TRUE(contains(events[0], "RMSE 0.0123 V")) << events[0];
+}
+
+TEST(LabTable, LabUnitsMatchTheLabReport) {
+  const std::string text = fit_coefficients_text(fit_msg("b", 1), true);
+  EXPECT_EQ(text, "c3 = 1.822 ± 0.011 g·cm²·s⁻¹, c4 = 1139.0 ± 2.0 g·cm²·rad·s⁻²");
+  EXPECT_EQ(fit_coefficients_text(fit_msg("b", 1), true, false), "c3 = 1.822 ± 0.011, c4 = 1139.0 ± 2.0");
+  LabTableOptions opt;
+  opt.lab_units = true;
+  LabTable table(opt);
+  table.on_fit("b", fit_msg("b", 1), t0);
+  EXPECT_TRUE(contains(table.render(t0), "coefficients in g·cm²·s⁻¹ (c1, c3) and g·cm²·rad·s⁻² (c2, c4)"));
+}
+
+TEST(LabTable, FitWithoutBestModelSaysSo) {
+  LabTable table;
+  fit_t m = fit_msg("b", 3, "");
+  m.bench_source = "default (no CONFIG yet)";
+  table.on_fit("b", m, t0);
+  EXPECT_TRUE(contains(table.render(t0), "run 3: no model converged"));
+  const auto events = table.take_events();
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_TRUE(contains(events[0], "no model converged")) << events[0];
+  EXPECT_TRUE(contains(events[0], "[J/K_b: default (no CONFIG yet)]")) << events[0];
+  // A best name that is not among the models gives no coefficients rather than wrong ones.
+  EXPECT_EQ(fit_coefficients_text(fit_msg("b", 1, "stribeck"), false), "");
+}
+
+TEST(LabTable, SequenceGapsRepeatsAndRestarts) {
+  LabTableOptions opt;
+  opt.gap_event_every_s = 10;
+  LabTable table(opt);
+  table.on_samples("b", samples_msg("b", 0, 5), t0);
+  table.on_samples("b", samples_msg("b", 5, 5), t0);
+  table.on_samples("b", samples_msg("b", 12, 3), t0 + sec);    // 10, 11 lost
+  table.on_samples("b", samples_msg("b", 12, 3), t0 + sec);    // repeated message: ignored
+  table.on_samples("b", samples_msg("b", 20, 1), t0 + 2 * sec);  // 15..19 lost
+  const auto* row = table.bench("b");
+  ASSERT_NE(row, nullptr);
+  EXPECT_EQ(row->seq_gaps, 2);
+  EXPECT_EQ(row->samples_missing, 7);
+  EXPECT_EQ(row->samples, 14);
+  EXPECT_EQ(row->sample_messages, 4);
+  EXPECT_TRUE(contains(table.render(t0 + 2 * sec), "2 (7 lost)"));
+  // One gap event, then none until gap_event_every_s has passed.
+  auto events = table.take_events();
+  ASSERT_EQ(events.size(), 1u) << joined(events);
+  EXPECT_TRUE(contains(events[0], "sequence gaps: 1 so far, 2 samples lost")) << events[0];
+  table.on_samples("b", samples_msg("b", 30, 1), t0 + 12 * sec);  // 21..29 lost
+  events = table.take_events();
+  ASSERT_EQ(events.size(), 1u) << joined(events);
+  EXPECT_TRUE(contains(events[0], "sequence gaps: 3 so far, 16 samples lost")) << events[0];
+  // A restarted bridge numbers from 0 again: not a gap.
+  table.on_samples("b", samples_msg("b", 0, 4), t0 + 13 * sec);
+  EXPECT_EQ(table.bench("b")->seq_restarts, 1);
+  EXPECT_EQ(table.bench("b")->seq_gaps, 3);
+  table.on_samples("b", samples_msg("b", 4, 4), t0 + 13 * sec);
+  EXPECT_EQ(table.bench("b")->seq_gaps, 3);
+}
+
+TEST(LabTable, BridgeStatusGoesToItsBenchServicesToTheirOwnRows) {
+  LabTable table;
+  table.on_status("bench-a",
+                  status_msg("bridge", "bench-a", "connected", {{"lines_good", 1520}, {"lines_bad", 3}},
+                             {{"connected", 1}, {"rate_hz", 50}}),
+                  t0);
+  table.on_status("fitter",
+                  status_msg("fitter", "fitter", "running",
+                             {{"messages", 99}, {"samples", 4500}, {"fits", 6}, {"seq_gaps", 2}, {"queue_drops", 0}}),
+                  t0);
+  table.on_status("logger", status_msg("logger", "logger", "running", {{"events", 9000}, {"drops", 0}}), t0);
+  EXPECT_EQ(table.bench_count(), 1u);  // "fitter" and "logger" are not benches
+  EXPECT_EQ(table.service_count(), 2u);
+  const auto* row = table.bench("bench-a");
+  ASSERT_NE(row, nullptr);
+  EXPECT_EQ(row->bridge_state, "connected");
+  EXPECT_EQ(row->lines_good, 1520);
+  EXPECT_EQ(row->lines_bad, 3);
+  EXPECT_DOUBLE_EQ(row->rate_hz, 50);
+  const auto* fitter = table.service("fitter", "fitter");
+  ASSERT_NE(fitter, nullptr);
+  ASSERT_EQ(fitter->counters.size(), 3u);  // samples, fits, seq_gaps: in the table's order
+  EXPECT_EQ(fitter->counters[0].first, "samples");
+  EXPECT_EQ(fitter->counters[2].second, 2);
+  const std::string text = table.render(t0);
+  EXPECT_TRUE(contains(text, "connected 1520/3 50 Hz")) << text;
+  EXPECT_TRUE(contains(text, "samples 4500, fits 6, seq_gaps 2")) << text;
+  EXPECT_TRUE(contains(text, "events 9000, drops 0")) << text;
+
+  // A disconnect and the bridge's error become events.
+  table.take_events();
+  status_t down = status_msg("bridge", "bench-a", "disconnected", {{"lines_good", 1520}});
+  down.last_error = "cannot open /dev/ttyACM0: No such file or directory";
+  table.on_status("bench-a", down, t0 + sec);
+  const auto events = table.take_events();
+  EXPECT_TRUE(contains(joined(events), "bench-a: bridge disconnected")) << joined(events);
+  EXPECT_TRUE(contains(joined(events), "cannot open /dev/ttyACM0")) << joined(events);
+}
+
+TEST(LabTable, AgeAndStaleMark) {
+  LabTableOptions opt;
+  opt.stale_s = 5;
+  LabTable table(opt);
+  table.on_run("b", run_msg("b", 1, run_t::STATE_COASTING), t0);
+  EXPECT_TRUE(contains(table.render(t0 + 2 * sec), "  2.0 s  ")) << table.render(t0 + 2 * sec);
+  EXPECT_TRUE(contains(table.render(t0 + 7 * sec), "  7.0 s !  ")) << table.render(t0 + 7 * sec);
+}
+
+TEST(LabTable, BoundedRowsAndEvents) {
+  LabTableOptions opt;
+  opt.max_benches = 3;
+  opt.max_events = 4;
+  LabTable table(opt);
+  for (int i = 0; i < 5; ++i) table.on_run("b" + std::to_string(i), run_msg("b", 1, run_t::STATE_COASTING), t0 + i);
+  EXPECT_EQ(table.bench_count(), 3u);
+  EXPECT_EQ(table.forgotten_rows(), 2);
+  EXPECT_EQ(table.bench("b0"), nullptr);  // the least recently heard went first
+  EXPECT_NE(table.bench("b4"), nullptr);
+  EXPECT_EQ(table.take_events().size(), 4u);
+  EXPECT_GT(table.dropped_events(), 0);
+}
+
+TEST(LabTable, BadMessagesCountedAndShown) {
+  LabTable table;
+  table.on_bad_message("SPINDOWN.x.FIT: 7 bytes that do not decode as fit_t", t0);
+  table.on_bad_message("SPINDOWN.x.FIT: 9 bytes that do not decode as fit_t", t0);
+  EXPECT_EQ(table.bad_messages(), 2);
+  EXPECT_TRUE(contains(table.render(t0), "2 undecodable messages; last: SPINDOWN.x.FIT: 9 bytes"));
+  EXPECT_EQ(table.take_events().size(), 1u);  // only the first becomes an event
+}
+
+TEST(LabTable, WidthCutsEveryLineAndColumnsAlign) {
+  LabTable table;
+  table.on_fit("bench-a", fit_msg("bench-a", 2), t0);
+  table.on_fit("b", fit_msg("b", 1, ""), t0);
+  const std::string full = table.render(t0);
+  std::istringstream lines(full);
+  std::string line, header, first, second;
+  std::getline(lines, line);  // title
+  std::getline(lines, header);
+  std::getline(lines, first);
+  std::getline(lines, second);
+  // Columns line up in code points, whatever bytes "±" and "·" take: row "b" (sorted first) has
+  // no RMSE, its "-" sits under the header's RMSE, as bench-a's value does.
+  const auto rmse_col = header.find("RMSE");
+  ASSERT_NE(rmse_col, std::string::npos);
+  EXPECT_EQ(first.substr(rmse_col, 2), "- ") << full;
+  EXPECT_EQ(second.substr(rmse_col, 8), "0.0123 V") << full;
+  EXPECT_TRUE(second.starts_with("bench-a")) << full;
+  const std::string cut = table.render(t0, 40);
+  std::istringstream cut_lines(cut);
+  while (std::getline(cut_lines, line)) EXPECT_LE(display_width(line), 40u) << line;
+  EXPECT_EQ(display_width("c3 = 1 ± 2 g·cm²"), 16u);
+}
+
+TEST(LabTable, ChangedFlagFollowsInput) {
+  LabTable table;
+  EXPECT_FALSE(table.changed());
+  table.on_config("b", config_t{}, t0);
+  EXPECT_TRUE(table.changed());
+  table.clear_changed();
+  EXPECT_FALSE(table.changed());
+  EXPECT_FALSE(contains(table.render(t0), "(no bench heard yet)"));
+  EXPECT_TRUE(contains(LabTable().render(t0), "(no bench heard yet)"));
+}
+
+}  // namespace
+}  // namespace spindown
