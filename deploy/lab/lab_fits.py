@@ -111,7 +111,8 @@ def check_runs(live_path, truth_args):
             got.remove(match[0])
         for f in got:
             problems.append(f"{bench}: fit of run {f['run']} (cut {f.get('t_cut_s')}) matches no run the bench sent")
-        print(f"{bench}: {len(t['runs'])} runs sent, {len(fits.get(bench, []))} fitted live; "
+        sent = len(t["runs"])
+        print(f"{bench}: {sent} run{'' if sent == 1 else 's'} sent, {len(fits.get(bench, []))} fitted live; "
               f"cuts within {1e3 * worst:.0f} ms of the truth")
     for p in problems:
         print("  MISSING/EXTRA: " + p)

@@ -23,6 +23,7 @@ cleanup() {
   if [[ -z ${KEEP_WORK:-} ]]; then rm -rf "$LAB_WORK"; else echo "work dir kept: $LAB_WORK"; fi
 }
 trap cleanup EXIT
+trap 'echo "lab test: interrupted" >&2; exit 143' TERM INT  # the EXIT trap still removes the namespaces
 fail() {
   echo "FAIL: $*" >&2
   for f in "$LAB_WORK"/*.err; do echo "--- $f" >&2; tail -8 "$f" >&2; done
