@@ -447,16 +447,22 @@ TEST(StatusHeartbeat, DueOncePerIntervalWithoutCatchUpBursts) {
 TEST(StatusHeartbeat, PublishesOnLcm) {
   lcm::LCM lcm("memq://");
   ASSERT_TRUE(lcm.good());
-  struct Sink {
-    std::vector<status_t> got;
-    void on(const lcm::ReceiveBuffer*, const std::string&, const status_t* m) { got.push_back(*m); }
-  } sink;
-  lcm.subscribe("SPINDOWN.logger.STATUS", &Sink::on, &sink);
+  // A C callback, not LCM's C++ subscribe template: under UBSan the 1.3.1 template's memq
+  // dispatch reports a null subscription pointer inside LCM's own header.
+  std::vector<status_t> got;
+  auto on_status = [](const lcm_recv_buf_t* rbuf, const char*, void* user) {
+    status_t st;
+    if (st.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) >= 0)
+      static_cast<std::vector<status_t>*>(user)->push_back(st);
+  };
+  lcm_subscription_t* sub = lcm_subscribe(lcm.getUnderlyingLCM(), "SPINDOWN.logger.STATUS", on_status, &got);
+  ASSERT_NE(sub, nullptr);
   StatusHeartbeat hb("logger", "x", kT0);
   hb.set_counter("events", 3);
   ASSERT_EQ(hb.publish(lcm, "SPINDOWN.logger.STATUS", kT0), 0);
-  for (int i = 0; i < 10 && sink.got.empty(); ++i) lcm.handleTimeout(100);
-  ASSERT_EQ(sink.got.size(), 1u);
-  EXPECT_EQ(find_counter(sink.got[0], "events"), 3);
+  for (int i = 0; i < 10 && got.empty(); ++i) lcm.handleTimeout(100);
+  lcm_unsubscribe(lcm.getUnderlyingLCM(), sub);
+  ASSERT_EQ(got.size(), 1u);
+  EXPECT_EQ(find_counter(got[0], "events"), 3);
   EXPECT_FALSE(hb.due(kT0 + 10));
 }
