@@ -13,7 +13,13 @@
 //    (ADC top) is skipped: the coast starts where it leaves it;
 //  * the stop is the start of a stop_hold_s window that is flat (no significant slope) and low;
 //    the zero level and noise come from that standstill, the stop time from the approach line;
-//  * a coast that approaches standstill asymptotically (pure viscous) is not a stop.
+//  * a coast that approaches standstill asymptotically (pure viscous) is not a stop: it is
+//    closed, never stopped, once even the long window sees no decay;
+//  * a cut needs a visible change (step or kink) unless the stream starts mid-coast, and after a
+//    stop a new coast must start above the standstill.
+// Latency: a cut is announced ~0.25–1 s after it (4 s for very slow, noisy coasts), a stop
+// ~stop_hold_s after it (up to 3·stop_hold_s when the noise hides a slow final decline), a run
+// tail_s after its stop.
 #include <cstddef>
 #include <limits>
 #include <string>
@@ -27,7 +33,9 @@ namespace spindown {
 struct RunEvent {
   enum class Kind {
     cut,         // a coast started: run has number, cut_index, t_cut_s, lead_in
-    stop,        // standstill reached: run also has stop_index, t_stop_s, zero_level
+    stop,        // standstill reached: run also has stop_index, t_stop_s, zero_level. Provisional:
+                 // if the reading keeps falling during the tail, a diagnostic says the stop was
+                 // retracted and a later stop event follows
     complete,    // the run is final (tail collected, or closed without a stop)
     ignored,     // a coast too short or otherwise unusable; diagnostic says why
     diagnostic,  // a note or warning not tied to a finished run (clipping, bad samples…)

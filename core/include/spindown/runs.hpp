@@ -26,13 +26,16 @@ struct RunOptions {
 
 struct Run {
   int number = 0;                  // 1-based, in order of the cut
-  std::size_t cut_index = 0;       // first coasting sample (index into the recording/stream)
+  std::size_t cut_index = 0;       // first coasting sample (index into the recording/stream); after a
+                                   // clipped (pinned) start, the first sample below the clip
   std::size_t stop_index = 0;      // first sample at standstill (== end_index if never stopped)
   std::size_t end_index = 0;       // one past the last sample given to the fit (tail included)
   double t_cut_s = 0;              // estimated cut: midway between last powered and first coasting sample
-  double t_stop_s = std::numeric_limits<double>::quiet_NaN();  // device time of the stop
+                                   // (with clipping: midway into the pinned stretch, the real cut)
+  double t_stop_s = std::numeric_limits<double>::quiet_NaN();  // device time of the stop (= t of stop_index)
   bool stopped = false;
-  double zero_level = 0;           // reading at standstill (median of the stopped tail)
+  double zero_level = 0;           // reading at standstill (median of the stopped tail; for an
+                                   // asymptotic coast its floor; 0 when the coast was cut short)
   double noise_level = 0;          // standard deviation of the reading at standstill
   std::string lead_in;             // "zeros", "floating", "supply", "powered", "none"
   double period_s = 0;             // median sample period within the coast
@@ -43,6 +46,9 @@ struct Segmentation {
   std::vector<Diagnostic> diagnostics;  // runs ignored and why, clipping, etc.
 };
 
+// Feeds every sample to a RunDetector (run_detector.hpp), restarting it at each
+// rec.clock_restarts index, so the live fitter finds the same runs. Runs that never stop are
+// returned with stopped=false and a note in diagnostics.
 Segmentation find_runs(const Recording& rec, const RunOptions& opt = {});
 
 }  // namespace spindown
