@@ -350,8 +350,8 @@ std::string LabTable::render(std::int64_t now_us, std::size_t width) const {
   for (const auto& [id, r] : benches_)
     rows.push_back({id, run_state_text(r), age_text(r.last_message_us, now_us, opt_.stale_s), bridge_text(r),
                     gaps_text(r), rmse_text(r), fit_text(r)});
-  if (benches_.empty()) rows.push_back({"(no bench heard yet)"});
   out += format_columns(rows, width);
+  if (benches_.empty()) out += "(no bench heard yet)\n";
   if (!benches_.empty())
     out += cut_to_width(opt_.lab_units ? "coefficients in g·cm²·s⁻¹ (c1, c3) and g·cm²·rad·s⁻² (c2, c4)"
                                        : "coefficients in N·m·s/rad (c1, c3) and N·m (c2, c4)",
