@@ -43,8 +43,12 @@ FitterService::~FitterService() {
   if (worker_.joinable()) worker_.join();
 }
 
-void FitterService::on_lcm(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
-  const std::size_t size = rbuf->data_size > 0 ? rbuf->data_size : 0;
+void FitterService::on_lcm(const lcm_recv_buf_t* rbuf, const char* channel, void* self) {
+  static_cast<FitterService*>(self)->enqueue(rbuf, channel);
+}
+
+void FitterService::enqueue(const lcm_recv_buf_t* rbuf, const char* channel) {
+  const std::size_t size = rbuf->data_size;
   {
     std::lock_guard lock(mu_);
     if (queue_.size() >= opt_.max_queue_messages || queue_bytes_ + size > opt_.max_queue_bytes) {
@@ -161,10 +165,16 @@ void FitterService::worker() {
 
 int FitterService::run(const std::atomic<bool>& stop_flag) {
   start_us_ = wall_us();
-  lcm::Subscription* sub = lcm_.subscribe(subscription_regex(opt_.core.bench_regex), &FitterService::on_lcm, this);
+  lcm_t* raw = lcm_.getUnderlyingLCM();
+  lcm_subscription_t* sub =
+      lcm_subscribe(raw, subscription_regex(opt_.core.bench_regex).c_str(), &FitterService::on_lcm, this);
+  if (!sub) {
+    fmt::print(stderr, "spindown-fitter: cannot subscribe (bad --bench regex?)\n");
+    return 2;
+  }
   // Our handler only copies into the service's queue, but LCM's own default of 30 queued
   // messages drops silently in a burst (design §7).
-  sub->setQueueCapacity(100000);
+  lcm_subscription_set_queue_capacity(sub, 100000);
   worker_ = std::thread([this] { worker(); });
   int failures = 0;
   while (!stop_flag) {
@@ -179,7 +189,7 @@ int FitterService::run(const std::atomic<bool>& stop_flag) {
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
-  lcm_.unsubscribe(sub);
+  lcm_unsubscribe(raw, sub);
   {
     std::lock_guard lock(mu_);
     stopping_ = true;

@@ -48,7 +48,10 @@ class FitterService final : public FitterSink {
     std::vector<unsigned char> data;
     std::int64_t recv_utime = 0;
   };
-  void on_lcm(const lcm::ReceiveBuffer* rbuf, const std::string& channel);
+  // LCM's C callback (the C++ wrapper's member-function subscription trips UBSan's vptr check
+  // in LCM 1.3.1's own header).
+  static void on_lcm(const lcm_recv_buf_t* rbuf, const char* channel, void* self);
+  void enqueue(const lcm_recv_buf_t* rbuf, const char* channel);
   void worker();
   void publish_status(std::int64_t now_us, const char* state);
   // The hook for SPINDOWN.<bench>.EXPLAIN: see fitter_service.cpp.

@@ -110,8 +110,10 @@ struct FitSeen {
 
 class FitListener {
  public:
+  // LCM's C API: the C++ wrapper's member-function subscription trips UBSan inside LCM 1.3.1's
+  // own header.
   explicit FitListener(const std::string& url) : lcm_(url) {
-    if (lcm_.good()) lcm_.subscribe("SPINDOWN\\..*\\.FIT", &FitListener::on_fit, this);
+    if (lcm_.good()) lcm_subscribe(lcm_.getUnderlyingLCM(), "SPINDOWN\\..*\\.FIT", &FitListener::on_raw, this);
   }
   bool good() { return lcm_.good(); }
   void start() {
@@ -133,8 +135,14 @@ class FitListener {
   }
 
  private:
-  void on_fit(const lcm::ReceiveBuffer* rbuf, const std::string&, const spindown::fit_t* m) {
-    FitSeen f{m->bench, m->run, m->t_cut_s, m->t_stop_s, m->latency_s, rbuf->recv_utime, Clock::now(),
+  static void on_raw(const lcm_recv_buf_t* rbuf, const char*, void* self) {
+    spindown::fit_t m;
+    if (m.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) < 0) return;
+    static_cast<FitListener*>(self)->on_fit(rbuf->recv_utime, m);
+  }
+  void on_fit(std::int64_t recv_utime, const spindown::fit_t& msg) {
+    const spindown::fit_t* m = &msg;
+    FitSeen f{m->bench, m->run, m->t_cut_s, m->t_stop_s, m->latency_s, recv_utime, Clock::now(),
               m->best, m->bench_source, m->samples};
     std::lock_guard lock(mu_);
     fits_.push_back(std::move(f));
