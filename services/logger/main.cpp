@@ -59,16 +59,12 @@ long udp_receive_buffer_errors() {
   return result;
 }
 
-class Receiver {
- public:
-  explicit Receiver(spindown::LogRecorder& recorder) : recorder_(recorder) {}
-  void on_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
-    recorder_.offer(rbuf->recv_utime, channel, rbuf->data, static_cast<std::int32_t>(rbuf->data_size));
-  }
-
- private:
-  spindown::LogRecorder& recorder_;
-};
+// A plain C callback on lcm_subscribe: LCM 1.3.1's C++ subscribe templates trip UBSan's vptr
+// check inside LCM's own header, and a raw subscription is all the logger needs.
+extern "C" void on_event(const lcm_recv_buf_t* rbuf, const char* channel, void* user) {
+  static_cast<spindown::LogRecorder*>(user)->offer(rbuf->recv_utime, channel, rbuf->data,
+                                                   static_cast<std::int32_t>(rbuf->data_size));
+}
 
 }  // namespace
 
@@ -149,15 +145,14 @@ int main(int argc, char** argv) {
   spindown::LogRecorder recorder(writer, r);
   recorder.start();
 
-  Receiver receiver(recorder);
-  lcm::Subscription* sub = lcm.subscribe(channels, &Receiver::on_message, &receiver);
+  lcm_subscription_t* sub = lcm_subscribe(lcm.getUnderlyingLCM(), channels.c_str(), on_event, &recorder);
   if (!sub) {
     fmt::print(stderr, "spindown-logger: cannot subscribe to channels '{}' (bad regex?)\n", channels);
     recorder.stop("subscribe failed");
     return 2;
   }
   // LCM 1.3.1 drops silently past 30 queued messages per subscription.
-  sub->setQueueCapacity(static_cast<int>(r.queue_capacity));
+  lcm_subscription_set_queue_capacity(sub, static_cast<int>(r.queue_capacity));
   pthread_sigmask(SIG_UNBLOCK, &stop_signals, nullptr);
   if (!quiet)
     fmt::print(stderr, "spindown-logger: channels '{}' on {} -> {} (flush every {} s{}{})\n", channels, url,
@@ -195,7 +190,7 @@ int main(int argc, char** argv) {
   const auto drain_until = std::chrono::steady_clock::now() + std::chrono::seconds(2);
   for (int i = 0; i < 10000000 && std::chrono::steady_clock::now() < drain_until; ++i)
     if (lcm.handleTimeout(50) <= 0) break;
-  lcm.unsubscribe(sub);
+  lcm_unsubscribe(lcm.getUnderlyingLCM(), sub);
   recorder.stop("stopped");
   heartbeat(wall_us(), "stopped");
 
