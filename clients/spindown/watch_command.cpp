@@ -52,24 +52,28 @@ class WatchListener {
  public:
   WatchListener(LabTable& table, const std::string& bench_regex) : table_(table), wanted_(bench_regex) {}
 
-  void on_message(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  // LCM's C callback (the C++ wrapper's member-function subscriptions trip UBSan inside LCM
+  // 1.3.1's header, as spindown-fitter found).
+  static void on_lcm(const lcm_recv_buf_t* rbuf, const char* channel, void* user) {
+    auto* self = static_cast<WatchListener*>(user);
     try {
-      handle(rbuf, channel);
+      self->handle(rbuf, channel);
     } catch (const std::exception& e) {
-      table_.on_bad_message(fmt::format("{}: {}", channel, e.what()), rbuf->recv_utime);
+      self->table_.on_bad_message(fmt::format("{}: {}", channel, e.what()), rbuf->recv_utime);
     }
   }
 
  private:
   template <class Message>
-  bool decode(const lcm::ReceiveBuffer* rbuf, const std::string& channel, Message& m, const char* type) {
-    if (m.decode(rbuf->data, 0, rbuf->data_size) >= 0) return true;
-    table_.on_bad_message(fmt::format("{}: {} bytes that do not decode as {}", channel, rbuf->data_size, type),
+  bool decode(const lcm_recv_buf_t* rbuf, const std::string& channel, Message& m, const char* type) {
+    const auto size = static_cast<int>(rbuf->data_size);
+    if (m.decode(rbuf->data, 0, size) >= 0) return true;
+    table_.on_bad_message(fmt::format("{}: {} bytes that do not decode as {}", channel, size, type),
                           rbuf->recv_utime);
     return false;
   }
 
-  void handle(const lcm::ReceiveBuffer* rbuf, const std::string& channel) {
+  void handle(const lcm_recv_buf_t* rbuf, const std::string& channel) {
     const auto parsed = parse_channel(channel);
     if (!parsed) return;
     const std::string& id = parsed->bench;
@@ -151,8 +155,13 @@ int run_watch(const WatchCommandOptions& o) {
   topt.lab_units = o.lab_units;
   LabTable table(topt);
   WatchListener listener(table, o.bench_regex);
-  lcm::Subscription* sub = lcm.subscribe("SPINDOWN\\..*", &WatchListener::on_message, &listener);
-  sub->setQueueCapacity(10000);  // LCM's default of 30 drops silently in a burst (design §7)
+  lcm_t* raw = lcm.getUnderlyingLCM();
+  lcm_subscription_t* sub = lcm_subscribe(raw, "SPINDOWN\\..*", &WatchListener::on_lcm, &listener);
+  if (!sub) {
+    std::fprintf(stderr, "spindown watch: cannot subscribe to SPINDOWN\\..*\n");
+    return exit_unusable;
+  }
+  lcm_subscription_set_queue_capacity(sub, 10000);  // LCM's default of 30 drops silently in a burst (design §7)
 
   g_stop = false;
   struct sigaction sa{};
@@ -212,7 +221,7 @@ int run_watch(const WatchCommandOptions& o) {
       table.clear_changed();
     }
   }
-  lcm.unsubscribe(sub);
+  lcm_unsubscribe(raw, sub);
   sigaction(SIGINT, &old_int, nullptr);
   sigaction(SIGTERM, &old_term, nullptr);
   // The last state stays on screen (a redraw) or closes the log (plain, --once).
