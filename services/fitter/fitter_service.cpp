@@ -2,10 +2,12 @@
 
 #include <chrono>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <unistd.h>
 
 #include <spindown/status_t.hpp>
 
+#include "spindown/explain_message.hpp"
 #include "spindown/fit_message.hpp"
 #include "spindown/lcm_channels.hpp"
 
@@ -94,10 +96,27 @@ void FitterService::fit_ready(const FitResult& r) {
   publish_explain(r);
 }
 
-// Hook for the discrepancy workflow (design §6): when core/include/spindown/explain.hpp
-// provides explain_run(...), run it here on r.t_s/r.value with r.fit as the starting point and
-// publish the explain_t on channel_name(r.bench, ChannelKind::explain). Until then: nothing.
-void FitterService::publish_explain(const FitResult& r) { (void)r; }
+// The discrepancy workflow (design §6) on the run's own samples: r.t_s/r.value hold [cut, end)
+// of the bench's stream, so the run's indices are rebased onto them.
+void FitterService::publish_explain(const FitResult& r) {
+  if (opt_.explain_base.empty() || r.t_s.empty()) return;
+  Run run = r.fit.run;
+  const std::size_t cut = run.cut_index;
+  run.cut_index = 0;
+  run.stop_index = std::min(run.stop_index - std::min(run.stop_index, cut), r.t_s.size());
+  run.end_index = std::min(run.end_index - std::min(run.end_index, cut), r.t_s.size());
+  ExplainOptions eo;
+  eo.bench = r.fit.bench;
+  eo.base = opt_.explain_base;
+  const ExplainResult ex = explain_run(r.t_s, r.value, r.fit.quantity, run, eo);
+  if (!ex.ok) ++explain_failures_;
+  const explain_t msg = to_explain_message(ex, r.bench, wall_us());
+  if (lcm_.publish(channel_name(r.bench, ChannelKind::explain), &msg) != 0) ++publish_failures_;
+  ++explains_;
+  if (opt_.verbose)
+    fmt::print(stderr, "spindown-fitter: {} run {} explained: {} -> {} (RMSE {:.4g} -> {:.4g})\n", r.bench,
+               run.number, fmt::join(msg.base, "+"), fmt::join(msg.final_effects, "+"), msg.rmse_base, msg.rmse_final);
+}
 
 void FitterService::diagnostic(const std::string& bench, const Diagnostic& d) {
   if (opt_.verbose) fmt::print(stderr, "spindown-fitter: {}: {}\n", bench, d.to_string());
@@ -123,6 +142,10 @@ void FitterService::publish_status(std::int64_t now_us, const char* state) {
   s.counter_value.push_back(drops);
   s.counter_name.emplace_back("publish_failures");
   s.counter_value.push_back(publish_failures_);
+  s.counter_name.emplace_back("explains");
+  s.counter_value.push_back(explains_);
+  s.counter_name.emplace_back("explain_failures");
+  s.counter_value.push_back(explain_failures_);
   s.ncounters = static_cast<std::int32_t>(s.counter_name.size());
   const std::pair<const char*, double> gauges[] = {
       {"sample_rate_hz", rate_hz_},           {"queue_depth", double(depth)},

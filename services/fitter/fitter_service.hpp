@@ -14,6 +14,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "spindown/effects.hpp"
 #include "spindown/fitter_core.hpp"
 
 namespace spindown {
@@ -26,6 +27,9 @@ struct FitterServiceOptions {
   std::size_t max_queue_messages = 200000;  // received but not yet processed
   std::size_t max_queue_bytes = 64u << 20;
   bool verbose = false;                 // one line per run event and fit on stderr
+  // The discrepancy workflow on every fitted run, published on SPINDOWN.<bench>.EXPLAIN,
+  // starting from this base (the lab's belief: viscous). Empty = off.
+  std::vector<const Effect*> explain_base{find_effect("viscous")};
 };
 
 class FitterService final : public FitterSink {
@@ -54,7 +58,7 @@ class FitterService final : public FitterSink {
   void enqueue(const lcm_recv_buf_t* rbuf, const char* channel);
   void worker();
   void publish_status(std::int64_t now_us, const char* state);
-  // The hook for SPINDOWN.<bench>.EXPLAIN: see fitter_service.cpp.
+  // SPINDOWN.<bench>.EXPLAIN, after the FIT (the workflow takes tens of ms; FIT goes first).
   void publish_explain(const FitResult& result);
 
   FitterServiceOptions opt_;
@@ -74,6 +78,7 @@ class FitterService final : public FitterSink {
   // Worker-side measurements for the heartbeat.
   double last_latency_s_ = 0, max_latency_s_ = 0, last_fit_s_ = 0;
   std::int64_t publish_failures_ = 0;
+  std::int64_t explains_ = 0, explain_failures_ = 0;
   std::int64_t last_samples_ = 0, last_rate_us_ = 0;
   double rate_hz_ = 0;
   std::thread worker_;

@@ -9,6 +9,7 @@
 
 #include "fitter_service.hpp"
 #include "spindown/bench.hpp"
+#include "spindown/effects.hpp"
 #include "spindown/fit.hpp"
 #include "spindown/lcm_channels.hpp"
 
@@ -58,6 +59,12 @@ int main(int argc, char** argv) {
   app.add_option("--max-coast", o.core.runs.max_coast_s, "seconds before a coast that never stops is closed");
   app.add_option("--max-buffer", o.core.runs.max_buffer, "samples buffered per bench at most");
   app.add_option("--status-period", o.status_period_s, "seconds between heartbeats")->check(CLI::Range(0.05, 60.0));
+  std::string explain_base = "viscous";
+  app.add_option("--explain-base", explain_base,
+                 "base model of the discrepancy workflow published on SPINDOWN.<bench>.EXPLAIN: "
+                 "viscous|coulomb|combined|EFFECT,EFFECT… (default: viscous, the lab's belief)");
+  bool no_explain = false;
+  app.add_flag("--no-explain", no_explain, "do not run the discrepancy workflow (no EXPLAIN messages)");
   app.add_flag("-v,--verbose", o.verbose, "one line per run event and fit on stderr");
   CLI11_PARSE(app, argc, argv);
 
@@ -79,6 +86,15 @@ int main(int argc, char** argv) {
     }
   }
   std::string why;
+  if (no_explain) {
+    o.explain_base.clear();
+  } else {
+    o.explain_base = spindown::parse_effect_list(explain_base, &why);
+    if (o.explain_base.empty()) {
+      fmt::print(stderr, "spindown-fitter: --explain-base: {}\n", why);
+      return 2;
+    }
+  }
   if (!o.core.is_valid(&why)) {
     fmt::print(stderr, "spindown-fitter: {}\n", why);
     return 2;

@@ -63,6 +63,18 @@ print("live: 6 fits; after the true stop p50 %.3f s (host, speed 20); latency p5
       % (r["after_true_stop_s"]["p50"], 1e3 * r["latency_s"]["p50"]))
 EOF
 
+# The discrepancy workflow ran on every fitted run: one EXPLAIN per FIT, each with a story.
+"$B/spindown-log-summary" "$LOG" >"$T/summary.json" || fail "spindown-log-summary"
+python3 - "$T/summary.json" <<'EOF' || fail "EXPLAIN messages"
+import json, sys
+ch = json.load(open(sys.argv[1]))["files"][0]["channels"]
+fits = sum(n for c, n in ch.items() if c.endswith(".FIT"))
+explains = sum(n for c, n in ch.items() if c.endswith(".EXPLAIN"))
+assert fits == 6 and explains == 6, ch
+print("live: 6 FIT and 6 EXPLAIN messages in the log")
+EOF
+grep -q "explained: viscous -> " "$T/fitter.err" || { cat "$T/fitter.err"; fail "fitter did not explain from the viscous base"; }
+
 # ---- 2. refit == live, refit == fit -----------------------------------------------------------
 "$B/spindown" refit "$LOG" --compare >"$T/compare.out" 2>"$T/compare.err" || { cat "$T/compare.out"; fail "refit --compare"; }
 grep -q "6 runs refitted, 6 live FIT messages: 6 identical, 0 different" "$T/compare.out" || { cat "$T/compare.out"; fail "compare counts"; }
