@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "input_options.hpp"
+
 namespace CLI {
 class App;
 }
@@ -18,14 +20,7 @@ struct ExplainCommandOptions {
   std::string svg;               // output file, empty = none
   bool verbose = false;
 
-  // The bench, as for `spindown fit`: a value counts only when its flag was given.
-  double inertia_kg_m2 = 0;
-  double flywheel_radius_m = 0, flywheel_height_m = 0, flywheel_density_kg_m3 = 0, rotor_inertia_kg_m2 = 0;
-  double kb_v_s_per_rad = 0;
-  double speed_constant_rpm_per_v = 0;
-  bool inertia_given = false, flywheel_given = false, kb_given = false, speed_constant_given = false;
-
-  std::string time_column, value_column, time_unit, value_unit, delimiter;
+  InputOptions input;  // the bench and delimited-text columns, as for `spindown fit`
 };
 
 void setup_explain(CLI::App& app);

@@ -29,59 +29,11 @@ struct FitPlan {
   ReportOptions report;
 };
 
-// A finite number above (or, for non_negative, at least) zero; the message names no limits.
-CLI::Validator number_check(bool non_negative) {
-  return CLI::Validator(
-      [non_negative](std::string& text) -> std::string {
-        std::size_t used = 0;
-        double x = 0;
-        try {
-          x = std::stod(text, &used);
-        } catch (const std::exception&) {
-          used = 0;
-        }
-        if (used == 0 || used != text.size() || !std::isfinite(x) || x < 0 || (!non_negative && x == 0))
-          return fmt::format("'{}' is not a {} number", text, non_negative ? "non-negative" : "positive");
-        return {};
-      },
-      non_negative ? "NUMBER>=0" : "NUMBER>0");
-}
-const CLI::Validator positive = number_check(false);
-const CLI::Validator non_negative = number_check(true);
-
-[[noreturn]] void bad_usage(const std::string& why) { throw CLI::ValidationError(why); }
-
-char parse_delimiter(const std::string& s) {
-  if (s == "," || s == "comma") return ',';
-  if (s == ";" || s == "semicolon") return ';';
-  if (s == "\\t" || s == "\t" || s == "tab") return '\t';
-  if (s == " " || s == "space" || s == "whitespace") return ' ';
-  bad_usage(fmt::format("--delimiter '{}' is not one of: , ; tab space", s));
-}
-
 FitPlan plan_from(const FitCommandOptions& o) {
   FitPlan plan;
-  BenchParams& bench = plan.fit.bench;
-  if (o.inertia_given) {
-    bench.inertia_kg_m2 = o.inertia_kg_m2;
-    bench.inertia_source = "--inertia";
-  } else if (o.flywheel_given) {
-    bench.inertia_kg_m2 =
-        cylinder_inertia(o.flywheel_radius_m, o.flywheel_height_m, o.flywheel_density_kg_m3) + o.rotor_inertia_kg_m2;
-    bench.inertia_source = fmt::format("flywheel r={} m h={} m rho={} kg/m^3 + rotor {} kg*m^2", o.flywheel_radius_m,
-                                       o.flywheel_height_m, o.flywheel_density_kg_m3, o.rotor_inertia_kg_m2);
-  }
-  if (o.kb_given) {
-    bench.kb_v_s_per_rad = o.kb_v_s_per_rad;
-    bench.kb_source = "--kb";
-  } else if (o.speed_constant_given) {
-    bench.kb_v_s_per_rad = kb_from_speed_constant(o.speed_constant_rpm_per_v);
-    bench.kb_source = fmt::format("speed constant {} rpm/V", o.speed_constant_rpm_per_v);
-  }
-  plan.bench_from_user = o.inertia_given || o.flywheel_given || o.kb_given || o.speed_constant_given;
+  plan.fit.bench = bench_from(o.input);
+  plan.bench_from_user = o.input.bench_from_user();
   std::string why;
-  if (!bench.is_valid(&why)) bad_usage(why);
-
   if (!o.models.empty()) {
     plan.fit.models.clear();
     for (const auto& name : o.models) {
@@ -96,19 +48,7 @@ FitPlan plan_from(const FitCommandOptions& o) {
   }
   if (!plan.fit.is_valid(&why)) bad_usage(why);
 
-  DelimitedTextOptions& d = plan.read.delimited;
-  d.time_column = o.time_column;
-  d.value_column = o.value_column;
-  if (!o.time_unit.empty()) {
-    d.time_unit = parse_time_unit(o.time_unit);
-    if (!d.time_unit) bad_usage(fmt::format("--time-unit '{}' is not one of: s, ms, us", o.time_unit));
-  }
-  if (!o.value_unit.empty()) {
-    d.quantity = parse_quantity(o.value_unit);
-    if (!d.quantity) bad_usage(fmt::format("--value-unit '{}' is not one of: V, rpm, rad/s", o.value_unit));
-  }
-  if (!o.delimiter.empty()) d.delimiter = parse_delimiter(o.delimiter);
-  if (!plan.read.is_valid(&why)) bad_usage(why);
+  plan.read = read_options_from(o.input);
 
   plan.report.lab_units = o.lab_units;
   plan.report.max_diagnostics = o.verbose ? 0 : 8;
@@ -203,46 +143,10 @@ void setup_fit(CLI::App& app) {
   sub->add_flag("--lab-units", opt->lab_units, "Also give the lab's units (g·cm², g·cm²·s⁻¹, g·cm²·rad·s⁻²)");
   sub->add_flag("-v,--verbose", opt->verbose, "Show every diagnostic, notes included");
 
-  auto* inertia = sub->add_option("--inertia", opt->inertia_kg_m2, "Moment of inertia J (kg·m²)")
-                      ->check(positive)
-                      ->group("Bench");
-  auto* radius = sub->add_option("--flywheel-radius", opt->flywheel_radius_m, "Flywheel cylinder radius (m)")
-                     ->check(positive)
-                     ->group("Bench");
-  auto* height = sub->add_option("--flywheel-height", opt->flywheel_height_m, "Flywheel cylinder height (m)")
-                     ->check(positive)
-                     ->group("Bench");
-  auto* density = sub->add_option("--flywheel-density", opt->flywheel_density_kg_m3, "Flywheel density (kg/m³)")
-                      ->check(positive)
-                      ->group("Bench");
-  auto* rotor = sub->add_option("--rotor-inertia", opt->rotor_inertia_kg_m2, "Motor rotor inertia (kg·m²)")
-                    ->check(non_negative)
-                    ->group("Bench");
-  for (auto* o : {radius, height, density, rotor}) {
-    o->excludes(inertia);
-    for (auto* other : {radius, height, density, rotor})
-      if (other != o) o->needs(other);
-  }
-  auto* kb = sub->add_option("--kb", opt->kb_v_s_per_rad, "Back-EMF constant K_b (V·s/rad)")
-                 ->check(positive)
-                 ->group("Bench");
-  auto* kv = sub->add_option("--speed-constant", opt->speed_constant_rpm_per_v, "Motor speed constant (rpm/V)")
-                 ->check(positive)
-                 ->group("Bench");
-  kb->excludes(kv);
+  auto note_given = add_input_options(sub, opt->input);
 
-  const char* text = "Delimited text";
-  sub->add_option("--time-column", opt->time_column, "Time column: header name or 1-based index")->group(text);
-  sub->add_option("--value-column", opt->value_column, "Value column: header name or 1-based index")->group(text);
-  sub->add_option("--time-unit", opt->time_unit, "Time unit: ms, s or us")->group(text);
-  sub->add_option("--value-unit", opt->value_unit, "Value unit: V, rpm or rad/s")->group(text);
-  sub->add_option("--delimiter", opt->delimiter, "Column delimiter: , ; tab space")->group(text);
-
-  sub->callback([opt, inertia, radius, kb, kv]() {
-    opt->inertia_given = inertia->count() > 0;
-    opt->flywheel_given = radius->count() > 0;
-    opt->kb_given = kb->count() > 0;
-    opt->speed_constant_given = kv->count() > 0;
+  sub->callback([opt, note_given]() {
+    note_given();
     const int code = run_fit(*opt);
     if (code != exit_ok) throw CLI::RuntimeError(code);
   });

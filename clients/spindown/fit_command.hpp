@@ -4,6 +4,8 @@
 #include <string>
 #include <vector>
 
+#include "input_options.hpp"
+
 namespace CLI {
 class App;
 }
@@ -16,17 +18,7 @@ struct FitCommandOptions {
   bool lab_units = false;
   bool verbose = false;  // every diagnostic, notes included
   std::vector<std::string> models;  // names; empty = all
-
-  // The bench: J directly, or from flywheel geometry + rotor inertia; K_b directly or from
-  // the speed constant. A value counts only when its flag was given (the *_given flags).
-  double inertia_kg_m2 = 0;
-  double flywheel_radius_m = 0, flywheel_height_m = 0, flywheel_density_kg_m3 = 0, rotor_inertia_kg_m2 = 0;
-  double kb_v_s_per_rad = 0;
-  double speed_constant_rpm_per_v = 0;
-  bool inertia_given = false, flywheel_given = false, kb_given = false, speed_constant_given = false;
-
-  // Delimited text: columns and units when they are not obvious from the header.
-  std::string time_column, value_column, time_unit, value_unit, delimiter;
+  InputOptions input;  // the bench and delimited-text columns
 };
 
 void setup_fit(CLI::App& app);

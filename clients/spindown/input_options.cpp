@@ -1,0 +1,130 @@
+#include "input_options.hpp"
+
+#include <CLI/CLI.hpp>
+#include <cmath>
+#include <exception>
+#include <fmt/format.h>
+
+namespace spindown::cli {
+
+namespace {
+
+// A finite number above (or, for non_negative, at least) zero; the message names no limits.
+CLI::Validator number_check(bool non_negative) {
+  return CLI::Validator(
+      [non_negative](std::string& text) -> std::string {
+        std::size_t used = 0;
+        double x = 0;
+        try {
+          x = std::stod(text, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used == 0 || used != text.size() || !std::isfinite(x) || x < 0 || (!non_negative && x == 0))
+          return fmt::format("'{}' is not a {} number", text, non_negative ? "non-negative" : "positive");
+        return {};
+      },
+      non_negative ? "NUMBER>=0" : "NUMBER>0");
+}
+
+char parse_delimiter(const std::string& s) {
+  if (s == "," || s == "comma") return ',';
+  if (s == ";" || s == "semicolon") return ';';
+  if (s == "\\t" || s == "\t" || s == "tab") return '\t';
+  if (s == " " || s == "space" || s == "whitespace") return ' ';
+  bad_usage(fmt::format("--delimiter '{}' is not one of: , ; tab space", s));
+}
+
+}  // namespace
+
+void bad_usage(const std::string& why) { throw CLI::ValidationError(why); }
+
+std::function<void()> add_input_options(CLI::App* sub, InputOptions& opt) {
+  const CLI::Validator positive = number_check(false);
+  const CLI::Validator non_negative = number_check(true);
+  auto* inertia = sub->add_option("--inertia", opt.inertia_kg_m2, "Moment of inertia J (kg·m²)")
+                      ->check(positive)
+                      ->group("Bench");
+  auto* radius = sub->add_option("--flywheel-radius", opt.flywheel_radius_m, "Flywheel cylinder radius (m)")
+                     ->check(positive)
+                     ->group("Bench");
+  auto* height = sub->add_option("--flywheel-height", opt.flywheel_height_m, "Flywheel cylinder height (m)")
+                     ->check(positive)
+                     ->group("Bench");
+  auto* density = sub->add_option("--flywheel-density", opt.flywheel_density_kg_m3, "Flywheel density (kg/m³)")
+                      ->check(positive)
+                      ->group("Bench");
+  auto* rotor = sub->add_option("--rotor-inertia", opt.rotor_inertia_kg_m2, "Motor rotor inertia (kg·m²)")
+                    ->check(non_negative)
+                    ->group("Bench");
+  for (auto* o : {radius, height, density, rotor}) {
+    o->excludes(inertia);
+    for (auto* other : {radius, height, density, rotor})
+      if (other != o) o->needs(other);
+  }
+  auto* kb = sub->add_option("--kb", opt.kb_v_s_per_rad, "Back-EMF constant K_b (V·s/rad)")
+                 ->check(positive)
+                 ->group("Bench");
+  auto* kv = sub->add_option("--speed-constant", opt.speed_constant_rpm_per_v, "Motor speed constant (rpm/V)")
+                 ->check(positive)
+                 ->group("Bench");
+  kb->excludes(kv);
+
+  const char* text = "Delimited text";
+  sub->add_option("--time-column", opt.time_column, "Time column: header name or 1-based index")->group(text);
+  sub->add_option("--value-column", opt.value_column, "Value column: header name or 1-based index")->group(text);
+  sub->add_option("--time-unit", opt.time_unit, "Time unit: ms, s or us")->group(text);
+  sub->add_option("--value-unit", opt.value_unit, "Value unit: V, rpm or rad/s")->group(text);
+  sub->add_option("--delimiter", opt.delimiter, "Column delimiter: , ; tab space")->group(text);
+
+  return [&opt, inertia, radius, kb, kv]() {
+    opt.inertia_given = inertia->count() > 0;
+    opt.flywheel_given = radius->count() > 0;
+    opt.kb_given = kb->count() > 0;
+    opt.speed_constant_given = kv->count() > 0;
+  };
+}
+
+BenchParams bench_from(const InputOptions& o) {
+  BenchParams bench;
+  if (o.inertia_given) {
+    bench.inertia_kg_m2 = o.inertia_kg_m2;
+    bench.inertia_source = "--inertia";
+  } else if (o.flywheel_given) {
+    bench.inertia_kg_m2 =
+        cylinder_inertia(o.flywheel_radius_m, o.flywheel_height_m, o.flywheel_density_kg_m3) + o.rotor_inertia_kg_m2;
+    bench.inertia_source = fmt::format("flywheel r={} m h={} m rho={} kg/m^3 + rotor {} kg*m^2", o.flywheel_radius_m,
+                                       o.flywheel_height_m, o.flywheel_density_kg_m3, o.rotor_inertia_kg_m2);
+  }
+  if (o.kb_given) {
+    bench.kb_v_s_per_rad = o.kb_v_s_per_rad;
+    bench.kb_source = "--kb";
+  } else if (o.speed_constant_given) {
+    bench.kb_v_s_per_rad = kb_from_speed_constant(o.speed_constant_rpm_per_v);
+    bench.kb_source = fmt::format("speed constant {} rpm/V", o.speed_constant_rpm_per_v);
+  }
+  std::string why;
+  if (!bench.is_valid(&why)) bad_usage(why);
+  return bench;
+}
+
+ReadOptions read_options_from(const InputOptions& o) {
+  ReadOptions read;
+  DelimitedTextOptions& d = read.delimited;
+  d.time_column = o.time_column;
+  d.value_column = o.value_column;
+  if (!o.time_unit.empty()) {
+    d.time_unit = parse_time_unit(o.time_unit);
+    if (!d.time_unit) bad_usage(fmt::format("--time-unit '{}' is not one of: s, ms, us", o.time_unit));
+  }
+  if (!o.value_unit.empty()) {
+    d.quantity = parse_quantity(o.value_unit);
+    if (!d.quantity) bad_usage(fmt::format("--value-unit '{}' is not one of: V, rpm, rad/s", o.value_unit));
+  }
+  if (!o.delimiter.empty()) d.delimiter = parse_delimiter(o.delimiter);
+  std::string why;
+  if (!read.is_valid(&why)) bad_usage(why);
+  return read;
+}
+
+}  // namespace spindown::cli

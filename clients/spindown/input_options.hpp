@@ -1,0 +1,44 @@
+#pragma once
+// The options `spindown fit` and `spindown explain` share: the bench (J directly or from
+// flywheel geometry + rotor inertia; K_b directly or from a speed constant) and the columns
+// and units of delimited text. One definition, so both commands accept and check them alike.
+#include <functional>
+#include <string>
+
+#include "spindown/bench.hpp"
+#include "spindown/read_recording.hpp"
+
+namespace CLI {
+class App;
+}
+
+namespace spindown::cli {
+
+struct InputOptions {
+  // A bench value counts only when its flag was given (the *_given flags).
+  double inertia_kg_m2 = 0;
+  double flywheel_radius_m = 0, flywheel_height_m = 0, flywheel_density_kg_m3 = 0, rotor_inertia_kg_m2 = 0;
+  double kb_v_s_per_rad = 0;
+  double speed_constant_rpm_per_v = 0;
+  bool inertia_given = false, flywheel_given = false, kb_given = false, speed_constant_given = false;
+
+  // Delimited text: columns and units when they are not obvious from the header.
+  std::string time_column, value_column, time_unit, value_unit, delimiter;
+
+  // J or K_b given on the command line: never taken from a log's config.
+  bool bench_from_user() const { return inertia_given || flywheel_given || kb_given || speed_constant_given; }
+};
+
+// Adds the bench ("Bench" group) and delimited-text options to sub, bound to opt. Call the
+// returned function in the subcommand's callback: it records which bench flags were given.
+std::function<void()> add_input_options(CLI::App* sub, InputOptions& opt);
+
+// The bench the options describe (lab defaults where not given). Bad usage throws
+// CLI::ValidationError (exit code 2).
+BenchParams bench_from(const InputOptions& opt);
+// Reading options for the delimited-text columns and units. Bad usage throws CLI::ValidationError.
+ReadOptions read_options_from(const InputOptions& opt);
+
+[[noreturn]] void bad_usage(const std::string& why);
+
+}  // namespace spindown::cli
