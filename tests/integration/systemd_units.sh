@@ -1,0 +1,82 @@
+#!/usr/bin/env bash
+# deploy/systemd/*.service pass `systemd-analyze verify` with no complaint at all (an unknown key
+# or a bad value is only a warning there, so any output fails the test), with the ExecStart paths
+# pointed at this build's programs through a temporary copy; the bridge template is verified as
+# an instance. Also checks what the units promise: the unprivileged user, the hardening, only the
+# bench's serial device, the bench file and the LCM env file. Skips (exit 77) only when
+# systemd-analyze is not installed (Debian: apt-get install systemd).
+set -euo pipefail
+src="${SPINDOWN_SOURCE_DIR:?}"
+bin="${SPINDOWN_BIN_DIR:?}"
+analyze=$(command -v systemd-analyze || true)
+if [[ -z $analyze ]]; then
+  echo "SKIP: systemd-analyze is not installed (apt-get install systemd); the units were not verified"
+  exit 77
+fi
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail=0
+for p in spindown-bridge spindown-fitter spindown-logger; do
+  [[ -x $bin/$p ]] || { echo "FAIL: $bin/$p is not built"; exit 1; }
+done
+cp "$src"/deploy/systemd/*.service "$tmp/"
+sed -i "s#/usr/local/bin/#$bin/#g" "$tmp"/*.service
+grep -q "ExecStart=$bin/spindown-bridge " "$tmp/spindown-bridge@.service" || { echo "FAIL: ExecStart not rewritten"; exit 1; }
+
+verify() {  # UNIT...
+  local out rc=0
+  out=$(cd "$tmp" && SYSTEMD_UNIT_PATH="$tmp:" "$analyze" verify --man=no "$@" 2>&1) || rc=$?
+  if ((rc != 0)) || [[ -n $out ]]; then
+    echo "FAIL: systemd-analyze verify $* (exit $rc):"; echo "$out"; fail=1
+  else
+    echo "ok: systemd-analyze verify $*"
+  fi
+}
+verify spindown-fitter.service spindown-logger.service spindown-bridge@bench-1.service
+verify spindown-bridge@lab_3.service
+
+# The check itself catches mistakes: an unknown key, and a program that is not there.
+cp "$tmp/spindown-fitter.service" "$tmp/broken-key.service"
+sed -i 's/^NoNewPrivileges=yes/NoNewPrivilege=yes/' "$tmp/broken-key.service"
+cp "$tmp/spindown-fitter.service" "$tmp/broken-exec.service"
+sed -i "s#^ExecStart=$bin/spindown-fitter#ExecStart=$tmp/no-such-program#" "$tmp/broken-exec.service"
+for u in broken-key broken-exec; do
+  out=$(cd "$tmp" && SYSTEMD_UNIT_PATH="$tmp:" "$analyze" verify --man=no "$u.service" 2>&1 || true)
+  if [[ -z $out ]]; then echo "FAIL: verify said nothing about $u.service"; fail=1; else echo "ok: verify catches $u: $(head -1 <<<"$out")"; fi
+done
+
+# What the units promise.
+expect() {  # UNIT LINE
+  if grep -qxF -- "$2" "$src/deploy/systemd/$1"; then echo "ok: $1: $2"; else echo "FAIL: $1 lacks '$2'"; fail=1; fi
+}
+for u in spindown-bridge@.service spindown-fitter.service spindown-logger.service; do
+  for line in User=spindown NoNewPrivileges=yes ProtectSystem=strict ProtectHome=yes PrivateTmp=yes \
+    DevicePolicy=closed "RestrictAddressFamilies=AF_INET AF_UNIX" CapabilityBoundingSet= \
+    SystemCallFilter=@system-service Restart=on-failure EnvironmentFile=/etc/spindown/lcm.env; do
+    expect "$u" "$line"
+  done
+done
+expect spindown-bridge@.service "DeviceAllow=/dev/spindown/%i rw"
+expect spindown-bridge@.service "SupplementaryGroups=dialout"
+expect spindown-bridge@.service "ExecStart=/usr/local/bin/spindown-bridge --config /etc/spindown/benches/%i.toml --bench %i"
+expect spindown-fitter.service "ExecStart=/usr/local/bin/spindown-fitter --bench-config /etc/spindown/benches"
+expect spindown-logger.service "StateDirectory=spindown/logs"
+grep -q '^DeviceAllow=' "$src/deploy/systemd/spindown-fitter.service" && { echo "FAIL: the fitter may open devices"; fail=1; }
+grep -qx 'LCM_DEFAULT_URL=udpm://239.255.76.67:7667?ttl=1' "$src/deploy/systemd/lcm.env" ||
+  { echo "FAIL: lcm.env does not set the lab URL with ttl=1"; fail=1; }
+
+# The bridge reads its serial device from the bench file the unit names (no --device).
+cat >"$tmp/bench-9.toml" <<'TOML'
+bench_id = "bench-9"
+[serial]
+device = "/nonexistent/spindown/bench-9"
+TOML
+rc=0
+timeout 20 "$bin/spindown-bridge" --config "$tmp/bench-9.toml" --bench bench-9 --lcm-url memq:// --exit-on-missing \
+  >"$tmp/bridge.out" 2>"$tmp/bridge.err" || rc=$?
+if ((rc == 1)) && grep -q '/nonexistent/spindown/bench-9' "$tmp/bridge.err"; then
+  echo "ok: the bridge takes [serial] device from the bench file"
+else
+  echo "FAIL: bridge with only --config (exit $rc):"; cat "$tmp/bridge.err"; fail=1
+fi
+exit $fail
