@@ -82,28 +82,126 @@ double stop_time(const Theta& th) {
   return std::log1p(th.alpha * th.u0 / th.beta) / th.alpha;
 }
 
+// One pass of the model over the run, vectorised with Eigen: the closed form is decreasing, so
+// every sample after the predicted stop reads exactly 0 and only the moving samples need the
+// exponential; the stopped tail contributes Σy² from a precomputed suffix sum.
+class Evaluator {
+ public:
+  Evaluator(std::span<const double> tau, std::span<const double> y)
+      : tau_(tau), y_(y), tail_sq_(tau.size() + 1, 0.0), sorted_(std::is_sorted(tau.begin(), tau.end())) {
+    for (std::size_t i = tau.size(); i-- > 0;) tail_sq_[i] = tail_sq_[i + 1] + y[i] * y[i];
+    const auto n = static_cast<Eigen::Index>(tau.size());
+    e_.resize(n);
+    moving_.resize(n);
+    p_.resize(n);
+    dp_.resize(n);
+    r_.resize(n);
+    g_.resize(n, 3);
+  }
+
+  std::size_t size() const { return tau_.size(); }
+
+  // SSE at θ; with jac, also JᵀJ and Jᵀr (unused rows/columns of a smaller family are left
+  // as identity/zero so 3×3 solvers serve every family). Residuals and Jacobian rows of the
+  // moving samples stay in r() and jacobian() until the next call.
+  double operator()(const Family& f, const Theta& th, Eigen::Matrix3d* jtj = nullptr, Eigen::Vector3d* jtr = nullptr) {
+    // LM ends on an accepted point that the covariance and the statistics ask for again.
+    if (last_valid_ && same(f, th) && (!jtj || last_has_jac_)) {
+      if (jtj) *jtj = last_jtj_, *jtr = last_jtr_;
+      return last_sse_;
+    }
+    const std::size_t n = tau_.size();
+    std::size_t m = n;
+    const double ts = stop_time(th);
+    if (sorted_ && std::isfinite(ts)) m = static_cast<std::size_t>(std::upper_bound(tau_.begin(), tau_.end(), ts) - tau_.begin());
+    m_ = static_cast<Eigen::Index>(m);
+    const Eigen::Map<const Eigen::ArrayXd> t(tau_.data(), m_), y(y_.data(), m_);
+    auto e = e_.head(m_), p = p_.head(m_), dp = dp_.head(m_), r = r_.head(m_);
+    if (f.alpha_free && th.alpha != 0) {
+      e = (-th.alpha * t).exp();
+      // φ(x) = (1 − e^(−x))/x and dφ/dx; a series on the first samples, where x = ατ < 10⁻³
+      // and 1 − e would cancel (τ is sorted, so they are a prefix).
+      const Eigen::Index k =
+          sorted_ ? std::upper_bound(tau_.begin(), tau_.begin() + m_, 1e-3 / th.alpha) - tau_.begin() : m_;
+      for (Eigen::Index i = 0; i < k; ++i) {
+        const double x = th.alpha * t[i];
+        if (x < 1e-3) {
+          p[i] = 1.0 - x / 2 + x * x / 6 - x * x * x / 24;
+          dp[i] = -0.5 + x / 3 - x * x / 8;
+        } else {
+          p[i] = (1.0 - e[i]) / x;
+          dp[i] = (e[i] * (1.0 + x) - 1.0) / (x * x);
+        }
+      }
+      if (k < m_) {
+        const auto x = t.tail(m_ - k) * th.alpha;
+        const auto et = e.tail(m_ - k);
+        p.tail(m_ - k) = (1.0 - et) / x;
+        dp.tail(m_ - k) = (et * (1.0 + x) - 1.0) / x.square();
+      }
+    } else {
+      e.setOnes();
+      p.setOnes();
+      dp.setConstant(-0.5);
+    }
+    // model = max(0, u0·e − β·τ·φ); rounding may leave a sample at the stop just below 0.
+    r = th.u0 * e - th.beta * t * p;
+    auto moving = moving_.head(m_);
+    moving = (r > 0).cast<double>();
+    r = y - r.max(0.0);
+    const double sse = r.square().sum() + tail_sq_[m];
+    last_f_ = f, last_th_ = th, last_sse_ = sse, last_valid_ = true, last_has_jac_ = jtj != nullptr;
+    if (jtj) {
+      int j = 0;
+      g_.col(j++).head(m_) = (e * moving).matrix();
+      if (f.alpha_free) g_.col(j++).head(m_) = ((-th.u0 * t * e - th.beta * t * t * dp) * moving).matrix();
+      if (f.beta_free) g_.col(j++).head(m_) = (-t * p * moving).matrix();
+      const int np = f.size();
+      jtj->setIdentity();
+      jtr->setZero();
+      // p ≤ 3 columns: vectorised dot products beat a general matrix product here.
+      for (int a = 0; a < np; ++a) {
+        const auto ga = g_.col(a).head(m_);
+        (*jtr)[a] = ga.dot(r.matrix());
+        for (int b = 0; b <= a; ++b) (*jtj)(a, b) = (*jtj)(b, a) = ga.dot(g_.col(b).head(m_));
+      }
+      last_jtj_ = *jtj, last_jtr_ = *jtr;
+    }
+    return sse;
+  }
+
+  // After a call with jac: the moving samples' residuals and Jacobian rows.
+  auto residuals() const { return r_.head(m_); }
+  auto jacobian(int p) const { return g_.topLeftCorner(m_, p); }
+
+ private:
+  std::span<const double> tau_, y_;
+  std::vector<double> tail_sq_;
+  bool sorted_;
+  Eigen::Index m_ = 0;
+  Eigen::ArrayXd e_, p_, dp_, r_, moving_;
+  // The last evaluation, so asking again for the same point costs nothing.
+  bool same(const Family& f, const Theta& th) const {
+    return f.alpha_free == last_f_.alpha_free && f.beta_free == last_f_.beta_free && th.u0 == last_th_.u0 &&
+           th.alpha == last_th_.alpha && th.beta == last_th_.beta;
+  }
+  bool last_valid_ = false, last_has_jac_ = false;
+  Family last_f_{false, false};
+  Theta last_th_;
+  double last_sse_ = 0;
+  Eigen::Matrix3d last_jtj_;
+  Eigen::Vector3d last_jtr_;
+  Eigen::MatrixXd g_;
+};
+
 struct Problem {
   Family fam;
-  std::span<const double> tau, y;
+  Evaluator* eval;
   Eigen::Vector3d scale;  // parameters are optimised as x_j = θ_j / scale_j (conditioning)
   double sse0 = 1;        // objective normalisation
   int evals = 0;
   std::exception_ptr error;
 };
-
-double sse_and_gradient(const Problem& pb, const Theta& th, double* grad) {
-  const int p = pb.fam.size();
-  double g[3];
-  double sse = 0;
-  if (grad) std::fill(grad, grad + p, 0.0);
-  for (std::size_t i = 0; i < pb.tau.size(); ++i) {
-    const double r = pb.y[i] - reading(pb.fam, th, pb.tau[i], grad ? g : nullptr);
-    sse += r * r;
-    if (grad)
-      for (int j = 0; j < p; ++j) grad[j] -= 2 * r * g[j];
-  }
-  return sse;
-}
 
 // NLopt's C++ objective: never let an exception cross it (design §7).
 double nlopt_objective(unsigned n, const double* xs, double* grad, void* data) {
@@ -113,9 +211,11 @@ double nlopt_objective(unsigned n, const double* xs, double* grad, void* data) {
     double x[3];
     for (unsigned j = 0; j < n; ++j) x[j] = xs[j] * pb->scale[j];
     const Theta th = unpack(pb->fam, x);
-    const double sse = sse_and_gradient(*pb, th, grad);
-    if (grad)
-      for (unsigned j = 0; j < n; ++j) grad[j] *= pb->scale[j] / pb->sse0;
+    Eigen::Matrix3d jtj;
+    Eigen::Vector3d jtr;
+    const double sse = grad ? (*pb->eval)(pb->fam, th, &jtj, &jtr) : (*pb->eval)(pb->fam, th);
+    if (grad)  // d(Σr²)/dθ = −2·Jᵀr
+      for (unsigned j = 0; j < n; ++j) grad[j] = -2 * jtr[j] * pb->scale[j] / pb->sse0;
     return sse / pb->sse0;
   } catch (...) {
     pb->error = std::current_exception();
@@ -164,48 +264,62 @@ struct LmResult {
   bool converged = false;
 };
 
-double residuals(const Family& f, const Theta& th, std::span<const double> tau, std::span<const double> y,
-                 Eigen::Matrix3d& jtj, Eigen::Vector3d& jtr) {
-  const int p = f.size();
-  jtj.setZero();
-  jtr.setZero();
-  double sse = 0, g[3];
-  for (std::size_t i = 0; i < tau.size(); ++i) {
-    const double r = y[i] - reading(f, th, tau[i], g);
-    sse += r * r;
-    for (int a = 0; a < p; ++a) {
-      jtr[a] += g[a] * r;
-      for (int b = 0; b <= a; ++b) jtj(a, b) += g[a] * g[b];
-    }
+// Converged once the Gauss–Newton step from the current point is a tiny fraction of each
+// parameter's own statistical uncertainty s²·(JᵀJ)⁻¹ (both from the same JᵀJ, so the test
+// costs no evaluation): iterating further only moves digits nobody can use. A step that a
+// bound blocks (α or β held at 0) counts as zero.
+constexpr double negligible_step_in_se = 1e-3;
+
+bool at_minimum(const Family& f, const Theta& th, const Eigen::Matrix3d& jtj, const Eigen::Vector3d& jtr, double sse,
+                double dof) {
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(jtj);
+  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return false;
+  const Eigen::Matrix3d inv = ldlt.solve(Eigen::Matrix3d::Identity());
+  const Eigen::Vector3d step = inv * jtr;
+  if (!step.allFinite()) return false;
+  const double s2 = sse / dof;
+  double x[3];
+  int j = 0;
+  x[j++] = th.u0;
+  if (f.alpha_free) x[j++] = th.alpha;
+  if (f.beta_free) x[j++] = th.beta;
+  for (j = 0; j < f.size(); ++j) {
+    const bool blocked = j > 0 && x[j] <= 0 && step[j] < 0;
+    if (!blocked && std::abs(step[j]) > negligible_step_in_se * std::sqrt(std::max(s2 * inv(j, j), 0.0)) &&
+        std::abs(step[j]) > 1e-12 * std::abs(x[j]))
+      return false;
   }
-  for (int a = 0; a < p; ++a)
-    for (int b = a + 1; b < p; ++b) jtj(a, b) = jtj(b, a);
-  return sse;
+  return true;
 }
 
-LmResult levenberg_marquardt(const Family& f, Theta th, std::span<const double> tau, std::span<const double> y) {
+LmResult levenberg_marquardt(const Family& f, Theta th, Evaluator& eval) {
   const int p = f.size();
+  const double dof = static_cast<double>(std::max<std::size_t>(eval.size() - p, 1));
   LmResult out;
   Eigen::Matrix3d jtj, jtj_try;
   Eigen::Vector3d jtr, jtr_try;
-  double sse = residuals(f, th, tau, y, jtj, jtr);
+  double sse = eval(f, th, &jtj, &jtr);
   out.evals = 1;
   double lambda = 1e-3;
   for (int it = 0; it < 100 && out.evals < 200; ++it) {
-    Eigen::MatrixXd a = jtj.topLeftCorner(p, p);
-    a.diagonal() *= 1.0 + lambda;
-    const Eigen::LDLT<Eigen::MatrixXd> ldlt(a);
+    if (at_minimum(f, th, jtj, jtr, sse, dof)) {
+      out.converged = true;
+      break;
+    }
+    Eigen::Matrix3d a = jtj;
+    a.diagonal().head(p) *= 1.0 + lambda;
+    const Eigen::LDLT<Eigen::Matrix3d> ldlt(a);
     if (ldlt.info() != Eigen::Success) break;
-    const Eigen::VectorXd step = ldlt.solve(jtr.head(p));
+    const Eigen::Vector3d step = ldlt.solve(jtr);
     if (!step.allFinite()) break;
-    double x[3], s[3] = {0, 0, 0};
+    double x[3];
     int j = 0;
-    x[j] = th.u0, s[j] = step[j], ++j;
-    if (f.alpha_free) x[j] = th.alpha, s[j] = step[j], ++j;
-    if (f.beta_free) x[j] = th.beta, s[j] = step[j], ++j;
-    for (j = 0; j < p; ++j) x[j] = std::max(x[j] + s[j], j == 0 ? 1e-12 : 0.0);
+    x[j++] = th.u0;
+    if (f.alpha_free) x[j++] = th.alpha;
+    if (f.beta_free) x[j++] = th.beta;
+    for (j = 0; j < p; ++j) x[j] = std::max(x[j] + step[j], j == 0 ? 1e-12 : 0.0);
     const Theta trial = unpack(f, x);
-    const double sse_try = residuals(f, trial, tau, y, jtj_try, jtr_try);
+    const double sse_try = eval(f, trial, &jtj_try, &jtr_try);
     ++out.evals;
     if (sse_try <= sse) {
       const double gain = sse - sse_try;
@@ -214,13 +328,7 @@ LmResult levenberg_marquardt(const Family& f, Theta th, std::span<const double> 
       jtr = jtr_try;
       sse = sse_try;
       lambda = std::max(lambda / 10, 1e-12);
-      bool small = true;
-      j = 0;
-      if (std::abs(s[j]) > 1e-10 * std::abs(th.u0)) small = false;
-      ++j;
-      if (f.alpha_free && std::abs(s[j++]) > 1e-10 * std::max(th.alpha, 1e-9)) small = false;
-      if (f.beta_free && std::abs(s[j++]) > 1e-10 * std::max(th.beta, 1e-9 * th.u0)) small = false;
-      if (small || gain <= 1e-14 * sse) {
+      if (gain <= 1e-14 * sse) {
         out.converged = true;
         break;
       }
@@ -244,43 +352,40 @@ struct Covariance {
 
 // Parameter covariance from the Jacobian at the optimum. The classic s²(JᵀJ)⁻¹ assumes white
 // residuals; commutator ripple and quantization make them correlated, so the Newey–West
-// (HAC) sandwich is computed too and the larger variance of the two is kept.
-Covariance covariance(const Family& f, const Theta& th, std::span<const double> tau, std::span<const double> y) {
+// (HAC) sandwich is computed too and each parameter's variance is widened to the larger of
+// the two. Only its diagonal is needed: var_j = v_jᵀ·Ω·v_j with v_j = column j of (JᵀJ)⁻¹,
+// which is the long-run variance of the scalar series z_i = (g_i·v_j)·r_i.
+Covariance covariance(const Family& f, const Theta& th, Evaluator& eval) {
   const int p = f.size();
-  const auto n = static_cast<Eigen::Index>(tau.size());
-  Eigen::MatrixXd jac(n, p);
-  Eigen::VectorXd res(n);
-  for (Eigen::Index i = 0; i < n; ++i) {
-    double g[3];
-    res[i] = y[i] - reading(f, th, tau[i], g);
-    for (int j = 0; j < p; ++j) jac(i, j) = g[j];
-  }
+  Eigen::Matrix3d jtj;
+  Eigen::Vector3d jtr;
+  const double sse = eval(f, th, &jtj, &jtr);
+  const auto n = static_cast<Eigen::Index>(eval.size());
   Covariance out;
-  const Eigen::MatrixXd jtj = jac.transpose() * jac;
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(jtj);
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(jtj);
   if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return out;
-  const Eigen::MatrixXd inv = ldlt.solve(Eigen::MatrixXd::Identity(p, p));
+  const Eigen::Matrix3d inv = ldlt.solve(Eigen::Matrix3d::Identity());
   if (!inv.allFinite()) return out;
-  const double s2 = res.squaredNorm() / std::max<Eigen::Index>(1, n - p);
-  const Eigen::MatrixXd classic = s2 * inv;
+  const double s2 = sse / static_cast<double>(std::max<Eigen::Index>(1, n - p));
+  const Eigen::Matrix3d classic = s2 * inv;
 
   const int lags = static_cast<int>(std::ceil(4.0 * std::pow(n / 100.0, 2.0 / 9.0)));
-  const Eigen::MatrixXd score = jac.array().colwise() * res.array();  // rows: g_i·r_i
-  Eigen::MatrixXd meat = score.transpose() * score;
-  for (int l = 1; l <= lags && l < n; ++l) {
-    const double w = 1.0 - l / (lags + 1.0);
-    const Eigen::MatrixXd gamma = score.topRows(n - l).transpose() * score.bottomRows(n - l);
-    meat += w * (gamma + gamma.transpose());
+  const double dof = static_cast<double>(n) / static_cast<double>(std::max<Eigen::Index>(1, n - p));
+  const auto g = eval.jacobian(p);  // rows of the moving samples; the stopped tail scores zero
+  const auto r = eval.residuals();
+  const Eigen::Index m = r.size();
+  Eigen::Vector3d widen = Eigen::Vector3d::Ones();
+  for (int j = 0; j < p; ++j) {
+    const Eigen::ArrayXd z = (g * inv.col(j).head(p)).array() * r;
+    double omega = z.square().sum();
+    for (int l = 1; l <= lags && l < m; ++l)
+      omega += 2.0 * (1.0 - l / (lags + 1.0)) * (z.head(m - l) * z.tail(m - l)).sum();
+    widen[j] = std::sqrt(std::max(1.0, dof * omega / classic(j, j)));
   }
-  const double dof = static_cast<double>(n) / std::max<Eigen::Index>(1, n - p);
-  const Eigen::MatrixXd hac = dof * inv * meat * inv;
-  Eigen::MatrixXd cov = classic;
   // Keep the correlation structure of the classic estimate, widened per parameter.
-  Eigen::VectorXd widen(p);
-  for (int j = 0; j < p; ++j) widen[j] = std::sqrt(std::max(1.0, hac(j, j) / classic(j, j)));
-  cov = widen.asDiagonal() * classic * widen.asDiagonal();
-  out.cov.topLeftCorner(p, p) = cov;
-  out.ok = cov.allFinite();
+  out.cov = widen.asDiagonal() * classic * widen.asDiagonal();
+  for (int j = p; j < 3; ++j) out.cov.row(j).setZero(), out.cov.col(j).setZero();
+  out.ok = out.cov.allFinite();
   return out;
 }
 
@@ -302,11 +407,11 @@ double delta_se(const Family& f, const Eigen::Matrix3d& cov, double d_u0, double
 
 // Bounded quasi-Newton refinement with NLopt (the fallback when LM does not converge).
 // Returns "" on success or why it failed; th is updated to the best point found.
-std::string refine_with_nlopt(const Family& fam, std::span<const double> tau, std::span<const double> y, Theta& th,
+std::string refine_with_nlopt(const Family& fam, std::span<const double> tau, Evaluator& eval, Theta& th,
                               int& evals) {
   const int p = fam.size();
   const double span_s = std::max(tau.back(), 1e-3);
-  Problem pb{fam, tau, y, {}, 1.0, 0, nullptr};
+  Problem pb{fam, &eval, {}, 1.0, 0, nullptr};
   std::vector<double> x(p);
   {
     int j = 0;
@@ -314,7 +419,7 @@ std::string refine_with_nlopt(const Family& fam, std::span<const double> tau, st
     if (fam.alpha_free) pb.scale[j] = std::max(th.alpha, 1e-6 / span_s), x[j] = th.alpha / pb.scale[j], ++j;
     if (fam.beta_free) pb.scale[j] = std::max(th.beta, 1e-6 * th.u0 / span_s), x[j] = th.beta / pb.scale[j], ++j;
   }
-  pb.sse0 = std::max(sse_and_gradient(pb, th, nullptr), 1e-300);
+  pb.sse0 = std::max(eval(fam, th), 1e-300);
   nlopt::opt opt(nlopt::LD_LBFGS, static_cast<unsigned>(p));
   std::vector<double> lb(p, 0.0), ub(p, 1e6);
   lb[0] = 1e-9;
@@ -350,7 +455,7 @@ std::string refine_with_nlopt(const Family& fam, std::span<const double> tau, st
 }
 
 ModelFit fit_model(ModelKind kind, std::span<const double> tau, std::span<const double> y, std::size_t moving,
-                   double k, const BenchParams& bench, std::string_view runit) {
+                   double k, const BenchParams& bench, std::string_view runit, Evaluator* evaluator) {
   ModelFit out;
   out.kind = kind;
   out.n = tau.size();
@@ -369,18 +474,18 @@ ModelFit fit_model(ModelKind kind, std::span<const double> tau, std::span<const 
   if (fam.alpha_free && !(th.alpha > 0)) th.alpha = fam.beta_free ? 1e-3 / span_s : 1.0 / span_s;
   if (fam.beta_free && !(th.beta > 0)) th.beta = fam.alpha_free ? 1e-3 * th.u0 / span_s : th.u0 / span_s;
 
-  const LmResult lm = levenberg_marquardt(fam, th, tau, y);
+  Evaluator& eval = *evaluator;
+  const LmResult lm = levenberg_marquardt(fam, th, eval);
   out.evaluations = lm.evals;
   th = lm.theta;
   bool solved = lm.converged;
   std::string why;
   if (!solved) {
     // Fallback: NLopt's L-BFGS under bounds on scaled parameters, from LM's best point.
-    why = refine_with_nlopt(fam, tau, y, th, out.evaluations);
+    why = refine_with_nlopt(fam, tau, eval, th, out.evaluations);
     solved = why.empty();
   }
-  Problem pb{fam, tau, y, {}, 1.0, 0, nullptr};
-  const double sse = sse_and_gradient(pb, th, nullptr);
+  const double sse = eval(fam, th);
   const double n = static_cast<double>(tau.size());
   const double mean = std::accumulate(y.begin(), y.end(), 0.0) / n;
   double sst = 0;
@@ -395,7 +500,7 @@ ModelFit fit_model(ModelKind kind, std::span<const double> tau, std::span<const 
   out.rate = th.alpha;
   out.decel = th.beta / k;
 
-  const Covariance cv = covariance(fam, th, tau, y);
+  const Covariance cv = covariance(fam, th, eval);
   out.converged = solved && cv.ok;
   if (!solved) out.message = why;
   else if (!cv.ok) out.message = "parameters are not identifiable from this run (singular Jacobian)";
@@ -491,7 +596,8 @@ RunFit fit_run(std::span<const double> t_s, std::span<const double> value, Quant
   }
   const std::size_t moving = (run.stopped ? stop : end) - begin;
   const std::string_view runit = quantity_unit(q);
-  for (ModelKind kind : opt.models) out.models.push_back(fit_model(kind, tau, y, moving, k, opt.bench, runit));
+  Evaluator eval(tau, y);  // one workspace for every model of the run
+  for (ModelKind kind : opt.models) out.models.push_back(fit_model(kind, tau, y, moving, k, opt.bench, runit, &eval));
 
   // Best model: lowest BIC among converged fits (BIC penalises the extra parameter).
   const ModelFit* best = nullptr;
