@@ -117,45 +117,50 @@ class Evaluator {
     m_ = static_cast<Eigen::Index>(m);
     const Eigen::Map<const Eigen::ArrayXd> t(tau_.data(), m_), y(y_.data(), m_);
     auto e = e_.head(m_), p = p_.head(m_), dp = dp_.head(m_), r = r_.head(m_);
-    if (f.alpha_free && th.alpha != 0) {
+    auto moving = moving_.head(m_);
+    const double tau_max = m_ == 0 ? 0.0 : sorted_ ? t[m_ - 1] : t.maxCoeff();
+    const bool decaying = f.alpha_free && th.alpha * tau_max >= 1e-3;
+    if (decaying) {
+      // With c = β/α the model is (u0 + c)·e − c: no division per sample. Its α-derivative,
+      // −(u0 + c)·τ·e + (c/α)·(1 − e), loses only ~ε·βτ/α to cancellation where ατ is small.
+      const double c = th.beta / th.alpha;
       e = (-th.alpha * t).exp();
-      // φ(x) = (1 − e^(−x))/x and dφ/dx; a series on the first samples, where x = ατ < 10⁻³
-      // and 1 − e would cancel (τ is sorted, so they are a prefix).
-      const Eigen::Index k =
-          sorted_ ? std::upper_bound(tau_.begin(), tau_.begin() + m_, 1e-3 / th.alpha) - tau_.begin() : m_;
-      for (Eigen::Index i = 0; i < k; ++i) {
-        const double x = th.alpha * t[i];
-        if (x < 1e-3) {
-          p[i] = 1.0 - x / 2 + x * x / 6 - x * x * x / 24;
-          dp[i] = -0.5 + x / 3 - x * x / 8;
-        } else {
-          p[i] = (1.0 - e[i]) / x;
-          dp[i] = (e[i] * (1.0 + x) - 1.0) / (x * x);
-        }
-      }
-      if (k < m_) {
-        const auto x = t.tail(m_ - k) * th.alpha;
-        const auto et = e.tail(m_ - k);
-        p.tail(m_ - k) = (1.0 - et) / x;
-        dp.tail(m_ - k) = (et * (1.0 + x) - 1.0) / x.square();
+      r = (th.u0 + c) * e - c;
+      moving = (r > 0).cast<double>();
+      r = y - r.max(0.0);
+      if (jtj) {
+        int j = 0;
+        g_.col(j++).head(m_) = (e * moving).matrix();
+        g_.col(j++).head(m_) = ((c / th.alpha * (1.0 - e) - (th.u0 + c) * t * e) * moving).matrix();
+        if (f.beta_free) g_.col(j++).head(m_) = ((e - 1.0) * (moving / th.alpha)).matrix();
       }
     } else {
-      e.setOnes();
-      p.setOnes();
-      dp.setConstant(-0.5);
+      // α·τ below 10⁻³ everywhere (or α fixed at 0): φ(x) = (1 − e^(−x))/x by its series, which
+      // is exact to rounding there and has the Coulomb limit φ = 1.
+      if (f.alpha_free && th.alpha != 0) {
+        e = (-th.alpha * t).exp();
+        const auto x = t * th.alpha;
+        p = 1.0 - x / 2 + x * x / 6 - x * x * x / 24;
+        dp = -0.5 + x / 3 - x * x / 8;
+      } else {
+        e.setOnes();
+        p.setOnes();
+        dp.setConstant(-0.5);
+      }
+      // model = max(0, u0·e − β·τ·φ); rounding may leave a sample at the stop just below 0.
+      r = th.u0 * e - th.beta * t * p;
+      moving = (r > 0).cast<double>();
+      r = y - r.max(0.0);
+      if (jtj) {
+        int j = 0;
+        g_.col(j++).head(m_) = (e * moving).matrix();
+        if (f.alpha_free) g_.col(j++).head(m_) = ((-th.u0 * t * e - th.beta * t * t * dp) * moving).matrix();
+        if (f.beta_free) g_.col(j++).head(m_) = (-t * p * moving).matrix();
+      }
     }
-    // model = max(0, u0·e − β·τ·φ); rounding may leave a sample at the stop just below 0.
-    r = th.u0 * e - th.beta * t * p;
-    auto moving = moving_.head(m_);
-    moving = (r > 0).cast<double>();
-    r = y - r.max(0.0);
     const double sse = r.square().sum() + tail_sq_[m];
     last_f_ = f, last_th_ = th, last_sse_ = sse, last_valid_ = true, last_has_jac_ = jtj != nullptr;
     if (jtj) {
-      int j = 0;
-      g_.col(j++).head(m_) = (e * moving).matrix();
-      if (f.alpha_free) g_.col(j++).head(m_) = ((-th.u0 * t * e - th.beta * t * t * dp) * moving).matrix();
-      if (f.beta_free) g_.col(j++).head(m_) = (-t * p * moving).matrix();
       const int np = f.size();
       jtj->setIdentity();
       jtr->setZero();
@@ -226,32 +231,43 @@ double nlopt_objective(unsigned n, const double* xs, double* grad, void* data) {
 // Starting point from the integral form of the ODE, linear in the unknowns:
 //   r(τ) = u0 − α·∫₀^τ r dt − β·τ     (while moving)
 // one least-squares solve over the samples before the stop: no derivatives of noisy data,
-// no initial guess needed.
-Theta integral_start(const Family& f, std::span<const double> tau, std::span<const double> y,
-                     std::size_t moving) {
-  const int p = f.size();
+// no initial guess needed. The normal equations of the full form (columns 1, −∫r, −τ) are
+// built once per run; each family solves its own sub-block.
+struct IntegralForm {
   Eigen::Matrix3d ata = Eigen::Matrix3d::Zero();
   Eigen::Vector3d atb = Eigen::Vector3d::Zero();
+};
+
+IntegralForm integral_form(std::span<const double> tau, std::span<const double> y, std::size_t moving) {
+  IntegralForm out;
   double integral = 0;
   for (std::size_t i = 0; i < moving; ++i) {
     if (i > 0) integral += 0.5 * (y[i] + y[i - 1]) * (tau[i] - tau[i - 1]);
-    double row[3];
-    int j = 0;
-    row[j++] = 1.0;
-    if (f.alpha_free) row[j++] = -integral;
-    if (f.beta_free) row[j++] = -tau[i];
-    for (int a = 0; a < p; ++a) {
-      atb[a] += row[a] * y[i];
-      for (int b = 0; b < p; ++b) ata(a, b) += row[a] * row[b];
-    }
+    const Eigen::Vector3d row(1.0, -integral, -tau[i]);
+    out.atb += row * y[i];
+    out.ata.noalias() += row * row.transpose();
+  }
+  return out;
+}
+
+Theta integral_start(const Family& f, const IntegralForm& form) {
+  const int p = f.size();
+  int idx[3], j = 0;
+  idx[j++] = 0;
+  if (f.alpha_free) idx[j++] = 1;
+  if (f.beta_free) idx[j++] = 2;
+  Eigen::Matrix3d ata = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d atb = Eigen::Vector3d::Zero();
+  for (int a = 0; a < p; ++a) {
+    atb[a] = form.atb[idx[a]];
+    for (int c = 0; c < p; ++c) ata(a, c) = form.ata(idx[a], idx[c]);
   }
   Theta th;
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(ata.topLeftCorner(p, p));
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(ata);
   if (ldlt.info() != Eigen::Success) return th;
-  const Eigen::VectorXd sol = ldlt.solve(atb.head(p));
+  const Eigen::Vector3d sol = ldlt.solve(atb);
   if (!sol.allFinite()) return th;
-  th = unpack(f, sol.data());
-  return th;
+  return unpack(f, sol.data());
 }
 
 // Levenberg–Marquardt in Eigen with the bounds α, β ≥ 0, u0 > 0 enforced by projection. The
@@ -455,7 +471,8 @@ std::string refine_with_nlopt(const Family& fam, std::span<const double> tau, Ev
 }
 
 ModelFit fit_model(ModelKind kind, std::span<const double> tau, std::span<const double> y, std::size_t moving,
-                   double k, const BenchParams& bench, std::string_view runit, Evaluator* evaluator) {
+                   double k, const BenchParams& bench, std::string_view runit, Evaluator* evaluator,
+                   const IntegralForm& form) {
   ModelFit out;
   out.kind = kind;
   out.n = tau.size();
@@ -467,7 +484,7 @@ ModelFit fit_model(ModelKind kind, std::span<const double> tau, std::span<const 
   }
 
   // Start: the integral form; guard it into the feasible region (α, β ≥ 0, u0 > 0).
-  Theta th = integral_start(fam, tau, y, moving);
+  Theta th = integral_start(fam, form);
   const double y_first = *std::max_element(y.begin(), y.begin() + std::min<std::size_t>(moving, 5));
   if (!(th.u0 > 0) || !std::isfinite(th.u0)) th.u0 = std::max(y_first, 1e-6);
   const double span_s = std::max(tau[moving - 1], 1e-3);
@@ -597,7 +614,9 @@ RunFit fit_run(std::span<const double> t_s, std::span<const double> value, Quant
   const std::size_t moving = (run.stopped ? stop : end) - begin;
   const std::string_view runit = quantity_unit(q);
   Evaluator eval(tau, y);  // one workspace for every model of the run
-  for (ModelKind kind : opt.models) out.models.push_back(fit_model(kind, tau, y, moving, k, opt.bench, runit, &eval));
+  const IntegralForm form = integral_form(tau, y, moving);
+  for (ModelKind kind : opt.models)
+    out.models.push_back(fit_model(kind, tau, y, moving, k, opt.bench, runit, &eval, form));
 
   // Best model: lowest BIC among converged fits (BIC penalises the extra parameter).
   const ModelFit* best = nullptr;
