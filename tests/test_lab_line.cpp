@@ -1,5 +1,10 @@
 #include <gtest/gtest.h>
 
+#include <charconv>
+#include <cmath>
+#include <vector>
+#include <cstring>
+#include <random>
 #include <string>
 
 #include "spindown/lab_line.hpp"
@@ -87,4 +92,29 @@ TEST(LabLine, WhyIsEmptyForSamplesAndStaticForGarbage) {
     why = parse_lab_line(temp).why;
   }
   EXPECT_EQ(why, "value is not a number");  // still valid after the input is gone
+}
+
+// Plain decimals take a fast path; it must give the very same double as from_chars, bit for bit,
+// including the hardest cases (long fractions, halfway-looking digits, negative zero).
+TEST(LabLine, PlainDecimalsMatchFromCharsBitForBit) {
+  std::mt19937_64 rng(7);
+  std::vector<std::string> values = {"0", "0.00", "-0.00", "5.00", "4.99", "0.1", "0.3", "2.675", "1.005",
+                                     "123456789012345", "0.123456789012345", "999999999.999999", "1.", "-3.21"};
+  for (int k = 0; k < 20000; ++k) {
+    const int frac = static_cast<int>(rng() % 16);
+    std::string digits = std::to_string(rng() % 1000000000000000ull);
+    if (frac > 0 && frac < static_cast<int>(digits.size())) digits.insert(digits.size() - frac, ".");
+    values.push_back((rng() % 2 ? "-" : "") + digits);
+  }
+  for (const std::string& v : values) {
+    const LabLine l = parse_lab_line("1000\t" + v);
+    double expected = 0;
+    std::from_chars(v.data(), v.data() + v.size(), expected);
+    if (std::fabs(expected) > 4294967040.0) {
+      EXPECT_EQ(l.kind, Kind::garbled) << v;
+      continue;
+    }
+    ASSERT_EQ(l.kind, Kind::sample) << v << ": " << l.why;
+    EXPECT_EQ(std::memcmp(&l.value, &expected, sizeof expected), 0) << v << " read as " << l.value;
+  }
 }

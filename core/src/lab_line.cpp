@@ -2,6 +2,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <system_error>
 
 namespace spindown {
@@ -19,6 +20,40 @@ constexpr std::size_t max_sample_line = 64;
 constexpr std::uint64_t max_device_ticks = 0xFFFFFFFFull;
 // Serial.print(float) prints "ovf" above this, so a larger number cannot come from the sketch.
 constexpr double max_printable_value = 4294967040.0;
+
+// The sketch prints values like "3.21" or "-0.01": digits, a point, digits. Those are read
+// here exactly as from_chars would (a mantissa below 2^53 divided by an exact power of ten
+// is correctly rounded); anything else (exponents, long mantissas, errors) goes to from_chars.
+bool parse_plain_decimal(const char* p, const char* end, double& value) {
+  static constexpr double pow10[] = {1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15};
+  const bool negative = p < end && *p == '-';
+  if (negative) ++p;
+  std::uint64_t mantissa = 0;
+  int digits = 0, fraction = -1;
+  for (; p < end; ++p) {
+    if (*p >= '0' && *p <= '9') {
+      mantissa = mantissa * 10 + static_cast<unsigned>(*p - '0');
+      ++digits;
+      if (fraction >= 0) ++fraction;
+    } else if (*p == '.' && fraction < 0) {
+      fraction = 0;
+    } else {
+      return false;
+    }
+  }
+  if (digits == 0 || digits > 15) return false;
+  const double v = static_cast<double>(mantissa) / pow10[fraction < 0 ? 0 : fraction];
+  value = negative ? -v : v;
+  return true;
+}
+
+LabLine sample_line(std::uint64_t ticks, double value) {
+  LabLine sample;
+  sample.kind = LabLine::Kind::sample;
+  sample.millis = static_cast<std::int64_t>(ticks);
+  sample.value = value;
+  return sample;
+}
 
 LabLine garbled(std::string_view why) {
   LabLine line;
@@ -59,6 +94,7 @@ LabLine parse_lab_line(std::string_view line) {
   const char* q = after_time;
   while (q < end && is_space(*q)) ++q;  // q < end: trailing space was trimmed above
   double value = 0;
+  if (parse_plain_decimal(q, end, value) && std::fabs(value) <= max_printable_value) return sample_line(ticks, value);
   auto [after_value, value_ec] = std::from_chars(q, end, value);
   if (value_ec == std::errc::invalid_argument) return garbled("value is not a number");
   if (value_ec == std::errc::result_out_of_range) return garbled("value out of range");
@@ -69,11 +105,7 @@ LabLine parse_lab_line(std::string_view line) {
   if (!std::isfinite(value)) return garbled("value is NaN or infinite");
   if (std::fabs(value) > max_printable_value) return garbled("value larger than an Arduino can print");
 
-  LabLine sample;
-  sample.kind = LabLine::Kind::sample;
-  sample.millis = static_cast<std::int64_t>(ticks);
-  sample.value = value;
-  return sample;
+  return sample_line(ticks, value);
 }
 
 }  // namespace spindown

@@ -1,6 +1,7 @@
 #include "text_support.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <fmt/format.h>
 
@@ -8,12 +9,15 @@ namespace spindown::text {
 
 bool looks_binary(std::string_view bytes, std::size_t* control_bytes, std::size_t* looked_at) {
   const std::size_t n = std::min<std::size_t>(bytes.size(), 8 * 1024);
+  // A table lookup per byte: the comparisons chain compiled to ~25 instructions a byte.
+  static constexpr auto is_control = [] {
+    std::array<std::uint8_t, 256> table{};
+    for (unsigned c = 0; c < 256; ++c) table[c] = (c < 0x20 || c == 0x7F) && c != '\t' && c != '\n' && c != '\r';
+    return table;
+  }();
   std::size_t control = 0;
   const auto* p = reinterpret_cast<const unsigned char*>(bytes.data());
-  for (std::size_t i = 0; i < n; ++i) {
-    const unsigned c = p[i];
-    control += (c < 0x20) + (c == 0x7F) - (c == '\t') - (c == '\n') - (c == '\r');
-  }
+  for (std::size_t i = 0; i < n; ++i) control += is_control[p[i]];
   if (control_bytes) *control_bytes = control;
   if (looked_at) *looked_at = n;
   return n > 0 && control * 10 > n;
