@@ -135,7 +135,9 @@ int run_explain(const ExplainCommandOptions& options) {
     }
     files.push_back(std::move(file));
   }
-  if (options.json) std::cout << explain_report_json(files).dump(2) << std::endl;
+  // replace: bytes that are not UTF-8 (a Latin-1 file name) never abort the output.
+  if (options.json)
+    std::cout << explain_report_json(files).dump(2, ' ', false, Json::error_handler_t::replace) << std::endl;
   if (!options.svg.empty()) {
     std::ofstream svg(options.svg, std::ios::binary | std::ios::trunc);
     if (svg) svg << explain_svg(files);

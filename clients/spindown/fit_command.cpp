@@ -166,7 +166,9 @@ int run_fit(const FitCommandOptions& options) {
     }
     if (options.json) files.push_back(std::move(file));
   }
-  if (options.json) std::cout << fit_report_json(files, plan.report).dump(2) << std::endl;
+  // replace: bytes that are not UTF-8 (a Latin-1 file name or config string) never abort the output.
+  if (options.json)
+    std::cout << fit_report_json(files, plan.report).dump(2, ' ', false, Json::error_handler_t::replace) << std::endl;
   return all_usable ? exit_ok : exit_unusable;
 }
 

@@ -346,7 +346,9 @@ int run_refit(const RefitCommandOptions& o) {
       std::cout.flush();
     }
   }
-  if (o.json && !o.compare) std::cout << Json{{"files", std::move(files)}}.dump(2) << std::endl;
+  // replace: bytes that are not UTF-8 (a config string in the log) never abort the output.
+  if (o.json && !o.compare)
+    std::cout << Json{{"files", std::move(files)}}.dump(2, ' ', false, Json::error_handler_t::replace) << std::endl;
   return ok ? exit_ok : exit_unusable;
 }
 

@@ -110,7 +110,7 @@ bool is_unit_word(std::string_view u) { return parse_time_unit(u) || parse_quant
 
 Column describe_column(std::string_view name) {
   Column c;
-  c.name = std::string(name);
+  c.name = text::escape_invalid_utf8(name);  // shown in messages, which must stay UTF-8
   std::string l = lower(name);
   const std::size_t open = l.find_first_of("([");
   if (open != std::string::npos) {

@@ -10,6 +10,7 @@
 #include "spindown/fit_message.hpp"
 #include "spindown/lcm_channels.hpp"
 #include "spindown/lcm_log_reader.hpp"
+#include "text_support.hpp"
 
 namespace spindown {
 
@@ -266,7 +267,7 @@ void FitterCore::on_config(std::string_view bench, const config_t& msg, std::int
   if (msg.bench != b->id) {
     ++counters_.bench_mismatch;
     error(fmt::format("SPINDOWN.{}.CONFIG: message names bench '{}'; the channel's bench is used", b->id,
-                      msg.bench.substr(0, 40)),
+                      text::escape_invalid_utf8(msg.bench.substr(0, 40))),
           recv_utime);
   }
   std::string why;
@@ -320,7 +321,8 @@ void FitterCore::on_samples(std::string_view bench, const samples_t& m, std::int
 
   if (m.bench != b.id) {
     ++counters_.bench_mismatch;
-    error(fmt::format("{}: message names bench '{}'; the channel's bench is used", ch, m.bench.substr(0, 40)),
+    error(fmt::format("{}: message names bench '{}'; the channel's bench is used", ch,
+                      text::escape_invalid_utf8(m.bench.substr(0, 40))),
           recv_utime);
   }
   const auto q = quantity_from_samples_code(m.quantity);

@@ -122,7 +122,7 @@ std::optional<BenchParams> bench_params_from_config(const config_t& config, std:
   p.kb_source = config.kb_source.empty() ? "config" : config.kb_source;
   std::string bad;
   if (!p.is_valid(&bad)) {
-    if (why) *why = fmt::format("config of bench '{}': {}", config.bench, bad);
+    if (why) *why = fmt::format("config of bench '{}': {}", text::escape_invalid_utf8(config.bench), bad);
     return std::nullopt;
   }
   return p;
@@ -139,6 +139,11 @@ LcmLogReader::LcmLogReader(const std::string& path) : path_(path) {
   }
   if (S_ISDIR(st.st_mode)) {
     open_error_ = fmt::format("cannot read {}: it is a directory", path);
+    return;
+  }
+  // lcm::LogFile seeks and fopen() would wait forever on a FIFO without a writer.
+  if (!S_ISREG(st.st_mode)) {
+    open_error_ = fmt::format("cannot read {} as an LCM log: not a regular file (a pipe, FIFO or device)", path);
     return;
   }
   size_ = static_cast<std::int64_t>(st.st_size);

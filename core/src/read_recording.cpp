@@ -1,5 +1,6 @@
 #include "spindown/read_recording.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <fcntl.h>
@@ -47,19 +48,30 @@ bool ReadOptions::is_valid(std::string* why) const {
   return true;
 }
 
-std::optional<std::string> read_file_bytes(const std::string& path, std::string* why, std::size_t max_bytes) {
+namespace {
+
+// Opens path for reading without blocking on a FIFO that has no writer yet (which would hang
+// forever), then makes reads blocking again so a pipe with a slow writer is read to its end.
+// A FIFO without a writer then reads as empty.
+int open_for_reading(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd < 0) return fd;
+  const int flags = ::fcntl(fd, F_GETFL);
+  if (flags >= 0) ::fcntl(fd, F_SETFL, flags & ~O_NONBLOCK);
+  return fd;
+}
+
+struct FdCloser {
+  int fd;
+  ~FdCloser() { ::close(fd); }
+};
+
+std::optional<std::string> read_fd_bytes(int fd, const struct stat& st, const std::string& path, std::string* why,
+                                         std::size_t max_bytes) {
   auto fail = [&](std::string msg) -> std::optional<std::string> {
     if (why) *why = std::move(msg);
     return std::nullopt;
   };
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) return fail(fmt::format("cannot open {}: {}", path, std::strerror(errno)));
-  struct Closer {
-    int fd;
-    ~Closer() { ::close(fd); }
-  } closer{fd};
-  struct stat st {};
-  if (::fstat(fd, &st) != 0) return fail(fmt::format("cannot read {}: {}", path, std::strerror(errno)));
   if (S_ISDIR(st.st_mode)) return fail(fmt::format("cannot read {}: it is a directory", path));
   if (S_ISREG(st.st_mode) && static_cast<std::size_t>(st.st_size) > max_bytes)
     return fail(fmt::format("cannot read {}: {} bytes is more than the {} bytes a text recording may have", path,
@@ -84,6 +96,23 @@ std::optional<std::string> read_file_bytes(const std::string& path, std::string*
   }
   bytes.resize(have);
   return bytes;
+}
+
+}  // namespace
+
+std::optional<std::string> read_file_bytes(const std::string& path, std::string* why, std::size_t max_bytes) {
+  const int fd = open_for_reading(path);
+  if (fd < 0) {
+    if (why) *why = fmt::format("cannot open {}: {}", path, std::strerror(errno));
+    return std::nullopt;
+  }
+  FdCloser closer{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) {
+    if (why) *why = fmt::format("cannot read {}: {}", path, std::strerror(errno));
+    return std::nullopt;
+  }
+  return read_fd_bytes(fd, st, path, why, max_bytes);
 }
 
 FileFormat detect_format(std::string_view head, const ReadOptions& options) {
@@ -133,24 +162,41 @@ std::vector<Recording> read_recordings(const std::string& path, const ReadOption
     return out;
   }
 
-  // An LCM log is streamed, never loaded whole: look at its first word only.
+  // An LCM log is streamed, never loaded whole: look at its first word only. A pipe, FIFO or
+  // device can be read only once, so it is read whole here (an LCM log cannot come that way:
+  // lcm::LogFile seeks).
   char head[4] = {};
   std::size_t head_len = 0;
+  std::optional<std::string> stream_bytes;
   {
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    const int fd = open_for_reading(path);
     if (fd < 0) {
       add(failed(path, fmt::format("cannot open {}: {}", path, std::strerror(errno))), {});
       return out;
     }
+    FdCloser closer{fd};
     struct stat st {};
     if (::fstat(fd, &st) == 0 && S_ISDIR(st.st_mode)) {
-      ::close(fd);
       add(failed(path, fmt::format("cannot read {}: it is a directory", path)), {});
       return out;
     }
-    const ssize_t n = ::read(fd, head, sizeof head);
-    ::close(fd);
-    head_len = n > 0 ? static_cast<std::size_t>(n) : 0;
+    if (!S_ISREG(st.st_mode)) {
+      stream_bytes = read_fd_bytes(fd, st, path, &why, std::size_t{1} << 30);
+      if (!stream_bytes) {
+        add(failed(path, why), {});
+        return out;
+      }
+      if (detect_format(*stream_bytes, options) == FileFormat::lcm_log || options.format == FileFormat::lcm_log) {
+        add(failed(path, fmt::format("cannot read {} as an LCM log: it is a pipe or device, and lcm::LogFile needs a "
+                                     "regular file",
+                                     path)),
+            {});
+        return out;
+      }
+    } else {
+      const ssize_t n = ::read(fd, head, sizeof head);
+      head_len = n > 0 ? static_cast<std::size_t>(n) : 0;
+    }
   }
 
   if (detect_format(std::string_view(head, head_len), options) == FileFormat::lcm_log ||
@@ -181,7 +227,7 @@ std::vector<Recording> read_recordings(const std::string& path, const ReadOption
     return out;
   }
 
-  auto bytes = read_file_bytes(path, &why);
+  auto bytes = stream_bytes ? std::move(stream_bytes) : read_file_bytes(path, &why);
   if (!bytes) {
     add(failed(path, why), {});
     return out;

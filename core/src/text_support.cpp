@@ -102,7 +102,7 @@ std::string putty_header_note(std::string_view line) {
   if (at != std::string_view::npos) {
     std::string_view when = line.substr(at + tag.size());
     when = when.substr(0, std::min(when.find(" ="), std::size_t{40}));
-    return fmt::format("PuTTY log header skipped (log started {})", when);
+    return fmt::format("PuTTY log header skipped (log started {})", escape_invalid_utf8(when));
   }
   return fmt::format("PuTTY log header skipped: {}", quote_line(line));
 }
