@@ -263,3 +263,23 @@ TEST(Fit, ModelNamesRoundTrip) {
   for (ModelKind k : all_models) EXPECT_EQ(parse_model(model_name(k)), k);
   EXPECT_FALSE(parse_model("stribeck").has_value());
 }
+
+// Whole-millisecond clocks let the fit build e^(−ατ) from a few distinct time steps; a clock
+// with jitter in every step takes one exponential per sample. Both must give the same fit.
+TEST(Fit, FewDistinctTimeStepsAndJitteredStepsGiveTheSameFit) {
+  SyntheticRunSpec spec;
+  spec.noise_v = 0.004;
+  const Case whole_ms = make_case(spec);
+  Case jittered = whole_ms;
+  for (std::size_t i = 0; i < jittered.t.size(); ++i) jittered.t[i] += 1e-9 * static_cast<double>((i * 7919) % 101);
+  const RunFit a = fit_case(whole_ms), b = fit_case(jittered);
+  ASSERT_EQ(a.models.size(), b.models.size());
+  for (std::size_t k = 0; k < a.models.size(); ++k) {
+    ASSERT_TRUE(a.models[k].converged && b.models[k].converged) << model_name(a.models[k].kind);
+    for (std::size_t j = 0; j < a.models[k].params.size(); ++j) {
+      const Parameter &pa = a.models[k].params[j], &pb = b.models[k].params[j];
+      EXPECT_NEAR(pa.value, pb.value, 1e-3 * pa.std_error) << model_name(a.models[k].kind) << " " << pa.name;
+      EXPECT_NEAR(pa.std_error, pb.std_error, 1e-3 * pa.std_error) << model_name(a.models[k].kind) << " " << pa.name;
+    }
+  }
+}

@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <exception>
 #include <fmt/format.h>
 #include <limits>
@@ -90,6 +91,7 @@ class Evaluator {
   Evaluator(std::span<const double> tau, std::span<const double> y)
       : tau_(tau), y_(y), tail_sq_(tau.size() + 1, 0.0), sorted_(std::is_sorted(tau.begin(), tau.end())) {
     for (std::size_t i = tau.size(); i-- > 0;) tail_sq_[i] = tail_sq_[i + 1] + y[i] * y[i];
+    index_time_steps();
     const auto n = static_cast<Eigen::Index>(tau.size());
     e_.resize(n);
     moving_.resize(n);
@@ -124,7 +126,7 @@ class Evaluator {
       // With c = β/α the model is (u0 + c)·e − c: no division per sample. Its α-derivative,
       // −(u0 + c)·τ·e + (c/α)·(1 − e), loses only ~ε·βτ/α to cancellation where ατ is small.
       const double c = th.beta / th.alpha;
-      e = (-th.alpha * t).exp();
+      decay(th.alpha, m_);
       r = (th.u0 + c) * e - c;
       moving = (r > 0).cast<double>();
       r = y - r.max(0.0);
@@ -180,6 +182,43 @@ class Evaluator {
   auto jacobian(int p) const { return g_.topLeftCorner(m_, p); }
 
  private:
+  // e_i = exp(−α·τ_i) for the first m samples. A device clock ticks in whole units, so the
+  // steps τ_i − τ_(i−1) take a handful of values: then e_i = e_(i−1)·exp(−α·Δ) needs one
+  // exponential per distinct step instead of one per sample. Exact anchors every
+  // anchor_every samples keep the product's rounding drift below 10⁻¹³.
+  void decay(double alpha, Eigen::Index m) {
+    if (step_code_.empty() || m < 2 * anchor_every) {
+      e_.head(m) = (-alpha * Eigen::Map<const Eigen::ArrayXd>(tau_.data(), m)).exp();
+      return;
+    }
+    for (std::size_t d = 0; d < steps_.size(); ++d) step_factor_[d] = std::exp(-alpha * steps_[d]);
+    for (Eigen::Index i = 0; i < m; ++i)
+      e_[i] = i % anchor_every == 0 ? std::exp(-alpha * tau_[i]) : e_[i - 1] * step_factor_[step_code_[i]];
+  }
+
+  void index_time_steps() {
+    constexpr std::size_t max_steps = 32;
+    if (!sorted_ || tau_.size() < 2) return;
+    std::vector<std::uint8_t> code(tau_.size(), 0);
+    for (std::size_t i = 1; i < tau_.size(); ++i) {
+      const double step = tau_[i] - tau_[i - 1];
+      auto it = std::find(steps_.begin(), steps_.end(), step);
+      if (it == steps_.end()) {
+        if (steps_.size() == max_steps) {  // jittered clock: one exponential per sample
+          steps_.clear();
+          return;
+        }
+        it = steps_.insert(steps_.end(), step);
+      }
+      code[i] = static_cast<std::uint8_t>(it - steps_.begin());
+    }
+    step_code_ = std::move(code);
+    step_factor_.resize(steps_.size());
+  }
+  static constexpr Eigen::Index anchor_every = 64;
+  std::vector<double> steps_, step_factor_;
+  std::vector<std::uint8_t> step_code_;
+
   std::span<const double> tau_, y_;
   std::vector<double> tail_sq_;
   bool sorted_;
