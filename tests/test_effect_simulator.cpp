@@ -43,10 +43,55 @@ TEST(EffectSimulator, MatchesCoastSimulatorForEveryCombination) {
   expect_matches_coast({1.822e-7, 1.1389e-4}, w0, 0.02, 1e-6);               // closed form
   expect_matches_coast({1.2e-6, 0}, w0, 0.02, 1e-6);                        // viscous only
   expect_matches_coast({0, 1.1e-4}, w0, 0.05, 1e-6);                        // Coulomb only
-  expect_matches_coast({1.5e-7, 1e-4, 2e-4, 35}, w0, 0.02, 2e-3);           // Stribeck (RK4)
-  expect_matches_coast({8e-8, 1e-4, 0, 0, 7e-10}, w0, 0.02, 2e-3);          // windage (RK4)
-  expect_matches_coast({8e-8, 1e-4, 3e-4, 20, 7e-10}, w0, 0.05, 2e-3);      // all, 50 ms loop
-  expect_matches_coast({8e-8, 1e-4, 3e-4, 20, 7e-10}, w0, 0.010, 2e-3);     // all, 10 ms loop
+  expect_matches_coast({1.5e-7, 1e-4, 2e-4, 35}, w0, 0.02, 1e-5);           // Stribeck (ODE)
+  expect_matches_coast({8e-8, 1e-4, 0, 0, 7e-10}, w0, 0.02, 1e-5);          // windage (ODE)
+  expect_matches_coast({8e-8, 1e-4, 3e-4, 20, 7e-10}, w0, 0.05, 1e-5);      // all, 50 ms loop
+  expect_matches_coast({8e-8, 1e-4, 3e-4, 20, 7e-10}, w0, 0.010, 1e-5);     // all, 10 ms loop
+}
+
+// The adaptive ODE path against the closed form on the same physics (a windage term of 0 forces
+// the ODE path): speeds, the stop and the sensitivities, for coasts that stop and one that does not.
+TEST(EffectSimulator, OdePathMatchesTheClosedForm) {
+  const EffectSimulator closed({find_effect("viscous"), find_effect("coulomb")}, 1.0);
+  const EffectSimulator ode({find_effect("viscous"), find_effect("coulomb"), find_effect("windage")}, 1.0);
+  ASSERT_TRUE(closed.closed_form());
+  ASSERT_FALSE(ode.closed_form());
+  const auto tau = grid(0.02, 45.0);
+  const std::size_t n = tau.size();
+  for (const auto& p : std::vector<std::vector<double>>{{346, 0.016, 10.1}, {346, 0.1, 0}, {300, 0, 9}, {300, 0.04, 3}}) {
+    std::vector<double> a(n), b(n), ja(n * 3), jb(n * 4);
+    closed.simulate(p, tau, a, ja);
+    const std::vector<double> p_ode{p[0], p[1], p[2], 0.0};
+    ode.simulate(p_ode, tau, b, jb);
+    const double ts = closed.stop_time(p);
+    for (std::size_t i = 0; i < n; ++i) {
+      ASSERT_NEAR(b[i], a[i], 1e-7) << "w0 " << p[0] << " τ=" << tau[i];
+      if (std::abs(tau[i] - ts) < 1e-3) continue;  // the kink at the stop
+      for (int j = 0; j < 3; ++j)
+        ASSERT_NEAR(jb[i * 4 + j], ja[i * 3 + j], 1e-6 * (std::abs(ja[i * 3 + j]) + 1e-3)) << "param " << j << " τ=" << tau[i];
+    }
+  }
+}
+
+// The samples are read from the integrator's dense output: the same instant gives the same
+// speed whatever the sampling grid around it (10 ms, 50 ms, a single sample).
+TEST(EffectSimulator, SpeedAtAnInstantDoesNotDependOnTheSampleGrid) {
+  const EffectSimulator sim({find_effect("viscous"), find_effect("coulomb"), find_effect("stribeck"),
+                             find_effect("windage")},
+                            1.0);
+  const std::vector<double> th{346, 0.007, 8.9, 17.7, 20, 6.2e-5};
+  const double ts = sim.stop_time(th);
+  ASSERT_TRUE(std::isfinite(ts));
+  for (double at : {0.5, 7.25, 0.5 * ts, ts - 0.3, ts - 0.01}) {
+    std::vector<double> fine = grid(0.01, at), coarse = grid(0.05, at);
+    fine.push_back(at);
+    coarse.push_back(at);
+    const double one = sim.omega(th, std::vector<double>{at})[0];
+    EXPECT_NEAR(sim.omega(th, fine).back(), one, 1e-7) << at;
+    EXPECT_NEAR(sim.omega(th, coarse).back(), one, 1e-7) << at;
+    EXPECT_GT(one, 0) << at;
+  }
+  EXPECT_EQ(sim.omega(th, std::vector<double>{ts + 0.01})[0], 0.0);
 }
 
 TEST(EffectSimulator, StaysStoppedAndAddsTheSensorOffset) {
@@ -100,7 +145,7 @@ TEST(EffectSimulator, SensitivitiesMatchFiniteDifferences) {
         if (std::abs(tau[i] - ts) < 0.1) continue;  // the kink at the stop
         const double num = (up[i] - dn[i]) / (2 * h);
         ASSERT_NEAR(jac[i * P + j], num, 1e-4 * (std::abs(num) + 1e-3))
-            << (closed ? "closed form" : "RK4") << " param " << j << " τ=" << tau[i];
+            << (closed ? "closed form" : "ODE") << " param " << j << " τ=" << tau[i];
       }
     }
   }

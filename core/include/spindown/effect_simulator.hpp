@@ -40,7 +40,10 @@ class EffectSimulator {
   double rate(std::span<const double> theta, double omega) const;
   double stop_time(std::span<const double> theta) const;
 
-  double max_step_s = 0.025;  // RK4 sub-step limit (the sample grid is used when finer)
+  // Integrator: absolute error per step in ω, as a fraction of ω0 (readings' noise is
+  // absolute), and the largest step in seconds.
+  double tolerance = 1e-10;
+  double max_step_s = std::numeric_limits<double>::infinity();
 
  private:
   struct Deriv {
@@ -49,6 +52,9 @@ class EffectSimulator {
   };
   void eval(std::span<const double> theta, double omega, Deriv& d, bool with_params) const;
   double time_to_stop(std::span<const double> theta, double omega) const;
+  // The ODE path of simulate(): finish(i, ω, ∂ω/∂θ) for every sample i in order.
+  template <class Finish>
+  void integrate(std::span<const double> theta, std::span<const double> tau, bool want_jac, Finish& finish) const;
 
   std::vector<const Effect*> effects_;
   std::vector<int> first_;

@@ -43,7 +43,9 @@ struct Effect {
   std::vector<EffectParam> params;  // the first is a linear amplitude (used by starting regressions)
 
   // Torque effects: T/J (rad/s²) at ω ≥ 0 for internal parameters p; optional derivatives
-  // d(T/J)/dω and d(T/J)/dp_j (p.size() entries).
+  // d(T/J)/dω and d(T/J)/dp_j (p.size() entries). The simulator also evaluates it slightly
+  // below 0 inside the integration step that reaches the stop: the formula must continue
+  // smoothly there (finite, no kink at 0).
   double (*rate)(const double* p, double omega, double* d_omega, double* d_p) = nullptr;
   // Sensor effects: what is added to the reading (reading unit), with d/dp_j.
   double (*reading)(const double* p, double omega, double* d_p) = nullptr;
