@@ -1,0 +1,224 @@
+// monte_carlo: the accuracy study of issue 6. Generates RUNS runs of one bench and one friction
+// truth at the lab's noise and quantization (white noise, 1 % commutator ripple, 10-bit ADC on
+// 5 V, 2-decimal printing, 20 ms loop with jitter), fits each one as `spindown fit` does (read
+// the printed text, find the run, fit the three models; the combined model's c3 and c4 are
+// kept), and computes the Cramér–Rao bound for the same sampling and noise.
+//
+// Writes into OUT_DIR: the runs as printed (runNNNNN.txt) and index.tsv (for SciPy, with the
+// cut and the stop given for free), spindown.tsv (c3, c4 and their standard errors per run) and
+// crb.json (truth, effective noise, the bound). bench/monte_carlo.sh runs SciPy on the same
+// files and prints the comparison.
+//
+// The bound: parameters θ = (u0, a = c3/J, d = K_b·c4/J) of the reading u(τ) = (u0 + d/a)e^(−aτ)
+// − d/a (0 after the stop), with the cut time and the zero level known (a bound for estimators
+// that must find them too). Fisher information F = Σ ∇u ∇uᵀ / σ² over each run's own sample
+// times, averaged over runs. Quantization is treated as additive noise, measured rather than
+// assumed: the error e = printed reading − true reading over the coasts holds white noise, the
+// ADC step, the printing step (≈ σ_w² + Δ_adc²/12 + Δ_print²/12 when the noise dithers them) and
+// the commutator ripple, whose variance grows with the reading (ripple·u)²/2. So σ² is taken as
+// a function of the true reading, σ²(u) = α + β·u², by least squares of e² on u² over all runs,
+// and F = Σ ∇u ∇uᵀ / σ²(u). (The bound with one constant σ² = mean e² is reported beside it:
+// looser where the ripple is small, tighter where it is large.)
+//
+// usage: monte_carlo OUT_DIR [RUNS=500] [SEED=1] [TRUTH_JSON]
+//   TRUTH_JSON: a shared/data *.truth.json (c_v, c_c, e0, noise_v, ripple); default the lab's 3 V run.
+#include <Eigen/Dense>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fmt/format.h>
+#include <fstream>
+#include <iostream>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "spindown/arduino_text.hpp"
+#include "spindown/fit.hpp"
+#include "spindown/runs.hpp"
+#include "spindown/synthetic_run.hpp"
+
+namespace {
+
+using namespace spindown;
+
+struct Truth {
+  double c_v = 1.822e-7, c_c = 1.1389e-4, e0 = 2.8, noise_v = 0.004, ripple = 0.01;
+};
+
+// The true reading (V) τ seconds after the cut, and its gradient in (u0, a, d).
+struct Model {
+  double u0, a, d;
+  double value(double tau) const {
+    const double u = (u0 + d / a) * std::exp(-a * tau) - d / a;
+    return u > 0 ? u : 0.0;
+  }
+  Eigen::Vector3d gradient(double tau) const {
+    const double e = std::exp(-a * tau);
+    if ((u0 + d / a) * e - d / a <= 0) return Eigen::Vector3d::Zero();  // stopped: flat
+    return {e, -(d / (a * a)) * e - tau * (u0 + d / a) * e + d / (a * a), (e - 1) / a};
+  }
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2 || argc > 5) {
+    std::cerr << "usage: monte_carlo OUT_DIR [RUNS=500] [SEED=1] [TRUTH_JSON]\n";
+    return 2;
+  }
+  const std::filesystem::path dir = argv[1];
+  const long runs = argc > 2 ? std::strtol(argv[2], nullptr, 10) : 500;
+  const long seed = argc > 3 ? std::strtol(argv[3], nullptr, 10) : 1;
+  if (runs < 2 || runs > 100'000 || seed < 0) {
+    std::cerr << "monte_carlo: RUNS must be 2…100000 and SEED ≥ 0\n";
+    return 2;
+  }
+  Truth truth;
+  if (argc > 4) {
+    std::ifstream f(argv[4]);
+    try {
+      const auto j = nlohmann::json::parse(f);
+      truth.c_v = j.at("c_v");
+      truth.c_c = j.at("c_c");
+      truth.e0 = j.at("e0");
+      truth.noise_v = j.value("noise_v", truth.noise_v);
+      truth.ripple = j.value("ripple", truth.ripple);
+    } catch (const std::exception& e) {
+      std::cerr << fmt::format("monte_carlo: {}: not a truth file with c_v, c_c, e0 ({})\n", argv[4], e.what());
+      return 2;
+    }
+  }
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) {
+    std::cerr << fmt::format("monte_carlo: cannot create {}: {}\n", dir.string(), ec.message());
+    return 1;
+  }
+
+  const BenchParams bench;  // the lab's J and K_b
+  const double J = bench.inertia_kg_m2, kb = bench.kb_v_s_per_rad;
+  const Model model{truth.e0, truth.c_v / J, kb * truth.c_c / J};
+  std::ofstream index(dir / "index.tsv"), ours(dir / "spindown.tsv");
+  index << "file\tt_cut_s\tt_stop_s\tJ\tKb\tc_v\tc_c\te0\tsamples\n";
+  ours << "file\tc3\tc4\tse3\tse4\n";
+
+  double sq_resid = 0;  // printed − true over the coasts
+  long n_resid = 0, fitted = 0, failed = 0;
+  double fit_seconds = 0;
+  // e² against u²: the sums of a straight-line fit e² = α + β·u².
+  double sx = 0, sy = 0, sxx = 0, sxy = 0;
+  std::vector<std::vector<double>> taus_per_run;  // the bound needs σ²(u), known only at the end
+  taus_per_run.reserve(static_cast<std::size_t>(runs));
+  for (long i = 0; i < runs; ++i) {
+    SyntheticRunSpec spec;
+    spec.friction = FrictionTerms{truth.c_v, truth.c_c};
+    spec.e0_v = truth.e0;
+    spec.noise_v = truth.noise_v;
+    spec.ripple = truth.ripple;
+    spec.lead_in_s = 1.0;
+    spec.tail_s = 2.0;
+    spec.seed = static_cast<std::uint64_t>(seed * 1'000'003 + i);
+    const SyntheticRun run = make_synthetic_run(spec);
+    const std::string name = fmt::format("run{:05d}.txt", i + 1);
+    const std::string text = to_arduino_text(run, 2, true);
+    std::ofstream(dir / name, std::ios::binary) << text;
+    index << fmt::format("{}\t{:.6f}\t{:.6f}\t{:.9g}\t{:.9g}\t{:.9g}\t{:.9g}\t{:.4f}\t{}\n", name,
+                         run.t_cut_ms / 1000.0, run.t_cut_ms / 1000.0 + run.t_stop_s, J, kb, truth.c_v, truth.c_c,
+                         truth.e0, run.t_ms.size());
+
+    // The bound's information over this run's sample times (printed millis are floored: +0.5 ms).
+    std::vector<double>& taus = taus_per_run.emplace_back();
+    for (std::size_t k = 0; k < run.t_ms.size(); ++k) {
+      const double tau = (run.t_ms[k] + 0.5 - run.t_cut_ms) / 1000.0;
+      if (tau < 0) continue;
+      taus.push_back(tau);
+      if (tau < run.t_stop_s) {
+        const double u = model.value(tau), r = run.volts[k] - u;
+        sq_resid += r * r;
+        ++n_resid;
+        sx += u * u;
+        sy += r * r;
+        sxx += u * u * u * u;
+        sxy += u * u * r * r;
+      }
+    }
+
+    // spindown, as `spindown fit` does it.
+    const auto t0 = std::chrono::steady_clock::now();
+    const Recording rec = read_arduino_text(text, name);
+    const Segmentation seg = find_runs(rec);
+    const FitOptions opt;
+    const ModelFit* combined = nullptr;
+    RunFit fit;
+    if (seg.runs.size() == 1) {
+      fit = fit_run(rec, seg.runs.front(), opt);
+      combined = fit.model(ModelKind::combined);
+    }
+    fit_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const Parameter* c3 = combined ? combined->param("c3") : nullptr;
+    const Parameter* c4 = combined ? combined->param("c4") : nullptr;
+    if (!combined || !combined->converged || !c3 || !c4) {
+      ++failed;
+      std::cerr << fmt::format("monte_carlo: {}: {} runs found, combined fit {}\n", name, seg.runs.size(),
+                               combined ? combined->message : "missing");
+      continue;
+    }
+    ++fitted;
+    ours << fmt::format("{}\t{:.9g}\t{:.9g}\t{:.9g}\t{:.9g}\n", name, c3->value, c4->value, c3->std_error,
+                        c4->std_error);
+  }
+
+  const double sigma2 = sq_resid / double(n_resid);
+  const double nr = double(n_resid);
+  const double beta = (nr * sxy - sx * sy) / (nr * sxx - sx * sx), alpha = (sy - beta * sx) / nr;
+  // The bound's variances of c3, c4 averaged over runs, for σ²(u) = α + β·u² and for constant σ².
+  double crb_var3 = 0, crb_var4 = 0, flat_var3 = 0, flat_var4 = 0;
+  for (const auto& taus : taus_per_run) {
+    Eigen::Matrix3d F = Eigen::Matrix3d::Zero(), F_flat = Eigen::Matrix3d::Zero();
+    for (double tau : taus) {
+      const Eigen::Vector3d g = model.gradient(tau);
+      const double u = model.value(tau);
+      F += g * g.transpose() / std::max(alpha + beta * u * u, 1e-12);
+      F_flat += g * g.transpose() / sigma2;
+    }
+    const Eigen::Matrix3d cov = F.inverse(), cov_flat = F_flat.inverse();
+    crb_var3 += J * J * cov(1, 1);
+    crb_var4 += (J / kb) * (J / kb) * cov(2, 2);
+    flat_var3 += J * J * cov_flat(1, 1);
+    flat_var4 += (J / kb) * (J / kb) * cov_flat(2, 2);
+  }
+  const double nruns = double(taus_per_run.size());
+  crb_var3 /= nruns;
+  crb_var4 /= nruns;
+  flat_var3 /= nruns;
+  flat_var4 /= nruns;
+  const double adc_step = 5.0 / 1024, print_step = 0.01;
+  const nlohmann::json out = {
+      {"runs", runs},
+      {"fitted", fitted},
+      {"failed", failed},
+      {"c_v", truth.c_v},
+      {"c_c", truth.c_c},
+      {"e0", truth.e0},
+      {"noise_v", truth.noise_v},
+      {"ripple", truth.ripple},
+      {"J", J},
+      {"Kb", kb},
+      {"sigma_eff_v", std::sqrt(sigma2)},
+      {"sigma_additive_model_v", std::sqrt(truth.noise_v * truth.noise_v + adc_step * adc_step / 12 +
+                                           print_step * print_step / 12)},
+      {"sigma2_alpha_v2", alpha},
+      {"sigma2_beta", beta},
+      {"sigma_at_zero_v", std::sqrt(std::max(alpha, 0.0))},
+      {"crb_sd_c3", std::sqrt(crb_var3)},
+      {"crb_sd_c4", std::sqrt(crb_var4)},
+      {"crb_flat_sd_c3", std::sqrt(flat_var3)},
+      {"crb_flat_sd_c4", std::sqrt(flat_var4)},
+      {"spindown_fit_ms_per_run", 1e3 * fit_seconds / double(runs)},
+  };
+  std::ofstream(dir / "crb.json") << out.dump(2) << '\n';
+  std::cout << out.dump(2) << '\n';
+  return failed == 0 ? 0 : 1;
+}

@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# The accuracy study of issue 6: RUNS (500) simulated lab runs at the lab's noise and
+# quantization (truth: shared/data/seed-3v-run1, combined friction), fitted by spindown
+# (bench/monte_carlo, as `spindown fit` does it) and by SciPy curve_fit of the lab's combined
+# curve on the same printed files (bench/scipy_lab_fits.py, cut and stop given for free), with
+# the Cramér–Rao bound for the same sampling and noise. Prints bias, spread, efficiency and the
+# calibration of the reported standard errors for c3 (c_v) and c4 (c_c).
+# Usage: bench/monte_carlo.sh [BIN_DIR]   (default build/bin; env RUNS=500 SEED=1 TRUTH=… KEEP=DIR)
+set -euo pipefail
+ROOT=$(cd "$(dirname "$0")/.." && pwd)
+BIN=${1:-${SPINDOWN_BIN_DIR:-$ROOT/build/bin}}
+RUNS=${RUNS:-500}
+SEED=${SEED:-1}
+DATA=${SPINDOWN_SHARED_DATA:-$ROOT/../shared/data}
+TRUTH=${TRUTH:-$DATA/seed-3v-run1.tsv.truth.json}
+[[ -x $BIN/monte_carlo ]] || { echo "missing $BIN/monte_carlo (build it first)" >&2; exit 2; }
+[[ -r $TRUTH ]] || { echo "no truth file $TRUTH (set TRUTH=… or SPINDOWN_SHARED_DATA)" >&2; exit 2; }
+if [[ -n ${KEEP:-} ]]; then WORK=$KEEP; mkdir -p "$WORK"; else
+  WORK=$(mktemp -d /tmp/spindown-mc.XXXXXX)
+  trap 'rm -rf "$WORK"' EXIT
+fi
+"$BIN/monte_carlo" "$WORK" "$RUNS" "$SEED" "$TRUTH" >/dev/null
+/usr/bin/python3 "$ROOT/bench/scipy_lab_fits.py" fit "$WORK" >"$WORK/scipy.tsv" 2>"$WORK/scipy.err" || true
+/usr/bin/python3 "$ROOT/bench/scipy_lab_fits.py" mc-summary "$WORK"
