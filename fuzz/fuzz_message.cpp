@@ -29,8 +29,12 @@ class CheckingSink : public FitterSink {
  public:
   void run_changed(const run_t& run) override { FUZZ_CHECK(!run.bench.empty()); }
   void fit_ready(const FitResult& r) override {
-    const fit_t msg = to_fit_message(r.fit, FitProvenance{r.bench, r.bench_source, r.first_seq, r.last_seq, 0},
-                                     now_us);
+    FitProvenance about;
+    about.bench = r.bench;
+    about.bench_source = r.bench_source;
+    about.first_seq = r.first_seq;
+    about.last_seq = r.last_seq;
+    const fit_t msg = to_fit_message(r.fit, about, now_us);
     std::vector<std::uint8_t> bytes(static_cast<std::size_t>(msg.getEncodedSize()));
     FUZZ_CHECK(msg.encode(bytes.data(), 0, static_cast<int>(bytes.size())) == static_cast<int>(bytes.size()));
     fit_t back;

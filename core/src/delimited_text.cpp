@@ -401,13 +401,13 @@ Recording read_delimited_text(std::string_view text, std::string source, const D
     if (!parse_number(fields[tcol], decimal_comma, t, w)) {
       ++bad;
       reporter.warn(line.number, fmt::format("{}: time '{}' is {}; skipped", text::quote_line(line.text),
-                                             fields[tcol].substr(0, 40), w));
+                                             text::escape_invalid_utf8(fields[tcol].substr(0, 40)), w));
       continue;
     }
     if (!parse_number(fields[vcol], decimal_comma, v, w)) {
       ++bad;
       reporter.warn(line.number, fmt::format("{}: value '{}' is {}; skipped", text::quote_line(line.text),
-                                             fields[vcol].substr(0, 40), w));
+                                             text::escape_invalid_utf8(fields[vcol].substr(0, 40)), w));
       continue;
     }
     raw.push_back({line.number, t, v, false, line.text});
@@ -460,33 +460,20 @@ Recording read_delimited_text(std::string_view text, std::string source, const D
     rec.error(0, fmt::format("no samples: {} lines, none with a usable time and value ({})", lines, columns));
     return rec;
   }
-  std::string summary = fmt::format("{} samples from {} lines; {}", rec.size(), lines, columns);
-  auto add = [&](std::size_t count, std::string_view what) {
-    if (count > 0) summary += fmt::format(", {} {}", count, what);
-  };
-  add(have_header ? 1 : 0, "header row");
-  add(headers, "PuTTY header");
-  add(comments, "comment");
-  add(blank, "blank");
-  add(bad, "unusable");
-  add(timeline.backwards, "time going back");
-  add(timeline.ahead, "time jumping ahead");
-  add(timeline.duplicates, "repeated time");
-  add(timeline.restarts, "clock restart");
-  rec.note(0, summary);
+  rec.note(0, text::summary_with_counts(fmt::format("{} samples from {} lines; {}", rec.size(), lines, columns),
+                                        {{have_header ? 1u : 0u, "header row"},
+                                         {headers, "PuTTY header"},
+                                         {comments, "comment"},
+                                         {blank, "blank"},
+                                         {bad, "unusable"}},
+                                        timeline));
   return rec;
 }
 
 Recording read_delimited_text_file(const std::string& path, const DelimitedTextOptions& options) {
-  std::string why;
-  auto bytes = read_file_bytes(path, &why);
-  if (!bytes) {
-    Recording rec;
-    rec.source = path;
-    rec.error(0, why);
-    return rec;
-  }
-  return read_delimited_text(*bytes, path, options);
+  return text::read_text_file(path, options, [](std::string_view bytes, const std::string& source, const auto& o) {
+    return read_delimited_text(bytes, source, o);
+  });
 }
 
 }  // namespace spindown

@@ -188,6 +188,19 @@ constexpr WireField fit_fields[] = {
     {"model_message", Wire::string, 11}, // 36
     {"first_seq", Wire::i64},            // 37
     {"last_seq", Wire::i64},             // 38
+    {"health_reference", Wire::boolean}, // 39
+    {"nfindings", Wire::i32},            // 40
+    {"finding_what", Wire::string, 40},  // 41
+    {"finding_level", Wire::string, 40}, // 42
+    {"finding_reason", Wire::string, 40},           // 43
+    {"finding_value", Wire::f64, 40},               // 44
+    {"finding_stderr", Wire::f64, 40},              // 45
+    {"finding_reference", Wire::f64, 40},           // 46
+    {"finding_reference_stderr", Wire::f64, 40},    // 47
+    {"finding_reference_name", Wire::string, 40},   // 48
+    {"finding_ratio", Wire::f64, 40},               // 49
+    {"finding_ratio_stderr", Wire::f64, 40},        // 50
+    {"finding_unit", Wire::string, 40},             // 51
 };
 
 constexpr WireField explain_fields[] = {

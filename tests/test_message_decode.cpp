@@ -1,0 +1,248 @@
+// decode_message: what the generated decoders accept, without their unbounded allocations.
+// The layouts in message_decode.cpp are checked against lcm-gen's encoder for every type, so a
+// field added to a .lcm file without a layout update fails here.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "spindown/message_decode.hpp"
+
+namespace spindown {
+namespace {
+
+template <class Msg>
+std::vector<std::uint8_t> encode(const Msg& m) {
+  std::vector<std::uint8_t> b(static_cast<std::size_t>(m.getEncodedSize()));
+  EXPECT_EQ(m.encode(b.data(), 0, static_cast<int>(b.size())), static_cast<int>(b.size()));
+  return b;
+}
+
+void put_be32(std::vector<std::uint8_t>& b, std::size_t at, std::int32_t v) {
+  const auto u = static_cast<std::uint32_t>(v);
+  b[at] = std::uint8_t(u >> 24);
+  b[at + 1] = std::uint8_t(u >> 16);
+  b[at + 2] = std::uint8_t(u >> 8);
+  b[at + 3] = std::uint8_t(u);
+}
+
+// Every field non-empty, every array with distinct lengths, so a layout error shifts bytes.
+samples_t make_samples() {
+  samples_t s;
+  s.utime = 1;
+  s.bench = "bench-a";
+  s.seq = 7;
+  s.clock_epoch = 2;
+  s.quantity = samples_t::QUANTITY_RPM;
+  s.n = 3;
+  s.device_time_us = {1, 2, 3};
+  s.host_time_us = {4, 5, 6};
+  s.value = {1.5, 2.5, 3.5};
+  s.raw_adc = {-1, -1, 7};
+  return s;
+}
+config_t make_config() {
+  config_t c;
+  c.bench = "b";
+  c.inertia_kg_m2 = 1e-5;
+  c.inertia_source = "lab default";
+  c.kb_v_s_per_rad = 0.008;
+  c.kb_source = "x";
+  c.quantity = 1;
+  c.adc_bits = 10;
+  c.firmware = "fw";
+  c.protocol = "lab-tsv";
+  c.baud = 9600;
+  c.device = "/dev/ttyACM0";
+  c.host = "h";
+  return c;
+}
+run_t make_run() {
+  run_t r;
+  r.bench = "b";
+  r.run = 3;
+  r.state = run_t::STATE_STOPPED;
+  r.t_cut_s = 1;
+  r.t_stop_s = NAN;
+  r.samples = 9;
+  r.note = "note";
+  return r;
+}
+fit_t make_fit() {
+  fit_t f;
+  f.bench = "bench-a";
+  f.residual_unit = "V";
+  f.bench_source = "config";
+  f.nmodels = 2;
+  f.model = {"viscous", "combined"};
+  f.rmse = {1, 2};
+  f.r2 = {1, 2};
+  f.aic = {1, 2};
+  f.bic = {1, 2};
+  f.t_stop_pred_s = {INFINITY, 2};
+  f.converged = {1, 0};
+  f.model_samples = {10, 11};
+  f.model_message = {"", "did not converge"};
+  f.nparams = 3;
+  f.param_model = {0, 1, 1};
+  f.param_name = {"c4", "c3", "c4"};
+  f.param_value = {1, 2, 3};
+  f.param_stderr = {0.1, 0.2, 0.3};
+  f.param_unit = {"a", "b", "c"};
+  f.best = "viscous";
+  f.best_reason = "r";
+  f.verdict = "ok";
+  f.verdict_reason = "v";
+  f.inertia_source = "i";
+  f.kb_source = "k";
+  f.lead_in = "zeros";
+  f.first_seq = 1;
+  f.last_seq = 2;
+  f.health_reference = 1;
+  f.nfindings = 2;
+  f.finding_what = {"dry friction", "time to stop"};
+  f.finding_level = {"ok", "check"};
+  f.finding_reason = {"r1", "r2"};
+  f.finding_value = {1, 2};
+  f.finding_stderr = {1, 2};
+  f.finding_reference = {1, 2};
+  f.finding_reference_stderr = {1, 2};
+  f.finding_reference_name = {"baseline", "lab limit"};
+  f.finding_ratio = {1, 2};
+  f.finding_ratio_stderr = {1, 2};
+  f.finding_unit = {"N*m", "s"};
+  return f;
+}
+explain_t make_explain() {
+  explain_t e;
+  e.bench = "b";
+  e.nbase = 1;
+  e.base = {"viscous"};
+  e.nsteps = 2;
+  e.step_added = {"coulomb", "windage"};
+  e.step_rmse_before = {3, 2};
+  e.step_rmse_after = {2, 1};
+  e.step_why = {"w1", "w2"};
+  e.nwhere = 3;
+  e.where_step = {0, 0, 1};
+  e.where_t_from_s = {0, 1, 2};
+  e.where_t_to_s = {1, 2, 3};
+  e.where_mean_residual = {0.1, 0.2, 0.3};
+  e.nfinal = 3;
+  e.final_effects = {"viscous", "coulomb", "windage"};
+  e.nparams = 4;
+  e.param_name = {"c1", "c2", "c3", "c4"};
+  e.param_value = {1, 2, 3, 4};
+  e.param_stderr = {1, 2, 3, 4};
+  e.param_unit = {"u", "u", "u", "u"};
+  e.story = "story";
+  return e;
+}
+status_t make_status() {
+  status_t s;
+  s.service = "bridge";
+  s.instance = "bench-a";
+  s.host = "h";
+  s.pid = 1;
+  s.state = "connected";
+  s.ncounters = 2;
+  s.counter_name = {"lines_good", "lines_bad"};
+  s.counter_value = {10, 1};
+  s.ngauges = 1;
+  s.gauge_name = {"rate_hz"};
+  s.gauge_value = {50};
+  s.last_error = "e";
+  return s;
+}
+
+template <class Msg>
+void expect_layout_matches(const Msg& original) {
+  const auto bytes = encode(original);
+  Msg back;
+  std::string why;
+  ASSERT_TRUE(decode_message(back, bytes.data(), static_cast<std::int64_t>(bytes.size()), &why)) << why;
+  EXPECT_EQ(encode(back), bytes);
+  // Every proper prefix is refused with a reason, and so is every prefix the generated decoder
+  // refuses: the layout walk and lcm-gen's decoder agree byte for byte.
+  for (std::size_t cut = 0; cut < bytes.size(); ++cut) {
+    Msg m;
+    why.clear();
+    EXPECT_FALSE(decode_message(m, bytes.data(), static_cast<std::int64_t>(cut), &why)) << Msg::getTypeName() << " " << cut;
+    EXPECT_FALSE(why.empty());
+    EXPECT_LT(Msg().decode(bytes.data(), 0, static_cast<int>(cut)), 0) << Msg::getTypeName() << " " << cut;
+  }
+}
+
+TEST(MessageDecode, LayoutOfEveryTypeMatchesTheGeneratedEncoder) {
+  expect_layout_matches(make_samples());
+  expect_layout_matches(make_config());
+  expect_layout_matches(make_run());
+  expect_layout_matches(make_fit());
+  expect_layout_matches(make_explain());
+  expect_layout_matches(make_status());
+}
+
+TEST(MessageDecode, WrongFingerprintIsNamed) {
+  const auto bytes = encode(make_config());
+  samples_t m;
+  std::string why;
+  EXPECT_FALSE(decode_message(m, bytes.data(), static_cast<std::int64_t>(bytes.size()), &why));
+  EXPECT_NE(why.find("not a samples_t"), std::string::npos) << why;
+}
+
+// The fuzzer's first find: a count of 2^31 − 1 in a small message made lcm-gen's decoder
+// resize vectors to tens of gigabytes before noticing the bytes were not there.
+TEST(MessageDecode, HugeArrayCountIsRefusedBeforeAnyAllocation) {
+  auto bytes = encode(make_fit());
+  // nmodels follows utime, bench, run, t_cut_s, t_stop_s, samples, J, K_b, bench_source,
+  // zero_level, residual_unit.
+  const std::size_t at = 8 + 8 + (4 + 8) + 4 + 8 + 8 + 4 + 8 + 8 + (4 + 7) + 8 + (4 + 2);
+  std::int32_t was = 0;
+  for (int k = 0; k < 4; ++k) was = (was << 8) | bytes[at + k];
+  ASSERT_EQ(was, 2);
+  put_be32(bytes, at, 0x7fffffff);
+  fit_t m;
+  std::string why;
+  EXPECT_FALSE(decode_message(m, bytes.data(), static_cast<std::int64_t>(bytes.size()), &why));
+  EXPECT_NE(why.find("nmodels = 2147483647"), std::string::npos) << why;
+  put_be32(bytes, at, -5);
+  EXPECT_FALSE(decode_message(m, bytes.data(), static_cast<std::int64_t>(bytes.size()), &why));
+  EXPECT_NE(why.find("negative"), std::string::npos) << why;
+}
+
+// A string length of INT_MIN overflowed `len - 1` inside the generated header (UB); zero made
+// std::string::assign throw.
+TEST(MessageDecode, BadStringLengthsAreRefused) {
+  auto bytes = encode(make_run());
+  for (const std::int32_t len : {0, -1, std::int32_t(0x80000000u), 0x7fffffff}) {
+    put_be32(bytes, 16, len);  // bench's length word, after the fingerprint and utime
+    run_t m;
+    std::string why;
+    EXPECT_FALSE(decode_message(m, bytes.data(), static_cast<std::int64_t>(bytes.size()), &why)) << len;
+    EXPECT_NE(why.find("string bench has length"), std::string::npos) << why;
+  }
+}
+
+TEST(MessageDecode, SampleCountLargerThanTheArraysSentIsRefused) {
+  auto bytes = encode(make_samples());
+  const std::size_t n_at = 8 + 8 + (4 + 8) + 8 + 4 + 1;
+  put_be32(bytes, n_at, 4);  // says 4 samples, carries 3
+  samples_t m;
+  std::string why;
+  EXPECT_FALSE(decode_message(m, bytes.data(), static_cast<std::int64_t>(bytes.size()), &why));
+  EXPECT_NE(why.find("n = 4"), std::string::npos) << why;
+}
+
+TEST(MessageDecode, NoDataOrTooMuchIsRefused) {
+  status_t m;
+  std::string why;
+  EXPECT_FALSE(decode_message(m, nullptr, 0, &why));
+  EXPECT_FALSE(decode_message(m, "x", std::int64_t{1} << 32, &why));
+  EXPECT_NE(why.find("more than an LCM message"), std::string::npos) << why;
+}
+
+}  // namespace
+}  // namespace spindown
