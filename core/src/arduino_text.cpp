@@ -126,34 +126,19 @@ Recording read_arduino_text(std::string_view text, std::string source, const Ard
                                blank, headers + column_headers, raw.size()));
     return rec;
   }
-  std::string summary = fmt::format("{} samples from {} lines", rec.size(), lines);
-  auto add = [&](std::size_t count, std::string_view what) {
-    if (count > 0) summary += fmt::format(", {} {}", count, what);
-  };
-  add(headers, "PuTTY header");
-  add(column_headers, "column header");
-  add(blank, "blank");
-  add(garbled, "garbled");
-  add(timeline.cut_first, "cut first line");
-  add(timeline.backwards, "time going back");
-  add(timeline.ahead, "time jumping ahead");
-  add(timeline.duplicates, "repeated time");
-  add(timeline.restarts, "clock restart");
-  add(timeline.wraps, "clock wrap");
-  rec.note(0, summary);
+  rec.note(0, text::summary_with_counts(fmt::format("{} samples from {} lines", rec.size(), lines),
+                                        {{headers, "PuTTY header"},
+                                         {column_headers, "column header"},
+                                         {blank, "blank"},
+                                         {garbled, "garbled"}},
+                                        timeline));
   return rec;
 }
 
 Recording read_arduino_text_file(const std::string& path, const ArduinoTextOptions& options) {
-  std::string why;
-  auto bytes = read_file_bytes(path, &why);
-  if (!bytes) {
-    Recording rec;
-    rec.source = path;
-    rec.error(0, why);
-    return rec;
-  }
-  return read_arduino_text(*bytes, path, options);
+  return text::read_text_file(path, options, [](std::string_view bytes, const std::string& source, const auto& o) {
+    return read_arduino_text(bytes, source, o);
+  });
 }
 
 }  // namespace spindown

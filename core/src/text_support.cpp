@@ -229,4 +229,18 @@ TimelineCounts build_timeline(const std::vector<RawSample>& raw, const TimelineR
   return counts;
 }
 
+std::string summary_with_counts(std::string head, std::initializer_list<Count> counts, const TimelineCounts& timeline) {
+  auto add = [&](std::size_t n, std::string_view what) {
+    if (n > 0) head += fmt::format(", {} {}", n, what);
+  };
+  for (const Count& c : counts) add(c.n, c.what);
+  add(timeline.cut_first, "cut first line");
+  add(timeline.backwards, "time going back");
+  add(timeline.ahead, "time jumping ahead");
+  add(timeline.duplicates, "repeated time");
+  add(timeline.restarts, "clock restart");
+  add(timeline.wraps, "clock wrap");
+  return head;
+}
+
 }  // namespace spindown::text

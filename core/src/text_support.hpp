@@ -7,10 +7,12 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <initializer_list>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "spindown/read_recording.hpp"
 #include "spindown/recording.hpp"
 
 namespace spindown::text {
@@ -108,5 +110,27 @@ struct TimelineCounts {
 // about every sample it did not use and every wrap, restart and gap.
 TimelineCounts build_timeline(const std::vector<RawSample>& raw, const TimelineRules& rules,
                               Recording& rec, LineReporter& reporter);
+
+// A reader's summary: head, then ", N what" for every count that is not zero, in order, then
+// the timeline's (cut first line, time going back, …, clock wrap).
+struct Count {
+  std::size_t n;
+  std::string_view what;
+};
+std::string summary_with_counts(std::string head, std::initializer_list<Count> counts, const TimelineCounts& timeline);
+
+// A reader's *_file variant: the file's bytes, or a Recording holding why they could not be read.
+template <class Options, class Reader>
+Recording read_text_file(const std::string& path, const Options& options, Reader&& read) {
+  std::string why;
+  auto bytes = read_file_bytes(path, &why);
+  if (!bytes) {
+    Recording rec;
+    rec.source = path;
+    rec.error(0, why);
+    return rec;
+  }
+  return read(*bytes, path, options);
+}
 
 }  // namespace spindown::text
