@@ -10,6 +10,7 @@
 #include "refit_command.hpp"
 #include "export_command.hpp"
 #include "watch_command.hpp"
+#include "report_command.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"spindown: fit friction models to DC-motor spin-down recordings"};
@@ -19,6 +20,7 @@ int main(int argc, char** argv) {
   spindown::cli::setup_refit(app);
   spindown::cli::setup_export(app);
   spindown::cli::setup_watch(app);
+  spindown::cli::setup_report(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {  // a subcommand finished with a non-zero exit code

@@ -8,10 +8,12 @@
 #include <map>
 #include <memory>
 #include <regex>
+#include <unistd.h>
 
 #include "exit_codes.hpp"
 #include "spindown/bench.hpp"
 #include "spindown/fit_message.hpp"
+#include "spindown/progress.hpp"
 
 namespace spindown::cli {
 
@@ -99,7 +101,7 @@ std::string run_key(const std::string& bench, int run) { return fmt::format("{}#
 }  // namespace
 
 LogRefit refit_log(const std::string& path, const FitterOptions& options, bool keep_live_fits,
-                   const std::function<void(const LcmLogEvent&)>& each_event) {
+                   const std::function<void(const LcmLogEvent&)>& each_event, const RefitProgressFn& progress) {
   LogRefit out;
   out.file.file = path;
   LcmLogReader reader(path);
@@ -113,8 +115,10 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
   std::int64_t last_utime = 0;
   std::size_t file_problems = 0;
   LcmLogEvent ev;
+  std::size_t events_seen = 0;
   while (reader.next(ev)) {
     if (each_event) each_event(ev);
+    if (progress && ++events_seen % 256 == 0) progress(ev.file_offset, reader.file_size(), out.runs.size());
     if (ev.number > 0) last_utime = ev.log_utime;
     if (!ev.bench.empty() && (ev.channel.ends_with(".SAMPLE") || ev.channel.ends_with(".CONFIG")) &&
         !order.contains(ev.bench)) {
@@ -217,6 +221,7 @@ void setup_refit(CLI::App& app) {
   sub->add_option("--models", opt->models, "Models to fit: viscous,coulomb,combined (default all)")->delimiter(',');
   sub->add_flag("--lab-units", opt->lab_units, "Also give the lab's units");
   sub->add_flag("-v,--verbose", opt->verbose, "Show every diagnostic, notes included");
+  sub->add_flag("--no-progress", opt->no_progress, "No progress line on a terminal (there is none when stderr is not one)");
   auto* live = sub->add_flag("--live", opt->live, "Print the FIT messages recorded in the log instead of refitting");
   sub->add_flag("--compare", opt->compare,
                 "Refit and compare with the recorded FIT messages, timing fields aside (exit 1 on a difference)")
@@ -253,8 +258,16 @@ int run_refit(const RefitCommandOptions& o) {
   report.diagnostics_in_text = false;
   bool ok = true;
   Json files = Json::array();
+  const bool show_progress = !o.no_progress && ProgressReporter::is_terminal(STDERR_FILENO);
   for (const auto& path : o.logs) {
-    LogRefit r = refit_log(path, fopt, o.live || o.compare);
+    // On a terminal only (never in pipes or files), throttled, erased before anything is printed.
+    ProgressReporter progress(STDERR_FILENO, show_progress);
+    LogRefit r = refit_log(path, fopt, o.live || o.compare, {},
+                           [&](std::int64_t done, std::int64_t total, std::size_t runs) {
+                             progress.update(done, total, fmt::format("refit: {}", path),
+                                             fmt::format("{} run{} fitted", runs, runs == 1 ? "" : "s"));
+                           });
+    progress.finish();
     // Problems on stderr, as `spindown fit` does.
     std::vector<Diagnostic> shown;
     for (const auto& d : r.file.diagnostics)

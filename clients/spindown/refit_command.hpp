@@ -41,8 +41,12 @@ struct LogRefit {
 
 // Streams one log through a FitterCore (each event in log order, its receive time from the
 // log). each_event, when given, sees every event first (export writes samples from it).
+// progress, when given, is told every few hundred events how far the read is (bytes of the
+// file) and how many runs have been fitted.
+using RefitProgressFn = std::function<void(std::int64_t bytes_done, std::int64_t bytes_total, std::size_t runs)>;
 LogRefit refit_log(const std::string& path, const FitterOptions& options, bool keep_live_fits,
-                   const std::function<void(const LcmLogEvent&)>& each_event = {});
+                   const std::function<void(const LcmLogEvent&)>& each_event = {},
+                   const RefitProgressFn& progress = {});
 
 // file_fit_json() with each run tagged as fit_message_json() tags a live FIT: bench.id,
 // first_seq, last_seq.
@@ -55,6 +59,7 @@ struct RefitCommandOptions {
   bool verbose = false;
   bool live = false;     // print the recorded FIT messages, not a refit
   bool compare = false;  // refit and compare with the recorded FIT messages (exit 1 on a difference)
+  bool no_progress = false;  // no progress line on a terminal
   std::string bench_regex = ".*";
   std::vector<std::string> models;
   double inertia_kg_m2 = 0, kb_v_s_per_rad = 0, speed_constant_rpm_per_v = 0;

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "spindown/fit_report.hpp"
+#include "spindown/svg_plot.hpp"
 
 namespace spindown {
 namespace {
@@ -177,102 +178,10 @@ std::string format_file_explain(const FileExplain& file) {
 
 namespace {
 
-// "Nice" axis ticks covering [lo, hi].
-std::vector<double> ticks(double lo, double hi, int target = 6) {
-  std::vector<double> out;
-  if (!(hi > lo)) return {lo};
-  const double raw = (hi - lo) / target;
-  const double mag = std::pow(10.0, std::floor(std::log10(raw)));
-  double step = mag;
-  for (double m : {1.0, 2.0, 2.5, 5.0, 10.0})
-    if (m * mag >= raw) {
-      step = m * mag;
-      break;
-    }
-  for (double t = std::ceil(lo / step) * step; t <= hi + 1e-9 * step && out.size() < 50; t += step)
-    out.push_back(std::abs(t) < 1e-12 * step ? 0.0 : t);
-  return out;
-}
-
-struct Panel {
-  double x, y, w, h;          // pixels
-  double x0, x1, y0, y1;      // data range
-  double px(double v) const { return x + (v - x0) / (x1 - x0) * w; }
-  double py(double v) const { return y + h - (v - y0) / (y1 - y0) * h; }
-};
-
-std::string polyline(const Panel& p, std::span<const double> xs, std::span<const double> ys, const char* style) {
-  std::string pts;
-  pts.reserve(xs.size() * 14);
-  for (std::size_t i = 0; i < xs.size(); ++i) {
-    if (!std::isfinite(ys[i])) continue;
-    pts += fmt::format("{:.1f},{:.1f} ", p.px(xs[i]), p.py(std::clamp(ys[i], p.y0, p.y1)));
-  }
-  return fmt::format("<polyline fill=\"none\" {} points=\"{}\"/>\n", style, pts);
-}
-
-std::string axes(const Panel& p, const std::string& xlabel, const std::string& ylabel) {
-  std::string s = fmt::format("<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"{:.1f}\" height=\"{:.1f}\" fill=\"none\" "
-                              "stroke=\"#444\"/>\n",
-                              p.x, p.y, p.w, p.h);
-  for (double t : ticks(p.x0, p.x1)) {
-    const double x = p.px(t);
-    s += fmt::format("<line x1=\"{0:.1f}\" y1=\"{1:.1f}\" x2=\"{0:.1f}\" y2=\"{2:.1f}\" stroke=\"#ddd\"/>\n", x, p.y,
-                     p.y + p.h);
-    s += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\">{:g}</text>\n", x, p.y + p.h + 16, t);
-  }
-  for (double t : ticks(p.y0, p.y1)) {
-    const double y = p.py(t);
-    s += fmt::format("<line x1=\"{0:.1f}\" y1=\"{1:.1f}\" x2=\"{2:.1f}\" y2=\"{1:.1f}\" stroke=\"#ddd\"/>\n", p.x, y,
-                     p.x + p.w);
-    s += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"end\">{:g}</text>\n", p.x - 6, y + 4, t);
-  }
-  s += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\" text-anchor=\"middle\">{}</text>\n", p.x + p.w / 2,
-                   p.y + p.h + 34, xlabel);
-  s += fmt::format("<text transform=\"translate({:.1f},{:.1f}) rotate(-90)\" text-anchor=\"middle\">{}</text>\n",
-                   p.x - 52, p.y + p.h / 2, ylabel);
-  return s;
-}
-
-std::string legend(double x, double y, const std::vector<std::pair<std::string, std::string>>& items) {
-  std::string s = fmt::format("<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"370\" height=\"{}\" fill=\"white\" "
-                              "fill-opacity=\"0.85\" stroke=\"#999\"/>\n",
-                              x, y, 8 + 18 * items.size());
-  for (std::size_t i = 0; i < items.size(); ++i) {
-    const double yy = y + 16 + 18.0 * static_cast<double>(i);
-    s += fmt::format("<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" {}/>\n", x + 8, yy - 4, x + 38,
-                     yy - 4, items[i].second);
-    s += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\">{}</text>\n", x + 46, yy, items[i].first);
-  }
-  return s;
-}
-
-std::string xml_escape(const std::string& in) {
-  std::string out;
-  for (char c : in) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
-    }
-  }
-  return out;
-}
-
-// Bin means of a residual, for a readable line through noisy points.
-void binned(std::span<const double> x, std::span<const double> r, std::size_t m, std::vector<double>& bx,
-            std::vector<double>& by) {
-  m = std::max<std::size_t>(m, 1);
-  for (std::size_t i = 0; i < x.size(); i += m) {
-    const std::size_t e = std::min(i + m, x.size());
-    double sx = 0, sy = 0;
-    for (std::size_t j = i; j < e; ++j) sx += x[j], sy += r[j];
-    bx.push_back(sx / static_cast<double>(e - i));
-    by.push_back(sy / static_cast<double>(e - i));
-  }
-}
+using svg::Panel;
+using svg::axes;
+using svg::legend;
+using svg::polyline;
 
 constexpr double fig_w = 960, fig_h = 700;
 
@@ -285,7 +194,7 @@ std::string run_figure(const std::string& file, const ExplainResult& r, double t
                                         r.run.number, r.base.label(), r.base.rmse, u, r.final_fit.label(),
                                         r.final_fit.rmse, u);
   s += fmt::format("<text x=\"{}\" y=\"{:.1f}\" text-anchor=\"middle\" font-size=\"15\" font-weight=\"bold\">{}</text>\n",
-                   fig_w / 2, top + 22, xml_escape(title));
+                   fig_w / 2, top + 22, svg::escape(title));
   if (n == 0 || !r.ok) return s;
   double ymin = 0, ymax = 0;
   for (double v : r.y) ymin = std::min(ymin, v), ymax = std::max(ymax, v);
@@ -298,8 +207,8 @@ std::string run_figure(const std::string& file, const ExplainResult& r, double t
     rf[i] = r.y[i] - r.final_fit.simulated[i];
   }
   std::vector<double> bx, bb, fx, fb;
-  binned(r.tau, rb, r.bin_samples, bx, bb);
-  binned(r.tau, rf, r.bin_samples, fx, fb);
+  svg::bin_means(r.tau, rb, r.bin_samples, bx, bb);
+  svg::bin_means(r.tau, rf, r.bin_samples, fx, fb);
   for (double v : bb) rmax = std::max(rmax, std::abs(v));
   for (double v : rf) rmax = std::max(rmax, std::abs(v));
   rmax *= 1.1;
@@ -308,9 +217,7 @@ std::string run_figure(const std::string& file, const ExplainResult& r, double t
   // Top: measurement, base and final simulations.
   s += axes(top_p, "time after the cut (s)", fmt::format("reading ({})", u));
   const std::size_t stride = std::max<std::size_t>(1, n / 2500);
-  for (std::size_t i = 0; i < n; i += stride)
-    s += fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"1.6\" fill=\"#777\"/>\n", top_p.px(r.tau[i]),
-                     top_p.py(r.y[i]));
+  s += svg::dots(top_p, r.tau, r.y, stride, 1.6, "#777");
   const char* base_style = "stroke=\"#d62728\" stroke-width=\"2\" stroke-dasharray=\"7,4\"";
   const char* final_style = "stroke=\"#1f77b4\" stroke-width=\"2\"";
   s += polyline(top_p, r.tau, r.base.simulated, base_style);
@@ -330,9 +237,7 @@ std::string run_figure(const std::string& file, const ExplainResult& r, double t
                        bot_p.h);
     }
   s += axes(bot_p, "time after the cut (s)", fmt::format("measurement - model ({})", u));
-  for (std::size_t i = 0; i < n; i += stride)
-    s += fmt::format("<circle cx=\"{:.1f}\" cy=\"{:.1f}\" r=\"1.2\" fill=\"#9ecae1\"/>\n", bot_p.px(r.tau[i]),
-                     bot_p.py(std::clamp(rf[i], -rmax, rmax)));
+  s += svg::dots(bot_p, r.tau, rf, stride, 1.2, "#9ecae1");
   s += polyline(bot_p, bx, bb, "stroke=\"#d62728\" stroke-width=\"2\"");
   s += polyline(bot_p, fx, fb, "stroke=\"#1f77b4\" stroke-width=\"2\"");
   s += legend(bot_p.x + bot_p.w - 380, bot_p.y + 8,

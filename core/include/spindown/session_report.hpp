@@ -1,0 +1,150 @@
+#pragma once
+// One lab session's results gathered for a report: every input file read (Arduino/PuTTY text,
+// delimited text, LCM logs with one recording per bench), every run fitted with each model,
+// explained (design §6) and judged for motor health; runs grouped by bench in time order, and
+// per bench the drift of the friction coefficients (combined model's c_v, c_c) over its runs
+// with a trend and its uncertainty. html_report.hpp renders it; building it never throws for
+// bad input (problems become diagnostics and failures, and the rest is still used).
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "spindown/bench.hpp"
+#include "spindown/explain.hpp"
+#include "spindown/fit.hpp"
+#include "spindown/motor_health.hpp"
+#include "spindown/read_recording.hpp"
+#include "spindown/recording.hpp"
+#include "spindown/runs.hpp"
+
+namespace spindown {
+
+// What one bench's TOML file (--bench-config) says that a report uses.
+struct BenchReference {
+  std::string file;
+  MotorHealthConfig health;           // datasheet / baseline / thresholds
+  std::optional<BenchParams> params;  // J, K_b when its [bench] section sets them
+};
+
+// Reads bench_id, [bench] (J, K_b) and [motor]/[baseline]/[health]. Throws std::runtime_error
+// naming the file, the key and what was wrong.
+std::pair<std::string, BenchReference> load_bench_reference(const std::string& toml_path);
+
+struct SessionReportOptions {
+  ReadOptions read;
+  FitOptions fit;               // models and the default bench (lab defaults or the command line's)
+  ExplainOptions explain;       // base model and workflow settings (bench set per run)
+  bool explain_runs = true;
+  bool bench_from_user = false; // J/K_b from the command line: never from a log's CONFIG or a bench file
+  std::string text_bench;       // bench id for text files; empty: the file name without its extension
+  std::map<std::string, BenchReference, std::less<>> references;  // by bench id
+  std::size_t max_diagnostics_per_file = 200;  // kept per file; the rest are counted
+};
+
+struct ReportRun {
+  std::string bench;
+  std::size_t file_index = 0;     // into SessionReport::files
+  std::string source;             // the recording (file, or "FILE SPINDOWN.<bench>.SAMPLE")
+  RunFit fit;
+  bool explained = false;
+  ExplainResult explain;          // when explained
+  std::vector<double> tau, y;     // the fitted samples: seconds after the cut, raw reading
+  HealthVerdict health;
+  std::string health_config;      // the bench file the verdict used; "" = no reference configured
+  std::optional<double> cut_unix_s;  // wall-clock time of the cut when the file tells it
+  int order = 0;                  // 1-based position among its bench's runs (time order)
+};
+
+struct ReportFile {
+  std::string file;
+  FileFormat format = FileFormat::automatic;
+  std::uintmax_t bytes = 0;
+  std::size_t samples = 0;
+  std::vector<std::string> benches;
+  std::optional<double> start_unix_s;   // PuTTY header or the log's first event
+  std::vector<Diagnostic> diagnostics;  // at most max_diagnostics_per_file
+  std::size_t diagnostics_dropped = 0;
+  std::vector<std::string> failures;    // why the file or a run in it could not be used
+};
+
+// A friction coefficient over a bench's runs: weighted least-squares line through the values
+// (weights 1/stderr²), its slope's standard error widened by the scatter beyond the stated
+// errors (Birge ratio), and the change the line makes over the runs' span.
+struct CoefficientTrend {
+  std::string name;               // "c_v" or "c_c"
+  std::string unit;               // ASCII SI unit
+  std::vector<double> x, value, std_error;  // the points (x in x_unit)
+  std::string x_unit;             // "day" when every run has a wall-clock time, else "run"
+  double mean = 0, mean_stderr = 0;
+  double slope = 0, slope_stderr = 0;        // per x_unit
+  double intercept = 0;                      // the line's value at x = 0
+  double change = 0, change_stderr = 0;      // slope × span (SI)
+  double relative_change = 0, relative_change_stderr = 0;  // change / mean
+  bool enough = false;            // at least min_runs points with a spread in x
+  bool drifting = false;          // |slope| > drift_sigma·stderr and |relative change| ≥ drift_fraction
+  std::string words;              // "dry friction rose 35 % ± 6 % over 5 runs: drifting"
+};
+
+struct TrendRules {
+  std::size_t min_runs = 3;
+  double drift_sigma = 3.0;
+  double drift_fraction = 0.10;
+};
+
+CoefficientTrend coefficient_trend(std::string name, std::string unit, std::string x_unit, std::vector<double> x,
+                                   std::vector<double> value, std::vector<double> std_error,
+                                   const TrendRules& rules = {});
+
+struct BenchSummary {
+  std::string bench;
+  std::vector<std::size_t> runs;  // indices into SessionReport::runs, time order
+  HealthLevel worst = HealthLevel::ok;
+  bool has_reference = false;
+  std::string reference_file;
+  CoefficientTrend viscous, coulomb;  // from the combined model
+};
+
+struct SessionReport {
+  std::vector<ReportFile> files;      // time order when every file has a start time, else as given
+  std::vector<ReportRun> runs;        // by bench (sorted id), then time order
+  std::vector<BenchSummary> benches;  // sorted by id
+  bool files_time_ordered = false;    // files were sorted by their start times
+  std::vector<std::string> notes;     // session-wide remarks (unused bench configs, …)
+  bool usable() const;                // no file or run failed
+};
+
+struct ReportProgress {
+  std::uintmax_t bytes_done = 0, bytes_total = 0;
+  std::size_t runs_found = 0, runs_done = 0;
+  std::string_view file;
+};
+using ReportProgressFn = std::function<void(const ReportProgress&)>;
+
+// Reads, fits, explains and judges every file; never throws for bad input.
+SessionReport build_session_report(std::span<const std::string> paths, const SessionReportOptions& options,
+                                   const ReportProgressFn& progress = {});
+
+// The pieces, for callers that already hold recordings (tests, services).
+// One run of rec on bench: fit, explain, health.
+ReportRun make_report_run(const Recording& rec, const Run& run, const std::string& bench, const BenchParams& params,
+                          const SessionReportOptions& options);
+// Sorts runs by bench then time order, numbers them, and fills the bench summaries.
+void summarize_session(SessionReport& report);
+
+// "=~=~=~ PuTTY log 2023.09.14 10:21:33 =~=~=~" → seconds since the epoch (the clock's local
+// time taken as UTC); nullopt when the text does not start with such a header.
+std::optional<double> putty_log_time(std::string_view head);
+
+// The combined model's c_v and c_c with their standard errors, when it converged.
+struct FrictionEstimate {
+  double c_viscous = 0, c_viscous_stderr = 0, c_coulomb = 0, c_coulomb_stderr = 0;
+};
+std::optional<FrictionEstimate> combined_friction(const RunFit& fit);
+
+}  // namespace spindown

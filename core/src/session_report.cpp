@@ -1,0 +1,407 @@
+#include "spindown/session_report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <exception>
+#include <filesystem>
+#include <fmt/format.h>
+#include <fstream>
+#include <numeric>
+#include <stdexcept>
+
+#include "spindown/bridge_settings.hpp"
+#include "spindown/lcm_log_reader.hpp"
+#include "spindown/quantity.hpp"
+
+namespace spindown {
+
+namespace {
+
+std::string file_stem(const std::string& path) {
+  std::string name = std::filesystem::path(path).filename().string();
+  const auto dot = name.find_last_of('.');
+  if (dot != std::string::npos && dot > 0) name.resize(dot);
+  return name.empty() ? path : name;
+}
+
+std::string first_error(const Recording& rec) {
+  for (const auto& d : rec.diagnostics)
+    if (d.severity == Diagnostic::Severity::error) return d.message;
+  return "no samples";
+}
+
+// The first bytes of a file (for the PuTTY header); "" when it cannot be read.
+std::string file_head(const std::string& path, std::size_t n) {
+  std::ifstream in(path, std::ios::binary);
+  std::string s(n, '\0');
+  in.read(s.data(), static_cast<std::streamsize>(n));
+  s.resize(static_cast<std::size_t>(std::max<std::streamsize>(in.gcount(), 0)));
+  return s;
+}
+
+// Receive time of the log's first event (seconds since the epoch); looks at a few events only.
+std::optional<double> lcm_log_start(const std::string& path) {
+  LcmLogReader reader(path);
+  if (!reader.good()) return std::nullopt;
+  LcmLogEvent ev;
+  for (int i = 0; i < 64 && reader.next(ev); ++i)
+    if (ev.number > 0 && ev.log_utime > 0) return static_cast<double>(ev.log_utime) * 1e-6;
+  return std::nullopt;
+}
+
+void keep_diagnostics(ReportFile& file, const std::vector<Diagnostic>& more, std::size_t cap) {
+  for (const auto& d : more) {
+    if (file.diagnostics.size() < cap)
+      file.diagnostics.push_back(d);
+    else
+      ++file.diagnostics_dropped;
+  }
+}
+
+std::string percent(double x) { return fmt::format("{:.0f} %", 100 * x); }
+
+}  // namespace
+
+std::pair<std::string, BenchReference> load_bench_reference(const std::string& toml_path) {
+  BenchReference ref;
+  ref.file = toml_path;
+  ref.health = load_motor_health_config(toml_path);
+  BridgeSettings settings;
+  load_bridge_settings(toml_path, settings);
+  if (settings.params.inertia_source != BenchParams{}.inertia_source ||
+      settings.params.kb_source != BenchParams{}.kb_source) {
+    ref.params = settings.params;
+    if (ref.params->inertia_source == "config file") ref.params->inertia_source = toml_path;
+    if (ref.params->kb_source == "config file") ref.params->kb_source = toml_path;
+  }
+  return {bench_id_of_config(toml_path), std::move(ref)};
+}
+
+std::optional<double> putty_log_time(std::string_view head) {
+  const auto at = head.find("PuTTY log ");
+  if (at == std::string_view::npos || head.substr(0, at).find('\n') != std::string_view::npos) return std::nullopt;
+  std::tm tm{};
+  int year = 0, month = 0, day = 0, hour = 0, minute = 0, second = 0;
+  const std::string text(head.substr(at + 10, 19));
+  if (std::sscanf(text.c_str(), "%4d.%2d.%2d %2d:%2d:%2d", &year, &month, &day, &hour, &minute, &second) != 6)
+    return std::nullopt;
+  if (month < 1 || month > 12 || day < 1 || day > 31 || hour > 23 || minute > 59 || second > 60) return std::nullopt;
+  tm.tm_year = year - 1900;
+  tm.tm_mon = month - 1;
+  tm.tm_mday = day;
+  tm.tm_hour = hour;
+  tm.tm_min = minute;
+  tm.tm_sec = second;
+  return static_cast<double>(timegm(&tm));
+}
+
+std::optional<FrictionEstimate> combined_friction(const RunFit& fit) {
+  const ModelFit* m = fit.model(ModelKind::combined);
+  if (!m || !m->converged) return std::nullopt;
+  const Parameter* cv = m->param("c3");
+  const Parameter* cc = m->param("c4");
+  if (!cv || !cc || !std::isfinite(cv->value) || !std::isfinite(cc->value)) return std::nullopt;
+  return FrictionEstimate{cv->value, cv->std_error, cc->value, cc->std_error};
+}
+
+CoefficientTrend coefficient_trend(std::string name, std::string unit, std::string x_unit, std::vector<double> x,
+                                   std::vector<double> value, std::vector<double> std_error, const TrendRules& rules) {
+  CoefficientTrend t;
+  t.name = std::move(name);
+  t.unit = std::move(unit);
+  t.x_unit = std::move(x_unit);
+  t.x = std::move(x);
+  t.value = std::move(value);
+  t.std_error = std::move(std_error);
+  const std::size_t n = std::min({t.x.size(), t.value.size(), t.std_error.size()});
+  const std::string what = t.name == "c_v" ? "viscous friction" : t.name == "c_c" ? "dry friction" : t.name;
+  // Weights 1/σ²; a zero or missing σ gets the median σ so one point cannot take all the weight.
+  std::vector<double> sig;
+  for (std::size_t i = 0; i < n; ++i)
+    if (t.std_error[i] > 0 && std::isfinite(t.std_error[i])) sig.push_back(t.std_error[i]);
+  std::sort(sig.begin(), sig.end());
+  const double fallback = sig.empty() ? 1.0 : sig[sig.size() / 2];
+  double sw = 0, swx = 0, swy = 0;
+  std::vector<double> w(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double s = t.std_error[i] > 0 && std::isfinite(t.std_error[i]) ? t.std_error[i] : fallback;
+    w[i] = 1 / (s * s);
+    sw += w[i], swx += w[i] * t.x[i], swy += w[i] * t.value[i];
+  }
+  if (n == 0) {
+    t.words = fmt::format("{}: no run with a combined fit", what);
+    return t;
+  }
+  t.mean = swy / sw;
+  t.mean_stderr = std::sqrt(1 / sw);
+  const double xm = swx / sw;
+  double sxx = 0, sxy = 0;
+  for (std::size_t i = 0; i < n; ++i) sxx += w[i] * (t.x[i] - xm) * (t.x[i] - xm), sxy += w[i] * (t.x[i] - xm) * (t.value[i] - t.mean);
+  const auto [xlo, xhi] = std::minmax_element(t.x.begin(), t.x.begin() + static_cast<std::ptrdiff_t>(n));
+  const double span = *xhi - *xlo;
+  t.enough = n >= rules.min_runs && span > 0 && sxx > 0;
+  if (!t.enough) {
+    t.words = fmt::format("{}: {} run{}, too few for a trend (need {})", what, n, n == 1 ? "" : "s", rules.min_runs);
+    return t;
+  }
+  t.slope = sxy / sxx;
+  const double icpt = t.mean - t.slope * xm;
+  t.intercept = icpt;
+  double chi2 = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double r = t.value[i] - (icpt + t.slope * t.x[i]);
+    chi2 += w[i] * r * r;
+  }
+  // Scatter beyond the stated errors (run-to-run variation) widens the slope's error.
+  const double birge = n > 2 ? std::max(1.0, std::sqrt(chi2 / static_cast<double>(n - 2))) : 1.0;
+  t.slope_stderr = birge / std::sqrt(sxx);
+  t.mean_stderr *= birge;
+  t.change = t.slope * span;
+  t.change_stderr = t.slope_stderr * span;
+  if (t.mean != 0) {
+    t.relative_change = t.change / std::abs(t.mean);
+    t.relative_change_stderr = t.change_stderr / std::abs(t.mean);
+  }
+  const bool significant = std::abs(t.slope) > rules.drift_sigma * t.slope_stderr;
+  t.drifting = significant && std::abs(t.relative_change) >= rules.drift_fraction;
+  const std::string over = t.x_unit == "day" ? fmt::format("over {:.3g} days ({} runs)", span, n)
+                                             : fmt::format("over {} runs", n);
+  const std::string verdict = t.drifting ? "drifting"
+                              : significant ? "a small but clear change"
+                                            : "steady within its uncertainty";
+  t.words = fmt::format("{} {} {} ± {} {}: {}", what, t.change >= 0 ? "rose" : "fell", percent(std::abs(t.relative_change)),
+                        percent(t.relative_change_stderr), over, verdict);
+  return t;
+}
+
+ReportRun make_report_run(const Recording& rec, const Run& run, const std::string& bench, const BenchParams& params,
+                          const SessionReportOptions& options) {
+  ReportRun out;
+  out.bench = bench;
+  out.source = rec.source;
+  FitOptions fopt = options.fit;
+  fopt.bench = params;
+  out.fit = fit_run(rec, run, fopt);
+  const std::size_t end = std::min(run.end_index, rec.size());
+  for (std::size_t i = std::min(run.cut_index, end); i < end; ++i) {
+    out.tau.push_back(rec.t_s[i] - run.t_cut_s);
+    out.y.push_back(rec.value[i]);
+  }
+  if (options.explain_runs) {
+    ExplainOptions eopt = options.explain;
+    eopt.bench = params;
+    try {
+      out.explain = explain_run(rec, run, eopt);
+      out.explained = true;
+    } catch (const std::exception& e) {
+      out.explain.ok = false;
+      out.explain.message = fmt::format("could not be explained: {}", e.what());
+    }
+  }
+  MotorHealthConfig health;
+  if (auto it = options.references.find(bench); it != options.references.end()) {
+    health = it->second.health;
+    out.health_config = it->second.file;
+  }
+  out.health = assess_health(out.fit, health);
+  if (!out.health.has_reference) out.health_config.clear();
+  return out;
+}
+
+void summarize_session(SessionReport& report) {
+  // By bench id, then file (time) order, then run number.
+  std::stable_sort(report.runs.begin(), report.runs.end(), [](const ReportRun& a, const ReportRun& b) {
+    if (a.bench != b.bench) return a.bench < b.bench;
+    if (a.file_index != b.file_index) return a.file_index < b.file_index;
+    return a.fit.run.number < b.fit.run.number;
+  });
+  // Within a bench whose every run has a wall-clock time, that time decides.
+  for (auto first = report.runs.begin(); first != report.runs.end();) {
+    auto last = std::find_if(first, report.runs.end(), [&](const ReportRun& r) { return r.bench != first->bench; });
+    if (std::all_of(first, last, [](const ReportRun& r) { return r.cut_unix_s.has_value(); }))
+      std::stable_sort(first, last, [](const ReportRun& a, const ReportRun& b) { return *a.cut_unix_s < *b.cut_unix_s; });
+    first = last;
+  }
+  report.benches.clear();
+  for (std::size_t i = 0; i < report.runs.size(); ++i) {
+    ReportRun& r = report.runs[i];
+    if (report.benches.empty() || report.benches.back().bench != r.bench) {
+      report.benches.emplace_back();
+      report.benches.back().bench = r.bench;
+    }
+    BenchSummary& b = report.benches.back();
+    b.runs.push_back(i);
+    r.order = static_cast<int>(b.runs.size());
+    if (static_cast<int>(r.health.level) > static_cast<int>(b.worst)) b.worst = r.health.level;
+    if (r.health.has_reference) {
+      b.has_reference = true;
+      b.reference_file = r.health_config;
+    }
+  }
+  for (BenchSummary& b : report.benches) {
+    bool wall_clock = true;
+    for (std::size_t i : b.runs) wall_clock = wall_clock && report.runs[i].cut_unix_s.has_value();
+    double t0 = 0;
+    if (wall_clock && !b.runs.empty()) t0 = *report.runs[b.runs.front()].cut_unix_s;
+    std::vector<double> x, cv, cv_se, cc, cc_se;
+    for (std::size_t i : b.runs) {
+      const ReportRun& r = report.runs[i];
+      const auto f = combined_friction(r.fit);
+      if (!f) continue;
+      x.push_back(wall_clock ? (*r.cut_unix_s - t0) / 86400.0 : static_cast<double>(r.order));
+      cv.push_back(f->c_viscous), cv_se.push_back(f->c_viscous_stderr);
+      cc.push_back(f->c_coulomb), cc_se.push_back(f->c_coulomb_stderr);
+    }
+    // Runs minutes apart on one day say nothing per day: fall back to run order then.
+    const std::string x_unit =
+        wall_clock && !x.empty() && *std::max_element(x.begin(), x.end()) >= 1.0 ? "day" : "run";
+    if (x_unit == "run" && wall_clock) {
+      x.clear();
+      for (std::size_t i : b.runs)
+        if (combined_friction(report.runs[i].fit)) x.push_back(static_cast<double>(report.runs[i].order));
+    }
+    b.viscous = coefficient_trend("c_v", "N*m*s/rad", x_unit, x, cv, cv_se);
+    b.coulomb = coefficient_trend("c_c", "N*m", x_unit, x, cc, cc_se);
+  }
+}
+
+bool SessionReport::usable() const {
+  for (const auto& f : files)
+    if (!f.failures.empty()) return false;
+  return true;
+}
+
+SessionReport build_session_report(std::span<const std::string> paths, const SessionReportOptions& options,
+                                   const ReportProgressFn& progress) {
+  SessionReport report;
+  // File sizes and start times first: the order of the session and the total for progress.
+  std::uintmax_t total = 0;
+  for (const auto& path : paths) {
+    ReportFile f;
+    f.file = path;
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(path, ec);
+    f.bytes = ec ? 0 : size;
+    total += f.bytes;
+    const std::string head = file_head(path, 512);
+    const FileFormat format = head.empty() ? FileFormat::automatic : detect_format(head, options.read);
+    f.format = format;
+    if (format == FileFormat::lcm_log)
+      f.start_unix_s = lcm_log_start(path);
+    else if (format == FileFormat::arduino_text)
+      f.start_unix_s = putty_log_time(head);
+    report.files.push_back(std::move(f));
+  }
+  report.files_time_ordered =
+      !report.files.empty() &&
+      std::all_of(report.files.begin(), report.files.end(), [](const ReportFile& f) { return f.start_unix_s.has_value(); });
+  if (report.files_time_ordered)
+    std::stable_sort(report.files.begin(), report.files.end(),
+                     [](const ReportFile& a, const ReportFile& b) { return *a.start_unix_s < *b.start_unix_s; });
+  else if (report.files.size() > 1)
+    report.notes.push_back("not every file tells when it was recorded (PuTTY header or LCM log): runs are in the "
+                           "order the files were given");
+
+  ReportProgress p;
+  p.bytes_total = total;
+  std::uintmax_t bytes_before = 0;
+  std::vector<bool> reference_used(options.references.size(), false);
+  for (std::size_t fi = 0; fi < report.files.size(); ++fi) {
+    ReportFile& file = report.files[fi];
+    p.file = file.file;
+    if (progress) progress(p);
+    try {
+      std::vector<RecordingInfo> info;
+      const auto recordings = read_recordings(file.file, options.read, &info);
+      // Runs of every recording first, so progress knows how many are coming.
+      std::vector<Segmentation> segs;
+      std::size_t runs_in_file = 0;
+      for (const Recording& rec : recordings) {
+        segs.push_back(rec.empty() ? Segmentation{} : find_runs(rec));
+        runs_in_file += segs.back().runs.size();
+      }
+      p.runs_found += runs_in_file;
+      std::size_t runs_done_in_file = 0;
+      for (std::size_t k = 0; k < recordings.size(); ++k) {
+        const Recording& rec = recordings[k];
+        const RecordingInfo* ri = k < info.size() ? &info[k] : nullptr;
+        if (ri && file.format == FileFormat::automatic) file.format = ri->format;
+        const bool is_log = ri && ri->format == FileFormat::lcm_log;
+        const std::string bench = is_log && !ri->bench.empty() ? ri->bench
+                                  : !options.text_bench.empty() ? options.text_bench
+                                                                : file_stem(file.file);
+        const std::string where = recordings.size() > 1 ? fmt::format("{}: ", rec.source) : std::string{};
+        if (std::find(file.benches.begin(), file.benches.end(), bench) == file.benches.end())
+          file.benches.push_back(bench);
+        file.samples += rec.size();
+        keep_diagnostics(file, rec.diagnostics, options.max_diagnostics_per_file);
+        if (rec.empty()) {
+          file.failures.push_back(where + first_error(rec));
+          continue;
+        }
+        // J and K_b: command line, else the log's CONFIG, else the bench's file, else the lab's.
+        BenchParams params = options.fit.bench;
+        const auto ref = options.references.find(bench);
+        if (ref != options.references.end())
+          reference_used[static_cast<std::size_t>(std::distance(options.references.begin(), ref))] = true;
+        if (!options.bench_from_user) {
+          bool from_config = false;
+          if (ri && ri->config) {
+            std::string why;
+            if (auto b = bench_params_from_config(*ri->config, &why)) {
+              params = *b;
+              from_config = true;
+            } else {
+              keep_diagnostics(file,
+                               {{Diagnostic::Severity::warning, rec.source, 0,
+                                 fmt::format("bench config not used ({}); {}", why,
+                                             ref != options.references.end() && ref->second.params
+                                                 ? "the bench file's J and K_b used"
+                                                 : "lab defaults assumed")}},
+                               options.max_diagnostics_per_file);
+            }
+          }
+          if (!from_config && ref != options.references.end() && ref->second.params) params = *ref->second.params;
+        }
+        const Segmentation& seg = segs[k];
+        keep_diagnostics(file, seg.diagnostics, options.max_diagnostics_per_file);
+        if (seg.runs.empty()) {
+          file.failures.push_back(where + fmt::format("no spin-down run found in {} samples", rec.size()));
+          continue;
+        }
+        for (const Run& run : seg.runs) {
+          ReportRun r = make_report_run(rec, run, bench, params, options);
+          r.file_index = fi;
+          if (file.start_unix_s && !rec.t_s.empty()) r.cut_unix_s = *file.start_unix_s + (run.t_cut_s - rec.t_s.front());
+          if (r.fit.best.empty()) {
+            std::string why;
+            for (const auto& m : r.fit.models)
+              if (!m.message.empty()) why += fmt::format("; {}: {}", model_name(m.kind), m.message);
+            file.failures.push_back(where + fmt::format("run {}: no model converged{}", run.number, why));
+          }
+          report.runs.push_back(std::move(r));
+          ++p.runs_done;
+          ++runs_done_in_file;
+          p.bytes_done = bytes_before + file.bytes * runs_done_in_file / std::max<std::size_t>(runs_in_file, 1);
+          if (progress) progress(p);
+        }
+      }
+    } catch (const std::exception& e) {
+      file.failures.push_back(fmt::format("could not be processed: {}", e.what()));
+    }
+    if (file.format == FileFormat::automatic) file.format = options.read.format;
+    bytes_before += file.bytes;
+    p.bytes_done = bytes_before;
+    if (progress) progress(p);
+  }
+  std::size_t i = 0;
+  for (const auto& [bench, ref] : options.references)
+    if (!reference_used[i++])
+      report.notes.push_back(fmt::format("bench config {} (bench {}) matches no bench in these files", ref.file, bench));
+  summarize_session(report);
+  return report;
+}
+
+}  // namespace spindown
