@@ -11,6 +11,7 @@
 #include "export_command.hpp"
 #include "watch_command.hpp"
 #include "report_command.hpp"
+#include "doctor_command.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"spindown: fit friction models to DC-motor spin-down recordings"};
@@ -21,6 +22,7 @@ int main(int argc, char** argv) {
   spindown::cli::setup_export(app);
   spindown::cli::setup_watch(app);
   spindown::cli::setup_report(app);
+  spindown::cli::setup_doctor(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {  // a subcommand finished with a non-zero exit code

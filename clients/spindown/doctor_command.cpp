@@ -1,0 +1,368 @@
+#include "doctor_command.hpp"
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fmt/format.h>
+#include <fstream>
+#include <iostream>
+#include <lcm/lcm.h>
+#include <memory>
+#include <sstream>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "exit_codes.hpp"
+#include "spindown/clock_checks.hpp"
+#include "spindown/config_t.hpp"
+#include "spindown/doctor_check.hpp"
+#include "spindown/lcm_channels.hpp"
+#include "spindown/lcm_self_test.hpp"
+#include "spindown/lcm_url.hpp"
+#include "spindown/network_checks.hpp"
+#include "spindown/serial_inventory.hpp"
+#include "spindown/status_t.hpp"
+
+namespace spindown::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+const std::vector<std::string> all_checks = {"ttl", "route", "firewall", "buffer", "selftest", "serial", "clock"};
+
+std::optional<std::string> read_file(const fs::path& path) {
+  std::ifstream in(path);
+  if (!in) return std::nullopt;
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::optional<long> read_long(const fs::path& path) {
+  const auto text = read_file(path);
+  if (!text) return std::nullopt;
+  try {
+    return std::stol(*text);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+// A program in PATH or the admin directories (nft and iptables live in /usr/sbin).
+std::string find_program(const std::string& name) {
+  std::string path = std::getenv("PATH") ? std::getenv("PATH") : "";
+  path += ":/usr/sbin:/sbin";
+  std::istringstream dirs(path);
+  std::string dir;
+  while (std::getline(dirs, dir, ':')) {
+    if (dir.empty()) continue;
+    const fs::path p = fs::path(dir) / name;
+    if (::access(p.c_str(), X_OK) == 0) return p.string();
+  }
+  return {};
+}
+
+// Runs a program (no shell), its stdout captured (at most 4 MB); nullopt when it cannot run or
+// exits non-zero (then why holds its first stderr line or the exit status).
+std::optional<std::string> capture(const std::vector<std::string>& argv, std::string* why) {
+  int out_pipe[2], err_pipe[2];
+  if (::pipe(out_pipe) != 0) return std::nullopt;
+  if (::pipe(err_pipe) != 0) {
+    ::close(out_pipe[0]);
+    ::close(out_pipe[1]);
+    return std::nullopt;
+  }
+  const pid_t pid = ::fork();
+  if (pid < 0) return std::nullopt;
+  if (pid == 0) {
+    ::dup2(out_pipe[1], 1);
+    ::dup2(err_pipe[1], 2);
+    ::close(out_pipe[0]);
+    ::close(err_pipe[0]);
+    std::vector<char*> args;
+    for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+    args.push_back(nullptr);
+    ::execv(args[0], args.data());
+    _exit(127);
+  }
+  ::close(out_pipe[1]);
+  ::close(err_pipe[1]);
+  std::string out, err;
+  char buf[4096];
+  for (ssize_t n; (n = ::read(out_pipe[0], buf, sizeof buf)) > 0;)
+    if (out.size() < (4u << 20)) out.append(buf, static_cast<std::size_t>(n));
+  for (ssize_t n; (n = ::read(err_pipe[0], buf, sizeof buf)) > 0;)
+    if (err.size() < 4096) err.append(buf, static_cast<std::size_t>(n));
+  ::close(out_pipe[0]);
+  ::close(err_pipe[0]);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return out;
+  if (why) {
+    *why = err.substr(0, err.find('\n'));
+    if (why->empty()) *why = fmt::format("exit status {}", WIFEXITED(status) ? WEXITSTATUS(status) : -1);
+  }
+  return std::nullopt;
+}
+
+std::vector<NetInterface> read_interfaces() {
+  std::vector<NetInterface> out;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator("/sys/class/net", ec)) {
+    const auto flags = read_file(e.path() / "flags");
+    if (!flags) continue;
+    if (auto i = interface_from_flags(e.path().filename().string(), *flags)) out.push_back(*i);
+  }
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.name < b.name; });
+  return out;
+}
+
+// The NTP client running here, from the process names.
+std::string running_ntp_client() {
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator("/proc", ec)) {
+    const std::string pid = e.path().filename().string();
+    if (pid.find_first_not_of("0123456789") != std::string::npos) continue;
+    auto comm = read_file(e.path() / "comm");
+    if (!comm) continue;
+    while (!comm->empty() && comm->back() == '\n') comm->pop_back();
+    if (*comm == "chronyd") return "chrony";
+    if (*comm == "systemd-timesyn") return "systemd-timesyncd";
+    if (*comm == "ntpd") return "ntpd";
+    if (*comm == "openntpd") return "openntpd";
+  }
+  return {};
+}
+
+std::string this_host_name() {
+  char name[256] = {};
+  if (::gethostname(name, sizeof name - 1) != 0) return {};
+  return name;
+}
+
+std::int64_t wall_us() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+// Listens to the lab's STATUS and CONFIG messages and feeds their utime into the tracker.
+struct SkewListener {
+  ClockSkewTracker tracker;
+  static void on_lcm(const lcm_recv_buf_t* rbuf, const char* channel, void* user) {
+    auto* self = static_cast<SkewListener*>(user);
+    const auto parsed = parse_channel(channel);
+    if (!parsed) return;
+    const std::int64_t received = rbuf->recv_utime > 0 ? rbuf->recv_utime : wall_us();
+    const auto size = static_cast<int>(rbuf->data_size);
+    if (parsed->kind == ChannelKind::status) {
+      status_t m;
+      if (m.decode(rbuf->data, 0, size) >= 0) self->tracker.add(m.host, m.service + " " + m.instance, m.utime, received);
+    } else if (parsed->kind == ChannelKind::config) {
+      config_t m;
+      if (m.decode(rbuf->data, 0, size) >= 0) self->tracker.add(m.host, "bridge " + m.bench, m.utime, received);
+    }
+  }
+};
+
+std::vector<HostSkew> listen_for_clocks(const std::string& url, double seconds) {
+  SkewListener listener;
+  lcm_t* lcm = lcm_create(url.c_str());
+  if (!lcm) return {};
+  lcm_subscription_t* sub = lcm_subscribe(lcm, "SPINDOWN\\..*\\.(STATUS|CONFIG)", &SkewListener::on_lcm, &listener);
+  if (sub) lcm_subscription_set_queue_capacity(sub, 10000);
+  // LCM 1.3.1: fd -1 after a failed receive setup; lcm_handle_timeout would abort on it.
+  if (!sub || lcm_get_fileno(lcm) < 0) {
+    if (sub) lcm_unsubscribe(lcm, sub);
+    lcm_destroy(lcm);
+    return {};
+  }
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                                          std::chrono::duration<double>(seconds));
+  for (int i = 0; i < 100000 && std::chrono::steady_clock::now() < end; ++i)
+    if (lcm_handle_timeout(lcm, 50) < 0) break;
+  if (sub) lcm_unsubscribe(lcm, sub);
+  lcm_destroy(lcm);
+  return listener.tracker.hosts();
+}
+
+bool wanted(const DoctorCommandOptions& o, const std::string& check) {
+  return o.checks.empty() || std::find(o.checks.begin(), o.checks.end(), check) != o.checks.end();
+}
+
+int list_serial_numbers(const DoctorCommandOptions& o) {
+  const auto ports = list_usb_serial_ports(o.sysfs_tty);
+  if (o.json) {
+    nlohmann::json list = nlohmann::json::array();
+    for (const auto& p : ports)
+      list.push_back({{"device", p.device}, {"serial", p.usb_serial}, {"vendor_id", p.vendor_id}, {"product_id", p.product_id},
+                      {"manufacturer", p.manufacturer}, {"product", p.product}, {"usb_port", p.usb_port},
+                      {"udev_rule", udev_rule_line(p, "BENCH")}});
+    std::cout << nlohmann::json{{"ports", list}}.dump(2) << '\n';
+    return ports.empty() ? exit_unusable : exit_ok;
+  }
+  if (ports.empty()) {
+    std::cout << "no USB serial port found under " << o.sysfs_tty
+              << ": is the Arduino plugged in (and powered)? `dmesg | tail` shows what the kernel saw\n";
+    return exit_unusable;
+  }
+  for (const auto& p : ports) {
+    std::cout << fmt::format("{}  serial {}  USB {}:{} {}{}{}  port {}\n", p.device,
+                             p.usb_serial.empty() ? "(none)" : p.usb_serial, p.vendor_id, p.product_id, p.manufacturer,
+                             p.manufacturer.empty() || p.product.empty() ? "" : " ", p.product, p.usb_port);
+    std::cout << "  " << udev_rule_line(p, "BENCH") << '\n';
+  }
+  std::cout << "Put each line in /etc/udev/rules.d/99-spindown.rules with BENCH = the bench id, then\n"
+               "  udevadm control --reload && udevadm trigger --subsystem-match=tty\n";
+  return exit_ok;
+}
+
+}  // namespace
+
+void setup_doctor(CLI::App& app) {
+  auto opt = std::make_shared<DoctorCommandOptions>();
+  CLI::App* sub = app.add_subcommand("doctor", "Check what breaks LCM labs on this PC and say how to fix each");
+  sub->footer(
+      "Checks: ttl (LCM URL's TTL: 0 this host, 1 the lab LAN), route (a route for the multicast group), firewall "
+      "(nft/iptables rules dropping UDP to the LCM port or multicast; read-only, needs root to read them), buffer "
+      "(net.core.rmem_max vs LCM's recommended 2 MB), selftest (an LCM message published and received on the URL), "
+      "serial (bench files; each bench's device exists and the service user may read and write it), clock (this PC's "
+      "NTP sync; the clock skew of every lab PC heard on LCM during --listen).\n"
+      "The LCM URL: --lcm-url, else LCM_DEFAULT_URL, else the one in /etc/spindown/lcm.env (the services'), else "
+      "LCM's default.\n"
+      "Exit codes: 0 every check ok (or skipped), 1 warnings, 2 failures or bad usage. --serial-numbers: 0 ports "
+      "found, 1 none.");
+  sub->add_option("--lcm-url", opt->lcm_url, "LCM URL to check (default: LCM_DEFAULT_URL, else /etc/spindown/lcm.env)");
+  sub->add_option("--env-file", opt->env_file, "The services' LCM env file")->capture_default_str();
+  sub->add_option("--bench-config", opt->bench_config,
+                  "Bench files or directories (default /etc/spindown/benches when it exists)");
+  sub->add_option("--service-user", opt->service_user, "User the services run as")->capture_default_str();
+  sub->add_option("--checks", opt->checks, "Only these checks: ttl,route,firewall,buffer,selftest,serial,clock")
+      ->delimiter(',')
+      ->check(CLI::IsMember(all_checks));
+  sub->add_option("--timeout", opt->timeout_s, "Seconds the LCM self-test waits for its message")
+      ->capture_default_str()
+      ->check(CLI::Range(0.1, 30.0));
+  sub->add_option("--listen", opt->listen_s, "Seconds to listen for other lab PCs' clocks (0: do not listen)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 60.0));
+  sub->add_flag("--single-host", opt->single_host, "The whole lab runs on this PC: ttl=0 is intended");
+  sub->add_flag("--json", opt->json, "One JSON object: checks with name, level, detail, fix; summary; exit_code");
+  sub->add_flag("--serial-numbers", opt->serial_numbers,
+                "List USB serial ports with their boards' serial numbers and the udev rule line for each");
+  sub->add_option("--sysfs-tty", opt->sysfs_tty, "Where the tty class lives (tests give a fixture)")->capture_default_str();
+  sub->callback([opt]() {
+    const int code = run_doctor(*opt);
+    if (code != exit_ok) throw CLI::RuntimeError(code);
+  });
+}
+
+int run_doctor(const DoctorCommandOptions& o) {
+  if (o.serial_numbers) return list_serial_numbers(o);
+  std::vector<DoctorCheck> checks;
+
+  // The URL: what this process would use, and what the services use.
+  std::optional<std::string> services_url;
+  if (const auto text = read_file(o.env_file)) {
+    const auto env = parse_env_file(*text);
+    if (const auto it = env.find("LCM_DEFAULT_URL"); it != env.end() && !it->second.empty()) services_url = it->second;
+  }
+  const char* env = std::getenv("LCM_DEFAULT_URL");
+  const auto resolved = resolve_lcm_url(o.lcm_url, env && *env ? std::optional<std::string>(env) : std::nullopt,
+                                        services_url, o.env_file);
+  std::string why;
+  const auto url = parse_lcm_url(resolved.url, &why);
+  const bool network = wanted(o, "ttl") || wanted(o, "route") || wanted(o, "firewall") || wanted(o, "buffer") ||
+                       wanted(o, "selftest");
+  if (!url && network) {
+    checks.push_back({"LCM URL", CheckLevel::fail, fmt::format("{} (from {})", why, resolved.source),
+                      "LCM_DEFAULT_URL=udpm://239.255.76.67:7667?ttl=1 in /etc/spindown/lcm.env"});
+  }
+  bool lcm_works = false;
+  if (url) {
+    if (wanted(o, "ttl")) checks.push_back(check_lcm_ttl(*url, resolved.source, o.single_host, services_url));
+    if (wanted(o, "route")) {
+      const auto routes = parse_proc_net_route(read_file("/proc/net/route").value_or(""));
+      checks.push_back(check_multicast_route(*url, routes, read_interfaces()));
+    }
+    if (wanted(o, "firewall")) {
+      std::optional<std::string> nft, ipt;
+      std::string nft_why, ipt_why;
+      const std::string nft_bin = find_program("nft");
+      const std::string ipt_bin = find_program("iptables-save");
+      if (!nft_bin.empty()) nft = capture({nft_bin, "list", "ruleset"}, &nft_why);
+      // iptables-nft rules are in nft's ruleset already; iptables-save only without nft.
+      if (!nft && !ipt_bin.empty()) ipt = capture({ipt_bin}, &ipt_why);
+      if (!nft && !ipt && (!nft_bin.empty() || !ipt_bin.empty())) {
+        checks.push_back({"firewall", CheckLevel::skip,
+                          fmt::format("cannot read the rules ({}{}): run spindown doctor as root to check them",
+                                      nft_bin.empty() ? "iptables-save: " + ipt_why : "nft list ruleset: " + nft_why,
+                                      ""),
+                          ""});
+      } else {
+        checks.push_back(check_firewall(*url, nft, ipt));
+      }
+    }
+    if (wanted(o, "buffer")) {
+      std::optional<long> errors;
+      if (const auto snmp = read_file("/proc/net/snmp")) errors = parse_udp_rcvbuf_errors(*snmp);
+      checks.push_back(check_receive_buffer(read_long("/proc/sys/net/core/rmem_max"), errors));
+    }
+    if (wanted(o, "selftest")) {
+      const auto t = run_lcm_self_test(resolved.url, o.timeout_s);
+      lcm_works = t.received;
+      checks.push_back(check_lcm_self_test(t));
+    } else {
+      lcm_works = true;  // not tested: try to listen anyway
+    }
+  }
+
+  if (wanted(o, "serial")) {
+    std::vector<std::string> sources = o.bench_config;
+    std::error_code ec;
+    if (sources.empty() && fs::is_directory("/etc/spindown/benches", ec)) sources.push_back("/etc/spindown/benches");
+    if (sources.empty()) {
+      checks.push_back({"bench files", CheckLevel::skip, "no /etc/spindown/benches on this PC (no bench configured here)", ""});
+    } else {
+      std::string where;
+      for (const auto& s : sources) where += (where.empty() ? "" : ", ") + s;
+      const auto files = read_bench_files(sources);
+      for (auto& c : check_bench_files(files, where)) checks.push_back(std::move(c));
+      const ServiceUser user = lookup_service_user(o.service_user);
+      for (const auto& f : files) {
+        if (!f.settings) continue;
+        const bool enabled_here =
+            fs::exists(fmt::format("/etc/systemd/system/multi-user.target.wants/spindown-bridge@{}.service", f.stem), ec);
+        checks.push_back(check_serial_device(f.stem, f.settings->device, device_facts(f.settings->device), user, enabled_here));
+      }
+    }
+  }
+
+  if (wanted(o, "clock")) {
+    checks.push_back(check_clock_sync(read_kernel_clock_state(), running_ntp_client()));
+    if (o.listen_s > 0 && url && lcm_works) {
+      if (!o.json) std::fprintf(stderr, "spindown doctor: listening %.3g s for the lab's clocks on %s\n", o.listen_s,
+                                resolved.url.c_str());
+      for (auto& c : check_clock_skew(listen_for_clocks(resolved.url, o.listen_s), this_host_name(), o.listen_s))
+        checks.push_back(std::move(c));
+    } else if (o.listen_s > 0) {
+      checks.push_back({"clock skew", CheckLevel::skip, "LCM does not work here: no other PC's clock to compare", ""});
+    }
+  }
+
+  if (o.json) {
+    auto j = doctor_json(checks);
+    j["lcm_url"] = resolved.url;
+    j["lcm_url_source"] = resolved.source;
+    std::cout << j.dump(2) << '\n';
+  } else {
+    std::cout << render_doctor_text(checks);
+  }
+  std::cout.flush();
+  return doctor_exit_code(checks);
+}
+
+}  // namespace spindown::cli
