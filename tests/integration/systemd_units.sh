@@ -35,6 +35,17 @@ verify() {  # UNIT...
 verify spindown-fitter.service spindown-logger.service spindown-bridge@bench-1.service
 verify spindown-bridge@lab_3.service
 
+# systemd's own exposure score (0 = locked down … 10 = exposed): the hardening stays in place.
+for u in spindown-fitter.service spindown-logger.service spindown-bridge@bench-1.service; do
+  score=$(cd "$tmp" && SYSTEMD_UNIT_PATH="$tmp:" "$analyze" security --offline=yes --no-pager "$u" 2>/dev/null |
+          sed -n 's/.*Overall exposure level for [^:]*: \([0-9.]*\).*/\1/p')
+  if [[ -n $score ]] && python3 -c "import sys; sys.exit(0 if float('$score') <= 2.5 else 1)"; then
+    echo "ok: $u exposure $score (systemd-analyze security)"
+  else
+    echo "FAIL: $u exposure '${score:-?}' (want ≤ 2.5)"; fail=1
+  fi
+done
+
 # The check itself catches mistakes: an unknown key, and a program that is not there.
 cp "$tmp/spindown-fitter.service" "$tmp/broken-key.service"
 sed -i 's/^NoNewPrivileges=yes/NoNewPrivilege=yes/' "$tmp/broken-key.service"
