@@ -365,3 +365,19 @@ TEST(ArduinoText, OptionsValidate) {
   const Recording r = read_arduino_text(cadence(0, 5), "x", o);
   EXPECT_TRUE(r.has_errors());
 }
+
+// Found by tests/integration/hostile_inputs.sh: a line with Latin-1 bytes was quoted raw in its
+// warning, and `spindown fit --json` then stopped with nlohmann::json's "invalid UTF-8" error.
+// Bytes that are not UTF-8 are escaped; valid UTF-8 is kept and never cut inside a character.
+TEST(ArduinoText, BytesThatAreNotUtf8AreEscapedInMessages) {
+  std::string text = "1000\t2.50\r\n\xff\xfe\xc3\x28\t\xa0\r\n";
+  text += std::string(38, 'a') + "\xc2\xb5\xc2\xb5 more\r\n";  // 'µ' at characters 39 and 40, then cut
+  for (int i = 1; i < 40; ++i) text += std::to_string(1000 + 20 * i) + "\t2.50\r\n";
+  const Recording r = read_arduino_text(text, "latin1.tsv");
+  const Diagnostic* bad = at_line(r, 2);
+  ASSERT_NE(bad, nullptr);
+  EXPECT_NE(bad->message.find("\"\\xff\\xfe\\xc3(\\t\\xa0\""), std::string::npos) << bad->message;
+  const Diagnostic* cut = at_line(r, 3);
+  ASSERT_NE(cut, nullptr);
+  EXPECT_NE(cut->message.find(std::string(38, 'a') + "\xc2\xb5\xc2\xb5\"…"), std::string::npos) << cut->message;
+}

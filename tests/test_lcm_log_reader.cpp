@@ -9,6 +9,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <limits>
 #include <string>
+#include <sys/stat.h>
 #include <unistd.h>
 #include <vector>
 
@@ -415,4 +416,18 @@ TEST(LcmLogReader, MissingEmptyAndNonLogFiles) {
   const LcmLogContents tx = read_lcm_log(text.path);
   EXPECT_EQ(tx.events, 0);
   EXPECT_TRUE(mentions(tx.diagnostics, "not an LCM event and no event follows"));
+}
+
+// Found by tests/integration/hostile_inputs.sh: `spindown refit` on a FIFO without a writer
+// waited forever in fopen(). A log must be a regular file (lcm::LogFile seeks); say so at once.
+TEST(LcmLogReader, AFifoOrDeviceIsRefusedNotWaitedOn) {
+  const std::string fifo = ::testing::TempDir() + "spindown_lcm_fifo_" + std::to_string(::getpid());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const LcmLogContents f = read_lcm_log(fifo);
+  std::filesystem::remove(fifo);
+  ASSERT_TRUE(f.has_errors());
+  EXPECT_TRUE(mentions(f.diagnostics, "not a regular file"));
+  const LcmLogContents null = read_lcm_log("/dev/null");
+  ASSERT_TRUE(null.has_errors());
+  EXPECT_TRUE(mentions(null.diagnostics, "not a regular file"));
 }

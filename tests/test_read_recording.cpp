@@ -6,6 +6,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <random>
 #include <string>
+#include <sys/stat.h>
 #include <unistd.h>
 #include <vector>
 
@@ -243,4 +244,37 @@ TEST(ReadRecording, ReadFileBytes) {
   EXPECT_NE(why.find("more than"), std::string::npos);
   EXPECT_FALSE(read_file_bytes("/nonexistent", &why));
   EXPECT_NE(why.find("cannot open /nonexistent"), std::string::npos);
+}
+
+// Found by tests/integration/hostile_inputs.sh: `spindown fit` on a FIFO without a writer
+// blocked forever in open(). It now reads as an empty file; a pipe with a writer is read to its
+// end in one pass (it cannot be opened twice).
+TEST(ReadRecordings, AFifoWithoutAWriterIsEmptyNotAHang) {
+  const std::string fifo = ::testing::TempDir() + "spindown_read_fifo_" + std::to_string(::getpid());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const auto recs = read_recordings(fifo);
+  std::filesystem::remove(fifo);
+  ASSERT_EQ(recs.size(), 1u);
+  EXPECT_TRUE(recs[0].empty());
+  ASSERT_TRUE(recs[0].has_errors());
+  EXPECT_NE(recs[0].diagnostics.back().message.find("empty"), std::string::npos)
+      << recs[0].diagnostics.back().message;
+}
+
+TEST(ReadRecordings, APipeIsReadToItsEndAndDevNullIsEmpty) {
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  std::string text;
+  for (int i = 0; i < 200; ++i) text += std::to_string(5000 + 20 * i) + "\t2.50\r\n";
+  ASSERT_EQ(::write(fds[1], text.data(), text.size()), static_cast<ssize_t>(text.size()));
+  ::close(fds[1]);
+  const auto recs = read_recordings("/proc/self/fd/" + std::to_string(fds[0]));
+  ::close(fds[0]);
+  ASSERT_EQ(recs.size(), 1u);
+  EXPECT_EQ(recs[0].size(), 200u);
+
+  const auto null = read_recordings("/dev/null");
+  ASSERT_EQ(null.size(), 1u);
+  EXPECT_TRUE(null[0].empty());
+  EXPECT_TRUE(null[0].has_errors());
 }
