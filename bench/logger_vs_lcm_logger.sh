@@ -4,7 +4,12 @@
 #   A  burst: 4 benches × N messages as fast as the publisher sends, then SIGTERM at once
 #   B  quiet tail: 200 messages at 100 Hz, 2 s of silence, then SIGKILL
 #   C  load: 100 benches at 50 Hz for 10 s (5000 msg/s): CPU of each logger, drops
+#   K  issue 6: KILL_BURST (50,000) messages at full speed, a 200 ms pause, then SIGKILL; with
+#      spindown-logger's default flush interval (0.5 s) and with --flush-interval 0.1. What
+#      spindown-logger must keep: every message sent more than one flush interval before the kill
+#      (counted from the publisher's first/last send time, the burst's rate being uniform).
 # Usage: bench/logger_vs_lcm_logger.sh [BIN_DIR]   (default build/bin)
+# ONLY=K runs scenario K alone.
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BIN=${1:-${SPINDOWN_BIN_DIR:-$ROOT/build/bin}}
@@ -24,9 +29,9 @@ count() {  # count FILE...: SAMPLE messages in LCM logs
   "$BIN/spindown-log-summary" "$@" | python3 -c 'import json,sys; print(json.load(sys.stdin)["sample_messages"])'
 }
 cpu_ticks() { awk '{print $14 + $15}' "/proc/$1/stat"; }
-start_both() {  # start_both DIR
+start_both() {  # start_both DIR [FLUSH_INTERVAL_S]
   mkdir -p "$1/ours" "$1/theirs"
-  "$BIN/spindown-logger" --lcm-url "$URL" --dir "$1/ours" -q 2>"$1/ours.err" &
+  "$BIN/spindown-logger" --lcm-url "$URL" --dir "$1/ours" ${2:+--flush-interval "$2"} -q 2>"$1/ours.err" &
   OURS=$!
   lcm-logger -q --lcm-url="$URL" -c 'SPINDOWN\..*' "$1/theirs/lcmlog.lcm" 2>"$1/theirs.err" &
   THEIRS=$!
@@ -38,6 +43,36 @@ stop_both() {  # stop_both SIGNAL
   wait "$OURS" 2>/dev/null || true
   wait "$THEIRS" 2>/dev/null || true
 }
+
+now_us() { date +%s%6N; }
+json_field() { python3 -c "import json,sys; print(json.load(open(sys.argv[1]))[sys.argv[2]])" "$1" "$2"; }
+
+kill_after_burst() {  # kill_after_burst DIR FLUSH_S (empty = the logger's default, 0.5 s)
+  local n=${KILL_BURST:-50000} flush=${2:-0.5}
+  start_both "$1" "$2"
+  "$BIN/spindown-lcm-publish" --lcm-url "$URL" --bench burst --count "$n" --rate 0 >"$1/pub.json"
+  sleep 0.2
+  local kill_us; kill_us=$(now_us)
+  stop_both KILL
+  local first last protected
+  first=$(json_field "$1/pub.json" first_utime)
+  last=$(json_field "$1/pub.json" last_utime)
+  # Sent before kill − flush interval, at the burst's uniform rate.
+  protected=$(python3 -c "
+n, first, last, edge = $n, $first, $last, $kill_us - $flush * 1e6
+print(n if edge >= last else max(0, int(n * (edge - first) / max(last - first, 1))))")
+  printf '   flush %-4s s  burst %.3f s, kill %.3f s after its end; %d sent > one flush interval before the kill\n' \
+    "$flush" "$(awk "BEGIN{print ($last - $first) / 1e6}")" "$(awk "BEGIN{print ($kill_us - $last) / 1e6}")" "$protected"
+  printf '   %-16s %8s of %d\n' spindown-logger "$(count "$1"/ours/*.lcm)" "$n"
+  printf '   %-16s %8s of %d\n' lcm-logger "$(count "$1"/theirs/*)" "$n"
+}
+
+if [[ ${ONLY:-} == K ]]; then
+  echo "K  ${KILL_BURST:-50000} messages at full speed, 200 ms pause, SIGKILL"
+  kill_after_burst "$WORK/k1" ""
+  kill_after_burst "$WORK/k2" 0.1
+  exit 0
+fi
 
 N=${BURST:-20000}
 echo "A  burst of $((4 * N)) messages (4 benches, publisher at full speed), SIGTERM right after"
@@ -68,3 +103,7 @@ printf '   %-16s %8s of %s messages, CPU %.1f %% of one core\n' spindown-logger 
   "$(awk "BEGIN{print 100 * ($o1 - $o0) / $hz / $secs}")"
 printf '   %-16s %8s of %s messages, CPU %.1f %% of one core\n' lcm-logger "$(count "$WORK"/c/theirs/*)" "$sent" \
   "$(awk "BEGIN{print 100 * ($t1 - $t0) / $hz / $secs}")"
+
+echo "K  ${KILL_BURST:-50000} messages at full speed, 200 ms pause, SIGKILL"
+kill_after_burst "$WORK/k1" ""
+kill_after_burst "$WORK/k2" 0.1
