@@ -27,7 +27,7 @@ RunFit sample_fit() {
 
 TEST(FitMessage, RoundTripKeepsTheReport) {
   const RunFit fit = sample_fit();
-  FitProvenance about{"lab-3", "config", 100, 1500, 0.004};
+  FitProvenance about{"lab-3", "config", 100, 1500, 0.004, std::nullopt};
   const fit_t msg = to_fit_message(fit, about, 123);
   EXPECT_EQ(msg.nmodels, 3);
   EXPECT_EQ(msg.nparams, static_cast<std::int32_t>(msg.param_name.size()));
@@ -56,7 +56,7 @@ TEST(FitMessage, RoundTripKeepsTheReport) {
 }
 
 TEST(FitMessage, InconsistentArraysAreRefused) {
-  fit_t msg = to_fit_message(sample_fit(), {"b", "config", 0, 0, 0}, 0);
+  fit_t msg = to_fit_message(sample_fit(), {"b", "config", 0, 0, 0, std::nullopt}, 0);
   fit_t bad = msg;
   bad.nmodels = 5;
   std::string why;
@@ -71,10 +71,57 @@ TEST(FitMessage, InconsistentArraysAreRefused) {
   EXPECT_NE(why.find("magic"), std::string::npos);
 }
 
+TEST(FitMessage, HealthVerdictTravelsWithTheFit) {
+  const RunFit fit = sample_fit();
+  MotorHealthConfig cfg;
+  cfg.baseline = HealthBaseline{};
+  cfg.baseline->c_viscous = 1.822e-7;
+  cfg.baseline->c_viscous_stderr = 2e-9;
+  cfg.baseline->c_coulomb = 1.1389e-4 / 2.5;  // the run looks like 2.5× its baseline
+  cfg.baseline->c_coulomb_stderr = 2e-7;
+  const HealthVerdict verdict = assess_health(fit, cfg);
+  ASSERT_EQ(verdict.level, HealthLevel::service) << verdict.reason;
+  FitProvenance about{"lab-3", "config", 100, 1500, 0.004, verdict};
+  const fit_t msg = to_fit_message(fit, about, 123);
+  EXPECT_EQ(msg.verdict, "service");
+  EXPECT_EQ(msg.verdict_reason, verdict.reason);
+  EXPECT_TRUE(msg.health_reference);
+  EXPECT_EQ(msg.nfindings, static_cast<std::int32_t>(verdict.findings.size()));
+
+  std::vector<unsigned char> buf(static_cast<std::size_t>(msg.getEncodedSize()));
+  ASSERT_GT(msg.encode(buf.data(), 0, static_cast<int>(buf.size())), 0);
+  fit_t back;
+  ASSERT_GT(back.decode(buf.data(), 0, static_cast<int>(buf.size())), 0);
+  std::string why;
+  const auto again = health_from_fit_message(back, &why);
+  ASSERT_TRUE(again) << why;
+  EXPECT_EQ(health_json(*again).dump(), health_json(verdict).dump());
+  const auto j = fit_message_json(back, {}, &why);
+  ASSERT_TRUE(j) << why;
+  EXPECT_EQ((*j)["health"]["level"], "service");
+
+  // Without a bench file: no verdict, no "health" in the JSON.
+  const fit_t plain = to_fit_message(fit, {"lab-3", "config", 100, 1500, 0.004, std::nullopt}, 123);
+  EXPECT_EQ(plain.verdict, "");
+  EXPECT_EQ(plain.nfindings, 0);
+  EXPECT_FALSE(health_from_fit_message(plain));
+  EXPECT_FALSE(fit_message_json(plain)->contains("health"));
+
+  // Inconsistent finding arrays or an unknown level are refused with a reason.
+  fit_t bad = back;
+  bad.nfindings += 1;
+  EXPECT_FALSE(health_from_fit_message(bad, &why));
+  EXPECT_NE(why.find("nfindings"), std::string::npos);
+  bad = back;
+  bad.finding_level[0] = "doomed";
+  EXPECT_FALSE(fit_message_json(bad, {}, &why));
+  EXPECT_NE(why.find("doomed"), std::string::npos);
+}
+
 TEST(FitMessage, NeverStoppedRunHasNanStop) {
   RunFit fit = sample_fit();
   fit.run.stopped = false;
-  const fit_t msg = to_fit_message(fit, {"b", "config", 0, 0, 0}, 0);
+  const fit_t msg = to_fit_message(fit, {"b", "config", 0, 0, 0, std::nullopt}, 0);
   EXPECT_TRUE(std::isnan(msg.t_stop_s));
   const auto back = from_fit_message(msg);
   ASSERT_TRUE(back);

@@ -143,6 +143,23 @@ fit_t make_fit() {
   // Fields added to fit_t later: filled when this version of the type has them.
   if constexpr (requires { m.model_samples; }) m.model_samples = {1400, 1400, 1399};
   if constexpr (requires { m.model_message; }) m.model_message = {"", "", "did not converge: max evaluations"};
+  if constexpr (requires { m.nfindings; }) {  // motor health: one finding with its numbers
+    m.verdict = "service";
+    m.verdict_reason = "dry friction 2.5× the baseline: check bearings and alignment";
+    m.health_reference = true;
+    m.nfindings = 1;
+    m.finding_what = {"dry friction"};
+    m.finding_level = {"service"};
+    m.finding_reason = {m.verdict_reason};
+    m.finding_value = {2.85e-4};
+    m.finding_stderr = {1e-6};
+    m.finding_reference = {1.14e-4};
+    m.finding_reference_stderr = {4e-7};
+    m.finding_reference_name = {"baseline"};
+    m.finding_ratio = {2.5};
+    m.finding_ratio_stderr = {0.012};
+    m.finding_unit = {"N*m"};
+  }
   return m;
 }
 
@@ -253,6 +270,13 @@ TEST(LcmTypes, FitRoundTrip) {
   EXPECT_EQ(b.param_value, m.param_value);
   EXPECT_EQ(b.param_unit, m.param_unit);
   EXPECT_EQ(b.best, "combined");
+  EXPECT_EQ(b.verdict, "service");
+  EXPECT_TRUE(b.health_reference);
+  EXPECT_EQ(b.nfindings, 1);
+  EXPECT_EQ(b.finding_what, m.finding_what);
+  EXPECT_EQ(b.finding_reason, m.finding_reason);  // UTF-8 (×) survives
+  EXPECT_EQ(b.finding_ratio, m.finding_ratio);
+  EXPECT_EQ(b.finding_reference_name, m.finding_reference_name);
 }
 
 TEST(LcmTypes, ExplainRoundTrip) {

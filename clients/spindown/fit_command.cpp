@@ -7,13 +7,17 @@
 #include <exception>
 #include <fmt/format.h>
 #include <iostream>
+#include <map>
 #include <memory>
+#include <stdexcept>
 #include <string>
 
 #include "exit_codes.hpp"
 #include "spindown/bench.hpp"
+#include "spindown/bench_file.hpp"
 #include "spindown/fit.hpp"
 #include "spindown/fit_report.hpp"
+#include "spindown/motor_health.hpp"
 #include "spindown/read_recording.hpp"
 #include "spindown/runs.hpp"
 
@@ -27,12 +31,25 @@ struct FitPlan {
   FitOptions fit;
   bool bench_from_user = false;  // J or K_b given on the command line: never taken from a log's config
   ReportOptions report;
+  BenchFiles bench_files;        // --bench-config, by bench id
+  bool inertia_from_user = false, kb_from_user = false;  // flags win over a bench file
 };
+
+// The bench file for a recording: its bench id's (LCM logs), or the only one given (text files).
+const BenchFile* bench_file_for(const FitPlan& plan, const std::string& bench) {
+  if (!bench.empty()) {
+    auto it = plan.bench_files.files.find(bench);
+    return it == plan.bench_files.files.end() ? nullptr : &it->second;
+  }
+  return plan.bench_files.files.size() == 1 ? &plan.bench_files.files.begin()->second : nullptr;
+}
 
 FitPlan plan_from(const FitCommandOptions& o) {
   FitPlan plan;
   plan.fit.bench = bench_from(o.input);
   plan.bench_from_user = o.input.bench_from_user();
+  plan.inertia_from_user = o.input.inertia_given || o.input.flywheel_given;
+  plan.kb_from_user = o.input.kb_given || o.input.speed_constant_given;
   std::string why;
   if (!o.models.empty()) {
     plan.fit.models.clear();
@@ -49,6 +66,11 @@ FitPlan plan_from(const FitCommandOptions& o) {
   if (!plan.fit.is_valid(&why)) bad_usage(why);
 
   plan.read = read_options_from(o.input);
+  try {
+    plan.bench_files = load_bench_files(o.bench_configs);
+  } catch (const std::exception& e) {
+    bad_usage(fmt::format("--bench-config: {}", e.what()));
+  }
 
   plan.report.lab_units = o.lab_units;
   plan.report.max_diagnostics = o.verbose ? 0 : 8;
@@ -90,6 +112,22 @@ FileFit fit_file(const std::string& path, const FitPlan& plan) {
           out.diagnostics.push_back({Diagnostic::Severity::warning, rec.source, 0,
                                      fmt::format("bench config not used ({}); lab defaults assumed", why)});
       }
+      // A bench file's [bench] J and K_b win over the log's CONFIG; flags win over both.
+      const BenchFile* bench_file = bench_file_for(plan, k < info.size() ? info[k].bench : std::string{});
+      if (bench_file) {
+        if (bench_file->sets_inertia && !plan.inertia_from_user) {
+          fit_opt.bench.inertia_kg_m2 = bench_file->params.inertia_kg_m2;
+          fit_opt.bench.inertia_source = bench_file->params.inertia_source + " (" + bench_file->path + ")";
+        }
+        if (bench_file->sets_kb && !plan.kb_from_user) {
+          fit_opt.bench.kb_v_s_per_rad = bench_file->params.kb_v_s_per_rad;
+          fit_opt.bench.kb_source = bench_file->params.kb_source + " (" + bench_file->path + ")";
+        }
+      } else if (!plan.bench_files.files.empty()) {
+        out.diagnostics.push_back({Diagnostic::Severity::warning, rec.source, 0,
+                                   fmt::format("no --bench-config file for bench '{}': no health verdict",
+                                               k < info.size() ? info[k].bench : std::string{})});
+      }
       const Segmentation seg = find_runs(rec);
       out.diagnostics.insert(out.diagnostics.end(), seg.diagnostics.begin(), seg.diagnostics.end());
       if (seg.runs.empty()) {
@@ -103,6 +141,10 @@ FileFit fit_file(const std::string& path, const FitPlan& plan) {
           for (const auto& m : fit.models)
             if (!m.message.empty()) why += fmt::format("; {}: {}", model_name(m.kind), m.message);
           out.failures.push_back(where + fmt::format("run {}: no model converged{}", run.number, why));
+        }
+        if (bench_file) {
+          out.health.resize(out.runs.size());
+          out.health.push_back(assess_health(fit, bench_file->health));
         }
         out.runs.push_back(std::move(fit));
       }
@@ -143,6 +185,10 @@ void setup_fit(CLI::App& app) {
   sub->add_flag("--lab-units", opt->lab_units, "Also give the lab's units (g·cm², g·cm²·s⁻¹, g·cm²·rad·s⁻²)");
   sub->add_flag("-v,--verbose", opt->verbose, "Show every diagnostic, notes included");
 
+  sub->add_option("--bench-config", opt->bench_configs,
+                  "Per-bench TOML file(s): [bench] J/K_b (flags win) and [motor]/[baseline]/[health] for the "
+                  "motor health verdict; a directory means every *.toml in it")
+      ->check(CLI::ExistingPath);
   auto note_given = add_input_options(sub, opt->input);
 
   sub->callback([opt, note_given]() {

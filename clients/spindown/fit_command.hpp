@@ -19,6 +19,9 @@ struct FitCommandOptions {
   bool verbose = false;  // every diagnostic, notes included
   std::vector<std::string> models;  // names; empty = all
   InputOptions input;  // the bench and delimited-text columns
+  // Per-bench TOML files ([bench] J/K_b unless given as flags; [motor], [baseline], [health]
+  // for the motor health verdict printed after each run).
+  std::vector<std::string> bench_configs;
 };
 
 void setup_fit(CLI::App& app);

@@ -4,6 +4,7 @@
 #include <exception>
 #include <iostream>
 
+#include "baseline_command.hpp"
 #include "exit_codes.hpp"
 #include "explain_command.hpp"
 #include "fit_command.hpp"
@@ -21,6 +22,7 @@ int main(int argc, char** argv) {
   spindown::cli::setup_refit(app);
   spindown::cli::setup_export(app);
   spindown::cli::setup_watch(app);
+  spindown::cli::setup_baseline(app);
   spindown::cli::setup_report(app);
   spindown::cli::setup_doctor(app);
   try {

@@ -58,8 +58,30 @@ fit_t to_fit_message(const RunFit& fit, const FitProvenance& about, std::int64_t
   }
   m.best = fit.best;
   m.best_reason = fit.best_reason;
-  m.verdict = "";  // no reference configured: the health verdict belongs to a later stage
+  m.verdict = "";  // not assessed: the fitter has no bench file for this bench
   m.verdict_reason = "";
+  m.health_reference = false;
+  m.nfindings = 0;
+  if (about.health) {
+    const HealthVerdict& h = *about.health;
+    m.verdict = std::string(health_level_name(h.level));
+    m.verdict_reason = h.reason;
+    m.health_reference = h.has_reference;
+    for (const HealthFinding& f : h.findings) {
+      m.finding_what.push_back(f.what);
+      m.finding_level.emplace_back(health_level_name(f.level));
+      m.finding_reason.push_back(f.reason);
+      m.finding_value.push_back(f.value);
+      m.finding_stderr.push_back(f.std_error);
+      m.finding_reference.push_back(f.reference);
+      m.finding_reference_stderr.push_back(f.reference_std_error);
+      m.finding_reference_name.push_back(f.reference_name);
+      m.finding_ratio.push_back(f.ratio);
+      m.finding_ratio_stderr.push_back(f.ratio_std_error);
+      m.finding_unit.push_back(f.unit);
+      ++m.nfindings;
+    }
+  }
   m.latency_s = about.latency_s;
   m.inertia_source = fit.bench.inertia_source;
   m.kb_source = fit.bench.kb_source;
@@ -139,6 +161,50 @@ std::optional<RunFit> from_fit_message(const fit_t& m, std::string* why) {
   return fit;
 }
 
+std::optional<HealthVerdict> health_from_fit_message(const fit_t& m, std::string* why) {
+  if (m.verdict.empty()) return std::nullopt;
+  const auto n = static_cast<std::size_t>(std::max(m.nfindings, 0));
+  if (m.nfindings < 0 || m.finding_what.size() != n || m.finding_level.size() != n || m.finding_reason.size() != n ||
+      m.finding_value.size() != n || m.finding_stderr.size() != n || m.finding_reference.size() != n ||
+      m.finding_reference_stderr.size() != n || m.finding_reference_name.size() != n || m.finding_ratio.size() != n ||
+      m.finding_ratio_stderr.size() != n || m.finding_unit.size() != n) {
+    fail(why, fmt::format("FIT of bench {} run {}: health finding arrays do not match nfindings {}", m.bench, m.run,
+                          m.nfindings));
+    return std::nullopt;
+  }
+  const auto level = parse_health_level(m.verdict);
+  if (!level) {
+    fail(why, fmt::format("FIT of bench {} run {}: unknown health verdict '{}'", m.bench, m.run, m.verdict));
+    return std::nullopt;
+  }
+  HealthVerdict v;
+  v.level = *level;
+  v.reason = m.verdict_reason;
+  v.has_reference = m.health_reference;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto fl = parse_health_level(m.finding_level[i]);
+    if (!fl) {
+      fail(why, fmt::format("FIT of bench {} run {}: unknown health level '{}' of finding '{}'", m.bench, m.run,
+                            m.finding_level[i], m.finding_what[i]));
+      return std::nullopt;
+    }
+    HealthFinding f;
+    f.what = m.finding_what[i];
+    f.level = *fl;
+    f.reason = m.finding_reason[i];
+    f.value = m.finding_value[i];
+    f.std_error = m.finding_stderr[i];
+    f.reference = m.finding_reference[i];
+    f.reference_std_error = m.finding_reference_stderr[i];
+    f.reference_name = m.finding_reference_name[i];
+    f.ratio = m.finding_ratio[i];
+    f.ratio_std_error = m.finding_ratio_stderr[i];
+    f.unit = m.finding_unit[i];
+    v.findings.push_back(std::move(f));
+  }
+  return v;
+}
+
 std::optional<Json> fit_message_json(const fit_t& msg, const ReportOptions& opt, std::string* why) {
   auto fit = from_fit_message(msg, why);
   if (!fit) return std::nullopt;
@@ -146,6 +212,11 @@ std::optional<Json> fit_message_json(const fit_t& msg, const ReportOptions& opt,
   j["bench"]["id"] = msg.bench;
   j["first_seq"] = msg.first_seq;
   j["last_seq"] = msg.last_seq;
+  if (!msg.verdict.empty()) {
+    auto health = health_from_fit_message(msg, why);
+    if (!health) return std::nullopt;
+    j["health"] = health_json(*health);
+  }
   return j;
 }
 

@@ -232,9 +232,32 @@ Json run_fit_json(const RunFit& fit, const ReportOptions& opt) {
   return j;
 }
 
+Json health_json(const HealthVerdict& v) {
+  Json findings = Json::array();
+  for (const auto& f : v.findings)
+    findings.push_back({{"what", f.what},
+                        {"level", health_level_name(f.level)},
+                        {"reason", f.reason},
+                        {"value", number(f.value)},
+                        {"stderr", number(f.std_error)},
+                        {"reference", number(f.reference)},
+                        {"reference_stderr", number(f.reference_std_error)},
+                        {"reference_name", f.reference_name},
+                        {"ratio", number(f.ratio)},
+                        {"ratio_stderr", number(f.ratio_std_error)},
+                        {"unit", f.unit}});
+  return Json{{"level", health_level_name(v.level)},
+              {"reason", v.reason},
+              {"has_reference", v.has_reference},
+              {"findings", std::move(findings)}};
+}
+
 Json file_fit_json(const FileFit& file, const ReportOptions& opt) {
   Json runs = Json::array();
-  for (const auto& r : file.runs) runs.push_back(run_fit_json(r, opt));
+  for (std::size_t i = 0; i < file.runs.size(); ++i) {
+    runs.push_back(run_fit_json(file.runs[i], opt));
+    if (i < file.health.size() && file.health[i]) runs.back()["health"] = health_json(*file.health[i]);
+  }
   Json diagnostics = Json::array();
   for (const auto& d : file.diagnostics)
     diagnostics.push_back({{"severity", severity_name(d.severity)}, {"line", d.line}, {"message", d.message}});
@@ -328,7 +351,10 @@ std::string format_file_fit(const FileFit& file, const ReportOptions& opt) {
     for (const auto& line : summarize_diagnostics(file.diagnostics, opt.max_diagnostics)) out += "  " + line + '\n';
     for (const auto& why : file.failures) out += fmt::format("  not used: {}\n", why);
   }
-  for (const auto& r : file.runs) out += '\n' + format_run_fit(r, opt);
+  for (std::size_t i = 0; i < file.runs.size(); ++i) {
+    out += '\n' + format_run_fit(file.runs[i], opt);
+    if (i < file.health.size() && file.health[i]) out += format_health_verdict(*file.health[i]);
+  }
   return out;
 }
 

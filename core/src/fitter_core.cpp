@@ -531,6 +531,14 @@ void FitterCore::fit_and_publish(Bench& b, const Run& run, std::int64_t recv_uti
     ++counters_.fit_failures;
     error(fmt::format("{}: run {}: no model converged", b.channel, run.number), recv_utime);
   }
+  if (auto h = opt_.health.find(b.id); h != opt_.health.end()) {
+    try {
+      r.health = assess_health(r.fit, h->second);
+    } catch (const std::exception& e) {
+      ++counters_.internal_errors;
+      error(fmt::format("{}: run {}: the health verdict failed: {}", b.channel, run.number, e.what()), recv_utime);
+    }
+  }
   r.t_s = scratch_t_;
   r.value = scratch_v_;
   ++counters_.fits;

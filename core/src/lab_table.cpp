@@ -51,6 +51,7 @@ std::string fit_text(const LabBenchRow& r) {
   std::string s = fmt::format("run {} {}", r.fit_run, r.best);
   if (!r.coefficients.empty()) s += ": " + r.coefficients;
   if (r.bench_source != "config" && !r.bench_source.empty()) s += " (default J/K_b)";
+  if (!r.health.empty()) s += "; health " + r.health;
   return s;
 }
 
@@ -257,6 +258,8 @@ void LabTable::on_fit(std::string_view bench, const fit_t& msg, std::int64_t now
     if (msg.model[i] == msg.best) r.rmse = msg.rmse[i];
   r.residual_unit = msg.residual_unit;
   r.bench_source = msg.bench_source;
+  r.health = msg.verdict;
+  r.health_reason = msg.verdict_reason;
   std::string text;
   if (msg.best.empty()) {
     text = fmt::format("{}: run {} fit: no model converged", r.bench, msg.run);
@@ -266,6 +269,7 @@ void LabTable::on_fit(std::string_view bench, const fit_t& msg, std::int64_t now
     if (std::isfinite(r.rmse)) text += fmt::format(", RMSE {:.3g} {}", r.rmse, r.residual_unit);
   }
   if (!msg.bench_source.empty() && msg.bench_source != "config") text += fmt::format(" [J/K_b: {}]", msg.bench_source);
+  if (!msg.verdict.empty()) text += fmt::format("; health {}: {}", msg.verdict, msg.verdict_reason);
   event(std::move(text));
 }
 

@@ -87,13 +87,15 @@ double ratio_se(double a, double sa, double b, double sb) {
   return std::fabs(r) * std::hypot(sa / a, sb / b);
 }
 
-// Flagged only when the ratio clears a threshold by significance_sigma standard errors.
+// Flagged when the ratio is past a threshold and significant: it differs from 1 (the motor as
+// the reference describes it) by more than significance_sigma standard errors, so a ratio that
+// is past the threshold only by noise is not flagged.
 HealthLevel level_for_ratio(double r, double sr, const HealthThresholds& th) {
-  const double low = r - th.significance_sigma * sr;
-  const double high = r + th.significance_sigma * sr;
-  if (low >= th.service_ratio) return HealthLevel::service;
-  if (low >= th.check_ratio) return HealthLevel::check;
-  if (high <= 1.0 / th.check_ratio) return HealthLevel::check;  // far lower than expected: suspicious too
+  const bool significant = std::fabs(r - 1.0) > th.significance_sigma * sr;
+  if (!significant) return HealthLevel::ok;
+  if (r >= th.service_ratio) return HealthLevel::service;
+  if (r >= th.check_ratio) return HealthLevel::check;
+  if (r <= 1.0 / th.check_ratio) return HealthLevel::check;  // far lower than expected: suspicious too
   return HealthLevel::ok;
 }
 

@@ -84,15 +84,20 @@ void FitterService::fit_ready(const FitResult& r) {
   about.last_seq = r.last_seq;
   const std::int64_t now = wall_us();
   about.latency_s = 1e-6 * double(now - r.detected_utime);
+  about.health = r.health;
   const fit_t msg = to_fit_message(r.fit, about, now);
   if (lcm_.publish(channel_name(r.bench, ChannelKind::fit), &msg) != 0) ++publish_failures_;
   last_latency_s_ = about.latency_s;
   max_latency_s_ = std::max(max_latency_s_, about.latency_s);
   last_fit_s_ = r.fit_seconds;
-  if (opt_.verbose)
+  if (opt_.verbose) {
     fmt::print(stderr, "spindown-fitter: {} run {} fitted: best {} ({} samples, fit {:.1f} ms, latency {:.1f} ms)\n",
                r.bench, r.fit.run.number, r.fit.best.empty() ? "none" : r.fit.best, msg.samples, 1e3 * r.fit_seconds,
                1e3 * about.latency_s);
+    if (r.health)
+      fmt::print(stderr, "spindown-fitter: {} run {} health: {} — {}\n", r.bench, r.fit.run.number,
+                 health_level_name(r.health->level), r.health->reason);
+  }
   publish_explain(r);
 }
 

@@ -9,6 +9,7 @@
 
 #include "fitter_service.hpp"
 #include "spindown/bench.hpp"
+#include "spindown/bench_file.hpp"
 #include "spindown/effects.hpp"
 #include "spindown/fit.hpp"
 #include "spindown/lcm_channels.hpp"
@@ -35,6 +36,7 @@ int main(int argc, char** argv) {
   std::vector<std::string> models;
   double kv = 0;
   long recv_buf = 4 << 20;
+  std::vector<std::string> bench_configs;
   app.add_option("--lcm-url", o.lcm_url, "LCM URL (default: LCM_DEFAULT_URL or LCM's default)");
   app.add_option("--recv-buf", recv_buf, "udpm receive buffer bytes added to the URL (0 = leave the URL alone)");
   app.add_option("--bench", o.core.bench_regex, "benches to fit: regex on the bench id (default all)");
@@ -65,6 +67,9 @@ int main(int argc, char** argv) {
                  "viscous|coulomb|combined|EFFECT,EFFECT… (default: viscous, the lab's belief)");
   bool no_explain = false;
   app.add_flag("--no-explain", no_explain, "do not run the discrepancy workflow (no EXPLAIN messages)");
+  app.add_option("--bench-config", bench_configs,
+                 "per-bench TOML file(s) or a directory of them (/etc/spindown/benches): [motor], [baseline], "
+                 "[health] give each fit of that bench a motor health verdict");
   app.add_flag("-v,--verbose", o.verbose, "one line per run event and fit on stderr");
   CLI11_PARSE(app, argc, argv);
 
@@ -86,6 +91,12 @@ int main(int argc, char** argv) {
     }
   }
   std::string why;
+  try {
+    for (auto& [bench, file] : spindown::load_bench_files(bench_configs).files) o.core.health.emplace(bench, file.health);
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "spindown-fitter: --bench-config: {}\n", e.what());
+    return 2;
+  }
   if (no_explain) {
     o.explain_base.clear();
   } else {
@@ -110,5 +121,10 @@ int main(int argc, char** argv) {
   std::signal(SIGTERM, on_signal);
   fmt::print(stderr, "spindown-fitter: fitting benches matching '{}'{}; heartbeat on SPINDOWN.{}.STATUS\n",
              o.core.bench_regex, o.lcm_url.empty() ? "" : " on " + o.lcm_url, o.instance);
+  if (!o.core.health.empty()) {
+    std::string benches;
+    for (const auto& [bench, cfg] : o.core.health) benches += (benches.empty() ? "" : ", ") + bench;
+    fmt::print(stderr, "spindown-fitter: motor health verdicts for {}\n", benches);
+  }
   return service.run(g_stop);
 }

@@ -14,6 +14,7 @@
 
 #include "spindown/fit.hpp"
 #include "spindown/fit_report.hpp"
+#include "spindown/motor_health.hpp"
 #include "spindown/runs.hpp"
 
 namespace spindown {
@@ -25,6 +26,7 @@ struct FitProvenance {
   std::int64_t first_seq = 0; // sequence numbers of the run's first and last sample
   std::int64_t last_seq = 0;
   double latency_s = 0;       // host seconds from detection to publishing (0 offline)
+  std::optional<HealthVerdict> health;  // the motor health verdict, when the bench has a bench file
 };
 
 fit_t to_fit_message(const RunFit& fit, const FitProvenance& about, std::int64_t utime);
@@ -33,8 +35,12 @@ fit_t to_fit_message(const RunFit& fit, const FitProvenance& about, std::int64_t
 // and *why when the arrays are inconsistent (sizes, a parameter of a model that is not there,
 // an unknown model name).
 std::optional<RunFit> from_fit_message(const fit_t& msg, std::string* why = nullptr);
+// The health verdict a fit_t carries: nullopt when it was not assessed (verdict ""), or when
+// the finding arrays are inconsistent or a level unknown (then *why says so).
+std::optional<HealthVerdict> health_from_fit_message(const fit_t& msg, std::string* why = nullptr);
 
-// run_fit_json() of the message, plus "bench" -> "id" and "first_seq"/"last_seq"; nullopt and
+// run_fit_json() of the message, plus "bench" -> "id", "first_seq"/"last_seq" and "health" when
+// the message carries a verdict; nullopt and
 // *why when the message is inconsistent.
 std::optional<Json> fit_message_json(const fit_t& msg, const ReportOptions& opt = {}, std::string* why = nullptr);
 

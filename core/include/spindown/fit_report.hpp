@@ -3,6 +3,7 @@
 // (model | curve constants | coefficients ± standard error | RMSE | R² | BIC | predicted
 // stop), plus which model fits best and why. Shared by `spindown fit` and the live fitter.
 #include <cstddef>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -10,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "spindown/fit.hpp"
+#include "spindown/motor_health.hpp"
 #include "spindown/recording.hpp"
 
 namespace spindown {
@@ -21,6 +23,9 @@ struct FileFit {
   std::size_t lines_read = 0, lines_skipped = 0;
   std::vector<Diagnostic> diagnostics;  // reading, segmentation and fitting problems
   std::vector<RunFit> runs;
+  // Motor health verdict per run (same order as runs) when a bench file was given; empty or
+  // nullopt entries: not assessed (no "health" in JSON).
+  std::vector<std::optional<HealthVerdict>> health;
   // Why the file, or a run in it, could not be used; non-empty means exit code 1.
   std::vector<std::string> failures;
   bool usable() const { return failures.empty(); }
@@ -40,6 +45,10 @@ using Json = nlohmann::ordered_json;
 // "residual_unit":…,"r2":…,"aic":…,"bic":…}],"best":…}]}]}, plus extra fields (never fewer).
 // Non-finite numbers become null.
 Json run_fit_json(const RunFit& fit, const ReportOptions& opt = {});
+// A run's "health" object: {"level":"ok"|"check"|"service","reason":…,"has_reference":…,
+// "findings":[{"what":…,"level":…,"reason":…,"value":…,"stderr":…,"reference":…,
+// "reference_stderr":…,"reference_name":…,"ratio":…,"ratio_stderr":…,"unit":…}]}.
+Json health_json(const HealthVerdict& verdict);
 Json file_fit_json(const FileFit& file, const ReportOptions& opt = {});
 Json fit_report_json(std::span<const FileFit> files, const ReportOptions& opt = {});
 

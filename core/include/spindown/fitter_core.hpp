@@ -31,6 +31,7 @@
 
 #include "spindown/bench.hpp"
 #include "spindown/fit.hpp"
+#include "spindown/motor_health.hpp"
 #include "spindown/recording.hpp"
 #include "spindown/run_detector.hpp"
 #include "spindown/runs.hpp"
@@ -46,6 +47,9 @@ struct FitterOptions {
   std::size_t max_benches = 256;         // more: the least recently active bench is evicted
   double max_rate_hz = 5000;             // samples per second per bench (host time); 0 = no cap
   double burst_s = 2.0;                  // the cap's bucket holds this many seconds of samples
+  // Motor health references per bench id (the benches' TOML files): each fit of such a bench
+  // carries a verdict (FitResult::health); other benches' fits carry none.
+  std::map<std::string, MotorHealthConfig, std::less<>> health;
   bool is_valid(std::string* why) const;
 };
 
@@ -87,6 +91,7 @@ struct FitResult {
   std::int64_t first_seq = 0, last_seq = 0;
   std::int64_t detected_utime = 0; // receive time of the message that completed the run
   double fit_seconds = 0;          // CPU-clock time the fit took
+  std::optional<HealthVerdict> health;  // when FitterOptions::health has the bench
   std::span<const double> t_s;     // the run's samples [cut, end), valid during the call only
   std::span<const double> value;
 };

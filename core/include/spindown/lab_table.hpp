@@ -54,6 +54,8 @@ struct LabBenchRow {
   double rmse = 0;
   std::string residual_unit;
   std::string bench_source;          // "config" or why a default J/K_b was used
+  std::string health;                // motor health verdict "ok"/"check"/"service" ("" when not assessed)
+  std::string health_reason;         // its reason in words
 
   // From the bridge's SPINDOWN.<bench>.STATUS.
   bool has_bridge = false;

@@ -14,8 +14,8 @@
 //              two diagnosis rules as explicit limits: max_slowdown_s (too long to slow down:
 //              time to lose slowdown_fraction of the speed) and max_stop_s (too long to stop).
 //
-// A ratio is flagged only when it is beyond its threshold by more than significance_sigma
-// standard errors (noise alone never flags a motor). Without a datasheet or a baseline the
+// A ratio is flagged only when it is past its threshold and significant: it differs from 1 by
+// more than significance_sigma standard errors (a ratio past the threshold by noise is not). Without a datasheet or a baseline the
 // verdict says there is no reference (has_reference = false) instead of inventing one; the lab's
 // time rules still apply.
 #include <optional>
@@ -62,7 +62,7 @@ struct HealthBaseline {
 struct HealthThresholds {
   double check_ratio = 1.5;         // friction this many times the reference: "check"
   double service_ratio = 2.5;       // … this many times: "service"
-  double significance_sigma = 2.0;  // a ratio must clear its threshold by this many standard errors
+  double significance_sigma = 2.0;  // a ratio must differ from 1 by this many standard errors
   // The lab report's rules. Too long to slow down: the motor needs more than max_slowdown_s to
   // lose slowdown_fraction of its speed at the cut. Too long to stop: more than max_stop_s from
   // the cut to standstill (measured stop, else the best model's prediction).

@@ -1,0 +1,233 @@
+#include "baseline_command.hpp"
+
+#include <CLI/CLI.hpp>
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <exception>
+#include <filesystem>
+#include <fmt/format.h>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <optional>
+#include <sstream>
+
+#include "exit_codes.hpp"
+#include "spindown/bench_file.hpp"
+#include "spindown/fit.hpp"
+#include "spindown/fit_report.hpp"
+#include "spindown/health_baseline.hpp"
+#include "spindown/lcm_channels.hpp"
+#include "spindown/lcm_log_reader.hpp"
+#include "spindown/read_recording.hpp"
+#include "spindown/runs.hpp"
+
+namespace spindown::cli {
+
+namespace {
+
+std::string today_utc() {
+  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  std::tm utc{};
+  ::gmtime_r(&now, &utc);
+  return fmt::format("{:04}-{:02}-{:02}", utc.tm_year + 1900, utc.tm_mon + 1, utc.tm_mday);
+}
+
+// Writes text to path through a temporary file in the same directory, so a reader never sees
+// half a file. false and *why on failure.
+bool write_file(const std::string& path, const std::string& text, std::string* why) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) {
+      *why = fmt::format("cannot write {}", tmp);
+      return false;
+    }
+    out << text;
+    out.flush();
+    if (!out) {
+      *why = fmt::format("cannot write {}", tmp);
+      return false;
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    *why = fmt::format("cannot replace {}: {}", path, ec.message());
+    std::filesystem::remove(tmp, ec);
+    return false;
+  }
+  return true;
+}
+
+std::optional<std::string> read_text(const std::string& path, std::string* why) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    *why = fmt::format("cannot read {}", path);
+    return std::nullopt;
+  }
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+}  // namespace
+
+void setup_baseline(CLI::App& app) {
+  auto opt = std::make_shared<BaselineCommandOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "baseline", "Make a motor's health baseline from good runs (combined fits that converged) of one bench");
+  sub->footer(
+      "Writes the [baseline] section of the bench's TOML file: --update replaces it in place (other keys and "
+      "comments kept; [bench] J/K_b of that file used for the fits), -o writes a new file, neither prints it.\n"
+      "Exit codes: 0 ok, 1 no good run or the file could not be written, 2 bad usage.");
+  sub->add_option("FILE", opt->files, "LCM log, Arduino/PuTTY log or delimited text with the bench's good runs")
+      ->required();
+  sub->add_option("--bench", opt->bench, "Bench id: the bench in an LCM log; names the bench in the file")
+      ->required();
+  auto* out = sub->add_option("-o,--output", opt->output, "Write a new bench file (refused if it exists)");
+  sub->add_option("--update", opt->update, "Replace [baseline] in this existing bench file")
+      ->check(CLI::ExistingFile)
+      ->excludes(out);
+  sub->add_option("--date", opt->date, "Date recorded in the baseline (default today, UTC)");
+  auto note_given = add_input_options(sub, opt->input);
+  sub->callback([opt, note_given]() {
+    note_given();
+    const int code = run_baseline(*opt);
+    if (code != exit_ok) throw CLI::RuntimeError(code);
+  });
+}
+
+int run_baseline(const BaselineCommandOptions& o) {
+  std::string why;
+  if (!is_valid_bench_id(o.bench, &why)) bad_usage(fmt::format("--bench: {}", why));
+  if (!o.output.empty() && std::filesystem::exists(o.output))
+    bad_usage(fmt::format("-o {}: the file exists; use --update {} to replace its [baseline]", o.output, o.output));
+
+  // J and K_b: flags, else the bench file being updated, else an LCM log's CONFIG, else the lab's.
+  FitOptions fit_opt;
+  fit_opt.models = {ModelKind::combined};
+  fit_opt.bench = bench_from(o.input);
+  const bool inertia_from_user = o.input.inertia_given || o.input.flywheel_given;
+  const bool kb_from_user = o.input.kb_given || o.input.speed_constant_given;
+  bool bench_from_file = false;
+  if (!o.update.empty()) {
+    try {
+      const BenchFile f = load_bench_file(o.update);
+      if (f.bench != o.bench)
+        std::cerr << fmt::format("{}: warning: the file describes bench '{}', the baseline is for --bench {}\n",
+                                 o.update, f.bench, o.bench);
+      if (f.sets_inertia && !inertia_from_user) {
+        fit_opt.bench.inertia_kg_m2 = f.params.inertia_kg_m2;
+        fit_opt.bench.inertia_source = f.params.inertia_source;
+        bench_from_file = true;
+      }
+      if (f.sets_kb && !kb_from_user) {
+        fit_opt.bench.kb_v_s_per_rad = f.params.kb_v_s_per_rad;
+        fit_opt.bench.kb_source = f.params.kb_source;
+        bench_from_file = true;
+      }
+    } catch (const std::exception& e) {
+      bad_usage(fmt::format("--update: {}", e.what()));
+    }
+  }
+  const bool bench_fixed = inertia_from_user || kb_from_user || bench_from_file;
+  const ReadOptions read = read_options_from(o.input);
+
+  std::vector<BaselineRun> good;
+  std::size_t runs_seen = 0;
+  bool all_read = true;
+  for (const auto& path : o.files) {
+    std::vector<RecordingInfo> info;
+    const auto recordings = read_recordings(path, read, &info);
+    bool bench_found = false;
+    for (std::size_t k = 0; k < recordings.size(); ++k) {
+      const Recording& rec = recordings[k];
+      const RecordingInfo* about = k < info.size() ? &info[k] : nullptr;
+      if (about && !about->bench.empty() && about->bench != o.bench) continue;  // another bench in the log
+      bench_found = true;
+      for (const auto& d : rec.diagnostics)
+        if (d.severity == Diagnostic::Severity::error) std::cerr << d.to_string() << '\n';
+      if (rec.empty()) {
+        all_read = false;
+        continue;
+      }
+      FitOptions this_fit = fit_opt;
+      if (!bench_fixed && about && about->config)
+        if (auto b = bench_params_from_config(*about->config)) this_fit.bench = *b;
+      const Segmentation seg = find_runs(rec);
+      if (seg.runs.empty()) std::cerr << fmt::format("{}: no spin-down run found\n", path);
+      for (const Run& run : seg.runs) {
+        ++runs_seen;
+        const RunFit fit = fit_run(rec, run, this_fit);
+        const std::string source = fmt::format("{} run {}", path, run.number);
+        if (auto r = baseline_run(fit, source, &why)) {
+          std::cout << fmt::format("  used     {}: c_v = {} N·m·s/rad, c_c = {} N·m\n", source,
+                                   format_value_error(r->c_viscous, r->c_viscous_stderr),
+                                   format_value_error(r->c_coulomb, r->c_coulomb_stderr));
+          good.push_back(*r);
+        } else {
+          std::cout << fmt::format("  not used {}: {}\n", source, why);
+        }
+      }
+    }
+    if (!bench_found) {
+      std::cerr << fmt::format("{}: error: no samples of bench '{}' in this file\n", path, o.bench);
+      all_read = false;
+    }
+  }
+
+  std::string source = fmt::format("bench {}:", o.bench);
+  for (const auto& f : o.files) source += " " + std::filesystem::path(f).filename().string();
+  const auto baseline = make_baseline(good, o.date.empty() ? today_utc() : o.date, source, &why);
+  if (!baseline) {
+    std::cerr << fmt::format("spindown baseline: error: {} ({} run{} seen)\n", why, runs_seen,
+                             runs_seen == 1 ? "" : "s");
+    return exit_unusable;
+  }
+  std::cout << fmt::format(
+      "baseline of bench {} from {} of {} run{}: c_v = {} N·m·s/rad (spread {:.2g}), c_c = {} N·m (spread {:.2g}), "
+      "J = {:.6g} kg·m²\n",
+      o.bench, baseline->runs, runs_seen, runs_seen == 1 ? "" : "s",
+      format_value_error(baseline->c_viscous, baseline->c_viscous_stderr), baseline->c_viscous_spread,
+      format_value_error(baseline->c_coulomb, baseline->c_coulomb_stderr), baseline->c_coulomb_spread,
+      baseline->inertia_kg_m2);
+
+  const std::string section = baseline_toml_section(*baseline);
+  if (!o.update.empty()) {
+    const auto text = read_text(o.update, &why);
+    std::optional<std::string> updated;
+    if (text) updated = with_baseline_section(*text, *baseline, &why);
+    if (updated) {
+      if (!write_file(o.update, *updated, &why)) {
+        std::cerr << "spindown baseline: error: " << why << '\n';
+        return exit_unusable;
+      }
+      std::cout << fmt::format("[baseline] of {} updated in place (other keys and comments kept)\n", o.update);
+    } else {
+      // Not cleanly replaceable: the original stays untouched, the section goes beside it.
+      const std::string beside = o.update + ".baseline.toml";
+      std::string werr;
+      if (!write_file(beside, fmt::format("bench_id = \"{}\"\n\n{}", o.bench, section), &werr)) {
+        std::cerr << "spindown baseline: error: " << werr << '\n';
+        return exit_unusable;
+      }
+      std::cerr << fmt::format(
+          "spindown baseline: warning: {} not changed ({}); the baseline is in a new file {}: copy its "
+          "[baseline] section into the bench file\n",
+          o.update, why, beside);
+    }
+  } else if (!o.output.empty()) {
+    if (!write_file(o.output, fmt::format("bench_id = \"{}\"\n\n{}", o.bench, section), &why)) {
+      std::cerr << "spindown baseline: error: " << why << '\n';
+      return exit_unusable;
+    }
+    std::cout << fmt::format("baseline written to {} (a new bench file with bench_id and [baseline])\n", o.output);
+  } else {
+    std::cout << '\n' << section;
+  }
+  return all_read ? exit_ok : exit_unusable;
+}
+
+}  // namespace spindown::cli

@@ -1,0 +1,34 @@
+#pragma once
+// The per-bench TOML files of a lab (deploy/benches/<bench>.toml, installed as
+// /etc/spindown/benches/<bench>.toml): one file per bench, read by spindown-bridge ([serial],
+// [bench], …) and by the fitters for J/K_b and the motor health references ([motor],
+// [baseline], [health]). A bench's id is its bench_id key, else the file name without ".toml".
+#include <map>
+#include <string>
+#include <vector>
+
+#include "spindown/bench.hpp"
+#include "spindown/motor_health.hpp"
+
+namespace spindown {
+
+struct BenchFile {
+  std::string path;
+  std::string bench;           // bench id
+  BenchParams params;          // [bench] J and K_b (lab defaults where the file sets none)
+  bool sets_inertia = false;   // the file gives J (inertia_kg_m2 or flywheel geometry)
+  bool sets_kb = false;        // the file gives K_b (kb_v_s_per_rad or speed_constant_rpm_per_v)
+  MotorHealthConfig health;    // [motor], [baseline], [health]
+};
+
+struct BenchFiles {
+  std::map<std::string, BenchFile, std::less<>> files;  // by bench id
+};
+
+// Reads one bench file. Throws std::runtime_error naming the file and key.
+BenchFile load_bench_file(const std::string& path);
+// Each path is a file or a directory (every *.toml in it, sorted). Throws std::runtime_error
+// naming the file for an unreadable or bad file, or when two files describe the same bench.
+BenchFiles load_bench_files(const std::vector<std::string>& paths);
+
+}  // namespace spindown
