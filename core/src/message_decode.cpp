@@ -89,6 +89,8 @@ bool walk(std::string_view type, std::uint64_t expected_hash, std::span<const Wi
       continue;
     }
     // Strings: a big-endian int32 length that counts the NUL, then the bytes.
+    if (f.count_of < 0 && left < string_min_bytes)
+      return fail(why, fmt::format("{}: ends inside {} at byte {} (truncated)", type, f.name, pos));
     if (n * string_min_bytes > left)
       return fail(why, fmt::format("{}: {} = {} strings for {} need at least {} bytes, {} left at byte {} "
                                    "(truncated or damaged)",
