@@ -12,6 +12,7 @@
 #include <toml++/toml.h>
 
 #include "spindown/bench.hpp"
+#include "spindown/fit_report.hpp"
 
 namespace spindown {
 
@@ -99,7 +100,10 @@ HealthLevel level_for_ratio(double r, double sr, const HealthThresholds& th) {
   return HealthLevel::ok;
 }
 
-std::string times(double r) { return r < 9.95 ? fmt::format("{:.1f}×", r) : fmt::format("{:.0f}×", r); }
+std::string times(double r) {
+  if (r < 0.095) return fmt::format("{:.2f}×", r);
+  return r < 9.95 ? fmt::format("{:.1f}×", r) : fmt::format("{:.0f}×", r);
+}
 
 std::string seconds(double t) { return std::isfinite(t) ? fmt::format("{:.1f} s", t) : std::string("never"); }
 
@@ -550,8 +554,7 @@ std::string value_text(double value, double se, const std::string& unit) {
   if (!std::isfinite(value)) return std::isinf(value) ? "never" : "-";
   std::string u = unit == "N*m" ? "N·m" : unit == "N*m*s/rad" ? "N·m·s/rad" : unit == "kg*m^2" ? "kg·m²" : unit;
   if (unit == "s") return se > 0 ? fmt::format("{:.1f} ± {:.1f} s", value, se) : fmt::format("{:.1f} s", value);
-  if (se > 0) return fmt::format("{:.4g} ± {:.2g} {}", value, se, u);
-  return fmt::format("{:.4g} {}", value, u);
+  return format_value_error(value, se) + " " + u;
 }
 
 }  // namespace
@@ -566,7 +569,7 @@ std::string format_health_verdict(const HealthVerdict& v, std::string_view inden
     std::string line = fmt::format("{}  {:<26} {}", indent, f.what, value_text(f.value, f.std_error, f.unit));
     if (std::isfinite(f.reference))
       line += fmt::format("  vs {} {}", f.reference_name, value_text(f.reference, f.reference_std_error, f.unit));
-    if (f.ratio != 0 && f.unit != "s") line += fmt::format("  ratio {:.2f} ± {:.2f}", f.ratio, f.ratio_std_error);
+    if (f.ratio != 0 && f.unit != "s") line += "  ratio " + format_value_error(f.ratio, f.ratio_std_error);
     line += fmt::format("  [{}]", health_level_name(f.level));
     out += line + '\n';
   }
