@@ -67,8 +67,22 @@ const HealthFinding* finding(const HealthVerdict& v, std::string_view what) {
   return nullptr;
 }
 
+std::filesystem::path temp_dir() {
+  return std::filesystem::temp_directory_path() / ("spindown_health_" + std::to_string(::getpid()));
+}
+
+// Removes the test's files when the tests end.
+class TempDirCleanup : public ::testing::Environment {
+ public:
+  void TearDown() override {
+    std::error_code ec;
+    std::filesystem::remove_all(temp_dir(), ec);
+  }
+};
+const auto* const cleanup = ::testing::AddGlobalTestEnvironment(new TempDirCleanup);
+
 std::string temp_file(const std::string& name, const std::string& text) {
-  const auto dir = std::filesystem::temp_directory_path() / ("spindown_health_" + std::to_string(::getpid()));
+  const auto dir = temp_dir();
   std::filesystem::create_directories(dir);
   const auto path = (dir / name).string();
   std::ofstream(path) << text;
