@@ -21,7 +21,8 @@ if [[ -n ${KEEP:-} ]]; then WORK=$KEEP; mkdir -p "$WORK"; else
 fi
 
 echo "machine: $(lscpu | sed -n 's/^Model name: *//p'), $(nproc) cores; load average $(cut -d' ' -f1-3 /proc/loadavg)"
-printf '%-12s %9s %9s %8s %8s %12s %9s %6s\n' samples "log MB" messages "wall s" "CPU s" "samples/s" "max RSS" runs
+printf '%-12s %9s %9s %8s %8s %12s %12s %9s %6s\n' samples "log MB" messages "wall s" "CPU s" "samples/s" "per CPU s" \
+  "max RSS" runs
 for n in $SIZES; do
   log="$WORK/lab-$n-b$BATCH.lcm"
   [[ -s $log ]] || "$BIN/make_lcm_log" "$log" "$n" 4 "$BATCH" >"$WORK/make-$n.txt"
@@ -36,7 +37,7 @@ for n in $SIZES; do
     runs=-
   fi
   msgs=$(awk '{for (i = 1; i <= NF; i++) if ($i == "SAMPLE") print $(i - 1)}' "$WORK/make-$n.txt" 2>/dev/null || echo -)
-  printf '%-12s %9.1f %9s %8.2f %8.2f %12.0f %9s %6s\n' "$n" "$(stat -c %s "$log" | awk '{print $1 / 1e6}')" "$msgs" \
-    "$wall" "$cpu" "$(awk "BEGIN{print $n / $wall}")" "$rss" "$runs"
+  printf '%-12s %9.1f %9s %8.2f %8.2f %12.0f %12.0f %9s %6s\n' "$n" "$(stat -c %s "$log" | awk '{print $1 / 1e6}')" \
+    "$msgs" "$wall" "$cpu" "$(awk "BEGIN{print $n / $wall}")" "$(awk "BEGIN{print $n / $cpu}")" "$rss" "$runs"
 done
 echo "load average after: $(cut -d' ' -f1-3 /proc/loadavg)"
