@@ -5,9 +5,11 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <fcntl.h>
 #include <filesystem>
 #include <fmt/format.h>
 #include <fstream>
+#include <ifaddrs.h>
 #include <iostream>
 #include <lcm/lcm.h>
 #include <memory>
@@ -109,14 +111,18 @@ std::optional<std::string> capture(const std::vector<std::string>& argv, std::st
   return std::nullopt;
 }
 
+// The interfaces of this network namespace (getifaddrs asks the kernel; /sys/class/net would
+// show the namespace sysfs was mounted in).
 std::vector<NetInterface> read_interfaces() {
   std::vector<NetInterface> out;
-  std::error_code ec;
-  for (const auto& e : fs::directory_iterator("/sys/class/net", ec)) {
-    const auto flags = read_file(e.path() / "flags");
-    if (!flags) continue;
-    if (auto i = interface_from_flags(e.path().filename().string(), *flags)) out.push_back(*i);
+  ifaddrs* list = nullptr;
+  if (::getifaddrs(&list) != 0) return out;
+  for (const ifaddrs* a = list; a; a = a->ifa_next) {
+    if (!a->ifa_name) continue;
+    if (std::any_of(out.begin(), out.end(), [&](const NetInterface& i) { return i.name == a->ifa_name; })) continue;
+    if (auto i = interface_from_flags(a->ifa_name, fmt::format("{:x}", a->ifa_flags))) out.push_back(*i);
   }
+  ::freeifaddrs(list);
   std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.name < b.name; });
   return out;
 }
@@ -170,7 +176,18 @@ struct SkewListener {
 
 std::vector<HostSkew> listen_for_clocks(const std::string& url, double seconds) {
   SkewListener listener;
+  // LCM 1.3.1 prints its own multicast advice on stderr; the self-test above has reported it.
+  std::fflush(stderr);
+  const int saved = ::dup(2);
+  if (const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC); null >= 0) {
+    ::dup2(null, 2);
+    ::close(null);
+  }
   lcm_t* lcm = lcm_create(url.c_str());
+  if (saved >= 0) {
+    ::dup2(saved, 2);
+    ::close(saved);
+  }
   if (!lcm) return {};
   lcm_subscription_t* sub = lcm_subscribe(lcm, "SPINDOWN\\..*\\.(STATUS|CONFIG)", &SkewListener::on_lcm, &listener);
   if (sub) lcm_subscription_set_queue_capacity(sub, 10000);

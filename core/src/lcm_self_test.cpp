@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 #include <lcm/lcm.h>
 #include <random>
+#include <fcntl.h>
 #include <unistd.h>
 
 namespace spindown {
@@ -24,6 +25,29 @@ extern "C" void on_self_test_message(const lcm_recv_buf_t* rbuf, const char*, vo
   if (size == r->nonce.size() && std::memcmp(rbuf->data, r->nonce.data(), size) == 0) r->received = true;
 }
 
+// LCM 1.3.1 prints its own advice to stderr when multicast does not work ("LCM self test
+// failed!!", a route hint with ifconfig); the doctor says it with the fix, so LCM's text is held
+// back while the test runs.
+class QuietStderr {
+ public:
+  QuietStderr() : saved_(::dup(2)) {
+    const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
+    if (saved_ >= 0 && null >= 0) ::dup2(null, 2);
+    if (null >= 0) ::close(null);
+  }
+  ~QuietStderr() {
+    if (saved_ >= 0) {
+      ::dup2(saved_, 2);
+      ::close(saved_);
+    }
+  }
+  QuietStderr(const QuietStderr&) = delete;
+  QuietStderr& operator=(const QuietStderr&) = delete;
+
+ private:
+  int saved_;
+};
+
 }  // namespace
 
 LcmSelfTest run_lcm_self_test(const std::string& url, double timeout_s) {
@@ -34,6 +58,7 @@ LcmSelfTest run_lcm_self_test(const std::string& url, double timeout_s) {
   std::random_device rd;
   const auto nonce = fmt::format("{:08x}{:08x}", rd(), rd());
   t.channel = fmt::format("SPINDOWN_DOCTOR.{}.{}", ::getpid(), nonce.substr(0, 8));
+  QuietStderr quiet;
   lcm_t* lcm = lcm_create(url.empty() ? nullptr : url.c_str());
   if (!lcm) return t;
   t.started = true;
