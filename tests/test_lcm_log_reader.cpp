@@ -431,3 +431,27 @@ TEST(LcmLogReader, AFifoOrDeviceIsRefusedNotWaitedOn) {
   ASSERT_TRUE(null.has_errors());
   EXPECT_TRUE(mentions(null.diagnostics, "not a regular file"));
 }
+
+// Found by fuzz_config_t: a config_t whose string length is INT_MIN made lcm-gen's decoder
+// compute INT_MIN - 1 (signed overflow, UBSan) in the reader and in FitterCore; a length of 0
+// made std::string throw. The layout is now walked first and the event reported.
+TEST(LcmLogReader, ConfigWithABadStringLengthIsReportedNotDecoded) {
+  TempFile f("bad_string");
+  {
+    LogWriter w(f.path);
+    w.write("SPINDOWN.a.SAMPLE", batch("a", 0, 0, 10));
+    for (const std::uint32_t len : {0x80000000u, 0u, 0x7fffffffu}) {
+      std::vector<std::uint8_t> bytes(static_cast<std::size_t>(config("a").getEncodedSize()));
+      config("a").encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+      for (int k = 0; k < 4; ++k) bytes[16 + k] = static_cast<std::uint8_t>(len >> (24 - 8 * k));  // bench's length
+      w.write_raw("SPINDOWN.a.CONFIG", bytes);
+    }
+  }
+  const LcmLogContents c = read_lcm_log(f.path);
+  ASSERT_EQ(c.benches.size(), 1u);
+  EXPECT_FALSE(c.benches[0].config.has_value());
+  std::size_t reported = 0;
+  for (const auto& d : c.benches[0].recording.diagnostics)
+    reported += d.message.find("string bench has length") != std::string::npos;
+  EXPECT_EQ(reported, 3u) << all_diagnostics(c.benches[0].recording.diagnostics);
+}

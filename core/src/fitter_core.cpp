@@ -10,6 +10,7 @@
 #include "spindown/fit_message.hpp"
 #include "spindown/lcm_channels.hpp"
 #include "spindown/lcm_log_reader.hpp"
+#include "spindown/message_decode.hpp"
 #include "text_support.hpp"
 
 namespace spindown {
@@ -63,6 +64,9 @@ bool decode_checked(Msg& msg, const void* data, std::int64_t size, std::string* 
                        static_cast<std::uint64_t>(Msg::getHash()));
     return false;
   }
+  // lcm-gen's decoder sizes arrays and strings from the wire before checking them (a string
+  // length of INT_MIN overflows inside it): walk the message's layout first.
+  if (!check_message_encoding<Msg>(data, size, why)) return false;
   try {
     if (msg.decode(data, 0, static_cast<int>(size)) < 0) {
       *why = fmt::format("{} does not decode from {} bytes (truncated or damaged)", Msg::getTypeName(), size);

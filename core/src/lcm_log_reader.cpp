@@ -10,6 +10,7 @@
 #include <lcm/lcm-cpp.hpp>
 #include <sys/stat.h>
 
+#include "spindown/message_decode.hpp"
 #include "text_support.hpp"
 
 namespace spindown {
@@ -70,6 +71,9 @@ bool decode_checked(Msg& msg, const void* data, std::int32_t size, std::string* 
                        static_cast<std::uint64_t>(Msg::getHash()));
     return false;
   }
+  // lcm-gen's decoder sizes arrays and strings from the wire before checking them (a string
+  // length of INT_MIN overflows inside it): walk the message's layout first.
+  if (!check_message_encoding<Msg>(data, size, why)) return false;
   try {
     const int used = msg.decode(data, 0, size);
     if (used < 0) {

@@ -215,7 +215,8 @@ std::vector<Recording> read_recordings(const std::string& path, const ReadOption
       if (!log.has_errors()) {
         std::string channels;
         for (const auto& [name, count] : log.other_channels)
-          if (channels.size() < 300) channels += fmt::format("{}{} ({})", channels.empty() ? "" : ", ", name, count);
+          if (channels.size() < 300)
+            channels += fmt::format("{}{} ({})", channels.empty() ? "" : ", ", text::escape_invalid_utf8(name), count);
         for (const BenchLog& b : log.benches)
           channels += fmt::format("{}SPINDOWN.{}.CONFIG ({})", channels.empty() ? "" : ", ", b.bench,
                                   b.config_messages);
