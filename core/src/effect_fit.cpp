@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <limits>
 #include <nlopt.hpp>
+#include <utility>
 
 #include "spindown/effect_simulator.hpp"
 
@@ -109,6 +110,10 @@ std::vector<double> integral_start(const Setup& s) {
   const int q = static_cast<int>(torque.size());
   Eigen::MatrixXd a(static_cast<Eigen::Index>(m), q + 1);
   Eigen::VectorXd b(static_cast<Eigen::Index>(m));
+  for (std::size_t i = 0; i < m; ++i) {
+    a(static_cast<Eigen::Index>(i), 0) = 1.0;
+    b[static_cast<Eigen::Index>(i)] = w[i];
+  }
   for (double g : grid) {
     if (gridded >= 0 && shape_par[gridded].size() > 1) shape_par[gridded][1] = g;
     for (int c = 0; c < q; ++c) {
@@ -122,10 +127,9 @@ std::vector<double> integral_start(const Setup& s) {
         a(static_cast<Eigen::Index>(i), c + 1) = -integral;
       }
     }
-    for (std::size_t i = 0; i < m; ++i) {
-      a(static_cast<Eigen::Index>(i), 0) = 1.0;
-      b[static_cast<Eigen::Index>(i)] = w[i];
-    }
+    // Normal equations once; the active set works on the small (q+1)² system.
+    const Eigen::MatrixXd ata = a.transpose() * a;
+    const Eigen::VectorXd atb = a.transpose() * b;
     // Non-negative amplitudes by an active set: drop the most negative, solve again.
     std::vector<bool> active(q, true);
     Eigen::VectorXd sol = Eigen::VectorXd::Zero(q + 1);
@@ -133,11 +137,16 @@ std::vector<double> integral_start(const Setup& s) {
       std::vector<Eigen::Index> cols{0};
       for (int c = 0; c < q; ++c)
         if (active[c]) cols.push_back(c + 1);
-      Eigen::MatrixXd sub(a.rows(), static_cast<Eigen::Index>(cols.size()));
-      for (std::size_t c = 0; c < cols.size(); ++c) sub.col(static_cast<Eigen::Index>(c)) = a.col(cols[c]);
-      const Eigen::LDLT<Eigen::MatrixXd> ldlt(sub.transpose() * sub);
+      const auto k = static_cast<Eigen::Index>(cols.size());
+      Eigen::MatrixXd sub(k, k);
+      Eigen::VectorXd rhs(k);
+      for (Eigen::Index r = 0; r < k; ++r) {
+        rhs[r] = atb[cols[static_cast<std::size_t>(r)]];
+        for (Eigen::Index c = 0; c < k; ++c) sub(r, c) = ata(cols[static_cast<std::size_t>(r)], cols[static_cast<std::size_t>(c)]);
+      }
+      const Eigen::LDLT<Eigen::MatrixXd> ldlt(sub);
       if (ldlt.info() != Eigen::Success) break;
-      const Eigen::VectorXd x = ldlt.solve(sub.transpose() * b);
+      const Eigen::VectorXd x = ldlt.solve(rhs);
       if (!x.allFinite()) break;
       sol.setZero();
       for (std::size_t c = 0; c < cols.size(); ++c) sol[cols[c]] = x[static_cast<Eigen::Index>(c)];
@@ -167,40 +176,86 @@ std::vector<double> integral_start(const Setup& s) {
   return best_th;
 }
 
-// Levenberg–Marquardt on the simulator's exact sensitivities, bounds by projection.
+// JᵀJ (upper triangle, packed) and Jᵀr of a row-major n×P matrix with P fixed at compile time:
+// the accumulators stay in registers, which a general matrix product cannot do for these tall,
+// narrow Jacobians.
+template <int P>
+void normal_fixed(const double* jac, const double* r, std::size_t n, double* jtj_packed, double* jtr) {
+  double acc[P * (P + 1) / 2] = {};
+  double g_r[P] = {};
+  for (std::size_t i = 0; i < n; ++i) {
+    const double* g = jac + i * P;
+    const double ri = r ? r[i] : 0.0;
+    int k = 0;
+#pragma GCC unroll 12
+    for (int a = 0; a < P; ++a) {
+      g_r[a] += g[a] * ri;
+#pragma GCC unroll 12
+      for (int b = a; b < P; ++b) acc[k++] += g[a] * g[b];
+    }
+  }
+  std::copy(acc, acc + P * (P + 1) / 2, jtj_packed);
+  std::copy(g_r, g_r + P, jtr);
+}
+
+template <int... Ps>
+void normal_dispatch(std::integer_sequence<int, Ps...>, int p, const double* jac, const double* r, std::size_t n,
+                     double* packed, double* jtr) {
+  ((p == Ps + 1 ? normal_fixed<Ps + 1>(jac, r, n, packed, jtr) : void()), ...);
+}
+
+// JᵀJ (and Jᵀr when r is given) of a row-major n×p matrix, p ≤ EffectSimulator::max_params.
+void normal_equations(const double* jac, const double* r, std::size_t n, int p, Eigen::MatrixXd& jtj,
+                      Eigen::VectorXd& jtr) {
+  constexpr int max_p = EffectSimulator::max_params;
+  double packed[max_p * (max_p + 1) / 2] = {};
+  double g_r[max_p] = {};
+  normal_dispatch(std::make_integer_sequence<int, max_p>{}, p, jac, r, n, packed, g_r);
+  jtj.resize(p, p);
+  jtr.resize(p);
+  int k = 0;
+  for (int a = 0; a < p; ++a) {
+    jtr[a] = g_r[a];
+    for (int b = a; b < p; ++b) jtj(a, b) = jtj(b, a) = packed[k++];
+  }
+}
+
+// Levenberg–Marquardt on the simulator's exact sensitivities, bounds by projection. The
+// result keeps the simulation and Jacobian at its optimum (for the SSE and the covariance).
 struct LmResult {
   std::vector<double> theta;
+  std::vector<double> model, jac;  // at theta
   double sse = 0;
   int evals = 0;
   bool converged = false;
 };
 
-LmResult levenberg_marquardt(const Setup& s, std::vector<double> th) {
+// Simulates t with its sensitivities into model/jac; JᵀJ, Jᵀr and the SSE from them.
+double assemble_normal(const Setup& s, const std::vector<double>& t, std::vector<double>& model,
+                       std::vector<double>& jac, Eigen::MatrixXd& jtj, Eigen::VectorXd& jtr) {
   const std::size_t n = s.data.tau.size();
   const int P = s.sim.size();
+  model.resize(n);
+  jac.resize(n * P);
+  s.sim.simulate(t, s.data.tau, model, jac);
+  thread_local std::vector<double> r;  // residual scratch, reused across evaluations
+  r.resize(n);
+  double sse = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    r[i] = s.data.y[i] - model[i];
+    sse += r[i] * r[i];
+  }
+  normal_equations(jac.data(), r.data(), n, P, jtj, jtr);
+  return std::isfinite(sse) && jtj.allFinite() && jtr.allFinite() ? sse : std::numeric_limits<double>::infinity();
+}
+
+LmResult levenberg_marquardt(const Setup& s, std::vector<double> th) {
+  const int P = s.sim.size();
   LmResult out;
-  std::vector<double> model(n), jac(n * P), model_try(n);
-  auto assemble = [&](const std::vector<double>& t, Eigen::MatrixXd& jtj, Eigen::VectorXd& jtr) {
-    s.sim.simulate(t, s.data.tau, model, jac);
-    jtj.setZero(P, P);
-    jtr.setZero(P);
-    double sse = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      const double r = s.data.y[i] - model[i];
-      sse += r * r;
-      const double* g = &jac[i * P];
-      for (int a = 0; a < P; ++a) {
-        jtr[a] += g[a] * r;
-        for (int b = 0; b <= a; ++b) jtj(a, b) += g[a] * g[b];
-      }
-    }
-    for (int a = 0; a < P; ++a)
-      for (int b = a + 1; b < P; ++b) jtj(a, b) = jtj(b, a);
-    return std::isfinite(sse) ? sse : std::numeric_limits<double>::infinity();
-  };
+  std::vector<double> model_try, jac_try;
   Eigen::MatrixXd jtj, jtj_try;
   Eigen::VectorXd jtr, jtr_try;
-  double sse = assemble(th, jtj, jtr);
+  double sse = assemble_normal(s, th, out.model, out.jac, jtj, jtr);
   out.evals = 1;
   double lambda = 1e-3;
   for (int it = 0; it < 60 && out.evals < 80; ++it) {
@@ -227,7 +282,7 @@ LmResult levenberg_marquardt(const Setup& s, std::vector<double> th) {
     std::vector<double> trial(th);
     for (int j = 0; j < P; ++j) trial[j] += step[j];
     s.clamp(trial);
-    const double sse_try = assemble(trial, jtj_try, jtr_try);
+    const double sse_try = assemble_normal(s, trial, model_try, jac_try, jtj_try, jtr_try);
     ++out.evals;
     if (sse_try < sse) {
       const double gain = sse - sse_try;
@@ -235,8 +290,10 @@ LmResult levenberg_marquardt(const Setup& s, std::vector<double> th) {
       for (int j = 0; j < P; ++j)
         if (std::abs(trial[j] - th[j]) > 1e-7 * std::max(std::abs(th[j]), 1e-6 * s.typical[j])) small = false;
       th = trial;
-      jtj = jtj_try;
-      jtr = jtr_try;
+      std::swap(jtj, jtj_try);
+      std::swap(jtr, jtr_try);
+      std::swap(out.model, model_try);
+      std::swap(out.jac, jac_try);
       sse = sse_try;
       lambda = std::max(lambda / 10, 1e-12);
       if (small || gain <= 1e-10 * sse) {
@@ -315,10 +372,8 @@ std::string refine_with_nlopt(const Setup& s, std::vector<double>& th, int max_e
     opt.set_lower_bounds(lb);
     opt.set_upper_bounds(ub);
     opt.set_min_objective(nlopt_objective, &pb);
-    // After LM the polish only has to confirm the optimum: a loose tolerance ends it in a
-    // few evaluations; as the full refinement it runs to 1e-12.
-    opt.set_ftol_rel(max_evals <= 10 ? 1e-9 : 1e-12);
-    opt.set_xtol_rel(max_evals <= 10 ? 1e-7 : 1e-10);
+    opt.set_ftol_rel(1e-12);
+    opt.set_xtol_rel(1e-10);
     opt.set_maxeval(max_evals);
     const nlopt::result res = opt.optimize(x, fmin);
     if (res == nlopt::MAXEVAL_REACHED) why = fmt::format("no convergence within {} evaluations", max_evals);
@@ -348,11 +403,10 @@ std::string refine_with_nlopt(const Setup& s, std::vector<double>& th, int max_e
 // Covariance of θ from the Jacobian: classic s²(JᵀJ)⁻¹ widened per parameter to the
 // Newey–West (HAC) variance when residuals are correlated (ripple, quantization), as fit.cpp.
 // Parameters with no influence (a shape parameter whose amplitude is 0) get NaN.
-Eigen::MatrixXd covariance(const Setup& s, const std::vector<double>& th, bool& ok) {
+Eigen::MatrixXd covariance(const Setup& s, const std::vector<double>& model, const std::vector<double>& jacv,
+                           bool& ok) {
   const std::size_t n = s.data.tau.size();
   const int P = s.sim.size();
-  std::vector<double> model(n), jacv(n * P);
-  s.sim.simulate(th, s.data.tau, model, jacv);
   Eigen::MatrixXd cov = Eigen::MatrixXd::Constant(P, P, nan);
   std::vector<int> keep;
   for (int j = 0; j < P; ++j) {
@@ -362,35 +416,52 @@ Eigen::MatrixXd covariance(const Setup& s, const std::vector<double>& th, bool& 
   }
   const int p = static_cast<int>(keep.size());
   const auto N = static_cast<Eigen::Index>(n);
-  Eigen::MatrixXd jac(N, p);
-  Eigen::VectorXd res(N);
-  for (Eigen::Index i = 0; i < N; ++i) {
-    res[i] = s.data.y[static_cast<std::size_t>(i)] - model[static_cast<std::size_t>(i)];
-    for (int c = 0; c < p; ++c) jac(i, c) = jacv[static_cast<std::size_t>(i) * P + keep[c]];
-  }
   ok = false;
   if (p == 0 || N <= p) return cov;
   // Column scaling for conditioning.
-  Eigen::VectorXd cs = jac.colwise().norm().transpose();
-  const Eigen::MatrixXd js = jac * cs.cwiseInverse().asDiagonal();
-  const Eigen::MatrixXd jtj = js.transpose() * js;
+  std::vector<double> res(n), js(n * static_cast<std::size_t>(p));
+  Eigen::VectorXd cs = Eigen::VectorXd::Zero(p);
+  for (std::size_t i = 0; i < n; ++i)
+    for (int c = 0; c < p; ++c) cs[c] += jacv[i * P + keep[c]] * jacv[i * P + keep[c]];
+  cs = cs.cwiseSqrt();
+  double rss = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    res[i] = s.data.y[i] - model[i];
+    rss += res[i] * res[i];
+    for (int c = 0; c < p; ++c) js[i * p + c] = jacv[i * P + keep[c]] / cs[c];
+  }
+  Eigen::MatrixXd jtj;
+  Eigen::VectorXd unused;
+  normal_equations(js.data(), nullptr, n, p, jtj, unused);
   const Eigen::LDLT<Eigen::MatrixXd> ldlt(jtj);
   if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return cov;
   Eigen::MatrixXd inv = ldlt.solve(Eigen::MatrixXd::Identity(p, p));
   if (!inv.allFinite() || inv.diagonal().maxCoeff() > 1e12) return cov;
-  const double s2 = res.squaredNorm() / static_cast<double>(N - p);
+  const double s2 = rss / static_cast<double>(N - p);
   const Eigen::MatrixXd classic = s2 * inv;
+  // Newey–West: only the diagonal of inv·meat·inv is used, and eᵀ_j inv·Γ_l·inv e_j is the lag-l
+  // autocovariance of the series u_j(i) = (inv·score_i)_j, score_i = js_i·r_i.
   const int lags = static_cast<int>(std::ceil(4.0 * std::pow(static_cast<double>(N) / 100.0, 2.0 / 9.0)));
-  const Eigen::MatrixXd score = js.array().colwise() * res.array();
-  Eigen::MatrixXd meat = score.transpose() * score;
-  for (int l = 1; l <= lags && l < N; ++l) {
-    const double wgt = 1.0 - l / (lags + 1.0);
-    const Eigen::MatrixXd gamma = score.topRows(N - l).transpose() * score.bottomRows(N - l);
-    meat += wgt * (gamma + gamma.transpose());
-  }
-  const Eigen::MatrixXd hac = (static_cast<double>(N) / static_cast<double>(N - p)) * inv * meat * inv;
+  std::vector<double> u(n * static_cast<std::size_t>(p));
+  for (std::size_t i = 0; i < n; ++i)
+    for (int j = 0; j < p; ++j) {
+      double v = 0;
+      for (int c = 0; c < p; ++c) v += inv(j, c) * js[i * p + c];
+      u[i * p + j] = v * res[i];
+    }
   Eigen::VectorXd widen(p);
-  for (int j = 0; j < p; ++j) widen[j] = std::sqrt(std::max(1.0, hac(j, j) / classic(j, j)));
+  for (int j = 0; j < p; ++j) {
+    double hac = 0;
+    for (std::size_t i = 0; i < n; ++i) hac += u[i * p + j] * u[i * p + j];
+    for (int l = 1; l <= lags && l < N; ++l) {
+      const double wgt = 1.0 - l / (lags + 1.0);
+      double g = 0;
+      for (std::size_t i = 0; i + static_cast<std::size_t>(l) < n; ++i) g += u[i * p + j] * u[(i + l) * p + j];
+      hac += 2.0 * wgt * g;
+    }
+    hac *= static_cast<double>(N) / static_cast<double>(N - p);
+    widen[j] = std::sqrt(std::max(1.0, hac / classic(j, j)));
+  }
   Eigen::MatrixXd c = widen.asDiagonal() * classic * widen.asDiagonal();
   c = cs.cwiseInverse().asDiagonal() * c * cs.cwiseInverse().asDiagonal();
   for (int a = 0; a < p; ++a)
@@ -491,12 +562,22 @@ EffectFit fit_effects(const std::vector<const Effect*>& effects, const EffectFit
     if (again.sse < lm.sse) lm = again;
   }
   th = lm.theta;
-  // NLopt under bounds: a short polish after LM, the full refinement when LM did not converge.
-  const std::string why = refine_with_nlopt(s, th, lm.converged ? 4 : 300, out.evaluations);
+  // LM's stopping rule (relative step < 1e-7 or SSE gain < 1e-10) is already tight: a polish
+  // would only confirm it. NLopt under bounds takes over when LM did not converge.
+  std::string why;
+  if (!lm.converged) {
+    why = refine_with_nlopt(s, th, 300, out.evaluations);
+    if (th != lm.theta) {
+      Eigen::MatrixXd jtj;
+      Eigen::VectorXd jtr;
+      lm.sse = assemble_normal(s, th, lm.model, lm.jac, jtj, jtr);
+    }
+  }
   const bool solved = lm.converged || why.empty();
 
   out.theta = th;
-  out.sse = sse_of(s, th, out.simulated);
+  out.sse = lm.sse;
+  out.simulated = std::move(lm.model);
   const double dn = static_cast<double>(n);
   out.rmse = std::sqrt(out.sse / dn);
   const double ll = dn * std::log(std::max(out.sse / dn, 1e-300));
@@ -506,7 +587,7 @@ EffectFit fit_effects(const std::vector<const Effect*>& effects, const EffectFit
   out.t_stop_pred_s = s.sim.stop_time(th);
 
   bool cov_ok = false;
-  const Eigen::MatrixXd cov = covariance(s, th, cov_ok);
+  const Eigen::MatrixXd cov = covariance(s, out.simulated, lm.jac, cov_ok);
   out.converged = solved;
   if (!solved)
     out.message = why;

@@ -59,6 +59,7 @@ EffectSimulator::EffectSimulator(std::vector<const Effect*> effects, double read
   for (const Effect* e : effects_) {
     if (!e) throw std::invalid_argument("EffectSimulator: null effect");
     first_.push_back(size_);
+    if (e->kind == EffectKind::sensor) sensors_.push_back(first_.size() - 1);
     if (e->kind == EffectKind::torque) {
       if (e->name == "viscous" && viscous_ < 0)
         viscous_ = size_;
@@ -141,8 +142,7 @@ void EffectSimulator::simulate(std::span<const double> theta, std::span<const do
     double* row = want_jac ? &jac[i * P] : nullptr;
     if (row)
       for (int j = 0; j < P; ++j) row[j] = k_ * s[j];
-    for (std::size_t e = 0; e < effects_.size(); ++e) {
-      if (effects_[e]->kind != EffectKind::sensor) continue;
+    for (const std::size_t e : sensors_) {
       const int j = first_[e];
       y += effects_[e]->reading(theta.data() + j, w, row ? row + j : nullptr);
     }
@@ -153,21 +153,39 @@ void EffectSimulator::simulate(std::span<const double> theta, std::span<const do
   if (closed_) {
     const double a = viscous_ >= 0 ? theta[viscous_] : 0.0;
     const double b = coulomb_ >= 0 ? theta[coulomb_] : 0.0;
+    // e^(−aτ) by steps from the previous sample: a millisecond clock has few distinct steps, so
+    // exp runs once per distinct step; recomputed directly every 64 samples (error < 64·ε).
+    double t_prev = 0, e_prev = 1;
+    double step_dt[2] = {nan, nan}, step_e[2] = {1, 1};
     for (std::size_t i = 0; i < n; ++i) {
       const double t = std::max(tau[i], 0.0);
       const double x = a * t;
-      const double e = std::exp(-x);
+      double e;
+      if (i % 64 == 0) {
+        e = std::exp(-x);
+      } else {
+        const double dt = t - t_prev;
+        int slot = dt == step_dt[0] ? 0 : dt == step_dt[1] ? 1 : -1;
+        if (slot < 0) {
+          step_dt[1] = step_dt[0];
+          step_e[1] = step_e[0];
+          step_dt[0] = dt;
+          step_e[0] = std::exp(-a * dt);
+          slot = 0;
+        }
+        e = e_prev * step_e[slot];
+      }
+      t_prev = t;
+      e_prev = e;
       double p, dp;
       phi(x, e, p, dp);
       const double m = theta[0] * e - b * t * p;
       const bool moving = m > 0 || b <= 0;
       if (want_jac) {
-        std::fill(s, s + P, 0.0);
-        if (moving) {
-          s[0] = e;
-          if (viscous_ >= 0) s[viscous_] = -theta[0] * t * e - b * t * t * dp;
-          if (coulomb_ >= 0) s[coulomb_] = -t * p;
-        }
+        // Only ω0 and the closed-form parameters move ω; the rest of s stays 0.
+        s[0] = moving ? e : 0.0;
+        if (viscous_ >= 0) s[viscous_] = moving ? -theta[0] * t * e - b * t * t * dp : 0.0;
+        if (coulomb_ >= 0) s[coulomb_] = moving ? -t * p : 0.0;
       }
       finish(i, moving ? std::max(m, 0.0) : 0.0, s);
     }

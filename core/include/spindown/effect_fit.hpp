@@ -4,8 +4,8 @@
 // under bounds. Start: a regression of the integral form of the ODE on the candidate terms
 // (ω(τ) = ω(τ₀) − Σ a_e·∫ shape_e(ω) dτ, shape parameters on a small grid), or a warm start
 // from a nested model's optimum, whichever simulates closer. Refinement: Levenberg–Marquardt
-// on the exact sensitivities with the bounds enforced by projection, then NLopt (LD_LBFGS,
-// bounded, scaled) polishes and takes over when LM does not converge. Standard errors from the
+// on the exact sensitivities with the bounds enforced by projection; NLopt (LD_LBFGS,
+// bounded, scaled) takes over when LM does not converge. Standard errors from the
 // Jacobian at the optimum, widened Newey–West style when the residuals are correlated.
 //
 // ω0 is estimated at the detected cut. The cut time itself is not estimated separately: for

@@ -62,6 +62,7 @@ class EffectSimulator {
   double k_ = 1;
   bool closed_ = false;
   int viscous_ = -1, coulomb_ = -1;  // θ index of the closed-form parameters, or −1
+  std::vector<std::size_t> sensors_;  // indices of the sensor effects (added per sample)
 };
 
 // Internal θ for friction given in SI (FrictionTerms) on a model of viscous, coulomb,
