@@ -228,6 +228,10 @@ TEST(PuttyLogTime, ReadsTheHeader) {
 TEST(SvgPlot, EscapesAndTicks) {
   EXPECT_EQ(svg::escape("a<b & \"c\">"), "a&lt;b &amp; &quot;c&quot;&gt;");
   EXPECT_EQ(html_escape("it's <x>"), "it&#39;s &lt;x&gt;");
+  // Bytes that are not UTF-8 (a Latin-1 file name) and control characters become U+FFFD.
+  EXPECT_EQ(html_escape("caf\xe9.tsv"), "caf\xEF\xBF\xBD.tsv");
+  EXPECT_EQ(html_escape("a\x1b[2Jb"), "a\xEF\xBF\xBD[2Jb");
+  EXPECT_EQ(html_escape("g·cm² ✓ 😀"), "g·cm² ✓ 😀");
   const auto t = svg::nice_ticks(0, 10);
   ASSERT_FALSE(t.empty());
   EXPECT_DOUBLE_EQ(t.front(), 0);

@@ -73,7 +73,7 @@ TEST(ProgressReporter, ThrottledAndClearedAtTheEnd) {
 TEST(ProgressReporter, LineShowsDoneTotalRateAndEta) {
   const std::string line = ProgressReporter::format_line("refit: lab.lcm", 2'500'000, 10'000'000,
                                                          ProgressReporter::Unit::bytes, "3 runs fitted", 2.0, 0);
-  EXPECT_EQ(line, "refit: lab.lcm  2.5 MB / 10.0 MB (25 %)  3 runs fitted  1.2 MB/s  ETA 6 s");
+  EXPECT_EQ(line, "refit: lab.lcm  2.5 MB / 10.0 MB (25 %)  1.2 MB/s  ETA 6 s  3 runs fitted");
   const std::string msgs =
       ProgressReporter::format_line("x", 300, 0, ProgressReporter::Unit::messages, "", 3.0, 0);
   EXPECT_EQ(msgs, "x  300  100/s");

@@ -264,8 +264,8 @@ int run_refit(const RefitCommandOptions& o) {
     ProgressReporter progress(STDERR_FILENO, show_progress);
     LogRefit r = refit_log(path, fopt, o.live || o.compare, {},
                            [&](std::int64_t done, std::int64_t total, std::size_t runs) {
-                             progress.update(done, total, fmt::format("refit: {}", path),
-                                             fmt::format("{} run{} fitted", runs, runs == 1 ? "" : "s"));
+                             progress.update(done, total, "refit",
+                                             fmt::format("{} run{} fitted  {}", runs, runs == 1 ? "" : "s", path));
                            });
     progress.finish();
     // Problems on stderr, as `spindown fit` does.

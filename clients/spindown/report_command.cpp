@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <ctime>
 #include <exception>
+#include <filesystem>
 #include <fmt/format.h>
 #include <fstream>
 #include <iostream>
@@ -104,8 +105,10 @@ int run_report(const ReportCommandOptions& o) {
   {
     ProgressReporter progress(STDERR_FILENO, !o.no_progress && ProgressReporter::is_terminal(STDERR_FILENO));
     report = build_session_report(o.files, plan, [&](const ReportProgress& p) {
-      progress.update(static_cast<std::int64_t>(p.bytes_done), static_cast<std::int64_t>(p.bytes_total),
-                      fmt::format("report: {}", p.file), fmt::format("runs {}/{}", p.runs_done, p.runs_found));
+      // Numbers first, the file name last: a narrow terminal cuts the name, not the ETA.
+      progress.update(static_cast<std::int64_t>(p.bytes_done), static_cast<std::int64_t>(p.bytes_total), "report",
+                      fmt::format("runs {}/{}  {}", p.runs_done, p.runs_found,
+                                  std::filesystem::path(p.file).filename().string()));
     });
   }  // the progress line is gone before anything else goes to stderr
   for (const auto& file : report.files) {

@@ -136,16 +136,41 @@ constexpr double run_w = 960, run_h = 640;
 
 }  // namespace
 
+namespace {
+// Length of the valid UTF-8 sequence at s[i], 0 when the byte there does not start one.
+std::size_t utf8_sequence(std::string_view s, std::size_t i) {
+  const auto b = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
+  const unsigned char c = b(i);
+  std::size_t n = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+  if (n == 0 || i + n > s.size() || (n == 2 && c < 0xC2)) return 0;
+  for (std::size_t k = 1; k < n; ++k)
+    if ((b(i + k) & 0xC0) != 0x80) return 0;
+  if (n == 3 && ((c == 0xE0 && b(i + 1) < 0xA0) || (c == 0xED && b(i + 1) >= 0xA0))) return 0;  // overlong, surrogate
+  if (n == 4 && ((c == 0xF0 && b(i + 1) < 0x90) || c > 0xF4 || (c == 0xF4 && b(i + 1) >= 0x90))) return 0;
+  return n;
+}
+}  // namespace
+
 std::string html_escape(std::string_view in) {
   std::string out;
   out.reserve(in.size());
-  for (char c : in) {
+  for (std::size_t i = 0; i < in.size();) {
+    const char c = in[i];
+    const std::size_t n = utf8_sequence(in, i);
+    if (n == 0) {  // not UTF-8 (a Latin-1 file name): the replacement character, never broken text
+      out += "\xEF\xBF\xBD";
+      ++i;
+      continue;
+    }
     if (c == '\'')
       out += "&#39;";
     else if (c == '&' || c == '<' || c == '>' || c == '"')
       out += svg::escape(std::string_view(&c, 1));
+    else if (n == 1 && static_cast<unsigned char>(c) < 0x20 && c != '\n' && c != '\t' && c != '\r')
+      out += "\xEF\xBF\xBD";  // control characters are not allowed in HTML text
     else
-      out += c;
+      out.append(in.substr(i, n));
+    i += n;
   }
   return out;
 }
@@ -157,7 +182,7 @@ std::string run_figure_svg(const ReportRun& r) {
       "<svg class=\"run-plot\" width=\"{0}\" height=\"{1}\" viewBox=\"0 0 {0} {1}\" "
       "font-family=\"sans-serif\" font-size=\"12\" role=\"img\" aria-label=\"{2}\">\n<title>{2}</title>\n"
       "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n",
-      run_w, run_h, svg::escape(title));
+      run_w, run_h, html_escape(title));
   const std::size_t n = std::min(r.tau.size(), r.y.size());
   if (n < 2) {
     s += "<text x=\"480\" y=\"60\" text-anchor=\"middle\">no samples to plot</text>\n</svg>\n";
@@ -192,7 +217,7 @@ std::string run_figure_svg(const ReportRun& r) {
   Panel bot{80, 416, run_w - 110, 170, tmin, tmax, -rmax, rmax};
 
   s += fmt::format("<text x=\"{}\" y=\"24\" text-anchor=\"middle\" font-size=\"15\" font-weight=\"bold\">{}</text>\n",
-                   run_w / 2, svg::escape(title));
+                   run_w / 2, html_escape(title));
   s += svg::axes(top, "time after the cut (s)", fmt::format("reading ({})", unit));
   const std::size_t stride = std::max<std::size_t>(1, n / 2500);
   s += svg::dots(top, r.tau, r.y, stride, 1.6, "#777");
@@ -231,7 +256,7 @@ std::string trend_figure_svg(const BenchSummary& b) {
       "<svg class=\"trend-plot\" width=\"{0}\" height=\"{1}\" viewBox=\"0 0 {0} {1}\" "
       "font-family=\"sans-serif\" font-size=\"12\" role=\"img\" aria-label=\"friction over the runs of bench {2}\">\n"
       "<title>friction over the runs of bench {2}</title>\n<rect width=\"100%\" height=\"100%\" fill=\"white\"/>\n",
-      w, h, svg::escape(b.bench));
+      w, h, html_escape(b.bench));
   const CoefficientTrend* trends[] = {&b.viscous, &b.coulomb};
   for (int k = 0; k < 2; ++k) {
     const CoefficientTrend& t = *trends[k];
@@ -288,7 +313,11 @@ std::string trend_cell(const CoefficientTrend& t) {
     out += fmt::format("mean {}", lab ? fmt::format("{} {}", format_value_error(t.mean * lab->per_si, t.mean_stderr * lab->per_si), lab->pretty)
                                       : value_unit(t.mean, t.mean_stderr, t.unit));
   if (t.enough)
-    out += fmt::format("<br>trend {} per {}", value_unit(t.slope, t.slope_stderr, t.unit), esc(t.x_unit));
+    out += fmt::format("<br>trend {} per {}",
+                       lab ? fmt::format("{} {}", format_value_error(t.slope * lab->per_si, t.slope_stderr * lab->per_si),
+                                         lab->pretty)
+                           : value_unit(t.slope, t.slope_stderr, t.unit),
+                       esc(t.x_unit));
   out += fmt::format("<br><span class=\"{}\">{}</span>", t.drifting ? "drift" : t.enough ? "steady" : "noref",
                      esc(t.words));
   return out;

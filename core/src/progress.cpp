@@ -66,12 +66,12 @@ std::string ProgressReporter::format_line(std::string_view label, std::int64_t d
   } else {
     line += fmt::format("  {}", amount(d, unit));
   }
-  if (!extra.empty()) line += fmt::format("  {}", extra);
   if (elapsed_s > 0 && d > 0) {
     const double rate = d / elapsed_s;
     line += fmt::format("  {}/s", amount(rate, unit));
     if (total > 0) line += fmt::format("  ETA {}", duration((static_cast<double>(total) - d) / rate));
   }
+  if (!extra.empty()) line += fmt::format("  {}", extra);
   if (width > 0 && line.size() > width) line.resize(width);
   return line;
 }

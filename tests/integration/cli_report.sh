@@ -1,0 +1,168 @@
+#!/bin/bash
+# `spindown report`: one self-contained HTML page from the lab's sample files (with a bench
+# config whose baseline the motor is far above) and from a generated LCM log holding two
+# benches (spindown-run-publisher -> spindown-logger in a private network namespace, ttl=0).
+# Checks: exit codes, the page parses with balanced tags (python3 html.parser), no external
+# references, text from files escaped, one run figure per run, ± coefficients, verdicts, the
+# benches of the log grouped, and no progress output when stderr is not a terminal.
+if [ -z "${SPINDOWN_IN_NETNS:-}" ]; then
+  exec unshare -n env SPINDOWN_IN_NETNS=1 bash "$0" "$@"
+fi
+set -euo pipefail
+ip link set lo up
+ip route add 224.0.0.0/4 dev lo
+
+B=${SPINDOWN_BIN_DIR:?}
+D=${SPINDOWN_SHARED_DATA:?}
+T=$(mktemp -d /tmp/spindown-cli-report.XXXXXX)
+URL='udpm://239.255.76.67:7667?ttl=0'
+PIDS=()
+cleanup() {
+  for p in "${PIDS[@]}"; do kill "$p" 2>/dev/null || true; done
+  wait 2>/dev/null || true
+  rm -rf "$T"
+}
+trap cleanup EXIT
+fail() { echo "FAIL: $*" >&2; for f in "$T"/*.err; do echo "--- $f" >&2; tail -15 "$f" >&2; done; exit 1; }
+stop() {
+  kill -TERM "$1" 2>/dev/null || true
+  for _ in $(seq 100); do kill -0 "$1" 2>/dev/null || return 0; sleep 0.1; done
+  fail "process $1 did not stop on SIGTERM"
+}
+
+# The page parses, its tags balance, and it reaches nothing outside itself.
+check_page() {
+  python3 - "$1" <<'EOF'
+import sys
+from html.parser import HTMLParser
+VOID = {"meta", "br", "link", "img", "input", "hr", "wbr", "source", "col", "area", "base", "embed", "track"}
+class Check(HTMLParser):
+    def __init__(self):
+        super().__init__(convert_charrefs=True)
+        self.stack, self.errors, self.counts, self.text = [], [], {}, []
+    def handle_starttag(self, tag, attrs):
+        self.counts[tag] = self.counts.get(tag, 0) + 1
+        for name, value in attrs:
+            v = (value or "").lower()
+            if name in ("src", "href", "xlink:href") and not v.startswith("#"):
+                self.errors.append(f"external {name}={value!r} on <{tag}>")
+            if v.startswith(("http:", "https:", "//")):
+                self.errors.append(f"external reference {name}={value!r}")
+        if tag in ("script", "iframe", "object", "link", "img"):
+            self.errors.append(f"<{tag}> in the page")
+        if tag not in VOID:
+            self.stack.append((tag, self.getpos()))
+    def handle_startendtag(self, tag, attrs):
+        self.counts[tag] = self.counts.get(tag, 0) + 1
+    def handle_endtag(self, tag):
+        if not self.stack or self.stack[-1][0] != tag:
+            self.errors.append(f"</{tag}> at {self.getpos()} closes {self.stack[-1] if self.stack else 'nothing'}")
+            return
+        self.stack.pop()
+    def handle_data(self, data):
+        self.text.append(data)
+c = Check()
+page = open(sys.argv[1], encoding="utf-8").read()
+c.feed(page)
+c.close()
+if c.stack:
+    c.errors.append(f"unclosed: {c.stack[:5]}")
+low = page.lower()
+for bad in ("http://", "https://", "url(", "@import"):
+    if bad in low:
+        c.errors.append(f"{bad} in the page")
+if c.errors:
+    print("\n".join(c.errors[:20]))
+    sys.exit(1)
+print(f"{sys.argv[1]}: parses, tags balance, self-contained ({c.counts.get('svg', 0)} svg, "
+      f"{c.counts.get('table', 0)} tables)")
+EOF
+}
+count() { grep -o -- "$2" "$1" | wc -l; }
+no_progress() {  # stderr of a run whose stderr was a file: no progress line, no carriage return
+  if grep -q $'\r' "$1" || grep -Eq 'ETA|/s  |runs [0-9]+/[0-9]+' "$1"; then fail "progress output in $1 (not a terminal)"; fi
+}
+
+# --- 1. the lab's sample files, one of them against a baseline it is far above -------------
+cat >"$T/seed.toml" <<'EOF'
+bench_id = "seed-3v-run1"
+[baseline]
+c_viscous_n_m_s = 1.8e-7
+c_viscous_stderr = 0.05e-7
+c_coulomb_n_m = 4.0e-5
+c_coulomb_stderr = 0.04e-5
+runs = 4
+date = "2026-01-12"
+EOF
+"$B/spindown" report "$D"/*.tsv --bench-config "$T/seed.toml" -o "$T/data.html" >"$T/data.out" 2>"$T/data.err" \
+  || fail "report of the sample files exited $?"
+check_page "$T/data.html" || fail "sample-file page"
+no_progress "$T/data.err"
+runs=$(ls "$D"/*.tsv | wc -l)
+[ "$(count "$T/data.html" '<svg class="run-plot"')" -eq "$runs" ] || fail "want one run figure per file ($runs)"
+[ "$(count "$T/data.html" '<table class="coef">')" -eq "$runs" ] || fail "want one coefficient table per run"
+grep -q 'g·cm²·rad·s⁻²' "$T/data.html" || fail "no lab units"
+grep -Eq '[0-9] ± [0-9.]+\)?(e-0[0-9])? N·m·s/rad' "$T/data.html" || fail "no SI coefficient ± error"
+grep -q '<span class="badge service">SERVICE</span>' "$T/data.html" || fail "the bench above its baseline is not flagged"
+grep -q "$T/seed.toml" "$T/data.html" || fail "the verdict does not name its reference"
+grep -q 'no reference configured' "$T/data.html" || fail "benches without a config must say so"
+grep -q 'Missing effect: <strong>coulomb</strong>' "$T/data.html" || fail "no explain story"
+grep -q 'Summary across benches and runs' "$T/data.html" || fail "no summary"
+echo "sample files: $(cat "$T/data.out")"
+
+# --- 2. text from files is escaped ---------------------------------------------------------
+cp "$D/seed-3v-run1.tsv" "$T/<b>bold & \"q\".tsv"
+"$B/spindown" report "$T/<b>bold & \"q\".tsv" --bench '<script>alert(1)</script>' -o "$T/evil.html" \
+  >"$T/evil.out" 2>"$T/evil.err" || fail "report of a strangely named file exited $?"
+check_page "$T/evil.html" || fail "escaped page"
+grep -q '<script>' "$T/evil.html" && fail "a bench id reached the page unescaped"
+grep -q '<b>bold' "$T/evil.html" && fail "a file name reached the page unescaped"
+grep -q '&lt;script&gt;alert(1)&lt;/script&gt;' "$T/evil.html" || fail "escaped bench id missing"
+grep -q '&lt;b&gt;bold &amp; &quot;q&quot;.tsv' "$T/evil.html" || fail "escaped file name missing"
+
+# --- 3. a generated LCM log with two benches ----------------------------------------------
+mkdir -p "$T/log"
+"$B/spindown-logger" --lcm-url "$URL" --dir "$T/log" --prefix report --flush-interval 0.2 -q \
+  >"$T/logger.out" 2>"$T/logger.err" &
+LOGGER=$!; PIDS+=($LOGGER)
+sleep 0.5
+"$B/spindown-run-publisher" --lcm-url "$URL" --benches 2 --runs 2 --prefix lab- --speed 25 --batch 8 \
+  --stagger 0.2 --wait-fits 0 >"$T/publisher.out" 2>"$T/publisher.err" || fail "publisher exited $?"
+sleep 0.5
+stop "$LOGGER"
+LOG=$(ls "$T"/log/*.lcm | head -1)
+[ -s "$LOG" ] || fail "no log written"
+"$B/spindown" report "$LOG" -o "$T/log.html" >"$T/log.out" 2>"$T/log.err" || fail "report of the log exited $?"
+check_page "$T/log.html" || fail "log page"
+no_progress "$T/log.err"
+[ "$(count "$T/log.html" '<section class="bench"')" -eq 2 ] || fail "want the log's two benches as two sections"
+[ "$(count "$T/log.html" '<svg class="run-plot"')" -eq 4 ] || fail "want 4 run figures (2 benches x 2 runs)"
+[ "$(count "$T/log.html" '<svg class="trend-plot"')" -eq 2 ] || fail "want a trend figure per bench"
+grep -q 'id="bench-lab-000"' "$T/log.html" && grep -q 'id="bench-lab-001"' "$T/log.html" || fail "bench ids"
+echo "LCM log: $(cat "$T/log.out")"
+
+# Files of both kinds in one report; refit with --no-progress prints no progress either.
+"$B/spindown" report "$LOG" "$D/seed-3v-run1.tsv" -o "$T/both.html" --no-progress >"$T/both.out" 2>"$T/both.err" \
+  || fail "mixed report exited $?"
+check_page "$T/both.html" || fail "mixed page"
+[ "$(count "$T/both.html" '<svg class="run-plot"')" -eq 5 ] || fail "want 5 run figures in the mixed report"
+"$B/spindown" refit "$LOG" >"$T/refit.out" 2>"$T/refit.err" || fail "refit exited $?"
+no_progress "$T/refit.err"
+
+# --- 4. exit codes -------------------------------------------------------------------------
+set +e
+"$B/spindown" report "$D/seed-3v-run1.tsv" >/dev/null 2>"$T/usage.err"; rc=$?
+[ $rc -eq 2 ] || fail "no -o: want exit 2, got $rc"
+printf 'bench_id = "x"\n[baseline\n' >"$T/broken.toml"
+"$B/spindown" report "$D/seed-3v-run1.tsv" --bench-config "$T/broken.toml" -o "$T/x.html" >/dev/null 2>"$T/broken.err"; rc=$?
+[ $rc -eq 2 ] || fail "a broken bench config: want exit 2, got $rc"
+grep -q 'broken.toml' "$T/broken.err" || fail "the broken config's message does not name the file"
+"$B/spindown" report "$D/seed-3v-run1.tsv" "$T/missing.tsv" -o "$T/partial.html" >/dev/null 2>"$T/partial.err"; rc=$?
+[ $rc -eq 1 ] || fail "a missing file: want exit 1, got $rc"
+grep -q 'missing.tsv' "$T/partial.err" || fail "the missing file is not named"
+[ "$(count "$T/partial.html" '<svg class="run-plot"')" -eq 1 ] || fail "the usable file must still be reported"
+"$B/spindown" report "$D/seed-3v-run1.tsv" -o "$T/no/such/dir/x.html" >/dev/null 2>"$T/write.err"; rc=$?
+[ $rc -eq 1 ] || fail "unwritable output: want exit 1, got $rc"
+set -e
+check_page "$T/partial.html" || fail "partial page"
+echo "cli_report: ok"
