@@ -1,6 +1,6 @@
 #pragma once
 // Progress of a long job (a refit of a big log, a report of many files) on a terminal: one
-// line on stderr, "label  done / total (pct)  runs …  rate  ETA", redrawn in place at most
+// line on stderr, "label  done / total (pct)  rate  ETA  extra", redrawn in place at most
 // ten times a second and erased at the end. Only when the stream is a terminal: a pipe or a
 // file (tests, scripts, CI) gets nothing, so output stays clean and diffable.
 #include <cstdint>
