@@ -18,6 +18,7 @@
 #include "spindown/fit.hpp"
 #include "spindown/fit_report.hpp"
 #include "spindown/motor_health.hpp"
+#include "spindown/ordered_parallel.hpp"
 #include "spindown/read_recording.hpp"
 #include "spindown/runs.hpp"
 
@@ -189,6 +190,8 @@ void setup_fit(CLI::App& app) {
                   "Per-bench TOML file(s): [bench] J/K_b (flags win) and [motor]/[baseline]/[health] for the "
                   "motor health verdict; a directory means every *.toml in it")
       ->check(CLI::ExistingPath);
+  sub->add_option("-j,--jobs", opt->jobs, "Files fitted at once (default 0: one per core); output keeps the order given")
+      ->check(CLI::Range(0u, 1024u));
   auto note_given = add_input_options(sub, opt->input);
 
   sub->callback([opt, note_given]() {
@@ -202,16 +205,28 @@ int run_fit(const FitCommandOptions& options) {
   const FitPlan plan = plan_from(options);
   std::vector<FileFit> files;
   bool all_usable = true;
-  for (const auto& path : options.files) {
-    FileFit file = fit_file(path, plan);
-    report_problems(file, plan, options.verbose);
-    all_usable = all_usable && file.usable();
-    if (!options.json) {
-      std::cout << format_file_fit(file, plan.report) << '\n';
-      std::cout.flush();
-    }
-    if (options.json) files.push_back(std::move(file));
-  }
+  struct Done {
+    FileFit file;
+    std::string text;  // the file's tables, formatted by the worker too
+  };
+  // Files are independent: fit them on every core, report them in the order given.
+  for_each_ordered(
+      options.files.size(), options.jobs == 0 ? default_jobs() : options.jobs,
+      [&](std::size_t i) {
+        Done d{fit_file(options.files[i], plan), {}};
+        if (!options.json) d.text = format_file_fit(d.file, plan.report);
+        return d;
+      },
+      [&](std::size_t, Done d) {
+        report_problems(d.file, plan, options.verbose);
+        all_usable = all_usable && d.file.usable();
+        if (options.json) {
+          files.push_back(std::move(d.file));
+        } else {
+          std::cout << d.text << '\n';
+          std::cout.flush();
+        }
+      });
   // replace: bytes that are not UTF-8 (a Latin-1 file name or config string) never abort the output.
   if (options.json)
     std::cout << fit_report_json(files, plan.report).dump(2, ' ', false, Json::error_handler_t::replace) << std::endl;

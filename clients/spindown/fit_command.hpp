@@ -22,6 +22,7 @@ struct FitCommandOptions {
   // Per-bench TOML files ([bench] J/K_b unless given as flags; [motor], [baseline], [health]
   // for the motor health verdict printed after each run).
   std::vector<std::string> bench_configs;
+  unsigned jobs = 0;  // files fitted at once; 0 = one per core
 };
 
 void setup_fit(CLI::App& app);

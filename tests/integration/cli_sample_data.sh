@@ -87,4 +87,14 @@ count=$(python3 -c 'import json,sys; print(len(json.load(open(sys.argv[1]))["fil
 if ((rc != 0 || count != ${#files[@]})); then
   echo "FAIL all files: exit $rc, $count file entries for ${#files[@]} files"; fail=1
 fi
+
+# Several files fitted at once (--jobs) give the very same output, in the order given, as one
+# at a time: text and JSON, the files listed twice over so workers finish out of order.
+for fmt in "" "--json"; do
+  timeout 120 "$bin" fit $fmt -j 1 "${files[@]}" "${files[@]}" >"$tmp/serial" 2>"$tmp/serial.err" || true
+  timeout 120 "$bin" fit $fmt -j 3 "${files[@]}" "${files[@]}" >"$tmp/parallel" 2>"$tmp/parallel.err" || true
+  if ! cmp -s "$tmp/serial" "$tmp/parallel" || ! cmp -s "$tmp/serial.err" "$tmp/parallel.err"; then
+    echo "FAIL fit $fmt -j 3 differs from -j 1"; fail=1
+  fi
+done
 exit $fail
