@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <fmt/format.h>
 #include <fstream>
 #include <iterator>
 #include <lcm/lcm-cpp.hpp>
@@ -330,7 +331,7 @@ TEST(LcmLogReader, GarbageBetweenEventsIsSkipped) {
   }
   auto bytes = file_bytes(f.path);
   const std::size_t event_size = bytes.size() / 6;
-  // Junk after event 3 (LCM's reader then rejects event 3) and a damaged header on event 5.
+  // Junk after event 3 (skipped; event 3 itself is sound and kept) and a damaged header on event 5.
   std::vector<char> junk(37, '\x5A');
   bytes.insert(bytes.begin() + static_cast<std::ptrdiff_t>(3 * event_size), junk.begin(), junk.end());
   const std::size_t event5 = 4 * event_size + junk.size();
@@ -340,13 +341,97 @@ TEST(LcmLogReader, GarbageBetweenEventsIsSkipped) {
   const LcmLogContents c = read_lcm_log(f.path);
   SCOPED_TRACE(all_diagnostics(c.diagnostics));
   const Recording& r = c.benches.at(0).recording;
-  // Events 1, 2, 4, 6 survive; 3 is lost to lcm::LogFile's check, 5 to its header.
-  EXPECT_EQ(r.size(), 40u);
-  EXPECT_TRUE(mentions(c.diagnostics, "lcm::LogFile rejects it"));
-  EXPECT_TRUE(mentions(c.diagnostics, "not an LCM event"));
+  // Events 1 to 4 and 6 survive (lcm::LogFile used to drop 3 for the junk after it); 5 is lost to its header.
+  EXPECT_EQ(r.size(), 50u);
+  EXPECT_EQ(c.events, 5);
+  EXPECT_TRUE(mentions(c.diagnostics, "37 bytes at offset"));
+  EXPECT_TRUE(mentions(c.diagnostics, "not an LCM event; skipped to the next event"));
   EXPECT_TRUE(mentions(c.diagnostics, "damaged event header"));
   EXPECT_TRUE(mentions(r.diagnostics, "samples lost"));  // the sequence gaps show the loss too
   EXPECT_EQ(r.clock_restarts.size(), 0u);
+}
+
+// The reader parses events in place in 1 MiB blocks: events that straddle a block boundary and
+// an event larger than a block must come out whole and in order.
+TEST(LcmLogReader, EventsAcrossBlockBoundariesAndLargerThanABlock) {
+  TempFile f("blocks");
+  std::int64_t seq = 0;
+  {
+    LogWriter w(f.path);
+    auto put = [&](int n) {
+      w.write("SPINDOWN.a.SAMPLE", batch("a", seq, seq * 20000LL, n));
+      seq += n;
+    };
+    for (int i = 0; i < 800; ++i) put(100);  // ~2.3 MB: two block boundaries inside events
+    put(50'000);                              // ~1.4 MB in one event: more than a block
+    for (int i = 0; i < 10; ++i) put(100);
+  }
+  ASSERT_GT(std::filesystem::file_size(f.path), 3u << 20);
+  const LcmLogContents c = read_lcm_log(f.path);
+  SCOPED_TRACE(all_diagnostics(c.diagnostics));
+  EXPECT_TRUE(c.diagnostics.empty());
+  EXPECT_EQ(c.events, 811);
+  ASSERT_EQ(c.benches.size(), 1u);
+  EXPECT_EQ(c.benches[0].recording.size(), static_cast<std::size_t>(seq));
+  EXPECT_EQ(c.benches[0].samples_lost, 0);
+
+  LcmLogReader reader(f.path);
+  LcmLogEvent e;
+  std::int64_t last_offset = -1, n = 0, next_seq = 0;
+  for (int guard = 0; guard < 1000 && reader.next(e); ++guard) {
+    ASSERT_EQ(e.kind, LcmLogEvent::Kind::samples) << e.problem;
+    EXPECT_GT(e.file_offset, last_offset);
+    EXPECT_EQ(e.samples.seq, next_seq);
+    next_seq += e.samples.n;
+    last_offset = e.file_offset;
+    ++n;
+  }
+  EXPECT_EQ(n, 811);
+}
+
+// Garbage straddling a block boundary, full of partial event markers, is skipped to the next
+// real marker; the events on both sides are kept.
+TEST(LcmLogReader, GarbageAcrossABlockBoundaryWithPartialMarkersIsSkipped) {
+  TempFile f("garbage_block");
+  {
+    LogWriter w(f.path);
+    for (int i = 0; i < 500; ++i) w.write("SPINDOWN.a.SAMPLE", batch("a", 100 * i, 2'000'000LL * i, 100));
+  }
+  auto bytes = file_bytes(f.path);
+  const std::size_t event_size = bytes.size() / 500;
+  const std::size_t k = (std::size_t{1} << 20) / event_size;  // the event boundary just before 1 MiB
+  std::vector<char> junk;
+  for (int i = 0; i < 2000; ++i) junk.insert(junk.end(), {'\xED', '\xA1', '\xDA', '\x00'});
+  bytes.insert(bytes.begin() + static_cast<std::ptrdiff_t>(k * event_size), junk.begin(), junk.end());
+  put_file(f.path, bytes);
+
+  const LcmLogContents c = read_lcm_log(f.path);
+  SCOPED_TRACE(all_diagnostics(c.diagnostics));
+  EXPECT_EQ(c.events, 500);
+  EXPECT_EQ(c.benches.at(0).recording.size(), 50'000u);
+  ASSERT_EQ(c.diagnostics.size(), 1u);
+  EXPECT_NE(c.diagnostics[0].message.find(fmt::format("{} bytes at offset {}", junk.size(), k * event_size)),
+            std::string::npos);
+  EXPECT_NE(c.diagnostics[0].message.find(fmt::format("next event at offset {}", k * event_size + junk.size())),
+            std::string::npos);
+}
+
+// A few bytes after the last event (less than a marker) are reported, not read as an event.
+TEST(LcmLogReader, ShortTailAfterTheLastEventIsReported) {
+  TempFile f("short_tail");
+  {
+    LogWriter w(f.path);
+    for (int i = 0; i < 3; ++i) w.write("SPINDOWN.a.SAMPLE", batch("a", 10 * i, 200'000LL * i, 10));
+  }
+  auto bytes = file_bytes(f.path);
+  bytes.insert(bytes.end(), {'\xED', '\xA1'});
+  put_file(f.path, bytes);
+  const LcmLogContents c = read_lcm_log(f.path);
+  SCOPED_TRACE(all_diagnostics(c.diagnostics));
+  EXPECT_EQ(c.events, 3);
+  EXPECT_EQ(c.benches.at(0).recording.size(), 30u);
+  EXPECT_TRUE(mentions(c.diagnostics, "2 bytes at offset"));
+  EXPECT_TRUE(mentions(c.diagnostics, "no event follows"));
 }
 
 TEST(LcmLogReader, StreamingReaderHandsOutEventsInOrder) {

@@ -7,8 +7,9 @@
 #include <cstring>
 #include <fmt/format.h>
 #include <limits>
-#include <lcm/lcm-cpp.hpp>
+#include <fcntl.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "spindown/message_decode.hpp"
 #include "text_support.hpp"
@@ -135,6 +136,10 @@ std::optional<BenchParams> bench_params_from_config(const config_t& config, std:
 // ---------------------------------------------------------------------------------------------
 // LcmLogReader
 
+namespace {
+constexpr std::int64_t block_bytes = 1 << 20;  // one pread(2) per MiB, forward only
+}
+
 LcmLogReader::LcmLogReader(const std::string& path) : path_(path) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) {
@@ -145,47 +150,113 @@ LcmLogReader::LcmLogReader(const std::string& path) : path_(path) {
     open_error_ = fmt::format("cannot read {}: it is a directory", path);
     return;
   }
-  // lcm::LogFile seeks and fopen() would wait forever on a FIFO without a writer.
+  // open() would wait forever on a FIFO without a writer, and a device never ends.
   if (!S_ISREG(st.st_mode)) {
     open_error_ = fmt::format("cannot read {} as an LCM log: not a regular file (a pipe, FIFO or device)", path);
     return;
   }
   size_ = static_cast<std::int64_t>(st.st_size);
-  errno = 0;
-  log_ = std::make_unique<lcm::LogFile>(path, "r");
-  if (!log_->good()) {
-    open_error_ = fmt::format("cannot open {}: {}", path, errno ? std::strerror(errno) : "lcm::LogFile failed");
-    log_.reset();
+  fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd_ < 0) {
+    open_error_ = fmt::format("cannot open {}: {}", path, std::strerror(errno));
+    return;
+  }
+  ::posix_fadvise(fd_, 0, 0, POSIX_FADV_SEQUENTIAL);
+}
+
+LcmLogReader::~LcmLogReader() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+std::int64_t LcmLogReader::fill(std::int64_t n, const unsigned char** p) {
+  const std::int64_t wanted = std::min(n, size_ - pos_);
+  if (buffer_offset_ + buffered_ - pos_ < wanted && read_error_.empty()) {
+    // Keep the unparsed tail, then read whole blocks behind it up to the size seen at open.
+    const std::int64_t keep = std::max<std::int64_t>(buffer_offset_ + buffered_ - pos_, 0);
+    const std::int64_t need = std::max(wanted, std::min(block_bytes, size_ - pos_));
+    if (static_cast<std::int64_t>(buffer_.size()) < need) {
+      std::vector<unsigned char> bigger(static_cast<std::size_t>(std::max(need, block_bytes)));
+      if (keep > 0) std::memcpy(bigger.data(), buffer_.data() + (pos_ - buffer_offset_), static_cast<std::size_t>(keep));
+      buffer_.swap(bigger);
+    } else if (keep > 0 && pos_ != buffer_offset_) {
+      std::memmove(buffer_.data(), buffer_.data() + (pos_ - buffer_offset_), static_cast<std::size_t>(keep));
+    }
+    buffer_offset_ = pos_;
+    buffered_ = keep;
+    const std::int64_t room = std::min<std::int64_t>(static_cast<std::int64_t>(buffer_.size()), size_ - pos_);
+    while (buffered_ < room) {
+      const ssize_t got = ::pread(fd_, buffer_.data() + buffered_, static_cast<std::size_t>(room - buffered_),
+                                  static_cast<off_t>(buffer_offset_ + buffered_));
+      if (got > 0) {
+        buffered_ += got;
+      } else if (got < 0 && errno == EINTR) {
+        continue;
+      } else {
+        if (got < 0)
+          read_error_ = fmt::format("read error at offset {}: {}", buffer_offset_ + buffered_, std::strerror(errno));
+        else  // the file shrank since it was opened: what is there is all there is
+          size_ = buffer_offset_ + buffered_;
+        break;
+      }
+    }
+  }
+  *p = buffer_.data() + (pos_ - buffer_offset_);
+  return std::clamp<std::int64_t>(buffer_offset_ + buffered_ - pos_, 0, std::max<std::int64_t>(wanted, 0));
+}
+
+std::int64_t LcmLogReader::find_marker(std::int64_t from) {
+  pos_ = from;
+  const unsigned char* p = nullptr;
+  for (;;) {
+    const std::int64_t have = fill(block_bytes, &p);
+    if (have < 4) return -1;
+    const unsigned char first = lcm_log_magic >> 24;
+    for (const unsigned char* q = p; (q = static_cast<const unsigned char*>(std::memchr(q, first, static_cast<std::size_t>(p + have - 3 - q))));
+         ++q) {
+      if (be32(q) == lcm_log_magic) return pos_ + (q - p);
+      if (q + 1 >= p + have - 3) break;
+    }
+    pos_ += have - 3;  // the last 3 bytes may start a marker that the next block completes
   }
 }
 
-LcmLogReader::~LcmLogReader() = default;
+const LcmLogReader::ChannelInfo& LcmLogReader::channel_info(std::string_view channel) {
+  for (const ChannelInfo& c : channels_)
+    if (c.channel == channel) return c;
+  // Bounded: a log with thousands of distinct channel names only forgets the oldest.
+  if (channels_.size() >= 64) channels_.erase(channels_.begin());
+  ChannelInfo info;
+  info.channel.assign(channel);
+  if (const auto name = split_spindown_channel(channel)) {
+    info.bench.assign(name->bench);
+    info.kind = name->kind == "SAMPLE" ? 1 : name->kind == "CONFIG" ? 2 : 0;
+  }
+  channels_.push_back(std::move(info));
+  return channels_.back();
+}
 
 // Positioned where no event starts: finds the next event marker and reports the skipped
 // bytes. Always moves forward or ends the log.
 bool LcmLogReader::find_event_start(LcmLogEvent& event) {
-  FILE* f = log_->getFilePtr();
-  const std::int64_t from = ftello(f);
-  std::uint32_t word = 0;
-  std::int64_t pos = from;
-  int c = 0;
-  while ((c = std::getc(f)) != EOF) {
-    word = (word << 8) | static_cast<unsigned char>(c);
-    ++pos;
-    if (pos - from >= 4 && word == lcm_log_magic) break;
-  }
-  event = LcmLogEvent{};
+  const std::int64_t from = pos_;
+  const std::int64_t at = find_marker(from);
   event.kind = LcmLogEvent::Kind::problem;
+  event.number = 0;
+  event.log_utime = 0;
   event.file_offset = from;
-  if (c == EOF) {
+  event.channel.clear();
+  event.bench.clear();
+  event.data = nullptr;
+  event.data_size = 0;
+  if (at < 0) {
     done_ = true;
+    pos_ = size_;
     event.problem = fmt::format("{} bytes at offset {} (after event {}) are not an LCM event and no event follows; "
                                 "ignored",
                                 size_ - from, from, events_);
     return true;
   }
-  const std::int64_t at = pos - 4;
-  fseeko(f, at, SEEK_SET);
+  pos_ = at;
   event.problem = fmt::format("{} bytes at offset {} (after event {}) are not an LCM event; skipped to the next "
                               "event at offset {}",
                               at - from, from, events_, at);
@@ -193,90 +264,100 @@ bool LcmLogReader::find_event_start(LcmLogEvent& event) {
 }
 
 bool LcmLogReader::next(LcmLogEvent& event) {
-  if (!log_ || done_) return false;
-  FILE* f = log_->getFilePtr();
-  const std::int64_t at = ftello(f);
-  if (at < 0 || at >= size_) {
-    done_ = true;
-    return false;
-  }
-  unsigned char h[event_header_bytes];
-  const std::size_t got = std::fread(h, 1, sizeof h, f);
-  if (got < 4 || be32(h) != lcm_log_magic) {
-    fseeko(f, at, SEEK_SET);
-    return find_event_start(event);
-  }
-
+  if (fd_ < 0 || done_) return false;
+  const std::int64_t at = pos_;
   auto problem = [&](std::string text) {
     event.kind = LcmLogEvent::Kind::problem;
     event.number = 0;
     event.file_offset = at;
+    event.data = nullptr;
+    event.data_size = 0;
     event.problem = std::move(text);
     return true;
   };
+  if (at >= size_) {
+    done_ = true;
+    return false;
+  }
+  const unsigned char* h = nullptr;
+  const std::int64_t got = fill(event_header_bytes, &h);
+  if (!read_error_.empty() && got < std::min(event_header_bytes, size_ - at)) {
+    done_ = true;
+    event.channel.clear();
+    event.bench.clear();
+    return problem(fmt::format("{} (after event {}); the rest of the log is not read", read_error_, events_));
+  }
+  if (got < 4 || be32(h) != lcm_log_magic) return find_event_start(event);
+
   event.channel.clear();
   event.bench.clear();
-  if (got < sizeof h) {
+  if (got < event_header_bytes) {
     done_ = true;
+    pos_ = size_;
     return problem(fmt::format("the log ends inside an event header at offset {} ({} of {} bytes; truncated "
                                "after event {})",
                                at, got, event_header_bytes, events_));
   }
+  const std::int64_t utime = static_cast<std::int64_t>(be64(h + 12));
   const std::int32_t channel_len = static_cast<std::int32_t>(be32(h + 20));
   const std::int32_t data_len = static_cast<std::int32_t>(be32(h + 24));
   if (channel_len <= 0 || channel_len >= max_channel_bytes || data_len < 0) {
-    fseeko(f, at + 1, SEEK_SET);
+    pos_ = at + 1;
     return problem(fmt::format("damaged event header at offset {} (channel length {}, data length {}) after event "
                                "{}; looking for the next event",
                                at, channel_len, data_len, events_));
   }
   const std::int64_t left = size_ - at - event_header_bytes;
-  std::string channel(static_cast<std::size_t>(std::min<std::int64_t>(channel_len, std::max<std::int64_t>(left, 0))),
-                      '\0');
-  channel.resize(std::fread(channel.data(), 1, channel.size(), f));
   const std::int64_t end = at + event_header_bytes + channel_len + data_len;
   if (end > size_) {
     // Truncated (the logger stopped mid-write) or a damaged length: look for a later event.
-    fseeko(f, at + 1, SEEK_SET);
-    LcmLogEvent scan;
-    find_event_start(scan);
-    const bool more = !done_;
-    const std::int64_t resume = ftello(f);
+    const unsigned char* p = nullptr;
+    const std::int64_t have = fill(event_header_bytes + std::min<std::int64_t>(channel_len, std::max<std::int64_t>(left, 0)), &p);
+    const std::string channel(reinterpret_cast<const char*>(p) + std::min(have, event_header_bytes),
+                              static_cast<std::size_t>(std::max<std::int64_t>(have - event_header_bytes, 0)));
+    const std::int64_t resume = find_marker(at + 1);
+    if (resume < 0) {
+      done_ = true;
+      pos_ = size_;
+    } else {
+      pos_ = resume;
+    }
     return problem(fmt::format("event {} at offset {} (channel {}) needs {} bytes but the log has {} left: "
                                "truncated or damaged{}",
-                               events_ + 1, at, printable(channel), channel_len + data_len, left,
-                               more ? fmt::format("; skipped to the next event at offset {}", resume)
-                                    : std::string("; it is the last one and is lost")));
+                               events_ + 1, at, printable(channel), std::int64_t(channel_len) + data_len, left,
+                               resume >= 0 ? fmt::format("; skipped to the next event at offset {}", resume)
+                                           : std::string("; it is the last one and is lost")));
   }
-  fseeko(f, at, SEEK_SET);
-  const lcm::LogEvent* e = log_->readNextEvent();
-  if (!e) {
-    // The header was sound, so lcm_eventlog rejected (and lost) an event that is not followed
-    // by another event or the end of the file; say so rather than lose it silently.
-    fseeko(f, end, SEEK_SET);
-    return problem(fmt::format("event {} at offset {} (channel {}) is followed by bytes that are not an event; "
-                               "lcm::LogFile rejects it, so it is lost",
-                               events_ + 1, at, printable(channel)));
+  const unsigned char* p = nullptr;
+  const std::int64_t have = fill(end - at, &p);
+  if (have < end - at) {  // a read error inside the event
+    done_ = true;
+    return problem(fmt::format("{} inside event {} at offset {}; the rest of the log is not read", read_error_,
+                               events_ + 1, at));
   }
+  // Whatever follows (another event, the end, or garbage that the next call skips and
+  // reports), this event is sound: it is kept.
+  pos_ = end;
   ++events_;
   event.number = events_;
-  event.log_utime = e->timestamp;
+  event.log_utime = utime;
   event.file_offset = at;
-  event.channel = e->channel;
+  const std::string_view channel(reinterpret_cast<const char*>(p + event_header_bytes),
+                                 static_cast<std::size_t>(channel_len));
+  event.channel.assign(channel);
   event.problem.clear();
-  decode(event, e->data, e->datalen);
+  decode(event, channel_info(channel), p + event_header_bytes + channel_len, data_len);
   return true;
 }
 
-void LcmLogReader::decode(LcmLogEvent& event, const void* data, std::int32_t size) {
+void LcmLogReader::decode(LcmLogEvent& event, const ChannelInfo& info, const void* data, std::int32_t size) {
   event.data = data;
   event.data_size = size;
   event.kind = LcmLogEvent::Kind::other;
-  const auto name = split_spindown_channel(event.channel);
-  if (!name) return;
-  event.bench.assign(name->bench);
+  if (info.bench.empty()) return;
+  event.bench.assign(info.bench);
   std::string why;
-  if (name->kind == "SAMPLE") {
+  if (info.kind == 1) {
     const auto* d = static_cast<const unsigned char*>(data);
     const bool right_type = size >= 8 && be64(d) == static_cast<std::uint64_t>(samples_t::getHash());
     if ((!right_type || samples_prefix_ok(d, size, &why)) && decode_checked(event.samples, data, size, &why)) {
@@ -285,7 +366,7 @@ void LcmLogReader::decode(LcmLogEvent& event, const void* data, std::int32_t siz
     }
     event.kind = LcmLogEvent::Kind::problem;
     event.problem = fmt::format("event {} on {}: {}; skipped", event.number, event.channel, why);
-  } else if (name->kind == "CONFIG") {
+  } else if (info.kind == 2) {
     if (decode_checked(event.config, data, size, &why)) {
       event.kind = LcmLogEvent::Kind::config;
       return;

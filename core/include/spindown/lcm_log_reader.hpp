@@ -1,9 +1,13 @@
 #pragma once
-// LCM event logs (what lcm-logger and spindown-logger write), read with lcm::LogFile and the
-// log's own timestamps — never by file:// replay, which hands out wall-clock times (design
-// §7). LcmLogReader streams events one at a time, so a refit never holds a whole log in
-// memory; read_lcm_log() gathers one Recording per bench from SPINDOWN.<bench>.SAMPLE and the
-// latest SPINDOWN.<bench>.CONFIG.
+// LCM event logs (what lcm-logger and spindown-logger write), read with the log's own
+// timestamps — never by file:// replay, which hands out wall-clock times (design §7).
+// LcmLogReader streams events one at a time from one reusable block buffer (the file is read
+// forward in 1 MiB blocks, events parsed in place; no seeks), so a refit never holds a whole log
+// in memory; read_lcm_log() gathers one Recording per bench from SPINDOWN.<bench>.SAMPLE and
+// the latest SPINDOWN.<bench>.CONFIG.
+//
+// Event layout (lcm_eventlog): uint32 0xEDA1DA01, int64 event number, int64 timestamp (µs),
+// int32 channel length, int32 data length (all big-endian), channel bytes, data bytes.
 //
 // A damaged log is read as far as it can be: garbage between events is skipped to the next
 // event marker, a truncated last event or an undecodable message is reported (with its event
@@ -22,10 +26,6 @@
 
 #include "spindown/bench.hpp"
 #include "spindown/recording.hpp"
-
-namespace lcm {
-class LogFile;
-}
 
 namespace spindown {
 
@@ -67,27 +67,45 @@ class LcmLogReader {
   LcmLogReader& operator=(const LcmLogReader&) = delete;
 
   // False when the file could not be opened; open_error() says why (with errno text).
-  bool good() const { return log_ != nullptr; }
+  bool good() const { return fd_ >= 0; }
   const std::string& open_error() const { return open_error_; }
   const std::string& path() const { return path_; }
 
   // The next event (or problem); false at the end of the log. event is reused between calls
-  // (its vectors keep their capacity).
+  // (its vectors keep their capacity); event.data points into the reader's buffer.
   bool next(LcmLogEvent& event);
 
   std::int64_t events_read() const { return events_; }
   std::int64_t file_size() const { return size_; }
 
  private:
+  // What a channel name means, worked out once per distinct name (a log has a handful).
+  struct ChannelInfo {
+    std::string channel;
+    std::string bench;   // empty: not SPINDOWN.<bench>.<KIND>
+    int kind = 0;        // 0 other, 1 SAMPLE, 2 CONFIG
+  };
+  const ChannelInfo& channel_info(std::string_view channel);
+  // Makes n bytes from pos_ available in the buffer (fewer only at the end of the file or on a
+  // read error); returns how many are and points *p at the first.
+  std::int64_t fill(std::int64_t n, const unsigned char** p);
+  // Offset of the first event marker at or after from, or -1 when none follows.
+  std::int64_t find_marker(std::int64_t from);
   bool find_event_start(LcmLogEvent& event);
-  void decode(LcmLogEvent& event, const void* data, std::int32_t size);
+  void decode(LcmLogEvent& event, const ChannelInfo& info, const void* data, std::int32_t size);
 
   std::string path_;
   std::string open_error_;
-  std::unique_ptr<lcm::LogFile> log_;
+  int fd_ = -1;
   std::int64_t size_ = 0;
   std::int64_t events_ = 0;
   bool done_ = false;
+  std::vector<unsigned char> buffer_;  // file bytes [buffer_offset_, buffer_offset_ + buffered_)
+  std::int64_t buffer_offset_ = 0;
+  std::int64_t buffered_ = 0;
+  std::int64_t pos_ = 0;               // file offset of the next byte to parse
+  std::string read_error_;             // a failed read(2), reported once as a problem
+  std::vector<ChannelInfo> channels_;
 };
 
 struct LcmLogOptions {
