@@ -56,8 +56,11 @@ void BM_RefitLog(benchmark::State& state) {
     spindown::LcmLogEvent ev;
     std::int64_t last = 0;
     while (reader.next(ev)) {
-      if (ev.kind == spindown::LcmLogEvent::Kind::samples || ev.kind == spindown::LcmLogEvent::Kind::config)
-        core.on_message(ev.channel, ev.data, ev.data_size, ev.log_utime);
+      // As refit_log: the reader's decoded message goes to the core (decoded once).
+      if (ev.kind == spindown::LcmLogEvent::Kind::samples)
+        core.on_samples(ev.bench, ev.samples, ev.log_utime);
+      else if (ev.kind == spindown::LcmLogEvent::Kind::config)
+        core.on_config(ev.bench, ev.config, ev.log_utime);
       last = ev.log_utime;
     }
     core.finish(last);

@@ -126,9 +126,12 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
       out.bench_order.push_back(ev.bench);
     }
     switch (ev.kind) {
+      // Decoded (and checked) once, by the reader: the core takes the message as it is.
       case LcmLogEvent::Kind::samples:
+        core.on_samples(ev.bench, ev.samples, ev.log_utime);
+        break;
       case LcmLogEvent::Kind::config:
-        core.on_message(ev.channel, ev.data, ev.data_size, ev.log_utime);
+        core.on_config(ev.bench, ev.config, ev.log_utime);
         break;
       case LcmLogEvent::Kind::problem:
         if (ev.number > 0 && ev.data) {  // a message that does not decode: the core counts it
