@@ -21,6 +21,7 @@
 #include "spindown/clock_checks.hpp"
 #include "spindown/config_t.hpp"
 #include "spindown/doctor_check.hpp"
+#include "spindown/message_decode.hpp"
 #include "spindown/lcm_channels.hpp"
 #include "spindown/lcm_self_test.hpp"
 #include "spindown/lcm_url.hpp"
@@ -163,13 +164,13 @@ struct SkewListener {
     const auto parsed = parse_channel(channel);
     if (!parsed) return;
     const std::int64_t received = rbuf->recv_utime > 0 ? rbuf->recv_utime : wall_us();
-    const auto size = static_cast<int>(rbuf->data_size);
+    const auto size = static_cast<std::int64_t>(rbuf->data_size);
     if (parsed->kind == ChannelKind::status) {
       status_t m;
-      if (m.decode(rbuf->data, 0, size) >= 0) self->tracker.add(m.host, m.service + " " + m.instance, m.utime, received);
+      if (decode_message(m, rbuf->data, size)) self->tracker.add(m.host, m.service + " " + m.instance, m.utime, received);
     } else if (parsed->kind == ChannelKind::config) {
       config_t m;
-      if (m.decode(rbuf->data, 0, size) >= 0) self->tracker.add(m.host, "bridge " + m.bench, m.utime, received);
+      if (decode_message(m, rbuf->data, size)) self->tracker.add(m.host, "bridge " + m.bench, m.utime, received);
     }
   }
 };

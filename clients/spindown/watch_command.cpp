@@ -21,6 +21,7 @@
 #include "exit_codes.hpp"
 #include "spindown/lab_table.hpp"
 #include "spindown/lcm_channels.hpp"
+#include "spindown/message_decode.hpp"
 
 namespace spindown::cli {
 
@@ -66,9 +67,11 @@ class WatchListener {
  private:
   template <class Message>
   bool decode(const lcm_recv_buf_t* rbuf, const std::string& channel, Message& m, const char* type) {
-    const auto size = static_cast<int>(rbuf->data_size);
-    if (m.decode(rbuf->data, 0, size) >= 0) return true;
-    table_.on_bad_message(fmt::format("{}: {} bytes that do not decode as {}", channel, size, type),
+    // decode_message checks the layout first: a hostile packet cannot make it allocate gigabytes.
+    const auto size = static_cast<std::int64_t>(rbuf->data_size);
+    std::string why;
+    if (decode_message(m, rbuf->data, size, &why)) return true;
+    table_.on_bad_message(fmt::format("{}: {} bytes that do not decode as {}: {}", channel, size, type, why),
                           rbuf->recv_utime);
     return false;
   }

@@ -13,6 +13,7 @@
 #include <spindown/samples_t.hpp>
 
 #include "spindown/lcm_channels.hpp"
+#include "spindown/message_decode.hpp"
 
 namespace spindown {
 
@@ -263,7 +264,7 @@ void EventLogWriter::track_samples(std::string_view channel, const void* data, s
   const auto parsed = parse_channel(channel);
   if (!parsed || parsed->kind != ChannelKind::sample) return;
   samples_t s;
-  if (size <= 0 || s.decode(data, 0, size) < 0) {
+  if (size <= 0 || !decode_message(s, data, size)) {  // layout checked first: no allocation bombs
     ++counters_.decode_errors;
     return;
   }
