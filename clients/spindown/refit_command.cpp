@@ -2,13 +2,16 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cstdio>
 #include <exception>
 #include <fmt/format.h>
 #include <iostream>
 #include <map>
 #include <memory>
 #include <regex>
+#include <string_view>
 #include <unistd.h>
+#include <vector>
 
 #include "exit_codes.hpp"
 #include "spindown/bench.hpp"
@@ -21,29 +24,107 @@ namespace {
 
 constexpr std::size_t max_problems_listed = 20;  // per file, then counted
 
+constexpr std::size_t max_detector_notes = 1000;  // per file, then counted (memory flat)
+
 class RefitSink final : public FitterSink {
  public:
-  RefitSink(LogRefit& out, const std::string& path) : out_(out), path_(path) {}
+  RefitSink(LogRefit& out, const std::string& path, const RefitRunFn& each_run)
+      : out_(out), path_(path), each_run_(each_run) {}
   void run_changed(const run_t&) override {}
   void fit_ready(const FitResult& r) override {
-    out_.runs.push_back({r.bench, r.fit, r.bench_source, r.first_seq, r.last_seq});
+    ++out_.runs_fitted;
+    if (!each_run_) {
+      out_.runs.push_back({r.bench, r.fit, r.bench_source, r.first_seq, r.last_seq});
+      return;
+    }
+    if (r.fit.best.empty())
+      out_.file.failures.push_back(fmt::format("SPINDOWN.{}.SAMPLE: run {}: no model converged", r.bench,
+                                               r.fit.run.number));
+    each_run_(RefitRun{r.bench, r.fit, r.bench_source, r.first_seq, r.last_seq});
   }
   void problem(const std::string& text) override {
     if (++problems_ <= max_problems_listed)
       out_.file.diagnostics.push_back({Diagnostic::Severity::warning, path_, 0, text});
   }
   void diagnostic(const std::string&, const Diagnostic& d) override {
+    if (++notes_ > max_detector_notes) return;
     Diagnostic copy = d;
     copy.source = path_ + " " + d.source;
     out_.file.diagnostics.push_back(std::move(copy));
   }
   std::size_t problems() const { return problems_; }
+  std::size_t notes() const { return notes_; }
 
  private:
   LogRefit& out_;
   const std::string& path_;
-  std::size_t problems_ = 0;
+  const RefitRunFn& each_run_;
+  std::size_t problems_ = 0, notes_ = 0;
 };
+
+// One bench's formatted runs, held in an unlinked temporary file until the log is done (in
+// memory only if no temporary file can be made), so memory stays flat however long the log.
+class RunSpool {
+ public:
+  RunSpool() : file_(std::tmpfile()) {}
+  ~RunSpool() {
+    if (file_) std::fclose(file_);
+  }
+  RunSpool(const RunSpool&) = delete;
+  RunSpool& operator=(const RunSpool&) = delete;
+  void add(std::string_view text) {
+    ++runs_;
+    if (file_ && std::fwrite(text.data(), 1, text.size(), file_) == text.size()) return;
+    if (file_) {  // disk full: keep what is already spooled, carry on in memory
+      spilled_ = true;
+    }
+    memory_.append(text);
+  }
+  std::size_t runs() const { return runs_; }
+  // Copies everything to out, leaving out the first skip bytes.
+  void copy_to(std::ostream& out, std::size_t skip) {
+    if (file_) {
+      std::fflush(file_);
+      std::rewind(file_);
+      std::vector<char> block(1 << 16);
+      std::size_t got = 0;
+      while ((got = std::fread(block.data(), 1, block.size(), file_)) > 0) {
+        const std::size_t from = std::min(skip, got);
+        out.write(block.data() + from, static_cast<std::streamsize>(got - from));
+        skip -= from;
+      }
+    }
+    out << std::string_view(memory_).substr(std::min(skip, memory_.size()));
+  }
+
+ private:
+  std::FILE* file_ = nullptr;
+  std::string memory_;
+  bool spilled_ = false;
+  std::size_t runs_ = 0;
+};
+
+std::string indented(const std::string& text, std::size_t spaces) {
+  const std::string pad(spaces, ' ');
+  std::string out = pad;
+  out.reserve(text.size() + text.size() / 8);
+  for (char c : text) {
+    out += c;
+    if (c == '\n') out += pad;
+  }
+  return out;
+}
+
+std::string dump_json(const Json& j) { return j.dump(2, ' ', false, Json::error_handler_t::replace); }
+
+// A run as refit_file_json() lists it.
+Json refit_run_json(const RefitRun& run, const ReportOptions& opt) {
+  Json j = run_fit_json(run.fit, opt);
+  j["bench"]["id"] = run.bench;
+  j["first_seq"] = run.first_seq;
+  j["last_seq"] = run.last_seq;
+  return j;
+}
 
 // The first place two JSON values differ ("" when equal).
 std::string first_difference(const Json& a, const Json& b, const std::string& path) {
@@ -101,7 +182,8 @@ std::string run_key(const std::string& bench, int run) { return fmt::format("{}#
 }  // namespace
 
 LogRefit refit_log(const std::string& path, const FitterOptions& options, bool keep_live_fits,
-                   const std::function<void(const LcmLogEvent&)>& each_event, const RefitProgressFn& progress) {
+                   const std::function<void(const LcmLogEvent&)>& each_event, const RefitProgressFn& progress,
+                   const RefitRunFn& each_run) {
   LogRefit out;
   out.file.file = path;
   LcmLogReader reader(path);
@@ -109,7 +191,7 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
     out.file.failures.push_back(reader.open_error());
     return out;
   }
-  RefitSink sink(out, path);
+  RefitSink sink(out, path, each_run);
   FitterCore core(options, sink);
   std::map<std::string, std::size_t, std::less<>> order;
   std::int64_t last_utime = 0;
@@ -118,7 +200,7 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
   std::size_t events_seen = 0;
   while (reader.next(ev)) {
     if (each_event) each_event(ev);
-    if (progress && ++events_seen % 256 == 0) progress(ev.file_offset, reader.file_size(), out.runs.size());
+    if (progress && ++events_seen % 256 == 0) progress(ev.file_offset, reader.file_size(), out.runs_fitted);
     if (ev.number > 0) last_utime = ev.log_utime;
     if (!ev.bench.empty() && (ev.channel.ends_with(".SAMPLE") || ev.channel.ends_with(".CONFIG")) &&
         !order.contains(ev.bench)) {
@@ -167,6 +249,10 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
     out.file.diagnostics.push_back({Diagnostic::Severity::warning, path, 0,
                                     fmt::format("{} unusable messages or samples in all (first {} listed)",
                                                 sink.problems(), max_problems_listed)});
+  if (sink.notes() > max_detector_notes)
+    out.file.diagnostics.push_back({Diagnostic::Severity::note, path, 0,
+                                    fmt::format("{} run detector notes in all (first {} listed)", sink.notes(),
+                                                max_detector_notes)});
   out.file.diagnostics.push_back(
       {Diagnostic::Severity::note, path, 0,
        fmt::format("{} events: {} sample messages, {} config messages, {} samples used; {} decode errors, {} sequence "
@@ -193,7 +279,7 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
       out.file.failures.push_back(fmt::format("SPINDOWN.{}.SAMPLE: run {}: no model converged", r.bench,
                                               r.fit.run.number));
   }
-  if (out.runs.empty())
+  if (out.runs_fitted == 0)
     out.file.failures.push_back(c.samples > 0 ? fmt::format("no spin-down run found in {} samples", c.samples)
                                               : std::string("no samples on SPINDOWN.<bench>.SAMPLE channels"));
   return out;
@@ -262,14 +348,31 @@ int run_refit(const RefitCommandOptions& o) {
   bool ok = true;
   Json files = Json::array();
   const bool show_progress = !o.no_progress && ProgressReporter::is_terminal(STDERR_FILENO);
+  const bool stream = !o.live && !o.compare;  // runs formatted as fitted, not kept (memory flat)
+  bool first_file = true;
   for (const auto& path : o.logs) {
     // On a terminal only (never in pipes or files), throttled, erased before anything is printed.
     ProgressReporter progress(STDERR_FILENO, show_progress);
-    LogRefit r = refit_log(path, fopt, o.live || o.compare, {},
-                           [&](std::int64_t done, std::int64_t total, std::size_t runs) {
-                             progress.update(done, total, "refit",
-                                             fmt::format("{} run{} fitted  {}", runs, runs == 1 ? "" : "s", path));
-                           });
+    // Each bench's runs, formatted as they are fitted; printed by bench (first appearance) once
+    // the log is done, as the order contract wants.
+    std::vector<std::pair<std::string, std::unique_ptr<RunSpool>>> spools;
+    auto each_run = [&](RefitRun&& run) {
+      RunSpool* spool = nullptr;
+      for (auto& [bench, sp] : spools)
+        if (bench == run.bench) spool = sp.get();
+      if (!spool) spool = spools.emplace_back(run.bench, std::make_unique<RunSpool>()).second.get();
+      if (o.json)
+        spool->add(",\n" + indented(dump_json(refit_run_json(run, report)), 8));
+      else
+        spool->add(fmt::format("\n-- bench {} (J/K_b: {})\n", run.bench, run.bench_source) +
+                   format_run_fit(run.fit, report));
+    };
+    LogRefit r = refit_log(
+        path, fopt, o.live || o.compare, {},
+        [&](std::int64_t done, std::int64_t total, std::size_t runs) {
+          progress.update(done, total, "refit", fmt::format("{} run{} fitted  {}", runs, runs == 1 ? "" : "s", path));
+        },
+        stream ? RefitRunFn(each_run) : RefitRunFn());
     progress.finish();
     // Problems on stderr, as `spindown fit` does.
     std::vector<Diagnostic> shown;
@@ -346,25 +449,47 @@ int run_refit(const RefitCommandOptions& o) {
 
     for (const auto& why : r.file.failures) std::cerr << path << ": error: not used: " << why << '\n';
     ok = ok && r.file.usable();
+    // Spools by bench in order of first appearance (a bench never seen on SAMPLE/CONFIG last).
+    std::vector<RunSpool*> ordered;
+    for (const auto& id : r.bench_order)
+      for (auto& [bench, sp] : spools)
+        if (bench == id) ordered.push_back(sp.get());
+    for (auto& [bench, sp] : spools)
+      if (std::find(r.bench_order.begin(), r.bench_order.end(), bench) == r.bench_order.end())
+        ordered.push_back(sp.get());
     if (o.json) {
-      files.push_back(refit_file_json(r, report));
+      // The file's object as refit_file_json() gives it, its runs spliced in from the spools;
+      // the same bytes as dumping the whole document at once.
+      constexpr std::string_view hole = "(runs spliced here)";  // printed by dump() as it is
+      Json file = refit_file_json(r, report);
+      file["runs"] = hole;
+      const std::string text = indented(dump_json(file), 4);
+      const std::string key = fmt::format("\n      \"runs\": \"{}\"", hole);
+      const std::size_t at = text.find(key);
+      std::cout << (first_file ? "{\n  \"files\": [\n" : ",\n") << std::string_view(text).substr(0, at);
+      first_file = false;
+      if (ordered.empty()) {
+        std::cout << "\n      \"runs\": []";
+      } else {
+        std::cout << "\n      \"runs\": [\n";
+        for (std::size_t i = 0; i < ordered.size(); ++i) ordered[i]->copy_to(std::cout, i == 0 ? 2 : 0);
+        std::cout << "\n      ]";
+      }
+      std::cout << std::string_view(text).substr(at + key.size());
     } else {
-      std::size_t benches = 0;
-      std::string last;
-      for (const auto& run : r.runs)
-        if (run.bench != last) ++benches, last = run.bench;
+      const std::size_t runs = r.runs_fitted, benches = ordered.size();
       std::cout << fmt::format("== {}: {} samples from {} messages ({} skipped), {} run{} fitted on {} bench{}\n",
-                               path, r.file.samples, r.file.lines_read, r.file.lines_skipped, r.runs.size(),
-                               r.runs.size() == 1 ? "" : "s", benches, benches == 1 ? "" : "es");
-      for (const auto& run : r.runs)
-        std::cout << fmt::format("\n-- bench {} (J/K_b: {})\n", run.bench, run.bench_source)
-                  << format_run_fit(run.fit, report);
-      std::cout.flush();
+                               path, r.file.samples, r.file.lines_read, r.file.lines_skipped, runs,
+                               runs == 1 ? "" : "s", benches, benches == 1 ? "" : "es");
+      for (RunSpool* spool : ordered) spool->copy_to(std::cout, 0);
     }
+    std::cout.flush();
   }
   // replace: bytes that are not UTF-8 (a config string in the log) never abort the output.
-  if (o.json && !o.compare)
+  if (o.json && o.live)
     std::cout << Json{{"files", std::move(files)}}.dump(2, ' ', false, Json::error_handler_t::replace) << std::endl;
+  else if (o.json && stream && !first_file)
+    std::cout << "\n  ]\n}" << std::endl;
   return ok ? exit_ok : exit_unusable;
 }
 

@@ -1,10 +1,13 @@
 #pragma once
-// `spindown refit LOG...`: stream an LCM log (lcm::LogFile, the log's own order and receive
+// `spindown refit LOG...`: stream an LCM log (LcmLogReader, the log's own order and receive
 // times) through the live fitter's FitterCore, so every bench's runs and numbers are exactly
 // what spindown-fitter gave for that traffic; print them as `spindown fit` does (text or §5
 // JSON, each run tagged with its bench id and sequence numbers). --live prints the FIT
 // messages recorded in the log instead; --compare checks the refit against them.
-// Memory is bounded by the per-bench state, not by the log's length.
+// Memory is bounded by the per-bench state, not by the log's length: runs are formatted as they
+// are fitted and held, per bench, in an unlinked temporary file until the log is done (the
+// order contract needs every run of the first bench before the second's); --live and
+// --compare keep the runs in memory.
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -33,7 +36,8 @@ struct RefitRun {
 
 struct LogRefit {
   FileFit file;                 // runs ordered by bench (first appearance), then run number
-  std::vector<RefitRun> runs;   // the same runs, with their bench ids
+  std::vector<RefitRun> runs;   // the same runs, with their bench ids (empty when streamed)
+  std::size_t runs_fitted = 0;  // runs fitted, kept or streamed
   std::vector<fit_t> live;      // SPINDOWN.<bench>.FIT messages recorded in the log (when asked)
   FitterCounters counters;
   std::vector<std::string> bench_order;  // benches in order of first appearance
@@ -43,10 +47,14 @@ struct LogRefit {
 // log). each_event, when given, sees every event first (export writes samples from it).
 // progress, when given, is told every few hundred events how far the read is (bytes of the
 // file) and how many runs have been fitted.
+// each_run, when given, receives every run as soon as it is fitted (per bench in run order,
+// benches interleaved as the log has them) and the runs are not kept: LogRefit::runs and
+// file.runs stay empty and memory stays flat in the log's length (runs_fitted counts them).
 using RefitProgressFn = std::function<void(std::int64_t bytes_done, std::int64_t bytes_total, std::size_t runs)>;
+using RefitRunFn = std::function<void(RefitRun&& run)>;
 LogRefit refit_log(const std::string& path, const FitterOptions& options, bool keep_live_fits,
                    const std::function<void(const LcmLogEvent&)>& each_event = {},
-                   const RefitProgressFn& progress = {});
+                   const RefitProgressFn& progress = {}, const RefitRunFn& each_run = {});
 
 // file_fit_json() with each run tagged as fit_message_json() tags a live FIT: bench.id,
 // first_seq, last_seq.
