@@ -194,6 +194,7 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
   RefitSink sink(out, path, each_run);
   FitterCore core(options, sink);
   std::map<std::string, std::size_t, std::less<>> order;
+  std::vector<bool> channel_done;  // by LcmLogEvent::channel_id
   std::int64_t last_utime = 0;
   std::size_t file_problems = 0;
   LcmLogEvent ev;
@@ -202,10 +203,18 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
     if (each_event) each_event(ev);
     if (progress && ++events_seen % 256 == 0) progress(ev.file_offset, reader.file_size(), out.runs_fitted);
     if (ev.number > 0) last_utime = ev.log_utime;
-    if (!ev.bench.empty() && (ev.channel.ends_with(".SAMPLE") || ev.channel.ends_with(".CONFIG")) &&
-        !order.contains(ev.bench)) {
-      order.emplace(ev.bench, order.size());
-      out.bench_order.push_back(ev.bench);
+    // A bench's first SAMPLE/CONFIG fixes its place; checked once per channel, not per event.
+    const auto id = static_cast<std::size_t>(ev.channel_id);
+    if (ev.channel_id < 0 || id >= channel_done.size() || !channel_done[id]) {
+      if (!ev.bench.empty() && (ev.channel.ends_with(".SAMPLE") || ev.channel.ends_with(".CONFIG")) &&
+          !order.contains(ev.bench)) {
+        order.emplace(ev.bench, order.size());
+        out.bench_order.push_back(ev.bench);
+      }
+      if (ev.channel_id >= 0) {
+        if (id >= channel_done.size()) channel_done.resize(id + 1, false);
+        channel_done[id] = true;
+      }
     }
     switch (ev.kind) {
       // Decoded (and checked) once, by the reader: the core takes the message as it is.

@@ -220,19 +220,39 @@ std::int64_t LcmLogReader::find_marker(std::int64_t from) {
   }
 }
 
+namespace {
+// Length and three 8-byte words of the name (start, middle, end): channel names of one log
+// differ somewhere in there (SPINDOWN.<bench>.<KIND>), so equal keys almost always mean equal names.
+std::uint64_t channel_key(std::string_view c) {
+  auto word = [&](std::size_t at) {
+    std::uint64_t w = 0;
+    std::memcpy(&w, c.data() + at, std::min<std::size_t>(8, c.size() - at));
+    return w;
+  };
+  std::uint64_t k = c.size() * 0x9E3779B97F4A7C15ull;
+  if (c.empty()) return k;
+  k ^= word(0);
+  if (c.size() > 8) k ^= word(c.size() - 8) * 0xC2B2AE3D27D4EB4Full;
+  if (c.size() > 16) k ^= word(c.size() / 2 - 4) * 0x165667B19E3779F9ull;
+  return k;
+}
+}  // namespace
+
 const LcmLogReader::ChannelInfo& LcmLogReader::channel_info(std::string_view channel) {
+  const std::uint64_t key = channel_key(channel);
   for (const ChannelInfo& c : channels_)
-    if (c.channel == channel) return c;
-  // Bounded: a log with thousands of distinct channel names only forgets the oldest.
-  if (channels_.size() >= 64) channels_.erase(channels_.begin());
-  ChannelInfo info;
+    if (c.key == key && c.channel == channel) return c;
+  ChannelInfo& info = channels_.size() < max_channel_ids ? channels_.emplace_back() : uncached_;
+  info.key = key;
   info.channel.assign(channel);
+  info.bench.clear();
+  info.kind = 0;
+  info.id = &info == &uncached_ ? -1 : static_cast<std::int32_t>(channels_.size() - 1);
   if (const auto name = split_spindown_channel(channel)) {
     info.bench.assign(name->bench);
     info.kind = name->kind == "SAMPLE" ? 1 : name->kind == "CONFIG" ? 2 : 0;
   }
-  channels_.push_back(std::move(info));
-  return channels_.back();
+  return info;
 }
 
 // Positioned where no event starts: finds the next event marker and reports the skipped
@@ -244,6 +264,7 @@ bool LcmLogReader::find_event_start(LcmLogEvent& event) {
   event.number = 0;
   event.log_utime = 0;
   event.file_offset = from;
+  event.channel_id = -1;
   event.channel.clear();
   event.bench.clear();
   event.data = nullptr;
@@ -269,6 +290,7 @@ bool LcmLogReader::next(LcmLogEvent& event) {
   auto problem = [&](std::string text) {
     event.kind = LcmLogEvent::Kind::problem;
     event.number = 0;
+    event.channel_id = -1;
     event.file_offset = at;
     event.data = nullptr;
     event.data_size = 0;
@@ -353,6 +375,7 @@ bool LcmLogReader::next(LcmLogEvent& event) {
 void LcmLogReader::decode(LcmLogEvent& event, const ChannelInfo& info, const void* data, std::int32_t size) {
   event.data = data;
   event.data_size = size;
+  event.channel_id = info.id;
   event.kind = LcmLogEvent::Kind::other;
   if (info.bench.empty()) return;
   event.bench.assign(info.bench);
@@ -360,7 +383,13 @@ void LcmLogReader::decode(LcmLogEvent& event, const ChannelInfo& info, const voi
   if (info.kind == 1) {
     const auto* d = static_cast<const unsigned char*>(data);
     const bool right_type = size >= 8 && be64(d) == static_cast<std::uint64_t>(samples_t::getHash());
-    if ((!right_type || samples_prefix_ok(d, size, &why)) && decode_checked(event.samples, data, size, &why)) {
+    // samples_prefix_ok checks samples_t's whole layout (its strings and arrays are all in the
+    // prefix), so the generated decoder is safe without the general layout walk.
+    if (right_type && samples_prefix_ok(d, size, &why) && event.samples.decode(data, 0, size) >= 0) {
+      event.kind = LcmLogEvent::Kind::samples;
+      return;
+    }
+    if (why.empty() && decode_checked(event.samples, data, size, &why)) {
       event.kind = LcmLogEvent::Kind::samples;
       return;
     }

@@ -51,6 +51,9 @@ struct LcmLogEvent {
   std::int64_t log_utime = 0;    // receive time the logger wrote (µs since the Unix epoch)
   std::int64_t file_offset = 0;  // byte offset of the event (or of the damage)
   std::string channel;
+  // The channel name's index in this reader, the same for every event on it (a consumer's
+  // per-channel cache needs no string compare); -1 past LcmLogReader::max_channel_ids distinct names.
+  std::int32_t channel_id = -1;
   std::string bench;             // for SPINDOWN.<bench>.* channels, else empty
   samples_t samples;             // Kind::samples
   config_t config;               // Kind::config
@@ -78,12 +81,17 @@ class LcmLogReader {
   std::int64_t events_read() const { return events_; }
   std::int64_t file_size() const { return size_; }
 
+  // Distinct channel names remembered (with their id); more are parsed per event.
+  static constexpr std::size_t max_channel_ids = 256;
+
  private:
   // What a channel name means, worked out once per distinct name (a log has a handful).
   struct ChannelInfo {
+    std::uint64_t key = 0;  // cheap fingerprint of the name: most mismatches cost no memcmp
     std::string channel;
-    std::string bench;   // empty: not SPINDOWN.<bench>.<KIND>
-    int kind = 0;        // 0 other, 1 SAMPLE, 2 CONFIG
+    std::string bench;      // empty: not SPINDOWN.<bench>.<KIND>
+    int kind = 0;           // 0 other, 1 SAMPLE, 2 CONFIG
+    std::int32_t id = -1;
   };
   const ChannelInfo& channel_info(std::string_view channel);
   // Makes n bytes from pos_ available in the buffer (fewer only at the end of the file or on a
@@ -106,6 +114,7 @@ class LcmLogReader {
   std::int64_t pos_ = 0;               // file offset of the next byte to parse
   std::string read_error_;             // a failed read(2), reported once as a problem
   std::vector<ChannelInfo> channels_;
+  ChannelInfo uncached_;               // the name being read when channels_ is full
 };
 
 struct LcmLogOptions {
