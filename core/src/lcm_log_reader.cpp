@@ -1,6 +1,7 @@
 #include "spindown/lcm_log_reader.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -57,6 +58,35 @@ bool samples_prefix_ok(const unsigned char* d, std::int32_t size, std::string* w
     return false;
   }
   return true;
+}
+
+// samples_t from bytes that samples_prefix_ok() accepted, field by field into m's existing
+// storage (lcm-gen's decoder, one call per field and array, dominated a one-sample message).
+void decode_samples(const unsigned char* d, samples_t& m) {
+  auto i64 = [](const unsigned char* p) { return static_cast<std::int64_t>(be64(p)); };
+  std::size_t pos = 8;  // after the fingerprint
+  m.utime = i64(d + pos);
+  const auto bench_len = static_cast<std::size_t>(be32(d + pos + 8));
+  pos += 12;
+  m.bench.assign(reinterpret_cast<const char*>(d + pos), bench_len - 1);  // the length counts the NUL
+  pos += bench_len;
+  m.seq = i64(d + pos);
+  m.clock_epoch = static_cast<std::int32_t>(be32(d + pos + 8));
+  m.quantity = static_cast<std::int8_t>(d[pos + 12]);
+  m.n = static_cast<std::int32_t>(be32(d + pos + 13));
+  pos += 17;
+  const auto n = static_cast<std::size_t>(m.n);
+  m.device_time_us.resize(n);
+  m.host_time_us.resize(n);
+  m.value.resize(n);
+  m.raw_adc.resize(n);
+  for (std::size_t i = 0; i < n; ++i) m.device_time_us[i] = i64(d + pos + 8 * i);
+  pos += 8 * n;
+  for (std::size_t i = 0; i < n; ++i) m.host_time_us[i] = i64(d + pos + 8 * i);
+  pos += 8 * n;
+  for (std::size_t i = 0; i < n; ++i) m.value[i] = std::bit_cast<double>(be64(d + pos + 8 * i));
+  pos += 8 * n;
+  for (std::size_t i = 0; i < n; ++i) m.raw_adc[i] = static_cast<std::int32_t>(be32(d + pos + 4 * i));
 }
 
 template <class Msg>
@@ -226,33 +256,54 @@ namespace {
 std::uint64_t channel_key(std::string_view c) {
   auto word = [&](std::size_t at) {
     std::uint64_t w = 0;
-    std::memcpy(&w, c.data() + at, std::min<std::size_t>(8, c.size() - at));
+    std::memcpy(&w, c.data() + at, 8);
     return w;
   };
   std::uint64_t k = c.size() * 0x9E3779B97F4A7C15ull;
-  if (c.empty()) return k;
-  k ^= word(0);
-  if (c.size() > 8) k ^= word(c.size() - 8) * 0xC2B2AE3D27D4EB4Full;
-  if (c.size() > 16) k ^= word(c.size() / 2 - 4) * 0x165667B19E3779F9ull;
-  return k;
+  if (c.size() < 8) {
+    for (char ch : c) k = (k ^ static_cast<unsigned char>(ch)) * 0x100000001B3ull;
+    return k;
+  }
+  return k ^ word(0) ^ word(c.size() - 8) * 0xC2B2AE3D27D4EB4Full ^ word(c.size() / 2 - 4) * 0x165667B19E3779F9ull;
 }
 }  // namespace
 
 const LcmLogReader::ChannelInfo& LcmLogReader::channel_info(std::string_view channel) {
   const std::uint64_t key = channel_key(channel);
-  for (const ChannelInfo& c : channels_)
-    if (c.key == key && c.channel == channel) return c;
-  ChannelInfo& info = channels_.size() < max_channel_ids ? channels_.emplace_back() : uncached_;
-  info.key = key;
-  info.channel.assign(channel);
-  info.bench.clear();
-  info.kind = 0;
-  info.id = &info == &uncached_ ? -1 : static_cast<std::int32_t>(channels_.size() - 1);
-  if (const auto name = split_spindown_channel(channel)) {
-    info.bench.assign(name->bench);
-    info.kind = name->kind == "SAMPLE" ? 1 : name->kind == "CONFIG" ? 2 : 0;
+  // Loggers interleave benches in a steady pattern: try the channel that followed the last one.
+  if (last_channel_ >= 0) {
+    const std::int32_t guess = channels_[static_cast<std::size_t>(last_channel_)].next;
+    if (guess >= 0) {
+      const ChannelInfo& c = channels_[static_cast<std::size_t>(guess)];
+      if (c.key == key && c.channel == channel) {
+        last_channel_ = guess;
+        return c;
+      }
+    }
   }
-  return info;
+  const ChannelInfo* found = nullptr;
+  for (const ChannelInfo& c : channels_)
+    if (c.key == key && c.channel == channel) {
+      found = &c;
+      break;
+    }
+  if (!found) {
+    ChannelInfo& info = channels_.size() < max_channel_ids ? channels_.emplace_back() : uncached_;
+    info.key = key;
+    info.channel.assign(channel);
+    info.bench.clear();
+    info.kind = 0;
+    info.next = -1;
+    info.id = &info == &uncached_ ? -1 : static_cast<std::int32_t>(channels_.size() - 1);
+    if (const auto name = split_spindown_channel(channel)) {
+      info.bench.assign(name->bench);
+      info.kind = name->kind == "SAMPLE" ? 1 : name->kind == "CONFIG" ? 2 : 0;
+    }
+    found = &info;
+  }
+  if (last_channel_ >= 0 && found->id >= 0) channels_[static_cast<std::size_t>(last_channel_)].next = found->id;
+  last_channel_ = found->id;
+  return *found;
 }
 
 // Positioned where no event starts: finds the next event marker and reports the skipped
@@ -385,7 +436,8 @@ void LcmLogReader::decode(LcmLogEvent& event, const ChannelInfo& info, const voi
     const bool right_type = size >= 8 && be64(d) == static_cast<std::uint64_t>(samples_t::getHash());
     // samples_prefix_ok checks samples_t's whole layout (its strings and arrays are all in the
     // prefix), so the generated decoder is safe without the general layout walk.
-    if (right_type && samples_prefix_ok(d, size, &why) && event.samples.decode(data, 0, size) >= 0) {
+    if (right_type && samples_prefix_ok(d, size, &why)) {
+      decode_samples(d, event.samples);
       event.kind = LcmLogEvent::Kind::samples;
       return;
     }

@@ -92,6 +92,7 @@ class LcmLogReader {
     std::string bench;      // empty: not SPINDOWN.<bench>.<KIND>
     int kind = 0;           // 0 other, 1 SAMPLE, 2 CONFIG
     std::int32_t id = -1;
+    std::int32_t next = -1;  // id of the channel that followed this one last time
   };
   const ChannelInfo& channel_info(std::string_view channel);
   // Makes n bytes from pos_ available in the buffer (fewer only at the end of the file or on a
@@ -115,6 +116,7 @@ class LcmLogReader {
   std::string read_error_;             // a failed read(2), reported once as a problem
   std::vector<ChannelInfo> channels_;
   ChannelInfo uncached_;               // the name being read when channels_ is full
+  std::int32_t last_channel_ = -1;     // id of the previous event's channel
 };
 
 struct LcmLogOptions {
