@@ -5,30 +5,8 @@
 # another good run (text and --json). spindown-fitter --bench-config DIR publishes the verdict in
 # the FIT message (read back from the log by `spindown refit --live --json`). Private network
 # namespace, ttl=0.
-if [ -z "${SPINDOWN_IN_NETNS:-}" ]; then
-  exec unshare -n env SPINDOWN_IN_NETNS=1 bash "$0" "$@"
-fi
-set -euo pipefail
-ip link set lo up
-ip route add 224.0.0.0/4 dev lo
-
-B=${SPINDOWN_BIN_DIR:?}
+source "$(dirname "${BASH_SOURCE[0]}")/netns_common.bash"
 SRC=${SPINDOWN_SOURCE_DIR:?}
-T=$(mktemp -d /tmp/spindown-cli-baseline.XXXXXX)
-URL='udpm://239.255.76.67:7667?ttl=0'
-PIDS=()
-cleanup() {
-  for p in "${PIDS[@]}"; do kill "$p" 2>/dev/null || true; done
-  wait 2>/dev/null || true
-  rm -rf "$T"
-}
-trap cleanup EXIT
-fail() { echo "FAIL: $*" >&2; for f in "$T"/*.err "$T"/*.out; do [ -f "$f" ] && { echo "--- $f" >&2; tail -25 "$f" >&2; }; done; exit 1; }
-stop() {
-  kill -TERM "$1" 2>/dev/null || true
-  for _ in $(seq 100); do kill -0 "$1" 2>/dev/null || return 0; sleep 0.1; done
-  fail "process $1 did not stop on SIGTERM"
-}
 
 # ---- generated Arduino logs: the lab's bench, combined friction, noise, 2 decimals ---------------
 python3 - "$T" <<'EOF'

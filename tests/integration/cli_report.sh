@@ -5,30 +5,8 @@
 # Checks: exit codes, the page parses with balanced tags (python3 html.parser), no external
 # references, text from files escaped, one run figure per run, ± coefficients, verdicts, the
 # benches of the log grouped, and no progress output when stderr is not a terminal.
-if [ -z "${SPINDOWN_IN_NETNS:-}" ]; then
-  exec unshare -n env SPINDOWN_IN_NETNS=1 bash "$0" "$@"
-fi
-set -euo pipefail
-ip link set lo up
-ip route add 224.0.0.0/4 dev lo
-
-B=${SPINDOWN_BIN_DIR:?}
+source "$(dirname "${BASH_SOURCE[0]}")/netns_common.bash"
 D=${SPINDOWN_SHARED_DATA:?}
-T=$(mktemp -d /tmp/spindown-cli-report.XXXXXX)
-URL='udpm://239.255.76.67:7667?ttl=0'
-PIDS=()
-cleanup() {
-  for p in "${PIDS[@]}"; do kill "$p" 2>/dev/null || true; done
-  wait 2>/dev/null || true
-  rm -rf "$T"
-}
-trap cleanup EXIT
-fail() { echo "FAIL: $*" >&2; for f in "$T"/*.err; do echo "--- $f" >&2; tail -15 "$f" >&2; done; exit 1; }
-stop() {
-  kill -TERM "$1" 2>/dev/null || true
-  for _ in $(seq 100); do kill -0 "$1" 2>/dev/null || return 0; sleep 0.1; done
-  fail "process $1 did not stop on SIGTERM"
-}
 
 # The page parses, its tags balance, and it reaches nothing outside itself.
 check_page() {

@@ -5,29 +5,7 @@
 # heartbeat on SPINDOWN.fitter.STATUS counts each kind of damage and names the last one, the
 # refit of the log still equals the live fits, and `spindown export --csv` writes every sample
 # and every fitted model. Private network namespace, ttl=0.
-if [ -z "${SPINDOWN_IN_NETNS:-}" ]; then
-  exec unshare -n env SPINDOWN_IN_NETNS=1 bash "$0" "$@"
-fi
-set -euo pipefail
-ip link set lo up
-ip route add 224.0.0.0/4 dev lo
-
-B=${SPINDOWN_BIN_DIR:?}
-T=$(mktemp -d /tmp/spindown-fitter-faults.XXXXXX)
-URL='udpm://239.255.76.67:7667?ttl=0'
-PIDS=()
-cleanup() {
-  for p in "${PIDS[@]}"; do kill "$p" 2>/dev/null || true; done
-  wait 2>/dev/null || true
-  rm -rf "$T"
-}
-trap cleanup EXIT
-fail() { echo "FAIL: $*" >&2; for f in "$T"/*.err "$T"/*.out; do echo "--- $f" >&2; tail -15 "$f" >&2; done; exit 1; }
-stop() {
-  kill -TERM "$1" 2>/dev/null || true
-  for _ in $(seq 100); do kill -0 "$1" 2>/dev/null || return 0; sleep 0.1; done
-  fail "process $1 did not stop on SIGTERM"
-}
+source "$(dirname "${BASH_SOURCE[0]}")/netns_common.bash"
 
 mkdir -p "$T/log"
 "$B/spindown-logger" --lcm-url "$URL" --dir "$T/log" --prefix faults --flush-interval 0.2 >"$T/logger.out" 2>"$T/logger.err" &

@@ -7,25 +7,8 @@
 #  3. lcm-logplayer replays the log's SAMPLE/CONFIG on a *different* URL (other group and port)
 #     into a fresh fitter: its FITs equal the refit again, and nothing reached the first URL.
 # Everything runs in a private network namespace (unshare -n); ttl=0.
-if [ -z "${SPINDOWN_IN_NETNS:-}" ]; then
-  exec unshare -n env SPINDOWN_IN_NETNS=1 bash "$0" "$@"
-fi
-set -euo pipefail
-ip link set lo up
-ip route add 224.0.0.0/4 dev lo
-
-B=${SPINDOWN_BIN_DIR:?}
-T=$(mktemp -d /tmp/spindown-fitter-test.XXXXXX)
-URL='udpm://239.255.76.67:7667?ttl=0'
+source "$(dirname "${BASH_SOURCE[0]}")/netns_common.bash"
 REPLAY_URL='udpm://239.255.76.68:7668?ttl=0'
-PIDS=()
-cleanup() {
-  for p in "${PIDS[@]}"; do kill "$p" 2>/dev/null || true; done
-  wait 2>/dev/null || true
-  rm -rf "$T"
-}
-trap cleanup EXIT
-fail() { echo "FAIL: $*" >&2; for f in "$T"/*.err; do echo "--- $f" >&2; tail -20 "$f" >&2; done; exit 1; }
 
 start_logger() {  # URL DIR NAME; sets STARTED
   mkdir -p "$2"
@@ -34,11 +17,6 @@ start_logger() {  # URL DIR NAME; sets STARTED
   "$B/spindown-logger" --lcm-url "$1" --dir "$2" --prefix "$3" --flush-interval 0.2 >"$T/$3-logger.out" 2>"$T/$3-logger.err" &
   STARTED=$!
   PIDS+=($STARTED)
-}
-stop() {  # PID: SIGTERM, wait at most 10 s
-  kill -TERM "$1" 2>/dev/null || true
-  for _ in $(seq 100); do kill -0 "$1" 2>/dev/null || return 0; sleep 0.1; done
-  fail "process $1 did not stop on SIGTERM"
 }
 only_log() { ls "$1"/*.lcm | head -1; }
 
