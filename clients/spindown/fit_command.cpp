@@ -52,18 +52,7 @@ FitPlan plan_from(const FitCommandOptions& o) {
   plan.inertia_from_user = o.input.inertia_given || o.input.flywheel_given;
   plan.kb_from_user = o.input.kb_given || o.input.speed_constant_given;
   std::string why;
-  if (!o.models.empty()) {
-    plan.fit.models.clear();
-    for (const auto& name : o.models) {
-      if (name == "all") {
-        plan.fit.models.assign(std::begin(all_models), std::end(all_models));
-        continue;
-      }
-      auto kind = parse_model(name);
-      if (!kind) bad_usage(fmt::format("--models: unknown model '{}' (viscous, coulomb, combined, all)", name));
-      plan.fit.models.push_back(*kind);
-    }
-  }
+  if (!o.models.empty()) plan.fit.models = models_from(o.models);
   if (!plan.fit.is_valid(&why)) bad_usage(why);
 
   plan.read = read_options_from(o.input);

@@ -108,6 +108,20 @@ BenchParams bench_from(const InputOptions& o) {
   return bench;
 }
 
+std::vector<ModelKind> models_from(const std::vector<std::string>& names) {
+  std::vector<ModelKind> models;
+  for (const auto& name : names) {
+    if (name == "all") {
+      models.assign(std::begin(all_models), std::end(all_models));
+      continue;
+    }
+    auto kind = parse_model(name);
+    if (!kind) bad_usage(fmt::format("--models: unknown model '{}' (viscous, coulomb, combined, all)", name));
+    models.push_back(*kind);
+  }
+  return models;
+}
+
 ReadOptions read_options_from(const InputOptions& o) {
   ReadOptions read;
   DelimitedTextOptions& d = read.delimited;

@@ -4,8 +4,10 @@
 // and units of delimited text. One definition, so both commands accept and check them alike.
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "spindown/bench.hpp"
+#include "spindown/fit.hpp"
 #include "spindown/read_recording.hpp"
 
 namespace CLI {
@@ -38,6 +40,10 @@ std::function<void()> add_input_options(CLI::App* sub, InputOptions& opt);
 BenchParams bench_from(const InputOptions& opt);
 // Reading options for the delimited-text columns and units. Bad usage throws CLI::ValidationError.
 ReadOptions read_options_from(const InputOptions& opt);
+
+// The models --models names, in order ("all" stands for every model, in place of those named
+// before it). An unknown name throws CLI::ValidationError.
+std::vector<ModelKind> models_from(const std::vector<std::string>& names);
 
 [[noreturn]] void bad_usage(const std::string& why);
 

@@ -26,18 +26,7 @@ SessionReportOptions plan_from(const ReportCommandOptions& o) {
   plan.bench_from_user = o.input.bench_from_user();
   plan.read = read_options_from(o.input);
   std::string why;
-  if (!o.models.empty()) {
-    plan.fit.models.clear();
-    for (const auto& name : o.models) {
-      if (name == "all") {
-        plan.fit.models.assign(std::begin(all_models), std::end(all_models));
-        continue;
-      }
-      auto kind = parse_model(name);
-      if (!kind) bad_usage(fmt::format("--models: unknown model '{}' (viscous, coulomb, combined, all)", name));
-      plan.fit.models.push_back(*kind);
-    }
-  }
+  if (!o.models.empty()) plan.fit.models = models_from(o.models);
   if (!plan.fit.is_valid(&why)) bad_usage(why);
   plan.explain_runs = !o.no_explain;
   plan.explain.base = parse_effect_list(o.base, &why);
