@@ -310,8 +310,8 @@ void setup_refit(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "refit", "Refit LCM logs exactly as spindown-fitter did live (same runs, same numbers); --compare checks it");
   sub->footer(
-      "Reads each log with lcm::LogFile in its own order (never file:// replay). Runs are listed by bench, then run "
-      "number; in JSON each run also has bench.id, first_seq and last_seq.\n"
+      "Reads each log in its own order with its own timestamps (never file:// replay). Runs are listed by bench, "
+      "then run number; in JSON each run also has bench.id, first_seq and last_seq.\n"
       "Exit codes: 0 ok, 1 a log or run could not be used or --compare found a difference, 2 bad usage.");
   sub->add_option("LOG", opt->logs, "LCM event log(s) (spindown-logger, lcm-logger)")->required();
   sub->add_flag("--json", opt->json, "Print one JSON object {\"files\":[{\"runs\":[…]}]} instead of tables");
