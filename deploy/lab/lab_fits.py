@@ -8,9 +8,9 @@ usage:
       Prints, per bench and run, the best model and the combined model's c3, c4 (lab units)
       live / refit / truth; exit 0 when every live result equals its refit (timing fields
       latency_s and utime aside), 1 otherwise.
-  lab_fits.py check-runs LIVE.json BENCH=TRUTH.json ...
+  lab_fits.py check-runs LIVE.json [--cut-tolerance S] BENCH=TRUTH.json ...
       Every run a virtual bench sent (its --truth file) has exactly one live fit whose cut is
-      within 0.2 s of the true cut; exit 1 naming what is missing or extra.
+      within S seconds (default 0.2) of the true cut; exit 1 naming what is missing or extra.
 """
 import json
 import math
@@ -92,7 +92,7 @@ def compare(live_path, refit_path, truth_args):
     return same, differ
 
 
-def check_runs(live_path, truth_args):
+def check_runs(live_path, truth_args, cut_tolerance_s=0.2):
     live = runs_of(live_path)
     fits = {}
     for (bench, _), rs in live.items():
@@ -103,7 +103,7 @@ def check_runs(live_path, truth_args):
         worst = 0.0
         for tr in t["runs"]:
             cut = tr["cut_device_us"] / 1e6
-            match = [f for f in got if f.get("t_cut_s") is not None and abs(f["t_cut_s"] - cut) < 0.2]
+            match = [f for f in got if f.get("t_cut_s") is not None and abs(f["t_cut_s"] - cut) < cut_tolerance_s]
             if len(match) != 1:
                 problems.append(f"{bench}: run {tr['run']} (cut at {cut:.3f} s): {len(match)} fits")
                 continue
@@ -124,7 +124,10 @@ def main(argv):
         same, differ = compare(argv[1], argv[2], argv[3:])
         return 0 if differ == 0 and same > 0 else 1
     if len(argv) >= 3 and argv[0] == "check-runs":
-        return 0 if check_runs(argv[1], argv[2:]) else 1
+        rest, tolerance = argv[2:], 0.2
+        if len(rest) >= 2 and rest[0] == "--cut-tolerance":
+            tolerance, rest = float(rest[1]), rest[2:]
+        return 0 if check_runs(argv[1], rest, tolerance) else 1
     print(__doc__, file=sys.stderr)
     return 2
 

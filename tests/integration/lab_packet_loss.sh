@@ -57,7 +57,11 @@ watch_last_table | grep -Eq "^  lossy-[123]  .*  [1-9][0-9]* \([0-9]+ lost\)  " 
 
 # Fits still produced, for every run; the refit still equals the live fits.
 "$LAB_BIN/spindown" refit "$LOG" --live --json >"$LAB_WORK/live.json" 2>/dev/null || fail "refit --live"
-python3 "$src/deploy/lab/lab_fits.py" check-runs "$LAB_WORK/live.json" "${TRUTH_ARGS[@]}" ||
+# Every run must still be found and fitted. A lost sample at a supply lead-in's cut can move the
+# detected cut by a few tenths of a second (a known limit of the run detector, seen in about one
+# loss pattern in two dozen), so the match allows 1 s here; cut accuracy without loss is checked by
+# lab_veth and the CLI tests.
+python3 "$src/deploy/lab/lab_fits.py" check-runs "$LAB_WORK/live.json" --cut-tolerance 1.0 "${TRUTH_ARGS[@]}" ||
   fail "some run has no live fit under 5 % loss"
 "$LAB_BIN/spindown" refit "$LOG" --compare >"$LAB_WORK/compare.out" 2>/dev/null ||
   { cat "$LAB_WORK/compare.out"; fail "refit --compare found differences under loss"; }
