@@ -33,18 +33,11 @@ SessionReportOptions plan_from(const ReportCommandOptions& o) {
   if (plan.explain.base.empty()) bad_usage(fmt::format("--base: {}", why));
   if (!plan.explain.is_valid(&why)) bad_usage(fmt::format("--base: {}", why));
   plan.text_bench = o.text_bench;
-  for (const auto& path : o.bench_configs) {
-    try {
-      auto [bench, ref] = load_bench_reference(path);
-      if (plan.references.contains(bench))
-        bad_usage(fmt::format("--bench-config: {} and {} both describe bench '{}'", plan.references.at(bench).file,
-                              path, bench));
-      plan.references.emplace(std::move(bench), std::move(ref));
-    } catch (const CLI::ValidationError&) {
-      throw;
-    } catch (const std::exception& e) {
-      bad_usage(fmt::format("--bench-config: {}", e.what()));
-    }
+  try {  // one loader for fit, report and the fitter: files or directories, duplicate benches refused
+    for (const auto& [bench, file] : load_bench_files(o.bench_configs).files)
+      plan.references.emplace(bench, bench_reference(file));
+  } catch (const std::exception& e) {
+    bad_usage(fmt::format("--bench-config: {}", e.what()));
   }
   return plan;
 }
@@ -72,8 +65,9 @@ void setup_report(CLI::App& app) {
   sub->add_option("FILE", opt->files, "Arduino/PuTTY log, delimited text (CSV/TSV) or LCM log")->required();
   sub->add_option("-o,--output", opt->output, "The HTML page to write")->required();
   sub->add_option("--bench", opt->text_bench, "Bench id for the text files (default: each file's name)");
-  sub->add_option("--bench-config", opt->bench_configs, "Per-bench TOML file(s) with [motor]/[baseline]/[health]")
-      ->check(CLI::ExistingFile);
+  sub->add_option("--bench-config", opt->bench_configs,
+                  "Per-bench TOML file(s) with [motor]/[baseline]/[health]; a directory means every *.toml in it")
+      ->check(CLI::ExistingPath);
   sub->add_option("--base", opt->base, "The explain workflow's starting model (default viscous)");
   sub->add_option("--models", opt->models, "Models to fit: viscous,coulomb,combined (default all)")->delimiter(',');
   sub->add_flag("--no-explain", opt->no_explain, "Leave out the explain story (faster)");

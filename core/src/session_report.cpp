@@ -11,7 +11,6 @@
 #include <numeric>
 #include <stdexcept>
 
-#include "spindown/bridge_settings.hpp"
 #include "spindown/lcm_log_reader.hpp"
 #include "spindown/quantity.hpp"
 
@@ -64,19 +63,12 @@ std::string percent(double x) { return fmt::format("{:.0f} %", 100 * x); }
 
 }  // namespace
 
-std::pair<std::string, BenchReference> load_bench_reference(const std::string& toml_path) {
+BenchReference bench_reference(const BenchFile& file) {
   BenchReference ref;
-  ref.file = toml_path;
-  ref.health = load_motor_health_config(toml_path);
-  BridgeSettings settings;
-  load_bridge_settings(toml_path, settings);
-  if (settings.params.inertia_source != BenchParams{}.inertia_source ||
-      settings.params.kb_source != BenchParams{}.kb_source) {
-    ref.params = settings.params;
-    if (ref.params->inertia_source == "config file") ref.params->inertia_source = toml_path;
-    if (ref.params->kb_source == "config file") ref.params->kb_source = toml_path;
-  }
-  return {bench_id_of_config(toml_path), std::move(ref)};
+  ref.file = file.path;
+  ref.health = file.health;
+  if (file.sets_inertia || file.sets_kb) ref.params = file.params;
+  return ref;
 }
 
 std::optional<double> putty_log_time(std::string_view head) {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "spindown/bench.hpp"
+#include "spindown/bench_file.hpp"
 #include "spindown/explain.hpp"
 #include "spindown/fit.hpp"
 #include "spindown/motor_health.hpp"
@@ -32,9 +33,9 @@ struct BenchReference {
   std::optional<BenchParams> params;  // J, K_b when its [bench] section sets them
 };
 
-// Reads bench_id, [bench] (J, K_b) and [motor]/[baseline]/[health]. Throws std::runtime_error
-// naming the file, the key and what was wrong.
-std::pair<std::string, BenchReference> load_bench_reference(const std::string& toml_path);
+// What a report needs of a bench file (load_bench_file): its health references, and J, K_b
+// when its [bench] section sets them.
+BenchReference bench_reference(const BenchFile& file);
 
 struct SessionReportOptions {
   ReadOptions read;
