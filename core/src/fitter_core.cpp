@@ -47,37 +47,6 @@ bool samples_prefix_ok(const unsigned char* d, std::int64_t len, std::string* wh
   return true;
 }
 
-template <class Msg>
-bool decode_checked(Msg& msg, const void* data, std::int64_t size, std::string* why) {
-  const auto* d = static_cast<const unsigned char*>(data);
-  if (size < 8) {
-    *why = fmt::format("{} bytes, too short for {}", size, Msg::getTypeName());
-    return false;
-  }
-  if (size > std::numeric_limits<int>::max()) {
-    *why = fmt::format("{} bytes, too long for {}", size, Msg::getTypeName());
-    return false;
-  }
-  const std::uint64_t hash = be64(d);
-  if (hash != static_cast<std::uint64_t>(Msg::getHash())) {
-    *why = fmt::format("not a {} (type fingerprint {:#018x}, expected {:#018x})", Msg::getTypeName(), hash,
-                       static_cast<std::uint64_t>(Msg::getHash()));
-    return false;
-  }
-  // lcm-gen's decoder sizes arrays and strings from the wire before checking them (a string
-  // length of INT_MIN overflows inside it): walk the message's layout first.
-  if (!check_message_encoding<Msg>(data, size, why)) return false;
-  try {
-    if (msg.decode(data, 0, static_cast<int>(size)) < 0) {
-      *why = fmt::format("{} does not decode from {} bytes (truncated or damaged)", Msg::getTypeName(), size);
-      return false;
-    }
-  } catch (const std::exception& e) {  // a negative string length makes std::string throw
-    *why = fmt::format("{} does not decode ({})", Msg::getTypeName(), e.what());
-    return false;
-  }
-  return true;
-}
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -247,7 +216,7 @@ void FitterCore::on_message(std::string_view channel, const void* data, std::int
     samples_t msg;
     const auto* d = static_cast<const unsigned char*>(data);
     const bool right_type = size >= 8 && be64(d) == static_cast<std::uint64_t>(samples_t::getHash());
-    if ((right_type && !samples_prefix_ok(d, size, &why)) || !decode_checked(msg, data, size, &why)) {
+    if ((right_type && !samples_prefix_ok(d, size, &why)) || !decode_message(msg, data, size, &why)) {
       ++counters_.decode_errors;
       error(fmt::format("{}: {}; message skipped", channel, why), recv_utime);
       return;
@@ -255,7 +224,7 @@ void FitterCore::on_message(std::string_view channel, const void* data, std::int
     on_samples(bench, msg, recv_utime);
   } else {
     config_t msg;
-    if (!decode_checked(msg, data, size, &why)) {
+    if (!decode_message(msg, data, size, &why)) {
       ++counters_.decode_errors;
       error(fmt::format("{}: {}; message skipped", channel, why), recv_utime);
       return;

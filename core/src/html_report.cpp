@@ -14,6 +14,7 @@
 #include "spindown/lab_units.hpp"
 #include "spindown/quantity.hpp"
 #include "spindown/svg_plot.hpp"
+#include "text_support.hpp"
 
 namespace spindown {
 
@@ -136,27 +137,13 @@ constexpr double run_w = 960, run_h = 640;
 
 }  // namespace
 
-namespace {
-// Length of the valid UTF-8 sequence at s[i], 0 when the byte there does not start one.
-std::size_t utf8_sequence(std::string_view s, std::size_t i) {
-  const auto b = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
-  const unsigned char c = b(i);
-  std::size_t n = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
-  if (n == 0 || i + n > s.size() || (n == 2 && c < 0xC2)) return 0;
-  for (std::size_t k = 1; k < n; ++k)
-    if ((b(i + k) & 0xC0) != 0x80) return 0;
-  if (n == 3 && ((c == 0xE0 && b(i + 1) < 0xA0) || (c == 0xED && b(i + 1) >= 0xA0))) return 0;  // overlong, surrogate
-  if (n == 4 && ((c == 0xF0 && b(i + 1) < 0x90) || c > 0xF4 || (c == 0xF4 && b(i + 1) >= 0x90))) return 0;
-  return n;
-}
-}  // namespace
 
 std::string html_escape(std::string_view in) {
   std::string out;
   out.reserve(in.size());
   for (std::size_t i = 0; i < in.size();) {
     const char c = in[i];
-    const std::size_t n = utf8_sequence(in, i);
+    const std::size_t n = text::utf8_sequence_length(in, i);
     if (n == 0) {  // not UTF-8 (a Latin-1 file name): the replacement character, never broken text
       out += "\xEF\xBF\xBD";
       ++i;

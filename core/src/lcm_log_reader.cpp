@@ -89,34 +89,6 @@ void decode_samples(const unsigned char* d, samples_t& m) {
   for (std::size_t i = 0; i < n; ++i) m.raw_adc[i] = static_cast<std::int32_t>(be32(d + pos + 4 * i));
 }
 
-template <class Msg>
-bool decode_checked(Msg& msg, const void* data, std::int32_t size, std::string* why) {
-  const auto* d = static_cast<const unsigned char*>(data);
-  if (size < 8) {
-    *why = fmt::format("{} bytes, too short for {}", size, Msg::getTypeName());
-    return false;
-  }
-  const std::uint64_t hash = be64(d);
-  if (hash != static_cast<std::uint64_t>(Msg::getHash())) {
-    *why = fmt::format("not a {} (type fingerprint {:#018x}, expected {:#018x})", Msg::getTypeName(), hash,
-                       static_cast<std::uint64_t>(Msg::getHash()));
-    return false;
-  }
-  // lcm-gen's decoder sizes arrays and strings from the wire before checking them (a string
-  // length of INT_MIN overflows inside it): walk the message's layout first.
-  if (!check_message_encoding<Msg>(data, size, why)) return false;
-  try {
-    const int used = msg.decode(data, 0, size);
-    if (used < 0) {
-      *why = fmt::format("{} does not decode from {} bytes (truncated or damaged)", Msg::getTypeName(), size);
-      return false;
-    }
-  } catch (const std::exception& e) {  // negative string lengths make std::string throw
-    *why = fmt::format("{} does not decode ({})", Msg::getTypeName(), e.what());
-    return false;
-  }
-  return true;
-}
 
 }  // namespace
 
@@ -441,14 +413,14 @@ void LcmLogReader::decode(LcmLogEvent& event, const ChannelInfo& info, const voi
       event.kind = LcmLogEvent::Kind::samples;
       return;
     }
-    if (why.empty() && decode_checked(event.samples, data, size, &why)) {
+    if (why.empty() && decode_message(event.samples, data, size, &why)) {
       event.kind = LcmLogEvent::Kind::samples;
       return;
     }
     event.kind = LcmLogEvent::Kind::problem;
     event.problem = fmt::format("event {} on {}: {}; skipped", event.number, event.channel, why);
   } else if (info.kind == 2) {
-    if (decode_checked(event.config, data, size, &why)) {
+    if (decode_message(event.config, data, size, &why)) {
       event.kind = LcmLogEvent::Kind::config;
       return;
     }

@@ -54,7 +54,7 @@ bool fail(std::string* why, std::string text) {
 bool walk(std::string_view type, std::uint64_t expected_hash, std::span<const WireField> fields,
           const void* data, std::int64_t size, std::string* why) {
   if (data == nullptr && size != 0) return fail(why, fmt::format("{}: no data", type));
-  if (size < hash_bytes) return fail(why, fmt::format("{}: {} bytes, too short for a message", type, size));
+  if (size < hash_bytes) return fail(why, fmt::format("{} bytes, too short for {}", size, type));
   if (size > std::numeric_limits<int>::max())
     return fail(why, fmt::format("{}: {} bytes, more than an LCM message can hold", type, size));
   const auto* d = static_cast<const unsigned char*>(data);
