@@ -91,10 +91,18 @@ fi
 # Several files fitted at once (--jobs) give the very same output, in the order given, as one
 # at a time: text and JSON, the files listed twice over so workers finish out of order.
 for fmt in "" "--json"; do
-  timeout 120 "$bin" fit $fmt -j 1 "${files[@]}" "${files[@]}" >"$tmp/serial" 2>"$tmp/serial.err" || true
-  timeout 120 "$bin" fit $fmt -j 3 "${files[@]}" "${files[@]}" >"$tmp/parallel" 2>"$tmp/parallel.err" || true
+  rc1=0 rc3=0
+  timeout 120 "$bin" fit $fmt -j 1 "${files[@]}" "${files[@]}" >"$tmp/serial" 2>"$tmp/serial.err" || rc1=$?
+  timeout 120 "$bin" fit $fmt -j 3 "${files[@]}" "${files[@]}" >"$tmp/parallel" 2>"$tmp/parallel.err" || rc3=$?
+  # Both must have worked (a rejected -j would give two identical usage errors) …
+  if ((rc1 != 0 || rc3 != 0)) || [[ ! -s $tmp/serial ]]; then
+    echo "FAIL fit $fmt -j: exit $rc1 (-j 1), $rc3 (-j 3)"; fail=1
+  fi
+  # … and given the same bytes, in the same order.
   if ! cmp -s "$tmp/serial" "$tmp/parallel" || ! cmp -s "$tmp/serial.err" "$tmp/parallel.err"; then
     echo "FAIL fit $fmt -j 3 differs from -j 1"; fail=1
   fi
 done
+python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); sys.exit(0 if len(d["files"]) == 2 * int(sys.argv[2]) else 1)' \
+  "$tmp/parallel" "${#files[@]}" || { echo "FAIL fit --json -j 3: not one entry per file given"; fail=1; }
 exit $fail
