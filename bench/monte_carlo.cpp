@@ -100,9 +100,10 @@ int main(int argc, char** argv) {
   const BenchParams bench;  // the lab's J and K_b
   const double J = bench.inertia_kg_m2, kb = bench.kb_v_s_per_rad;
   const Model model{truth.e0, truth.c_v / J, kb * truth.c_c / J};
-  std::ofstream index(dir / "index.tsv"), ours(dir / "spindown.tsv");
+  std::ofstream index(dir / "index.tsv"), ours(dir / "spindown.tsv"), plain(dir / "spindown-unweighted.tsv");
   index << "file\tt_cut_s\tt_stop_s\tJ\tKb\tc_v\tc_c\te0\tsamples\n";
   ours << "file\tc3\tc4\tse3\tse4\n";
+  plain << "file\tc3\tc4\tse3\tse4\n";
 
   double sq_resid = 0;  // printed − true over the coasts
   long n_resid = 0, fitted = 0, failed = 0;
@@ -168,6 +169,15 @@ int main(int argc, char** argv) {
     ++fitted;
     ours << fmt::format("{}\t{:.9g}\t{:.9g}\t{:.9g}\t{:.9g}\n", name, c3->value, c4->value, c3->std_error,
                         c4->std_error);
+    // The same run by unweighted least squares (FitOptions::weighted = false), for comparison.
+    FitOptions unweighted;
+    unweighted.weighted = false;
+    const RunFit plain_fit = fit_run(rec, seg.runs.front(), unweighted);
+    if (const ModelFit* m = plain_fit.model(ModelKind::combined); m && m->converged) {
+      const Parameter *p3 = m->param("c3"), *p4 = m->param("c4");
+      plain << fmt::format("{}\t{:.9g}\t{:.9g}\t{:.9g}\t{:.9g}\n", name, p3->value, p4->value, p3->std_error,
+                           p4->std_error);
+    }
   }
 
   const double sigma2 = sq_resid / double(n_resid);

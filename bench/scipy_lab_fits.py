@@ -7,7 +7,8 @@ usage:
   scipy_lab_fits.py fit DIR        fits every file named in DIR/index.tsv (written by make_runs or
                                    monte_carlo); one TSV row per file on stdout, timings on stderr
   scipy_lab_fits.py mc-summary DIR bias, spread, efficiency and stderr calibration from
-                                   DIR/spindown.tsv, DIR/scipy.tsv and DIR/crb.json
+                                   DIR/spindown.tsv, DIR/scipy.tsv and DIR/crb.json (and
+                                   DIR/spindown-unweighted.tsv when there)
 
 The fits are the lab's three seed curves (design §1), each with scipy.optimize.curve_fit on the
 samples between the cut and the stop, both given for free from index.tsv (the lab chose them by
@@ -17,6 +18,7 @@ the lab's hand values (they had to fix A by hand for the exponential fit).
 """
 import json
 import math
+import os
 import sys
 import time
 
@@ -126,9 +128,13 @@ def cmd_mc_summary(directory):
             return {c[0]: dict(zip(header[1:], map(float, c[1:])))
                     for c in (line.rstrip("\n").split("\t") for line in f)}
     ours, theirs = load("spindown.tsv"), load("scipy.tsv")
+    estimators = [("spindown", ours)]
+    if os.path.exists(f"{directory}/spindown-unweighted.tsv"):
+        estimators.append(("spindown unweighted", load("spindown-unweighted.tsv")))
+    estimators.append(("SciPy curve_fit", theirs))
     with open(f"{directory}/crb.json") as f:
         crb = json.load(f)
-    common = sorted(set(ours) & set(theirs))
+    common = sorted(set.intersection(*(set(data) for _, data in estimators)))
     truth = {"c3": crb["c_v"], "c4": crb["c_c"]}
     print(f"Monte Carlo: {len(common)} runs in both ({len(ours)} spindown, {len(theirs)} SciPy); "
           f"truth c_v = {crb['c_v']:.6g} N·m·s/rad, c_c = {crb['c_c']:.6g} N·m; "
@@ -141,7 +147,7 @@ def cmd_mc_summary(directory):
     result = {}
     for coef, se in (("c3", "se3"), ("c4", "se4")):
         crb_sd = crb[f"crb_sd_{coef}"]
-        for who, data in (("spindown", ours), ("SciPy curve_fit", theirs)):
+        for who, data in estimators:
             v, mean, sd = stats(data[k][coef] for k in common)
             _, mse, _ = stats(data[k][se] for k in common)
             bias = mean - truth[coef]

@@ -209,6 +209,37 @@ TEST(Fit, StandardErrorsCoverTheTruth) {
   EXPECT_GE(inside_c4, runs * 80 / 100);
 }
 
+// The weights only re-balance samples: without ripple (equal noise everywhere) the weighted
+// fit is the unweighted one, and with ripple both stay within their errors of each other;
+// RMSE is in the reading's unit either way.
+TEST(Fit, WeightedFitAgreesWithUnweightedWhereNoiseIsEqual) {
+  for (double ripple : {0.0, 0.01}) {
+    SyntheticRunSpec spec;
+    spec.friction = FrictionTerms{1.822e-7, 1.1389e-4};
+    spec.noise_v = 0.004;
+    spec.ripple = ripple;
+    spec.adc_bits = 0;
+    spec.decimals = -1;
+    spec.seed = 11;
+    const Case c = make_case(spec);
+    FitOptions opt;
+    opt.bench = spec.bench;
+    const RunFit weighted = fit_run(c.t, c.run.volts, Quantity::back_emf_volts, c.seg, opt);
+    opt.weighted = false;
+    const RunFit plain = fit_run(c.t, c.run.volts, Quantity::back_emf_volts, c.seg, opt);
+    const ModelFit &w = *weighted.model(ModelKind::combined), &p = *plain.model(ModelKind::combined);
+    ASSERT_TRUE(w.converged && p.converged);
+    for (const char* name : {"c3", "c4"}) {
+      const double tol = ripple == 0 ? 0.1 : 1.0;  // in standard errors
+      EXPECT_NEAR(value(w, name), value(p, name), tol * p.param(name)->std_error) << name << " ripple " << ripple;
+    }
+    EXPECT_NEAR(w.rmse, p.rmse, 0.05 * p.rmse);
+    if (ripple > 0) {
+      EXPECT_LT(w.param("c4")->std_error, p.param("c4")->std_error);  // weighting gains precision
+    }
+  }
+}
+
 TEST(Fit, TooFewSamplesIsReportedNotFitted) {
   SyntheticRunSpec spec;
   const Case c = make_case(spec);

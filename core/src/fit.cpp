@@ -1,5 +1,7 @@
 #include "spindown/fit.hpp"
 
+#include "spindown/reading_noise.hpp"
+
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
@@ -85,12 +87,22 @@ double stop_time(const Theta& th) {
 
 // One pass of the model over the run, vectorised with Eigen: the closed form is decreasing, so
 // every sample after the predicted stop reads exactly 0 and only the moving samples need the
-// exponential; the stopped tail contributes Σy² from a precomputed suffix sum.
+// exponential; the stopped tail contributes Σw·y² from a precomputed suffix sum. Residuals and
+// Jacobian rows carry the square roots of the samples' weights (reading_noise.hpp), so every
+// sum of squares, JᵀJ and the covariance below are the weighted ones.
 class Evaluator {
  public:
-  Evaluator(std::span<const double> tau, std::span<const double> y)
-      : tau_(tau), y_(y), tail_sq_(tau.size() + 1, 0.0), sorted_(std::is_sorted(tau.begin(), tau.end())) {
-    for (std::size_t i = tau.size(); i-- > 0;) tail_sq_[i] = tail_sq_[i + 1] + y[i] * y[i];
+  Evaluator(std::span<const double> tau, std::span<const double> y, std::span<const double> sqrt_weight)
+      : tau_(tau),
+        y_(y),
+        sw_(sqrt_weight),
+        tail_sq_(tau.size() + 1, 0.0),
+        plain_tail_sq_(tau.size() + 1, 0.0),
+        sorted_(std::is_sorted(tau.begin(), tau.end())) {
+    for (std::size_t i = tau.size(); i-- > 0;) {
+      tail_sq_[i] = tail_sq_[i + 1] + sqrt_weight[i] * sqrt_weight[i] * y[i] * y[i];
+      plain_tail_sq_[i] = plain_tail_sq_[i + 1] + y[i] * y[i];
+    }
     index_time_steps();
     const auto n = static_cast<Eigen::Index>(tau.size());
     e_.resize(n);
@@ -117,7 +129,7 @@ class Evaluator {
     const double ts = stop_time(th);
     if (sorted_ && std::isfinite(ts)) m = static_cast<std::size_t>(std::upper_bound(tau_.begin(), tau_.end(), ts) - tau_.begin());
     m_ = static_cast<Eigen::Index>(m);
-    const Eigen::Map<const Eigen::ArrayXd> t(tau_.data(), m_), y(y_.data(), m_);
+    const Eigen::Map<const Eigen::ArrayXd> t(tau_.data(), m_), y(y_.data(), m_), sw(sw_.data(), m_);
     auto e = e_.head(m_), p = p_.head(m_), dp = dp_.head(m_), r = r_.head(m_);
     auto moving = moving_.head(m_);
     const double tau_max = m_ == 0 ? 0.0 : sorted_ ? t[m_ - 1] : t.maxCoeff();
@@ -128,8 +140,8 @@ class Evaluator {
       const double c = th.beta / th.alpha;
       decay(th.alpha, m_);
       r = (th.u0 + c) * e - c;
-      moving = (r > 0).cast<double>();
-      r = y - r.max(0.0);
+      moving = (r > 0).cast<double>() * sw;
+      r = (y - r.max(0.0)) * sw;
       if (jtj) {
         int j = 0;
         g_.col(j++).head(m_) = (e * moving).matrix();
@@ -151,8 +163,8 @@ class Evaluator {
       }
       // model = max(0, u0·e − β·τ·φ); rounding may leave a sample at the stop just below 0.
       r = th.u0 * e - th.beta * t * p;
-      moving = (r > 0).cast<double>();
-      r = y - r.max(0.0);
+      moving = (r > 0).cast<double>() * sw;
+      r = (y - r.max(0.0)) * sw;
       if (jtj) {
         int j = 0;
         g_.col(j++).head(m_) = (e * moving).matrix();
@@ -177,7 +189,14 @@ class Evaluator {
     return sse;
   }
 
-  // After a call with jac: the moving samples' residuals and Jacobian rows.
+  // Σr² without the weights at θ (for RMSE and R², which speak in the reading's unit).
+  double plain_sse(const Family& f, const Theta& th) {
+    (*this)(f, th);
+    const Eigen::Map<const Eigen::ArrayXd> sw(sw_.data(), m_);
+    return (r_.head(m_) / sw).square().sum() + plain_tail_sq_[static_cast<std::size_t>(m_)];
+  }
+
+  // After a call with jac: the moving samples' weighted residuals and Jacobian rows.
   auto residuals() const { return r_.head(m_); }
   auto jacobian(int p) const { return g_.topLeftCorner(m_, p); }
 
@@ -219,8 +238,8 @@ class Evaluator {
   std::vector<double> steps_, step_factor_;
   std::vector<std::uint8_t> step_code_;
 
-  std::span<const double> tau_, y_;
-  std::vector<double> tail_sq_;
+  std::span<const double> tau_, y_, sw_;
+  std::vector<double> tail_sq_, plain_tail_sq_;
   bool sorted_;
   Eigen::Index m_ = 0;
   Eigen::ArrayXd e_, p_, dp_, r_, moving_;
@@ -278,14 +297,17 @@ struct IntegralForm {
 };
 
 IntegralForm integral_form(std::span<const double> tau, std::span<const double> y, std::size_t moving) {
-  IntegralForm out;
-  double integral = 0;
+  // Scalar sums: a 3×3 outer product per sample costs several times more.
+  double integral = 0, s_i = 0, s_t = 0, s_ii = 0, s_it = 0, s_tt = 0, s_y = 0, s_iy = 0, s_ty = 0;
   for (std::size_t i = 0; i < moving; ++i) {
     if (i > 0) integral += 0.5 * (y[i] + y[i - 1]) * (tau[i] - tau[i - 1]);
-    const Eigen::Vector3d row(1.0, -integral, -tau[i]);
-    out.atb += row * y[i];
-    out.ata.noalias() += row * row.transpose();
+    const double t = tau[i], v = y[i];
+    s_i += integral, s_t += t, s_ii += integral * integral, s_it += integral * t, s_tt += t * t;
+    s_y += v, s_iy += integral * v, s_ty += t * v;
   }
+  IntegralForm out;  // columns (1, −∫r, −τ)
+  out.ata << static_cast<double>(moving), -s_i, -s_t, -s_i, s_ii, s_it, -s_t, s_it, s_tt;
+  out.atb << s_y, -s_iy, -s_ty;
   return out;
 }
 
@@ -431,7 +453,10 @@ Covariance covariance(const Family& f, const Theta& th, Evaluator& eval) {
   const Eigen::Index m = r.size();
   Eigen::Vector3d widen = Eigen::Vector3d::Ones();
   for (int j = 0; j < p; ++j) {
-    const Eigen::ArrayXd z = (g * inv.col(j).head(p)).array() * r;
+    // z = (g·v_j)∘r, as column sums: Eigen's general matrix–vector product is slow at p ≤ 3.
+    Eigen::ArrayXd z = g.col(0).array() * inv(0, j);
+    for (int c = 1; c < p; ++c) z += g.col(c).array() * inv(c, j);
+    z *= r;
     double omega = z.square().sum();
     for (int l = 1; l <= lags && l < m; ++l)
       omega += 2.0 * (1.0 - l / (lags + 1.0)) * (z.head(m - l) * z.tail(m - l)).sum();
@@ -541,14 +566,17 @@ ModelFit fit_model(ModelKind kind, std::span<const double> tau, std::span<const 
     why = refine_with_nlopt(fam, tau, eval, th, out.evaluations);
     solved = why.empty();
   }
-  const double sse = eval(fam, th);
+  // The likelihood is the weighted one (weights average 1, so with equal weights it is the
+  // classic n·log(SSE/n)); RMSE and R² are in the reading's own unit.
+  const double wsse = eval(fam, th);
+  const double sse = eval.plain_sse(fam, th);
   const double n = static_cast<double>(tau.size());
   const double mean = std::accumulate(y.begin(), y.end(), 0.0) / n;
   double sst = 0;
   for (double v : y) sst += (v - mean) * (v - mean);
   out.rmse = std::sqrt(sse / n);
   out.r2 = sst > 0 ? 1.0 - sse / sst : nan;
-  const double ll = n * std::log(std::max(sse / n, 1e-300));
+  const double ll = n * std::log(std::max(wsse / n, 1e-300));
   out.aic = ll + 2.0 * p;
   out.bic = ll + p * std::log(n);
   out.t_stop_pred_s = stop_time(th);
@@ -652,7 +680,10 @@ RunFit fit_run(std::span<const double> t_s, std::span<const double> value, Quant
   }
   const std::size_t moving = (run.stopped ? stop : end) - begin;
   const std::string_view runit = quantity_unit(q);
-  Evaluator eval(tau, y);  // one workspace for every model of the run
+  // Weights from the run's own noise (σ² growing with the reading), shared by every model.
+  const std::vector<double> sqrt_weight =
+      opt.weighted ? sqrt_fit_weights(y, estimate_reading_noise(y)) : std::vector<double>(y.size(), 1.0);
+  Evaluator eval(tau, y, sqrt_weight);  // one workspace for every model of the run
   const IntegralForm form = integral_form(tau, y, moving);
   for (ModelKind kind : opt.models)
     out.models.push_back(fit_model(kind, tau, y, moving, k, opt.bench, runit, &eval, form));

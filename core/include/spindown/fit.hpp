@@ -50,6 +50,9 @@ struct ModelFit {
 struct FitOptions {
   BenchParams bench;
   std::vector<ModelKind> models{all_models[0], all_models[1], all_models[2]};
+  // Weight each sample by 1/σ²(u), σ² estimated from the run (reading_noise.hpp); false: the
+  // lab's unweighted least squares.
+  bool weighted = true;
   bool is_valid(std::string* why) const;
 };
 

@@ -1,0 +1,68 @@
+#include "spindown/reading_noise.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace spindown {
+namespace {
+
+// Half-width of the local mean: wide enough that a sample's own error hardly moves ū (1/17
+// of it), narrow next to the coast's curvature at 50 Hz.
+constexpr std::size_t half_window = 8;
+
+// ū_i: mean of y over [i − h, i + h] clipped to the run, from prefix sums.
+std::vector<double> local_means(std::span<const double> y) {
+  const std::size_t n = y.size();
+  std::vector<double> prefix(n + 1, 0.0), mean(n);
+  for (std::size_t i = 0; i < n; ++i) prefix[i + 1] = prefix[i] + y[i];
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t lo = i >= half_window ? i - half_window : 0, hi = std::min(n, i + half_window + 1);
+    mean[i] = (prefix[hi] - prefix[lo]) / static_cast<double>(hi - lo);
+  }
+  return mean;
+}
+
+}  // namespace
+
+ReadingNoise estimate_reading_noise(std::span<const double> y, double max_ratio) {
+  ReadingNoise out;
+  const std::size_t n = y.size();
+  if (n < 32) return out;
+  const std::vector<double> mean = local_means(y);
+  // Least squares of v_i = d_i²/6 on x_i = ū_i².
+  double sx = 0, sv = 0, sxx = 0, sxv = 0, x_max = 0;
+  for (std::size_t i = 1; i + 1 < n; ++i) {
+    const double d = y[i + 1] - 2 * y[i] + y[i - 1];
+    const double v = d * d / 6, x = mean[i] * mean[i];
+    sx += x, sv += v, sxx += x * x, sxv += x * v;
+  }
+  for (double u : mean) x_max = std::max(x_max, u * u);  // every sample gets a weight
+  const double m = static_cast<double>(n - 2);
+  const double det = m * sxx - sx * sx;
+  double a = sv / m, b = 0;  // constant variance unless the reading explains it
+  if (det > 1e-12 * m * sxx) {
+    b = (m * sxv - sx * sv) / det;
+    a = (sv - b * sx) / m;
+    if (b < 0) b = 0, a = sv / m;
+  }
+  if (!(a + b * x_max > 0) || !std::isfinite(a) || !std::isfinite(b)) return out;
+  // (a + b·x_max)/a ≤ max_ratio, also when the regression's a came out ≤ 0.
+  out.a = std::max(a, b * x_max / std::max(max_ratio - 1.0, 1e-9));
+  if (!(out.a > 0)) return out;
+  out.b = b;
+  out.known = true;
+  return out;
+}
+
+std::vector<double> sqrt_fit_weights(std::span<const double> y, const ReadingNoise& noise) {
+  std::vector<double> sw(y.size(), 1.0);
+  if (!noise.known || y.empty()) return sw;
+  const std::vector<double> mean = local_means(y);
+  double total = 0;
+  for (std::size_t i = 0; i < y.size(); ++i) total += sw[i] = 1.0 / noise.variance(mean[i]);
+  const double scale = static_cast<double>(y.size()) / total;
+  for (double& w : sw) w = std::sqrt(w * scale);
+  return sw;
+}
+
+}  // namespace spindown

@@ -1,0 +1,77 @@
+// The reading's noise model σ²(u) = a + b·u², estimated from a run without any model fit, and
+// the fit weights built from it.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "spindown/reading_noise.hpp"
+
+using namespace spindown;
+
+namespace {
+
+// A 30 s coast sampled at 50 Hz (2.8 V → 0, combined friction), then 2 s at rest, with white
+// noise of sd white_v and a multiplicative error of sd rel (ripple-like: grows with u).
+std::vector<double> noisy_coast(double white_v, double rel, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> gauss;
+  std::vector<double> y;
+  const double alpha = 0.016, c = 5.06;  // u = (2.8 + c)·e^(−ατ) − c
+  for (int i = 0; i < 1700; ++i) {
+    const double tau = 0.02 * i;
+    const double u = std::max(0.0, (2.8 + c) * std::exp(-alpha * tau) - c);
+    y.push_back(u * (1.0 + rel * gauss(rng)) + white_v * gauss(rng));
+  }
+  return y;
+}
+
+TEST(ReadingNoise, WhiteNoiseGivesItsVarianceAndEqualWeights) {
+  const std::vector<double> y = noisy_coast(0.005, 0.0, 1);
+  const ReadingNoise noise = estimate_reading_noise(y);
+  ASSERT_TRUE(noise.known);
+  EXPECT_NEAR(std::sqrt(noise.variance(0.0)), 0.005, 0.0005);
+  EXPECT_NEAR(std::sqrt(noise.variance(2.8)), 0.005, 0.0005);  // b ≈ 0: no growth with u
+  const std::vector<double> sw = sqrt_fit_weights(y, noise);
+  const auto [lo, hi] = std::minmax_element(sw.begin(), sw.end());
+  EXPECT_LT(*hi / *lo, 1.1);
+}
+
+TEST(ReadingNoise, ErrorGrowingWithTheReadingIsFound) {
+  // 1 % ripple as sd 0.7 % (a sine's rms) on top of 5 mV white noise.
+  const std::vector<double> y = noisy_coast(0.005, 0.007, 2);
+  const ReadingNoise noise = estimate_reading_noise(y, 1000.0);  // no cap: the estimate itself
+  ASSERT_TRUE(noise.known);
+  EXPECT_NEAR(std::sqrt(noise.a), 0.005, 0.0007);
+  EXPECT_NEAR(std::sqrt(noise.b), 0.007, 0.0010);
+  // Weights: the quiet slow end counts more than the noisy start, and they average 1.
+  const std::vector<double> sw = sqrt_fit_weights(y, noise);
+  EXPECT_GT(sw[1400], 1.5 * sw[0]);
+  double mean_w = 0;
+  for (double s : sw) mean_w += s * s / static_cast<double>(sw.size());
+  EXPECT_NEAR(mean_w, 1.0, 1e-9);
+}
+
+TEST(ReadingNoise, WeightRatioIsCapped) {
+  const std::vector<double> y = noisy_coast(0.001, 0.02, 3);  // σ² spans ~3000× without the cap
+  const ReadingNoise noise = estimate_reading_noise(y, 4.0);
+  ASSERT_TRUE(noise.known);
+  const std::vector<double> sw = sqrt_fit_weights(y, noise);
+  const auto [lo, hi] = std::minmax_element(sw.begin(), sw.end());
+  EXPECT_LE((*hi / *lo) * (*hi / *lo), 4.0 + 1e-9);
+  EXPECT_GT((*hi / *lo) * (*hi / *lo), 3.0);
+}
+
+TEST(ReadingNoise, TooFewOrNoiselessSamplesFitUnweighted) {
+  const std::vector<double> few(20, 1.0);
+  EXPECT_FALSE(estimate_reading_noise(few).known);
+  const std::vector<double> flat(200, 0.0);  // no variance at all
+  const ReadingNoise none = estimate_reading_noise(flat);
+  EXPECT_FALSE(none.known);
+  const std::vector<double> sw = sqrt_fit_weights(flat, none);
+  EXPECT_TRUE(std::all_of(sw.begin(), sw.end(), [](double s) { return s == 1.0; }));
+}
+
+}  // namespace
