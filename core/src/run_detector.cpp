@@ -51,22 +51,6 @@ void RunDetector::WindowFit::clear(std::size_t at, double t_origin) {
   updates = 0;
 }
 
-double RunDetector::WindowFit::slope() const {
-  if (n < 2) return 0.0;
-  const double sxx_ = sxx();
-  if (!(sxx_ > 0)) return 0.0;
-  return (stv - st * sv / n) / sxx_;
-}
-
-double RunDetector::WindowFit::resid_sd() const {
-  if (n < 3) return 0.0;
-  const double syy = svv - sv * sv / n;
-  const double sxy = stv - st * sv / n;
-  const double sxx_ = sxx();
-  const double sse = sxx_ > 0 ? syy - sxy * sxy / sxx_ : syy;
-  return std::sqrt(std::max(sse, 0.0) / (n - 2));
-}
-
 double RunDetector::duration(const WindowFit& w) const {
   return w.end > w.first ? t(w.end - 1) - t(w.first) : 0.0;
 }
@@ -90,16 +74,29 @@ void RunDetector::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
 }
 
 void RunDetector::advance(WindowFit& w, std::size_t i) {
-  if (w.end != i) {  // not contiguous (after a reset): start again from i
-    w.clear(i, t(i));
+  const Sample* ring = ring_.get();
+  const std::size_t mask = mask_;
+  const Sample s = ring[i & mask];
+  if (w.end != i) w.clear(i, s.t);  // not contiguous (after a reset): start again from i
+  if (w.n == 0) w.t0 = s.t;
+  // Add sample i, then drop the oldest while the window is longer than its span (keeping at
+  // least 3). At a steady rate exactly one drops: that add and remove are one slide().
+  std::size_t first = w.first;
+  const auto expired = [&](std::size_t k) { return i + 1 - k > 2 && s.t - ring[k & mask].t > w.span_s; };
+  if (expired(first)) {
+    const Sample old = ring[first & mask];
+    w.slide(s.t, s.v, old.t, old.v);
+    ++first;
+  } else {
+    w.add(s.t, s.v);
   }
-  if (w.n == 0) w.t0 = t(i);
-  w.add(t(i), v(i));
+  while (expired(first)) {
+    const Sample old = ring[first & mask];
+    w.remove(old.t, old.v);
+    ++first;
+  }
+  w.first = first;
   w.end = i + 1;
-  while (w.end - w.first > 2 && t(i) - t(w.first) > w.span_s) {
-    w.remove(t(w.first), v(w.first));
-    ++w.first;
-  }
   if (w.updates > refresh_every) rebuild(w, w.first, w.end);
 }
 
@@ -108,14 +105,17 @@ void RunDetector::advance(WindowFit& w, std::size_t i) {
 RunDetector::RunDetector(RunOptions opt, std::string source) : opt_(std::move(opt)), source_(std::move(source)) {
   hold_.span_s = opt_.stop_hold_s;
   hold_long_.span_s = 3.0 * opt_.stop_hold_s;
+  ring_ = std::make_unique_for_overwrite<Sample[]>(initial_ring_size);
+  mask_ = initial_ring_size - 1;
 }
 
 void RunDetector::grow_ring() {
   // Keep [base_, next_index_) at the same positions modulo the new, doubled size.
-  std::vector<Sample> bigger(std::max<std::size_t>(64, 2 * ring_.size()));
-  const std::size_t mask = bigger.size() - 1;
+  const std::size_t size = 2 * ring_size();
+  auto bigger = std::make_unique_for_overwrite<Sample[]>(size);
+  const std::size_t mask = size - 1;
   for (std::size_t k = base_; k + 1 < next_index_; ++k) bigger[k & mask] = ring_[k & mask_];
-  ring_.swap(bigger);
+  ring_ = std::move(bigger);
   mask_ = mask;
 }
 
@@ -133,14 +133,23 @@ void RunDetector::emit_diag(Diagnostic::Severity sev, std::string msg) {
   events_.push_back(std::move(e));
 }
 
+double* RunDetector::scratch(std::size_t size) {
+  if (size > scratch_size_) {
+    scratch_size_ = std::max(size, 2 * scratch_size_);
+    scratch_ = std::make_unique_for_overwrite<double[]>(scratch_size_);
+  }
+  return scratch_.get();
+}
+
 double RunDetector::median_of(std::size_t from, std::size_t to) {
-  scratch_.clear();
-  for (std::size_t k = from; k < to; ++k) scratch_.push_back(v(k));
-  if (scratch_.empty()) return 0.0;
-  auto mid = scratch_.begin() + scratch_.size() / 2;
-  std::nth_element(scratch_.begin(), mid, scratch_.end());
+  if (to <= from) return 0.0;
+  const std::size_t n = to - from;
+  double* x = scratch(n);
+  for (std::size_t k = from; k < to; ++k) x[k - from] = v(k);
+  double* mid = x + n / 2;
+  std::nth_element(x, mid, x + n);
   double m = *mid;
-  if (scratch_.size() % 2 == 0) m = 0.5 * (m + *std::max_element(scratch_.begin(), mid));
+  if (n % 2 == 0) m = 0.5 * (m + *std::max_element(x, mid));
   return m;
 }
 
@@ -158,7 +167,7 @@ void RunDetector::push(double t_s, double value) {
   have_last_t_ = true;
   last_t_ = t_s;
   const std::size_t i = next_index_++;
-  if (next_index_ - base_ > ring_.size()) grow_ring();
+  if (next_index_ - base_ > ring_size()) grow_ring();
   ring_[i & mask_] = {t_s, value};
   // Track readings pinned at one positive value (a clipped converter) so the lead-in before
   // a long clip is still buffered when the coast leaves it.
@@ -252,12 +261,14 @@ void RunDetector::trim_idle() {
 }
 
 bool RunDetector::confirms_decline(const WindowFit& w) const {
+  // Cheapest tests first: an idle lead-in (zeros, a steady supply) fails one of them.
   if (w.n < 6 || w.first < lo_) return false;
+  const double mu = w.mean();
+  if (!(mu > 0)) return false;
   const double dur = duration(w);
   if (dur < 0.8 * w.span_s) return false;
-  const double mu = w.mean();
   const double s = w.slope();
-  if (!(mu > 0) || !(s < 0)) return false;
+  if (!(s < 0)) return false;
   const double sd = w.resid_sd();
   if (sd > confirm_max_roughness * mu) return false;
   if (-s * dur < 0.002 * mu) return false;
@@ -338,13 +349,14 @@ RunDetector::CutSplit RunDetector::split_at_cut(std::size_t a, std::size_t b, co
   if (!sp.clipped) {
     // Two-segment least squares over [a, b]: constant lead-in [a, c), linear coast [c, b].
     const std::size_t n = b - a + 1;
-    scratch_.assign(6 * (n + 1), 0.0);
-    double* pv = scratch_.data();  // prefix Σv, Σv² of [a, a+k)
+    double* pv = scratch(6 * (n + 1));  // prefix Σv, Σv² of [a, a+k)
     double* pvv = pv + (n + 1);
     double* ss = pvv + (n + 1);  // suffix Σt, Σt², Σv, Σtv of [a+k, b] (t relative to t(b))
     double* stt_ = ss + (n + 1);
     double* sv_ = stt_ + (n + 1);
     double* stv_ = sv_ + (n + 1);
+    pv[0] = pvv[0] = 0.0;
+    ss[n] = stt_[n] = sv_[n] = stv_[n] = 0.0;
     for (std::size_t k = 0; k < n; ++k) {
       const double x = v(a + k);
       pv[k + 1] = pv[k] + x;
@@ -512,6 +524,7 @@ bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
   }
   v0_ = sp.v0;
   coast_sd_ = sp.sd_post;
+  rise_jump_ = std::max(0.1 * std::abs(v0_), 8.0 * coast_sd_);
   level_min_ = std::numeric_limits<double>::infinity();
   rising_ = 0;
   state_ = State::coasting;
@@ -547,7 +560,8 @@ void RunDetector::coast_checks(std::size_t i, bool at_end) {
     to_idle(i + 1, true);
     return;
   }
-  if (t(i) - run_.t_cut_s > opt_.max_coast_s) {
+  const double t_i = t(i);
+  if (t_i - run_.t_cut_s > opt_.max_coast_s) {
     close_unstopped(i + 1, fmt::format("no standstill within max_coast_s ({:g} s): closed as never stopped",
                                        opt_.max_coast_s));
     to_idle(i + 1, true);
@@ -559,8 +573,7 @@ void RunDetector::coast_checks(std::size_t i, bool at_end) {
 
   // Power back before standstill: the reading climbs well above the coast's lowest level.
   if (dur >= 0.5 * hold_.span_s) level_min_ = std::min(level_min_, mu);
-  const double jump = std::max(0.1 * std::abs(v0_), 8.0 * coast_sd_);
-  if (v(i) > level_min_ + jump) {
+  if (v(i) > level_min_ + rise_jump_) {
     if (rising_++ == 0) rise_start_ = i;
     if (rising_ >= 3) {
       const std::size_t at = rise_start_;
@@ -576,31 +589,35 @@ void RunDetector::coast_checks(std::size_t i, bool at_end) {
   // the coast's mean rate or a three times longer window is flat too (noisy, slow coasts).
   if (dur < 0.9 * hold_.span_s) return;
   if (v0_ > 0 && mu > standstill_max_fraction * v0_) return;  // still high: the usual case, cheap
-  const double mean_rate = (v0_ - mu) / std::max(t(i) - run_.t_cut_s, 1e-9);
-  auto flat = [&](const WindowFit& w, bool* resolved) {
-    if (w.n < 3 || w.first < run_.cut_index) return false;
-    const double d = duration(w);
-    if (d < 0.9 * w.span_s) return false;
-    const double m = w.mean(), s = w.slope(), e = w.resid_sd(), sxx = w.sxx();
-    const double scale = std::max(std::abs(v0_), std::abs(m));
-    const double tiny = 1e-12 * (scale > 0 ? scale : 1.0);
-    const bool no_slope = std::abs(s) * std::sqrt(sxx) <= flat_t_stat * e + tiny;
-    const bool small_drop = std::abs(s) * d <= std::max(3.0 * e, 0.01 * std::abs(v0_)) + tiny;
-    const bool low = v0_ > 0 ? m <= standstill_max_fraction * v0_ : true;
-    if (resolved) *resolved = sxx > 0 && e / std::sqrt(sxx) <= slope_resolution * mean_rate;
-    return no_slope && small_drop && low;
-  };
+  const double mean_rate = (v0_ - mu) / std::max(t_i - run_.t_cut_s, 1e-9);
   bool resolved = at_end;
-  if (!flat(hold_, at_end ? nullptr : &resolved)) return;
+  if (!flat(hold_, mean_rate, at_end ? nullptr : &resolved)) return;
   if (creeping_ && !at_end) resolved = false;  // an asymptotic coast ends when the long window is flat
   if (!resolved) {
     if (!hold_long_live_) {
       reset_window(hold_long_, run_.cut_index, i + 1);
       hold_long_live_ = true;
     }
-    if (!flat(hold_long_, nullptr)) return;
+    if (!flat(hold_long_, mean_rate, nullptr)) return;
   }
   found_standstill(i, at_end);
+}
+
+bool RunDetector::flat(const WindowFit& w, double mean_rate, bool* resolved) const {
+  if (w.n < 3 || w.first < run_.cut_index) return false;
+  const double d = duration(w);
+  if (d < 0.9 * w.span_s) return false;
+  const double m = w.mean();
+  const bool low = v0_ > 0 ? m <= standstill_max_fraction * v0_ : true;
+  if (!low) return false;
+  const double s = w.slope(), e = w.resid_sd(), sxx = w.sxx();
+  const double scale = std::max(std::abs(v0_), std::abs(m));
+  const double tiny = 1e-12 * (scale > 0 ? scale : 1.0);
+  const bool no_slope = std::abs(s) * std::sqrt(sxx) <= flat_t_stat * e + tiny;
+  const bool small_drop = std::abs(s) * d <= std::max(3.0 * e, 0.01 * std::abs(v0_)) + tiny;
+  if (!(no_slope && small_drop)) return false;
+  if (resolved) *resolved = sxx > 0 && e / std::sqrt(sxx) <= slope_resolution * mean_rate;
+  return true;
 }
 
 void RunDetector::found_standstill(std::size_t i, bool at_end) {
@@ -785,12 +802,12 @@ void RunDetector::complete_run(std::size_t end) {
   }
   const std::size_t coast_end = r.stopped ? r.stop_index : end;
   // Median sample period within the coast.
-  scratch_.clear();
-  for (std::size_t k = r.cut_index + 1; k < coast_end; ++k) scratch_.push_back(t(k) - t(k - 1));
-  if (!scratch_.empty()) {
-    auto mid = scratch_.begin() + scratch_.size() / 2;
-    std::nth_element(scratch_.begin(), mid, scratch_.end());
-    r.period_s = *mid;
+  if (coast_end > r.cut_index + 1) {
+    const std::size_t n = coast_end - r.cut_index - 1;
+    double* dt = scratch(n);
+    for (std::size_t k = 0; k < n; ++k) dt[k] = t(r.cut_index + 1 + k) - t(r.cut_index + k);
+    std::nth_element(dt, dt + n / 2, dt + n);
+    r.period_s = dt[n / 2];
   }
   const std::size_t coast_n = coast_end - r.cut_index;
   const double coast_s = (r.stopped ? r.t_stop_s : (end > r.cut_index ? t(end - 1) : r.t_cut_s)) - r.t_cut_s;

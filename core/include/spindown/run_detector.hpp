@@ -20,8 +20,11 @@
 // Latency: a cut is announced ~0.25–1 s after it (4 s for very slow, noisy coasts), a stop
 // ~stop_hold_s after it (up to 3·stop_hold_s when the noise hides a slow final decline), a run
 // tail_s after its stop.
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -98,19 +101,45 @@ class RunDetector {
       stv -= t * v;
       ++updates;
     }
+    // add(t_in, v_in) then remove(t_out, v_out), bit for bit, in one pass over the sums.
+    void slide(double t_in, double v_in, double t_out, double v_out) {
+      t_in -= t0;
+      t_out -= t0;
+      st = st + t_in - t_out;
+      stt = stt + t_in * t_in - t_out * t_out;
+      sv = sv + v_in - v_out;
+      svv = svv + v_in * v_in - v_out * v_out;
+      stv = stv + t_in * v_in - t_out * v_out;
+      updates += 2;
+    }
     double mean() const { return n > 0 ? sv / n : 0.0; }
     double sxx() const { return stt - st * st / n; }
-    double slope() const;
-    double resid_sd() const;
+    double slope() const {
+      if (n < 2) return 0.0;
+      const double sxx_ = sxx();
+      if (!(sxx_ > 0)) return 0.0;
+      return (stv - st * sv / n) / sxx_;
+    }
+    double resid_sd() const {
+      if (n < 3) return 0.0;
+      const double syy = svv - sv * sv / n;
+      const double sxy = stv - st * sv / n;
+      const double sxx_ = sxx();
+      const double sse = sxx_ > 0 ? syy - sxy * sxy / sxx_ : syy;
+      return std::sqrt(std::max(sse, 0.0) / (n - 2));
+    }
   };
 
   // The buffer: a ring indexed by absolute sample index, holding [base_, next_index_).
-  struct Sample {
-    double t = 0, v = 0;
+  struct Sample {  // no initializers: a new ring is not written before it is used
+    double t, v;
   };
   double t(std::size_t i) const { return ring_[i & mask_].t; }
   double v(std::size_t i) const { return ring_[i & mask_].v; }
+  std::size_t ring_size() const { return mask_ + 1; }
   void grow_ring();
+  // The ring's first size: a lab run (30 s at 50 Hz) fits without growing.
+  static constexpr std::size_t initial_ring_size = 2048;
   void advance(WindowFit& w, std::size_t i);
   void rebuild(WindowFit& w, std::size_t from, std::size_t to);
   void reset_window(WindowFit& w, std::size_t lo, std::size_t end);
@@ -121,6 +150,9 @@ class RunDetector {
   void coast_checks(std::size_t i, bool at_end = false);
   void tail_step(std::size_t i);
   bool confirms_decline(const WindowFit& w) const;
+  // Whether w shows a standstill: full, low, and no significant slope or drop. *resolved (if
+  // given and w is flat) says whether its slope is resolved well below the coast's mean rate.
+  bool flat(const WindowFit& w, double mean_rate, bool* resolved) const;
   // Where the cut lies in [a, b] (b = newest sample), and what came before it.
   struct CutSplit {
     std::size_t a = 0, cut_index = 0, pre_end = 0, npre = 0;
@@ -146,7 +178,7 @@ class RunDetector {
   RunOptions opt_;
   std::string source_;
   State state_ = State::idle;
-  std::vector<Sample> ring_;
+  std::unique_ptr<Sample[]> ring_;
   std::size_t mask_ = 0;
   std::size_t base_ = 0;        // absolute index of the oldest buffered sample
   std::size_t next_index_ = 0;  // absolute index of the next sample
@@ -174,6 +206,7 @@ class RunDetector {
   Run run_;
   double v0_ = 0;          // reading at the cut (start of the coast line)
   double coast_sd_ = 0;    // coast noise near the cut
+  double rise_jump_ = 0;   // a reading this far above level_min_ is power coming back
   double level_min_ = 0;   // lowest hold-window mean seen in this coast
   int rising_ = 0;         // consecutive samples far above level_min_ (power back?)
   std::size_t rise_start_ = 0;
@@ -183,7 +216,10 @@ class RunDetector {
   std::string run_note_;   // note attached to the completed run
 
   std::vector<RunEvent> events_;
-  std::vector<double> scratch_;
+  // Work space for medians and the cut search, grown (never shrunk, never zeroed) as needed.
+  double* scratch(std::size_t size);
+  std::unique_ptr<double[]> scratch_;
+  std::size_t scratch_size_ = 0;
 };
 
 }  // namespace spindown
