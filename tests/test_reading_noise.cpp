@@ -30,11 +30,10 @@ std::vector<double> noisy_coast(double white_v, double rel, unsigned seed) {
 
 TEST(ReadingNoise, WhiteNoiseGivesItsVarianceAndEqualWeights) {
   const std::vector<double> y = noisy_coast(0.005, 0.0, 1);
-  const ReadingNoise noise = estimate_reading_noise(y);
+  const auto [noise, sw] = weigh_by_noise(y);
   ASSERT_TRUE(noise.known);
   EXPECT_NEAR(std::sqrt(noise.variance(0.0)), 0.005, 0.0005);
   EXPECT_NEAR(std::sqrt(noise.variance(2.8)), 0.005, 0.0005);  // b ≈ 0: no growth with u
-  const std::vector<double> sw = sqrt_fit_weights(y, noise);
   const auto [lo, hi] = std::minmax_element(sw.begin(), sw.end());
   EXPECT_LT(*hi / *lo, 1.1);
 }
@@ -42,12 +41,11 @@ TEST(ReadingNoise, WhiteNoiseGivesItsVarianceAndEqualWeights) {
 TEST(ReadingNoise, ErrorGrowingWithTheReadingIsFound) {
   // 1 % ripple as sd 0.7 % (a sine's rms) on top of 5 mV white noise.
   const std::vector<double> y = noisy_coast(0.005, 0.007, 2);
-  const ReadingNoise noise = estimate_reading_noise(y, 1000.0);  // no cap: the estimate itself
+  const auto [noise, sw] = weigh_by_noise(y, 1000.0);  // no cap: the estimate itself
   ASSERT_TRUE(noise.known);
   EXPECT_NEAR(std::sqrt(noise.a), 0.005, 0.0007);
   EXPECT_NEAR(std::sqrt(noise.b), 0.007, 0.0010);
   // Weights: the quiet slow end counts more than the noisy start, and they average 1.
-  const std::vector<double> sw = sqrt_fit_weights(y, noise);
   EXPECT_GT(sw[1400], 1.5 * sw[0]);
   double mean_w = 0;
   for (double s : sw) mean_w += s * s / static_cast<double>(sw.size());
@@ -56,9 +54,8 @@ TEST(ReadingNoise, ErrorGrowingWithTheReadingIsFound) {
 
 TEST(ReadingNoise, WeightRatioIsCapped) {
   const std::vector<double> y = noisy_coast(0.001, 0.02, 3);  // σ² spans ~3000× without the cap
-  const ReadingNoise noise = estimate_reading_noise(y, 4.0);
+  const auto [noise, sw] = weigh_by_noise(y, 4.0);
   ASSERT_TRUE(noise.known);
-  const std::vector<double> sw = sqrt_fit_weights(y, noise);
   const auto [lo, hi] = std::minmax_element(sw.begin(), sw.end());
   EXPECT_LE((*hi / *lo) * (*hi / *lo), 4.0 + 1e-9);
   EXPECT_GT((*hi / *lo) * (*hi / *lo), 3.0);
@@ -66,11 +63,11 @@ TEST(ReadingNoise, WeightRatioIsCapped) {
 
 TEST(ReadingNoise, TooFewOrNoiselessSamplesFitUnweighted) {
   const std::vector<double> few(20, 1.0);
-  EXPECT_FALSE(estimate_reading_noise(few).known);
+  EXPECT_FALSE(weigh_by_noise(few).noise.known);
   const std::vector<double> flat(200, 0.0);  // no variance at all
-  const ReadingNoise none = estimate_reading_noise(flat);
+  const auto [none, sw] = weigh_by_noise(flat);
   EXPECT_FALSE(none.known);
-  const std::vector<double> sw = sqrt_fit_weights(flat, none);
+  ASSERT_EQ(sw.size(), flat.size());
   EXPECT_TRUE(std::all_of(sw.begin(), sw.end(), [](double s) { return s == 1.0; }));
 }
 

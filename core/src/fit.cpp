@@ -682,7 +682,7 @@ RunFit fit_run(std::span<const double> t_s, std::span<const double> value, Quant
   const std::string_view runit = quantity_unit(q);
   // Weights from the run's own noise (σ² growing with the reading), shared by every model.
   const std::vector<double> sqrt_weight =
-      opt.weighted ? sqrt_fit_weights(y, estimate_reading_noise(y)) : std::vector<double>(y.size(), 1.0);
+      opt.weighted ? weigh_by_noise(y).sqrt_weight : std::vector<double>(y.size(), 1.0);
   Evaluator eval(tau, y, sqrt_weight);  // one workspace for every model of the run
   const IntegralForm form = integral_form(tau, y, moving);
   for (ModelKind kind : opt.models)

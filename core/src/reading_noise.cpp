@@ -10,26 +10,24 @@ namespace {
 // of it), narrow next to the coast's curvature at 50 Hz.
 constexpr std::size_t half_window = 8;
 
-// ū_i: mean of y over [i − h, i + h] clipped to the run, from prefix sums.
+// ū_i: mean of y over [i − h, i + h] clipped to the run, as a sliding window sum.
 std::vector<double> local_means(std::span<const double> y) {
   const std::size_t n = y.size();
-  std::vector<double> prefix(n + 1, 0.0), mean(n);
-  for (std::size_t i = 0; i < n; ++i) prefix[i + 1] = prefix[i] + y[i];
+  std::vector<double> mean(n);
+  double sum = 0;
+  std::size_t lo = 0, hi = 0;  // the window is [lo, hi)
   for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t lo = i >= half_window ? i - half_window : 0, hi = std::min(n, i + half_window + 1);
-    mean[i] = (prefix[hi] - prefix[lo]) / static_cast<double>(hi - lo);
+    for (; hi < std::min(n, i + half_window + 1); ++hi) sum += y[hi];
+    for (; lo + half_window < i; ++lo) sum -= y[lo];
+    mean[i] = sum / static_cast<double>(hi - lo);
   }
   return mean;
 }
 
-}  // namespace
-
-ReadingNoise estimate_reading_noise(std::span<const double> y, double max_ratio) {
+// Least squares of v_i = d_i²/6 on x_i = ū_i², d the second difference.
+ReadingNoise estimate(std::span<const double> y, std::span<const double> mean, double max_ratio) {
   ReadingNoise out;
   const std::size_t n = y.size();
-  if (n < 32) return out;
-  const std::vector<double> mean = local_means(y);
-  // Least squares of v_i = d_i²/6 on x_i = ū_i².
   double sx = 0, sv = 0, sxx = 0, sxv = 0, x_max = 0;
   for (std::size_t i = 1; i + 1 < n; ++i) {
     const double d = y[i + 1] - 2 * y[i] + y[i - 1];
@@ -54,15 +52,20 @@ ReadingNoise estimate_reading_noise(std::span<const double> y, double max_ratio)
   return out;
 }
 
-std::vector<double> sqrt_fit_weights(std::span<const double> y, const ReadingNoise& noise) {
-  std::vector<double> sw(y.size(), 1.0);
-  if (!noise.known || y.empty()) return sw;
+}  // namespace
+
+NoiseWeights weigh_by_noise(std::span<const double> y, double max_ratio) {
+  NoiseWeights out;
+  out.sqrt_weight.assign(y.size(), 1.0);
+  if (y.size() < 32) return out;
   const std::vector<double> mean = local_means(y);
+  out.noise = estimate(y, mean, max_ratio);
+  if (!out.noise.known) return out;
   double total = 0;
-  for (std::size_t i = 0; i < y.size(); ++i) total += sw[i] = 1.0 / noise.variance(mean[i]);
+  for (std::size_t i = 0; i < y.size(); ++i) total += out.sqrt_weight[i] = 1.0 / out.noise.variance(mean[i]);
   const double scale = static_cast<double>(y.size()) / total;
-  for (double& w : sw) w = std::sqrt(w * scale);
-  return sw;
+  for (double& w : out.sqrt_weight) w = std::sqrt(w * scale);
+  return out;
 }
 
 }  // namespace spindown

@@ -20,7 +20,10 @@ struct ReadingNoise {
   double variance(double u) const { return a + b * u * u; }
 };
 
-// σ²(u) from readings y (zero level removed) of one run, cut to end. Needs ≥ 32 samples.
+// σ²(u) from readings y (zero level removed) of one run, cut to end, and the square roots of
+// the fit weights 1/σ²(ū_i), ū the local mean around sample i, scaled so the weights average 1
+// over the run (weighted and plain sums of squares stay comparable); all ones when the noise
+// is not known (fewer than 32 samples, no variance).
 // The ratio of the largest to the smallest variance is capped at max_ratio. Not all error
 // averages out: the lab's 10-bit ADC (4.88 mV) printed with 2 decimals (10 mV) rounds odd
 // counts down, a pattern of up to ±2.5 mV that drifts with the reading, and weighting the
@@ -28,11 +31,10 @@ struct ReadingNoise {
 // Measured over 300 lab-like runs (bench/monte_carlo.sh; c3 bias, sd in % of the truth):
 // unweighted −0.24, 0.68; cap 2: −0.26, 0.63; cap 4: −0.29, 0.61; cap 8: −0.33, 0.59;
 // no cap: −0.57, 0.66. A cap of 4 gives the smallest mean squared error.
-ReadingNoise estimate_reading_noise(std::span<const double> y, double max_ratio = 4.0);
-
-// Square roots of the fit weights 1/σ²(ū_i), ū the local mean around sample i, scaled so the
-// weights average 1 over the run (weighted and plain sums of squares stay comparable). All
-// ones when the noise is not known.
-std::vector<double> sqrt_fit_weights(std::span<const double> y, const ReadingNoise& noise);
+struct NoiseWeights {
+  ReadingNoise noise;
+  std::vector<double> sqrt_weight;  // one per reading
+};
+NoiseWeights weigh_by_noise(std::span<const double> y, double max_ratio = 4.0);
 
 }  // namespace spindown
