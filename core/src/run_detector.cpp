@@ -547,7 +547,36 @@ void RunDetector::coast_step(std::size_t i) {
   coast_checks(i);
 }
 
+// Per coasting sample; kept small (the rare outcomes are calls) since it runs for every sample.
 void RunDetector::coast_checks(std::size_t i, bool at_end) {
+  const double t_i = t(i);
+  if (buffered() > opt_.max_buffer || t_i - run_.t_cut_s > opt_.max_coast_s) {
+    coast_too_long(i);
+    return;
+  }
+  if (hold_.n < 3 || hold_.first < run_.cut_index) return;
+  const double dur = duration(hold_);
+  const double mu = hold_.mean();
+
+  // Power back before standstill: the reading climbs well above the coast's lowest level.
+  if (dur >= 0.5 * hold_.span_s) level_min_ = std::min(level_min_, mu);
+  if (v(i) > level_min_ + rise_jump_) {
+    if (rising_++ == 0) rise_start_ = i;
+    if (rising_ >= 3) {
+      power_back();
+      return;
+    }
+  } else {
+    rising_ = 0;
+  }
+
+  // Standstill: the hold window is flat and low.
+  if (dur < 0.9 * hold_.span_s) return;
+  if (v0_ > 0 && mu > standstill_max_fraction * v0_) return;  // still high: the usual case, cheap
+  standstill_checks(i, at_end, (v0_ - mu) / std::max(t_i - run_.t_cut_s, 1e-9));
+}
+
+void RunDetector::coast_too_long(std::size_t i) {
   if (buffered() > opt_.max_buffer) {
     RunEvent e;
     e.kind = RunEvent::Kind::ignored;
@@ -560,36 +589,20 @@ void RunDetector::coast_checks(std::size_t i, bool at_end) {
     to_idle(i + 1, true);
     return;
   }
-  const double t_i = t(i);
-  if (t_i - run_.t_cut_s > opt_.max_coast_s) {
-    close_unstopped(i + 1, fmt::format("no standstill within max_coast_s ({:g} s): closed as never stopped",
-                                       opt_.max_coast_s));
-    to_idle(i + 1, true);
-    return;
-  }
-  if (hold_.n < 3 || hold_.first < run_.cut_index) return;
-  const double dur = duration(hold_);
-  const double mu = hold_.mean();
+  close_unstopped(i + 1, fmt::format("no standstill within max_coast_s ({:g} s): closed as never stopped",
+                                     opt_.max_coast_s));
+  to_idle(i + 1, true);
+}
 
-  // Power back before standstill: the reading climbs well above the coast's lowest level.
-  if (dur >= 0.5 * hold_.span_s) level_min_ = std::min(level_min_, mu);
-  if (v(i) > level_min_ + rise_jump_) {
-    if (rising_++ == 0) rise_start_ = i;
-    if (rising_ >= 3) {
-      const std::size_t at = rise_start_;
-      close_unstopped(at, fmt::format("the reading rose again at {} before standstill (power restored?)", fmt_s(t(at))));
-      to_idle(at, false);
-      return;
-    }
-  } else {
-    rising_ = 0;
-  }
+void RunDetector::power_back() {
+  const std::size_t at = rise_start_;
+  close_unstopped(at, fmt::format("the reading rose again at {} before standstill (power restored?)", fmt_s(t(at))));
+  to_idle(at, false);
+}
 
-  // Standstill: the hold window is flat and low, and either its slope is resolved well below
-  // the coast's mean rate or a three times longer window is flat too (noisy, slow coasts).
-  if (dur < 0.9 * hold_.span_s) return;
-  if (v0_ > 0 && mu > standstill_max_fraction * v0_) return;  // still high: the usual case, cheap
-  const double mean_rate = (v0_ - mu) / std::max(t_i - run_.t_cut_s, 1e-9);
+void RunDetector::standstill_checks(std::size_t i, bool at_end, double mean_rate) {
+  // The hold window is flat and low, and either its slope is resolved well below the coast's
+  // mean rate or a three times longer window is flat too (noisy, slow coasts).
   bool resolved = at_end;
   if (!flat(hold_, mean_rate, at_end ? nullptr : &resolved)) return;
   if (creeping_ && !at_end) resolved = false;  // an asymptotic coast ends when the long window is flat
@@ -670,8 +683,14 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
       }
     }
   }
-  std::size_t stop = run_.cut_index + 1;
-  while (stop < i && t(stop) < t_hit) ++stop;
+  // The first sample at or after t_hit (times never decrease within a stream), at most i.
+  std::size_t lo = run_.cut_index + 1, hi = std::max(lo, i);
+  while (lo < hi) {
+    const std::size_t mid = lo + (hi - lo) / 2;
+    if (t(mid) < t_hit) lo = mid + 1;
+    else hi = mid;
+  }
+  const std::size_t stop = lo;
 
   // A real stop arrives with a finite slope; an exponential creeps in.
   const double t_stop = t(stop);

@@ -148,6 +148,9 @@ class RunDetector {
   void idle_step(std::size_t i);
   void coast_step(std::size_t i);
   void coast_checks(std::size_t i, bool at_end = false);
+  void coast_too_long(std::size_t i);  // max_buffer or max_coast_s reached
+  void power_back();                   // the reading rose again before standstill
+  void standstill_checks(std::size_t i, bool at_end, double mean_rate);
   void tail_step(std::size_t i);
   bool confirms_decline(const WindowFit& w) const;
   // Whether w shows a standstill: full, low, and no significant slope or drop. *resolved (if
