@@ -20,8 +20,9 @@
 // and F = Σ ∇u ∇uᵀ / σ²(u). (The bound with one constant σ² = mean e² is reported beside it:
 // looser where the ripple is small, tighter where it is large.)
 //
-// usage: monte_carlo OUT_DIR [RUNS=500] [SEED=1] [TRUTH_JSON]
+// usage: monte_carlo OUT_DIR [RUNS=500] [SEED=1] [TRUTH_JSON] [ADC_BITS=10] [DECIMALS=2]
 //   TRUTH_JSON: a shared/data *.truth.json (c_v, c_c, e0, noise_v, ripple); default the lab's 3 V run.
+//   ADC_BITS 0 and DECIMALS −1 (printed to 6) take the quantization out, to see what it costs.
 #include <Eigen/Dense>
 #include <chrono>
 #include <cmath>
@@ -64,15 +65,17 @@ struct Model {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 2 || argc > 5) {
-    std::cerr << "usage: monte_carlo OUT_DIR [RUNS=500] [SEED=1] [TRUTH_JSON]\n";
+  if (argc < 2 || argc > 7) {
+    std::cerr << "usage: monte_carlo OUT_DIR [RUNS=500] [SEED=1] [TRUTH_JSON] [ADC_BITS=10] [DECIMALS=2]\n";
     return 2;
   }
   const std::filesystem::path dir = argv[1];
   const long runs = argc > 2 ? std::strtol(argv[2], nullptr, 10) : 500;
   const long seed = argc > 3 ? std::strtol(argv[3], nullptr, 10) : 1;
-  if (runs < 2 || runs > 100'000 || seed < 0) {
-    std::cerr << "monte_carlo: RUNS must be 2…100000 and SEED ≥ 0\n";
+  const long adc_bits = argc > 5 ? std::strtol(argv[5], nullptr, 10) : 10;
+  const long decimals = argc > 6 ? std::strtol(argv[6], nullptr, 10) : 2;
+  if (runs < 2 || runs > 100'000 || seed < 0 || adc_bits < 0 || adc_bits > 16 || decimals < -1 || decimals > 6) {
+    std::cerr << "monte_carlo: RUNS must be 2…100000, SEED ≥ 0, ADC_BITS 0…16, DECIMALS −1…6\n";
     return 2;
   }
   Truth truth;
@@ -121,9 +124,11 @@ int main(int argc, char** argv) {
     spec.lead_in_s = 1.0;
     spec.tail_s = 2.0;
     spec.seed = static_cast<std::uint64_t>(seed * 1'000'003 + i);
+    spec.adc_bits = static_cast<int>(adc_bits);
+    spec.decimals = static_cast<int>(decimals);
     const SyntheticRun run = make_synthetic_run(spec);
     const std::string name = fmt::format("run{:05d}.txt", i + 1);
-    const std::string text = to_arduino_text(run, 2, true);
+    const std::string text = to_arduino_text(run, decimals < 0 ? 6 : static_cast<int>(decimals), true);
     std::ofstream(dir / name, std::ios::binary) << text;
     index << fmt::format("{}\t{:.6f}\t{:.6f}\t{:.9g}\t{:.9g}\t{:.9g}\t{:.9g}\t{:.4f}\t{}\n", name,
                          run.t_cut_ms / 1000.0, run.t_cut_ms / 1000.0 + run.t_stop_s, J, kb, truth.c_v, truth.c_c,
@@ -204,7 +209,8 @@ int main(int argc, char** argv) {
   crb_var4 /= nruns;
   flat_var3 /= nruns;
   flat_var4 /= nruns;
-  const double adc_step = 5.0 / 1024, print_step = 0.01;
+  const double adc_step = adc_bits > 0 ? 5.0 / double(1L << adc_bits) : 0.0;
+  const double print_step = decimals >= 0 ? std::pow(10.0, -double(decimals)) : 0.0;
   const nlohmann::json out = {
       {"runs", runs},
       {"fitted", fitted},
@@ -214,6 +220,8 @@ int main(int argc, char** argv) {
       {"e0", truth.e0},
       {"noise_v", truth.noise_v},
       {"ripple", truth.ripple},
+      {"adc_bits", adc_bits},
+      {"decimals", decimals},
       {"J", J},
       {"Kb", kb},
       {"sigma_eff_v", std::sqrt(sigma2)},

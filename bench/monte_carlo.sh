@@ -5,7 +5,8 @@
 # curve on the same printed files (bench/scipy_lab_fits.py, cut and stop given for free), with
 # the Cramér–Rao bound for the same sampling and noise. Prints bias, spread, efficiency and the
 # calibration of the reported standard errors for c3 (c_v) and c4 (c_c).
-# Usage: bench/monte_carlo.sh [BIN_DIR]   (default build/bin; env RUNS=500 SEED=1 TRUTH=… KEEP=DIR)
+# Usage: bench/monte_carlo.sh [BIN_DIR]   (default build/bin; env RUNS=500 SEED=1 TRUTH=… KEEP=DIR
+#        ADC_BITS=10 DECIMALS=2: ADC_BITS=0 DECIMALS=-1 takes the lab's quantization out)
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
 BIN=${1:-${SPINDOWN_BIN_DIR:-$ROOT/build/bin}}
@@ -19,6 +20,6 @@ if [[ -n ${KEEP:-} ]]; then WORK=$KEEP; mkdir -p "$WORK"; else
   WORK=$(mktemp -d /tmp/spindown-mc.XXXXXX)
   trap 'rm -rf "$WORK"' EXIT
 fi
-"$BIN/monte_carlo" "$WORK" "$RUNS" "$SEED" "$TRUTH" >/dev/null
+"$BIN/monte_carlo" "$WORK" "$RUNS" "$SEED" "$TRUTH" "${ADC_BITS:-10}" "${DECIMALS:-2}" >/dev/null
 /usr/bin/python3 "$ROOT/bench/scipy_lab_fits.py" fit "$WORK" >"$WORK/scipy.tsv" 2>"$WORK/scipy.err" || true
 /usr/bin/python3 "$ROOT/bench/scipy_lab_fits.py" mc-summary "$WORK"

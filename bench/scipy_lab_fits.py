@@ -136,10 +136,13 @@ def cmd_mc_summary(directory):
         crb = json.load(f)
     common = sorted(set.intersection(*(set(data) for _, data in estimators)))
     truth = {"c3": crb["c_v"], "c4": crb["c_c"]}
+    bits, decimals = crb.get("adc_bits", 10), crb.get("decimals", 2)
+    adc = f"{bits}-bit ADC" if bits > 0 else "no ADC"
+    printed = f"{decimals} decimals" if decimals >= 0 else "full precision"
     print(f"Monte Carlo: {len(common)} runs in both ({len(ours)} spindown, {len(theirs)} SciPy); "
           f"truth c_v = {crb['c_v']:.6g} N·m·s/rad, c_c = {crb['c_c']:.6g} N·m; "
-          f"reading error (white {1e3 * crb['noise_v']:.1f} mV, {100 * crb['ripple']:.0f} % ripple, 10-bit ADC, "
-          f"2 decimals) measured: RMS {1e3 * crb['sigma_eff_v']:.2f} mV, σ²(u) = α + β·u² with "
+          f"reading error (white {1e3 * crb['noise_v']:.1f} mV, {100 * crb['ripple']:.0f} % ripple, {adc}, {printed}) "
+          f"measured: RMS {1e3 * crb['sigma_eff_v']:.2f} mV, σ²(u) = α + β·u² with "
           f"√α = {1e3 * crb['sigma_at_zero_v']:.2f} mV, √(2β) = {100 * math.sqrt(2 * max(crb['sigma2_beta'], 0)):.2f} %")
     hdr = ("coef", "estimator", "bias", "bias/sd", "sd", "CRB sd", "efficiency", "CRB sd (flat σ)", "mean stderr",
            "stderr/sd")
