@@ -58,4 +58,23 @@ void BM_FindRunsFiveRuns(benchmark::State& state) {
 }
 BENCHMARK(BM_FindRunsFiveRuns)->Unit(benchmark::kMicrosecond);
 
+// The live fitter's use: one push() per sample, events taken as they come.
+void BM_DetectorPerSample(benchmark::State& state) {
+  const auto rec = lab_run();
+  for (auto _ : state) {
+    spindown::RunDetector det;
+    std::size_t events = 0;
+    for (std::size_t i = 0; i < rec.size(); ++i) {
+      det.push(rec.t_s[i], rec.value[i]);
+      if (det.has_events()) events += det.take_events().size();
+    }
+    det.finish();
+    events += det.take_events().size();
+    benchmark::DoNotOptimize(events);
+  }
+  state.counters["samples"] = double(rec.size());
+  state.SetItemsProcessed(state.iterations() * std::int64_t(rec.size()));
+}
+BENCHMARK(BM_DetectorPerSample)->Unit(benchmark::kMicrosecond);
+
 }  // namespace
