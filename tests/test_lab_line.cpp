@@ -118,3 +118,72 @@ TEST(LabLine, PlainDecimalsMatchFromCharsBitForBit) {
     EXPECT_EQ(std::memcmp(&l.value, &expected, sizeof expected), 0) << v << " read as " << l.value;
   }
 }
+
+// The file reader's fast path must give what parse_lab_line gives for every line it accepts,
+// and take the line's whole length up to its terminator.
+namespace {
+
+void expect_fast_path_agrees(const std::string& line, const std::string& terminator) {
+  const std::string text = line + terminator + "12345\t1.00\r\n12345\t1.00\r\n";  // enough text after it
+  LabLine fast;
+  const std::size_t length = parse_printed_sample(text, fast);
+  if (length == 0) return;  // declined: the slow path judges it
+  ASSERT_EQ(length, line.size()) << '"' << line << '"';
+  const LabLine slow = parse_lab_line(line);
+  ASSERT_EQ(slow.kind, Kind::sample) << '"' << line << "\": " << slow.why;
+  EXPECT_EQ(fast.kind, Kind::sample);
+  EXPECT_EQ(fast.millis, slow.millis) << '"' << line << '"';
+  EXPECT_EQ(std::memcmp(&fast.value, &slow.value, sizeof(double)), 0) << '"' << line << "\" " << fast.value
+                                                                         << " vs " << slow.value;
+}
+
+}  // namespace
+
+TEST(LabLineFastPath, TakesTheSketchsLines) {
+  LabLine l;
+  EXPECT_EQ(parse_printed_sample("8245\t2.81\r\n8265\t2.80\r\n8285\t2.80\r\n", l), 9u);
+  EXPECT_EQ(l.kind, Kind::sample);
+  EXPECT_EQ(l.millis, 8245);
+  EXPECT_EQ(l.value, 2.81);
+  EXPECT_EQ(parse_printed_sample("0 -0.01\n8265\t2.80\r\n8285\t2.80\r\n", l), 7u);
+  EXPECT_EQ(l.value, -0.01);
+  EXPECT_TRUE(std::signbit(parse_printed_sample("0\t-0.00\n8265\t2.80\r\n8285\t2.80\r\n", l) ? l.value : 1.0));
+}
+
+TEST(LabLineFastPath, DeclinesWhatItDoesNotKnow) {
+  LabLine l;
+  for (const char* s : {"8245\t2.81",  // too little text left to read words safely
+                        " 8245\t2.81\r\n8265\t2.80\r\n8285\t2.80\r\n", "-20\t1.00\r\n8265\t2.80\r\n8285\t2.80\r\n",
+                        "12345678\t1.00\r\n8265\t2.80\r\n8285\t2.80\r\n", "5254\t2.8\t1.0\r\n8265\t2.80\r\n8285\t2.80\n",
+                        "5254\t2.x8\r\n8265\t2.80\r\n8285\t2.80\r\n", "5254\tnan\r\n8265\t2.80\r\n8285\t2.80\r\n",
+                        "5254\t1e3\r\n8265\t2.80\r\n8285\t2.80\r\n", "5254\t12345678\r\n8265\t2.80\r\n8285\t2.80\r\n",
+                        "5254\t1234567.5\r\n8265\t2.80\r\n8285\t2.80\r\n", "5254\t2.81 \r\n8265\t2.80\r\n8285\t2.80\r\n",
+                        "5254\t.\r\n8265\t2.80\r\n8285\t2.80\r\n", "5254\t-\r\n8265\t2.80\r\n8285\t2.80\r\n"})
+    EXPECT_EQ(parse_printed_sample(s, l), 0u) << s;
+}
+
+TEST(LabLineFastPath, AgreesWithTheSlowPathOnRandomLines) {
+  std::mt19937 rng(7);
+  const std::string alphabet = "0123456789012345678901234567890123456789..--\t \vxe+";  // no terminators
+  for (int i = 0; i < 200000; ++i) {
+    std::string line;
+    const int len = std::uniform_int_distribution<int>(0, 20)(rng);
+    for (int k = 0; k < len; ++k) line += alphabet[std::uniform_int_distribution<std::size_t>(0, alphabet.size() - 1)(rng)];
+    expect_fast_path_agrees(line, i % 2 ? "\r\n" : "\n");
+    if (HasFatalFailure()) return;
+  }
+  // Shaped like the sketch's lines: every split of up to 7 digits around a point, signs, separators.
+  for (int i = 0; i < 100000; ++i) {
+    const auto digits = [&](int n) {
+      std::string s;
+      for (int k = 0; k < n; ++k) s += static_cast<char>('0' + std::uniform_int_distribution<int>(0, 9)(rng));
+      return s;
+    };
+    std::string line = digits(std::uniform_int_distribution<int>(1, 9)(rng)) + (i % 3 ? "\t" : " ");
+    if (i % 5 == 0) line += '-';
+    line += digits(std::uniform_int_distribution<int>(0, 8)(rng));
+    if (i % 4) line += '.' + digits(std::uniform_int_distribution<int>(0, 8)(rng));
+    expect_fast_path_agrees(line, i % 2 ? "\r" : "\n");
+    if (HasFatalFailure()) return;
+  }
+}

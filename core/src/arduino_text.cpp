@@ -68,17 +68,29 @@ Recording read_arduino_text(std::string_view text, std::string source, const Ard
   std::int64_t first_bad_line = 0;
   std::string_view first_bad_why;
 
-  const std::int64_t lines = text::for_each_line(text, [&](std::int64_t n, std::string_view line) {
-    if (is_putty_header(line)) {
-      ++headers;
-      rec.note(n, text::putty_header_note(line));
-      session_start = first_content = true;
-      return;
+  // A line as the sketch prints it takes the fast path: parsed where it lies, no line split
+  // first. Anything else is split off and judged by parse_lab_line, which names what is wrong.
+  text::LineCursor cursor(text);
+  while (!cursor.at_end()) {
+    LabLine parsed;
+    std::string_view line;
+    if (const std::size_t length = parse_printed_sample(cursor.rest(), parsed)) {
+      line = cursor.rest().substr(0, length);
+      cursor.skip_line(length);
+    } else {
+      line = cursor.next_line();
+      if (is_putty_header(line)) {
+        ++headers;
+        rec.note(cursor.line_number(), text::putty_header_note(line));
+        session_start = first_content = true;
+        continue;
+      }
+      parsed = parse_lab_line(line);
     }
-    const LabLine parsed = parse_lab_line(line);
+    const std::int64_t n = cursor.line_number();
     if (parsed.kind == LabLine::Kind::blank) {
       ++blank;
-      return;
+      continue;
     }
     if (parsed.kind == LabLine::Kind::garbled) {
       if (first_content && is_column_header(line)) {
@@ -99,11 +111,12 @@ Recording read_arduino_text(std::string_view text, std::string source, const Ard
           reporter.warn(n, fmt::format("{}: {}; skipped", text::quote_line(line), parsed.why));
       }
       first_content = false;
-      return;
+      continue;
     }
     raw.push_back({n, static_cast<double>(parsed.millis), parsed.value, session_start, line});
     session_start = first_content = false;
-  });
+  }
+  const std::int64_t lines = cursor.line_number();
 
   text::TimelineRules rules;
   rules.units_per_s = 1000;

@@ -1,8 +1,10 @@
 #include "spindown/lab_line.hpp"
 
+#include <bit>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <system_error>
 
 namespace spindown {
@@ -13,6 +15,8 @@ constexpr bool is_space(char c) {
   return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f';
 }
 
+constexpr bool is_digit(char c) { return c >= '0' && c <= '9'; }
+
 // A sample line is ~12 characters; anything much longer is not one, and refusing it here
 // keeps the parser O(1) on a 10 MB line with no newline.
 constexpr std::size_t max_sample_line = 64;
@@ -20,18 +24,26 @@ constexpr std::size_t max_sample_line = 64;
 constexpr std::uint64_t max_device_ticks = 0xFFFFFFFFull;
 // Serial.print(float) prints "ovf" above this, so a larger number cannot come from the sketch.
 constexpr double max_printable_value = 4294967040.0;
+// Digits of a mantissa read exactly (below 2^53).
+constexpr int max_plain_digits = 15;
+
+// A plain decimal's value exactly as from_chars gives it: a mantissa below 2^53 divided by an
+// exact power of ten is correctly rounded.
+double plain_decimal_value(std::uint64_t mantissa, int fraction, bool negative) {
+  static constexpr double pow10[] = {1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15};
+  const double v = static_cast<double>(mantissa) / pow10[fraction < 0 ? 0 : fraction];
+  return negative ? -v : v;
+}
 
 // The sketch prints values like "3.21" or "-0.01": digits, a point, digits. Those are read
-// here exactly as from_chars would (a mantissa below 2^53 divided by an exact power of ten
-// is correctly rounded); anything else (exponents, long mantissas, errors) goes to from_chars.
+// here exactly; anything else (exponents, long mantissas, errors) goes to from_chars.
 bool parse_plain_decimal(const char* p, const char* end, double& value) {
-  static constexpr double pow10[] = {1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15};
   const bool negative = p < end && *p == '-';
   if (negative) ++p;
   std::uint64_t mantissa = 0;
   int digits = 0, fraction = -1;
   for (; p < end; ++p) {
-    if (*p >= '0' && *p <= '9') {
+    if (is_digit(*p)) {
       mantissa = mantissa * 10 + static_cast<unsigned>(*p - '0');
       ++digits;
       if (fraction >= 0) ++fraction;
@@ -41,9 +53,8 @@ bool parse_plain_decimal(const char* p, const char* end, double& value) {
       return false;
     }
   }
-  if (digits == 0 || digits > 15) return false;
-  const double v = static_cast<double>(mantissa) / pow10[fraction < 0 ? 0 : fraction];
-  value = negative ? -v : v;
+  if (digits == 0 || digits > max_plain_digits) return false;
+  value = plain_decimal_value(mantissa, fraction, negative);
   return true;
 }
 
@@ -106,6 +117,79 @@ LabLine parse_lab_line(std::string_view line) {
   if (std::fabs(value) > max_printable_value) return garbled("value larger than an Arduino can print");
 
   return sample_line(ticks, value);
+}
+
+namespace {
+
+// Eight bytes of text as a little-endian word: byte 0 is the first character. The fast path
+// reads digits eight at a time (SWAR, "SIMD within a register").
+std::uint64_t load_word(const char* p) {
+  std::uint64_t w;
+  std::memcpy(&w, p, sizeof w);
+  return w;
+}
+
+constexpr std::uint64_t every_byte(std::uint64_t b) { return b * 0x0101010101010101ull; }
+
+// How many of the word's first bytes are ASCII digits (0 to 8). A byte is a digit when its
+// high nibble is 3 and its low nibble at most 9; both tests are exact per byte (no carries).
+int leading_digits(std::uint64_t w) {
+  const std::uint64_t high_not_3 = (w & every_byte(0xF0)) ^ every_byte(0x30);
+  const std::uint64_t low_over_9 = ((w & every_byte(0x0F)) + every_byte(0x06)) & every_byte(0x10);
+  const std::uint64_t not_digit = high_not_3 | low_over_9;
+  return not_digit == 0 ? 8 : std::countr_zero(not_digit) / 8;
+}
+
+// The number the word's first n (1 to 8) digit bytes spell: they are moved to the top so the
+// bytes below read as leading zeros, then pairs, fours and eights are combined.
+std::uint64_t digits_value(std::uint64_t w, int n) {
+  w = (w & every_byte(0x0F)) << (8 * (8 - n));
+  w = (w * 10 + (w >> 8)) & 0x00FF00FF00FF00FFull;
+  w = (w * 100 + (w >> 16)) & 0x0000FFFF0000FFFFull;
+  return (w * 10000 + (w >> 32)) & 0xFFFFFFFFull;
+}
+
+// The word without its byte k (0 to 7): the bytes after it move down one, a zero comes in on top.
+std::uint64_t without_byte(std::uint64_t w, int k) {
+  const std::uint64_t below = (std::uint64_t{1} << (8 * k)) - 1;
+  return (w & below) | ((w >> 8) & ~below);
+}
+
+bool is_line_end(char c) { return c == '\r' || c == '\n'; }
+
+}  // namespace
+
+std::size_t parse_printed_sample(std::string_view text, LabLine& sample) {
+  if constexpr (std::endian::native != std::endian::little) return 0;
+  // The words and bytes read below lie within the text's first 18 bytes: with less than this
+  // left (a file's last line or two) the line takes the slow path.
+  constexpr std::size_t enough_text = 24;
+  if (text.size() < enough_text) return 0;
+  const char* const begin = text.data();
+
+  // Time: 1 to 7 digits (up to 2.7 hours of millis(); later times take the slow path), then a
+  // tab or a space.
+  const std::uint64_t time_word = load_word(begin);
+  const int time_digits = leading_digits(time_word);
+  if (time_digits == 0 || time_digits == 8) return 0;
+  if (begin[time_digits] != '\t' && begin[time_digits] != ' ') return 0;
+
+  // Value: [-]digits[.digits], 1 to 7 digits in all, then CR or LF. With the point taken out
+  // the digits are one run that digits_value reads at once.
+  const char* q = begin + time_digits + 1;
+  const bool negative = *q == '-';
+  if (negative) ++q;
+  std::uint64_t value_word = load_word(q);
+  const int whole_digits = leading_digits(value_word);
+  const bool point = whole_digits < 8 && q[whole_digits] == '.';
+  if (point) value_word = without_byte(value_word, whole_digits);
+  const int digits = leading_digits(value_word);  // at most 7 with a point (the top byte is 0)
+  const char* const stop = q + digits + (point ? 1 : 0);
+  if (digits == 0 || digits == 8 || !is_line_end(*stop)) return 0;
+  const double value = plain_decimal_value(digits_value(value_word, digits), point ? digits - whole_digits : -1, negative);
+
+  sample = sample_line(digits_value(time_word, time_digits), value);
+  return static_cast<std::size_t>(stop - begin);
 }
 
 }  // namespace spindown

@@ -17,28 +17,63 @@
 
 namespace spindown::text {
 
-// Calls on_line(line_number, line) for each line of text, without its terminator. LF, CR LF
-// and a lone CR (old Mac, some terminal programs) all end a line; a final line without a
-// terminator counts too. No allocation.
+// Walks text line by line. LF, CR LF and a lone CR (old Mac, some terminal programs) all end
+// a line; a final line without a terminator counts too. For readers that look at a line's
+// start before they know where it ends (the Arduino reader's fast path). No allocation.
+class LineCursor {
+ public:
+  explicit LineCursor(std::string_view text) : p_(text.data()), end_(text.data() + text.size()) {}
+
+  bool at_end() const { return p_ >= end_; }
+  // From the next line's start to the end of text.
+  std::string_view rest() const { return {p_, static_cast<std::size_t>(end_ - p_)}; }
+  // Number of the line last taken (1-based); after the last one, the number of lines.
+  std::int64_t line_number() const { return number_; }
+
+  // Takes the next line and returns it without its terminator.
+  std::string_view next_line() {
+    if (nl_ == nullptr || nl_ < p_) {
+      nl_ = static_cast<const char*>(std::memchr(p_, '\n', static_cast<std::size_t>(end_ - p_)));
+      if (!nl_) nl_ = end_;
+    }
+    const char* cr = static_cast<const char*>(std::memchr(p_, '\r', static_cast<std::size_t>(nl_ - p_)));
+    const char* stop = cr ? cr : nl_;
+    const std::string_view line(p_, static_cast<std::size_t>(stop - p_));
+    step_past(stop);
+    return line;
+  }
+
+  // Takes the next line when the caller has seen that it is `length` bytes long and ends
+  // there (at a CR, an LF or the end of text).
+  void skip_line(std::size_t length) { step_past(p_ + length); }
+
+ private:
+  void step_past(const char* stop) {
+    ++number_;
+    if (stop == end_) {
+      p_ = end_;
+      return;
+    }
+    p_ = stop + 1;
+    if (*stop == '\r' && p_ < end_ && *p_ == '\n') ++p_;
+  }
+
+  const char* p_;
+  const char* end_;
+  const char* nl_ = nullptr;  // next '\n' at or after p_ (or end_); kept so CR-only text stays O(n)
+  std::int64_t number_ = 0;
+};
+
+// Calls on_line(line_number, line) for each line of text, without its terminator (lines as
+// LineCursor splits them). Returns the number of lines.
 template <class OnLine>
 std::int64_t for_each_line(std::string_view text, OnLine&& on_line) {
-  const char* p = text.data();
-  const char* const end = p + text.size();
-  const char* nl = nullptr;  // next '\n' at or after p (or end); kept so CR-only text stays O(n)
-  std::int64_t number = 0;
-  while (p < end) {
-    if (nl == nullptr || nl < p) {
-      nl = static_cast<const char*>(std::memchr(p, '\n', static_cast<std::size_t>(end - p)));
-      if (!nl) nl = end;
-    }
-    const char* cr = static_cast<const char*>(std::memchr(p, '\r', static_cast<std::size_t>(nl - p)));
-    const char* stop = cr ? cr : nl;
-    on_line(++number, std::string_view(p, static_cast<std::size_t>(stop - p)));
-    if (stop == end) break;
-    p = stop + 1;
-    if (*stop == '\r' && p < end && *p == '\n') ++p;
+  LineCursor lines(text);
+  while (!lines.at_end()) {
+    const std::string_view line = lines.next_line();
+    on_line(lines.line_number(), line);
   }
-  return number;
+  return lines.line_number();
 }
 
 // True when the bytes are not text: more than 10 % control characters (NUL included; tab,

@@ -2,6 +2,7 @@
 // The lab sketch's serial protocol: one sample per line, "millis<TAB>volts" (volts from
 // Serial.println(float), two decimals), CR LF. A pure function so the file reader, the
 // serial bridge and the fuzzer share one parser.
+#include <cstddef>
 #include <cstdint>
 #include <string_view>
 
@@ -19,5 +20,12 @@ struct LabLine {
 // other whitespace between the fields; rejects extra fields, non-numbers, negative times,
 // NaN/inf and values outside what an Arduino can print.
 LabLine parse_lab_line(std::string_view line);
+
+// The file reader's fast path. When text starts with a sample line exactly as the sketch
+// prints it ("<digits><TAB or space>[-]<digits>[.<digits>]" followed by CR, LF or the end of
+// text), sets sample to what parse_lab_line would give for that line and returns the line's
+// length without its terminator. Returns 0 for anything else (leave it to parse_lab_line).
+// It never looks past the line's terminator.
+std::size_t parse_printed_sample(std::string_view text, LabLine& sample);
 
 }  // namespace spindown
