@@ -247,3 +247,81 @@ TEST(SummarizeDiagnostics, ErrorsFirstThenACount) {
   EXPECT_EQ(summarize_diagnostics(d, 0).size(), 21u);
   EXPECT_TRUE(summarize_diagnostics({}, 5).empty());
 }
+
+// `spindown fit --json` writes each file's entry as text, without the Json document: the bytes
+// must be the document's dump, whatever the report holds.
+namespace {
+
+std::string streamed(std::span<const FileFit> files, const ReportOptions& opt) {
+  std::string out;
+  FitReportJsonText doc;
+  for (const auto& f : files) doc.add(file_fit_json_text(f, opt), out);
+  doc.finish(out);
+  return out;
+}
+
+std::string document(std::span<const FileFit> files, const ReportOptions& opt) {
+  return fit_report_json(files, opt).dump(2, ' ', false, Json::error_handler_t::replace);
+}
+
+HealthVerdict a_verdict() {
+  HealthVerdict v;
+  v.level = HealthLevel::check;
+  v.reason = "dry friction 2.4× the baseline: check bearings";
+  v.has_reference = true;
+  HealthFinding f;
+  f.what = "dry friction";
+  f.level = HealthLevel::check;
+  f.reason = "2.4× the \"baseline\"\ttab";
+  f.value = 2.4e-4;
+  f.std_error = not_a_number;
+  f.reference = 1e-4;
+  f.reference_name = "baseline";
+  f.ratio = 2.4;
+  f.unit = "N*m";
+  v.findings = {f, f};
+  v.findings[1].value = inf;
+  return v;
+}
+
+}  // namespace
+
+TEST(FitReportJsonText, MatchesTheDocumentsDumpByteForByte) {
+  RunFit odd = lab_like_fit();
+  odd.run.number = 2;
+  odd.run.stopped = false;
+  odd.run.lead_in = "";
+  odd.best.clear();
+  odd.models[0].converged = false;
+  odd.models[0].message = "did not converge: \"λ\" grew \\ past 1e10\n";
+  odd.models[1].params.clear();
+  odd.models[2].rmse = not_a_number;
+  odd.models[2].bic = -inf;
+  odd.bench.inertia_source = "bench file (caf\xe9.toml)";  // Latin-1: not UTF-8
+  odd.bench.kb_source = "K_b ω";
+
+  FileFit usual = one_file(lab_like_fit());
+  FileFit two_runs = one_file(lab_like_fit());
+  two_runs.file = "name with \"quotes\" and \x01 control.tsv";
+  two_runs.runs.push_back(odd);
+  two_runs.health = {std::nullopt, a_verdict()};
+  two_runs.diagnostics.push_back({Diagnostic::Severity::warning, two_runs.file, 77, "\"5254\\t2.x8\": value is not a number"});
+  two_runs.diagnostics.push_back({Diagnostic::Severity::error, two_runs.file, 0, "bytes \xff\xfe not UTF-8"});
+  two_runs.failures = {"run 2: no model converged", "caf\xe9"};
+  FileFit empty;
+  empty.file = "empty.tsv";
+  empty.failures = {"no samples: the file is empty"};
+  FileFit health_only = one_file(lab_like_fit());
+  health_only.health = {a_verdict()};
+  FileFit repeated = one_file(lab_like_fit());  // a repeated key: the document keeps one member
+  repeated.runs[0].models[0].params.push_back(param("c1", 9.0, 1.0, "N*m*s/rad"));
+
+  const std::vector<FileFit> all = {usual, two_runs, empty, health_only, repeated};
+  for (const bool lab_units : {false, true}) {
+    ReportOptions opt;
+    opt.lab_units = lab_units;
+    EXPECT_EQ(streamed(all, opt), document(all, opt));
+    for (const auto& f : all) EXPECT_EQ(streamed({&f, 1}, opt), document({&f, 1}, opt)) << f.file;
+  }
+  EXPECT_EQ(streamed({}, {}), document({}, {}));
+}

@@ -192,33 +192,38 @@ void setup_fit(CLI::App& app) {
 
 int run_fit(const FitCommandOptions& options) {
   const FitPlan plan = plan_from(options);
-  std::vector<FileFit> files;
   bool all_usable = true;
+  // --json: one document, written once every file is done (so stderr's problems never land
+  // inside it), assembled from each file's text as it comes.
+  std::string json;
+  FitReportJsonText json_files;
   struct Done {
     FileFit file;
-    std::string text;  // the file's tables, formatted by the worker too
+    std::string text;  // the file's tables or JSON entry, formatted by the worker too
   };
   // Files are independent: fit them on every core, report them in the order given.
   for_each_ordered(
       options.files.size(), options.jobs == 0 ? default_jobs() : options.jobs,
       [&](std::size_t i) {
         Done d{fit_file(options.files[i], plan), {}};
-        if (!options.json) d.text = format_file_fit(d.file, plan.report);
+        // Bytes that are not UTF-8 (a Latin-1 file name or config string) are replaced, never abort the output.
+        d.text = options.json ? file_fit_json_text(d.file, plan.report) : format_file_fit(d.file, plan.report);
         return d;
       },
       [&](std::size_t, Done d) {
         report_problems(d.file, plan, options.verbose);
         all_usable = all_usable && d.file.usable();
         if (options.json) {
-          files.push_back(std::move(d.file));
+          json_files.add(d.text, json);
         } else {
           std::cout << d.text << '\n';
           std::cout.flush();
         }
       });
-  // replace: bytes that are not UTF-8 (a Latin-1 file name or config string) never abort the output.
-  if (options.json)
-    std::cout << fit_report_json(files, plan.report).dump(2, ' ', false, Json::error_handler_t::replace) << std::endl;
+  if (options.json) {
+    json_files.finish(json);
+    std::cout << json << std::endl;
+  }
   return all_usable ? exit_ok : exit_unusable;
 }
 

@@ -276,6 +276,273 @@ Json fit_report_json(std::span<const FileFit> files, const ReportOptions& opt) {
   return Json{{"files", std::move(list)}};
 }
 
+namespace {
+
+// Writes JSON laid out as nlohmann's dump(2, ' ', false, error_handler_t::replace): "{" then each
+// member on its own line indented two more, "key": value, ",\n" between members, the closing
+// bracket on its own line at the container's indent; "{}" and "[]" when empty.
+class PrettyJsonWriter {
+ public:
+  PrettyJsonWriter(std::string& out, std::size_t indent) : out_(out), indent_(indent) {}
+
+  void begin_object() { open('{'); }
+  void end_object() { close('}'); }
+  void begin_array() { open('['); }
+  void end_array() { close(']'); }
+
+  // A member's key; its value follows.
+  void key(std::string_view k) {
+    next_element();
+    string(k);
+    out_ += ": ";
+  }
+  // An array element's start; its value follows.
+  void element() { next_element(); }
+
+  void string(std::string_view s) {
+    if (is_plain(s)) {
+      out_ += '"';
+      out_ += s;
+      out_ += '"';
+    } else {  // escapes and bytes that are not UTF-8: nlohmann's own serializer, exactly
+      out_ += Json(s).dump(-1, ' ', false, Json::error_handler_t::replace);
+    }
+  }
+  void number(double x) {  // non-finite is null, as the document's number() makes it
+    if (std::isfinite(x)) out_ += Json(x).dump();
+    else out_ += "null";
+  }
+  void integer(std::int64_t n) { out_ += fmt::format_int(n).c_str(); }
+  void unsigned_integer(std::size_t n) { out_ += fmt::format_int(n).c_str(); }
+  void boolean(bool b) { out_ += b ? "true" : "false"; }
+  void null() { out_ += "null"; }
+
+  // Shorthands for a member and its value.
+  void member(std::string_view k, std::string_view v) {
+    key(k);
+    string(v);
+  }
+  void member(std::string_view k, const char* v) { member(k, std::string_view(v)); }
+  void member_number(std::string_view k, double x) {
+    key(k);
+    number(x);
+  }
+  void member(std::string_view k, bool b) {
+    key(k);
+    boolean(b);
+  }
+
+ private:
+  // Printable ASCII without '"' or '\\': written as it is.
+  static bool is_plain(std::string_view s) {
+    for (char c : s)
+      if (c < 0x20 || c > 0x7E || c == '"' || c == '\\') return false;
+    return true;
+  }
+  void open(char bracket) {
+    out_ += bracket;
+    empty_.push_back(true);
+    indent_ += 2;
+  }
+  void close(char bracket) {
+    indent_ -= 2;
+    if (!empty_.back()) {
+      out_ += '\n';
+      out_.append(indent_, ' ');
+    }
+    empty_.pop_back();
+    out_ += bracket;
+  }
+  void next_element() {
+    out_ += empty_.back() ? "\n" : ",\n";
+    empty_.back() = false;
+    out_.append(indent_, ' ');
+  }
+
+  std::string& out_;
+  std::size_t indent_;
+  std::vector<bool> empty_;  // per open container: nothing written in it yet
+};
+
+// A Json object keeps one member per key (a repeated key overwrites the first in place); the
+// writer does not, so a run with repeated parameter names goes through the document.
+bool has_repeated_param_names(const FileFit& file) {
+  for (const auto& run : file.runs)
+    for (const auto& m : run.models)
+      for (std::size_t i = 0; i < m.params.size(); ++i)
+        for (std::size_t j = 0; j < i; ++j)
+          if (m.params[i].name == m.params[j].name) return true;
+  return false;
+}
+
+// run_fit_json(fit, opt), member for member; leaves the run's object open (file_fit_json adds
+// "health" last).
+void write_run_fit(PrettyJsonWriter& w, const RunFit& fit, const ReportOptions& opt) {
+  const std::string_view residual_unit = quantity_unit(fit.quantity);
+  const Run& run = fit.run;
+  w.begin_object();
+  w.key("run"); w.integer(run.number);
+  w.member_number("t_cut_s", run.t_cut_s);
+  w.key("t_stop_s");
+  if (run.stopped) w.number(run.t_stop_s);
+  else w.null();
+  w.key("samples"); w.unsigned_integer(samples_in(run));
+  w.key("models");
+  w.begin_array();
+  for (const auto& m : fit.models) {
+    w.element();
+    w.begin_object();
+    w.member("name", model_name(m.kind));
+    w.key("params");
+    w.begin_object();
+    for (const auto& p : m.params) {
+      w.key(p.name);
+      w.begin_object();
+      w.member_number("value", p.value);
+      w.member_number("stderr", p.std_error);
+      w.member("unit", p.unit);
+      if (opt.lab_units)
+        if (auto lab = lab_unit_for(p.unit)) {
+          w.key("lab");
+          w.begin_object();
+          w.member_number("value", p.value * lab->per_si);
+          w.member_number("stderr", p.std_error * lab->per_si);
+          w.member("unit", lab->ascii);
+          w.end_object();
+        }
+      w.end_object();
+    }
+    w.end_object();
+    w.member_number("rmse", m.rmse);
+    w.member("residual_unit", residual_unit);
+    w.member_number("r2", m.r2);
+    w.member_number("aic", m.aic);
+    w.member_number("bic", m.bic);
+    w.member_number("t_stop_pred_s", m.t_stop_pred_s);
+    w.key("n"); w.unsigned_integer(m.n);
+    w.member("converged", m.converged);
+    if (!m.message.empty()) w.member("message", m.message);
+    w.end_object();
+  }
+  w.end_array();
+  w.key("best");
+  if (fit.best.empty()) w.null();
+  else w.string(fit.best);
+  w.member("best_reason", explain_best(fit));
+  w.member("stopped", run.stopped);
+  w.member("lead_in", run.lead_in);
+  w.member_number("zero_level", run.zero_level);
+  w.member_number("noise_level", run.noise_level);
+  w.member_number("period_s", run.period_s);
+  w.member("quantity", residual_unit);
+  w.key("bench");
+  w.begin_object();
+  w.member_number("J", fit.bench.inertia_kg_m2);
+  w.member("J_unit", "kg*m^2");
+  w.member("J_source", fit.bench.inertia_source);
+  w.member_number("Kb", fit.bench.kb_v_s_per_rad);
+  w.member("Kb_unit", "V*s/rad");
+  w.member("Kb_source", fit.bench.kb_source);
+  if (opt.lab_units) {
+    w.key("J_lab");
+    w.begin_object();
+    w.member_number("value", inertia_to_g_cm2(fit.bench.inertia_kg_m2));
+    w.member("unit", "g*cm^2");
+    w.end_object();
+  }
+  w.end_object();
+}
+
+// health_json(v), member for member.
+void write_health(PrettyJsonWriter& w, const HealthVerdict& v) {
+  w.begin_object();
+  w.member("level", health_level_name(v.level));
+  w.member("reason", v.reason);
+  w.member("has_reference", v.has_reference);
+  w.key("findings");
+  w.begin_array();
+  for (const auto& f : v.findings) {
+    w.element();
+    w.begin_object();
+    w.member("what", f.what);
+    w.member("level", health_level_name(f.level));
+    w.member("reason", f.reason);
+    w.member_number("value", f.value);
+    w.member_number("stderr", f.std_error);
+    w.member_number("reference", f.reference);
+    w.member_number("reference_stderr", f.reference_std_error);
+    w.member("reference_name", f.reference_name);
+    w.member_number("ratio", f.ratio);
+    w.member_number("ratio_stderr", f.ratio_std_error);
+    w.member("unit", f.unit);
+    w.end_object();
+  }
+  w.end_array();
+  w.end_object();
+}
+
+}  // namespace
+
+std::string file_fit_json_text(const FileFit& file, const ReportOptions& opt) {
+  constexpr std::size_t indent = 4;  // inside {"files": [ … ]}
+  std::string out(indent, ' ');
+  if (has_repeated_param_names(file)) {
+    const std::string text = file_fit_json(file, opt).dump(2, ' ', false, Json::error_handler_t::replace);
+    for (char c : text) {
+      out += c;
+      if (c == '\n') out.append(indent, ' ');  // a raw newline in a dump is always layout
+    }
+    return out;
+  }
+  out.reserve(2048 + 3072 * file.runs.size() + 128 * file.diagnostics.size());
+  PrettyJsonWriter w(out, indent);
+  w.begin_object();
+  w.member("file", file.file);
+  w.key("runs");
+  w.begin_array();
+  for (std::size_t i = 0; i < file.runs.size(); ++i) {
+    w.element();
+    write_run_fit(w, file.runs[i], opt);
+    if (i < file.health.size() && file.health[i]) {
+      w.key("health");
+      write_health(w, *file.health[i]);
+    }
+    w.end_object();
+  }
+  w.end_array();
+  w.key("samples_read"); w.unsigned_integer(file.samples);
+  w.key("lines_read"); w.unsigned_integer(file.lines_read);
+  w.key("lines_skipped"); w.unsigned_integer(file.lines_skipped);
+  w.key("diagnostics");
+  w.begin_array();
+  for (const auto& d : file.diagnostics) {
+    w.element();
+    w.begin_object();
+    w.member("severity", severity_name(d.severity));
+    w.key("line"); w.integer(d.line);
+    w.member("message", d.message);
+    w.end_object();
+  }
+  w.end_array();
+  w.key("failures");
+  w.begin_array();
+  for (const auto& why : file.failures) {
+    w.element();
+    w.string(why);
+  }
+  w.end_array();
+  w.end_object();
+  return out;
+}
+
+void FitReportJsonText::add(std::string_view file_json, std::string& out) {
+  out += any_ ? ",\n" : "{\n  \"files\": [\n";
+  out += file_json;
+  any_ = true;
+}
+
+void FitReportJsonText::finish(std::string& out) const { out += any_ ? "\n  ]\n}" : "{\n  \"files\": []\n}"; }
+
 std::vector<std::string> summarize_diagnostics(std::span<const Diagnostic> diagnostics, std::size_t max_shown) {
   std::vector<const Diagnostic*> order;
   for (const auto& d : diagnostics) order.push_back(&d);

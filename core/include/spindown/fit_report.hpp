@@ -6,6 +6,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -51,6 +52,23 @@ Json run_fit_json(const RunFit& fit, const ReportOptions& opt = {});
 Json health_json(const HealthVerdict& verdict);
 Json file_fit_json(const FileFit& file, const ReportOptions& opt = {});
 Json fit_report_json(std::span<const FileFit> files, const ReportOptions& opt = {});
+
+// `spindown fit --json` without a document: one entry of fit_report_json(files)'s "files"
+// array exactly as dump(2, ' ', false, Json::error_handler_t::replace) lays it out there
+// (indented four spaces, without the separator), written straight to text. Building and
+// freeing the Json document cost as much as reading the files.
+std::string file_fit_json_text(const FileFit& file, const ReportOptions& opt = {});
+
+// Appends file_fit_json_text() entries, in order, into the bytes of
+// fit_report_json(files).dump(2, ' ', false, Json::error_handler_t::replace).
+class FitReportJsonText {
+ public:
+  void add(std::string_view file_json, std::string& out);
+  void finish(std::string& out) const;  // no final newline, as dump() gives none
+
+ private:
+  bool any_ = false;
+};
 
 // Text for people.
 std::string format_run_fit(const RunFit& fit, const ReportOptions& opt = {});
