@@ -162,12 +162,12 @@ std::vector<Recording> read_recordings(const std::string& path, const ReadOption
     return out;
   }
 
-  // An LCM log is streamed, never loaded whole: look at its first word only. A pipe, FIFO or
-  // device can be read only once, so it is read whole here (an LCM log cannot come that way:
-  // lcm::LogFile seeks).
+  // An LCM log is streamed, never loaded whole: look at its first word only. Text is read
+  // whole through the same descriptor (one open per file). A pipe, FIFO or device can be read
+  // only once, so it is read whole first (an LCM log cannot come that way: lcm::LogFile seeks).
   char head[4] = {};
   std::size_t head_len = 0;
-  std::optional<std::string> stream_bytes;
+  std::optional<std::string> text_bytes;
   {
     const int fd = open_for_reading(path);
     if (fd < 0) {
@@ -176,17 +176,21 @@ std::vector<Recording> read_recordings(const std::string& path, const ReadOption
     }
     FdCloser closer{fd};
     struct stat st {};
-    if (::fstat(fd, &st) == 0 && S_ISDIR(st.st_mode)) {
+    if (::fstat(fd, &st) != 0) {
+      add(failed(path, fmt::format("cannot read {}: {}", path, std::strerror(errno))), {});
+      return out;
+    }
+    if (S_ISDIR(st.st_mode)) {
       add(failed(path, fmt::format("cannot read {}: it is a directory", path)), {});
       return out;
     }
     if (!S_ISREG(st.st_mode)) {
-      stream_bytes = read_fd_bytes(fd, st, path, &why, std::size_t{1} << 30);
-      if (!stream_bytes) {
+      text_bytes = read_fd_bytes(fd, st, path, &why, std::size_t{1} << 30);
+      if (!text_bytes) {
         add(failed(path, why), {});
         return out;
       }
-      if (detect_format(*stream_bytes, options) == FileFormat::lcm_log || options.format == FileFormat::lcm_log) {
+      if (detect_format(*text_bytes, options) == FileFormat::lcm_log || options.format == FileFormat::lcm_log) {
         add(failed(path, fmt::format("cannot read {} as an LCM log: it is a pipe or device, and lcm::LogFile needs a "
                                      "regular file",
                                      path)),
@@ -194,8 +198,17 @@ std::vector<Recording> read_recordings(const std::string& path, const ReadOption
         return out;
       }
     } else {
-      const ssize_t n = ::read(fd, head, sizeof head);
+      const ssize_t n = ::pread(fd, head, sizeof head, 0);
       head_len = n > 0 ? static_cast<std::size_t>(n) : 0;
+      const bool lcm = detect_format(std::string_view(head, head_len), options) == FileFormat::lcm_log ||
+                       options.format == FileFormat::lcm_log;
+      if (!lcm) {
+        text_bytes = read_fd_bytes(fd, st, path, &why, std::size_t{1} << 30);
+        if (!text_bytes) {
+          add(failed(path, why), {});
+          return out;
+        }
+      }
     }
   }
 
@@ -228,16 +241,12 @@ std::vector<Recording> read_recordings(const std::string& path, const ReadOption
     return out;
   }
 
-  auto bytes = stream_bytes ? std::move(stream_bytes) : read_file_bytes(path, &why);
-  if (!bytes) {
-    add(failed(path, why), {});
-    return out;
-  }
-  const FileFormat format = detect_format(*bytes, options);
+  const std::string& bytes = *text_bytes;
+  const FileFormat format = detect_format(bytes, options);
   if (format == FileFormat::delimited_text)
-    add(read_delimited_text(*bytes, path, options.delimited), {FileFormat::delimited_text, {}, {}, 0});
+    add(read_delimited_text(bytes, path, options.delimited), {FileFormat::delimited_text, {}, {}, 0});
   else
-    add(read_arduino_text(*bytes, path, options.arduino), {FileFormat::arduino_text, {}, {}, 0});
+    add(read_arduino_text(bytes, path, options.arduino), {FileFormat::arduino_text, {}, {}, 0});
   return out;
 }
 
