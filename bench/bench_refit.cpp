@@ -52,13 +52,13 @@ void BM_RefitLog(benchmark::State& state) {
   for (auto _ : state) {
     CountingSink sink;
     spindown::FitterCore core(opt, sink);
-    spindown::LcmLogReader reader(path);
+    spindown::LcmLogReader reader(path, spindown::LcmSamples::view_only);
     spindown::LcmLogEvent ev;
     std::int64_t last = 0;
     while (reader.next(ev)) {
       // As refit_log: the reader's decoded message goes to the core (decoded once).
       if (ev.kind == spindown::LcmLogEvent::Kind::samples)
-        core.on_samples(ev.bench, ev.samples, ev.log_utime);
+        core.on_samples(ev.bench, ev.samples_view, ev.log_utime);
       else if (ev.kind == spindown::LcmLogEvent::Kind::config)
         core.on_config(ev.bench, ev.config, ev.log_utime);
       last = ev.log_utime;

@@ -3,6 +3,8 @@
 // other benches' results; the same input gives the same numbers as find_runs + fit_run.
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -11,6 +13,7 @@
 
 #include "spindown/fit_message.hpp"
 #include "spindown/fitter_core.hpp"
+#include "spindown/message_decode.hpp"
 #include "spindown/runs.hpp"
 #include "spindown/synthetic_run.hpp"
 
@@ -285,6 +288,45 @@ TEST(FitterCore, OptionsSayWhatIsWrong) {
   o = {};
   o.max_benches = 0;
   EXPECT_FALSE(o.is_valid(&why));
+}
+
+// The log reader's in-place view and the decoded samples_t give the same runs, numbers and
+// counters, with benches interleaved (the bench guess) and evicted (the guess forgets them).
+TEST(FitterCore, SamplesViewAndDecodedMessageGiveTheSameResults) {
+  const Stream a = make_stream(2, 11), b = make_stream(1, 21), c = make_stream(1, 31);
+  auto run = [&](bool view, std::size_t max_benches) {
+    CollectingSink sink;
+    FitterOptions o;
+    o.max_benches = max_benches;
+    FitterCore core(o, sink);
+    const std::pair<const char*, const Stream*> benches[] = {{"a", &a}, {"b", &b}, {"c", &c}};
+    std::int64_t utime = 0;
+    for (std::size_t i = 0; i < a.t_us.size(); ++i)
+      for (const auto& [id, s] : benches) {
+        if (i >= s->t_us.size()) continue;
+        const samples_t m = batch(id, *s, i, 1, static_cast<std::int64_t>(i));
+        utime += 5000;
+        if (view) {
+          const auto bytes = encode(m);
+          SamplesView v;
+          EXPECT_TRUE(view_samples_message(v, bytes.data(), static_cast<std::int64_t>(bytes.size())));
+          core.on_samples(id, v, utime);
+        } else {
+          core.on_samples(id, m, utime);
+        }
+      }
+    core.finish(utime);
+    std::vector<std::string> out;
+    for (const auto& f : sink.fits)
+      out.push_back(fmt::format("{} {} {} {} {}", f.bench, f.fit.run.number, f.first_seq, f.last_seq,
+                                f.fit.best.empty() ? 0.0 : f.fit.models.front().rmse));
+    out.push_back(fmt::format("{} {} {}", core.counters().samples, core.counters().dropped_benches, sink.runs.size()));
+    return out;
+  };
+  const auto decoded = run(false, 256);
+  EXPECT_GE(decoded.size(), 5u);  // four runs and the counters
+  EXPECT_EQ(run(true, 256), decoded);
+  EXPECT_EQ(run(true, 2), run(false, 2));  // three benches, two held: evictions all along
 }
 
 }  // namespace

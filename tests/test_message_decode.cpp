@@ -3,6 +3,8 @@
 // field added to a .lcm file without a layout update fails here.
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -242,6 +244,67 @@ TEST(MessageDecode, NoDataOrTooMuchIsRefused) {
   EXPECT_FALSE(decode_message(m, nullptr, 0, &why));
   EXPECT_FALSE(decode_message(m, "x", std::int64_t{1} << 32, &why));
   EXPECT_NE(why.find("more than an LCM message"), std::string::npos) << why;
+}
+
+// The in-place view of a samples_t (the log reader's and the fitter's fast path) reads every
+// field as the generated decoder does, and accepts and refuses the same bytes.
+TEST(MessageDecode, SamplesViewAgreesWithTheGeneratedDecoder) {
+  const samples_t sent = make_samples();
+  const auto bytes = encode(sent);
+  SamplesView view;
+  std::string why;
+  ASSERT_TRUE(view_samples_message(view, bytes.data(), static_cast<std::int64_t>(bytes.size()), &why)) << why;
+  EXPECT_EQ(view.utime, sent.utime);
+  EXPECT_EQ(view.bench, sent.bench);
+  EXPECT_EQ(view.seq, sent.seq);
+  EXPECT_EQ(view.clock_epoch, sent.clock_epoch);
+  EXPECT_EQ(view.quantity, sent.quantity);
+  ASSERT_EQ(view.n, sent.n);
+  for (std::int32_t i = 0; i < view.n; ++i) {
+    EXPECT_EQ(view.device_time_us(i), sent.device_time_us[static_cast<std::size_t>(i)]);
+    EXPECT_EQ(view.value(i), sent.value[static_cast<std::size_t>(i)]);
+  }
+  samples_t copied;
+  copied.value = {9, 9, 9, 9, 9};  // storage reused, resized to n
+  samples_from_view(view, copied);
+  samples_t decoded;
+  ASSERT_TRUE(decode_message(decoded, bytes.data(), static_cast<std::int64_t>(bytes.size()), &why)) << why;
+  EXPECT_EQ(encode(copied), encode(decoded));
+}
+
+TEST(MessageDecode, SamplesViewRefusesWhatTheDecoderRefusesInTheReadersWords) {
+  SamplesView view;
+  std::string why;
+  auto bytes = encode(make_samples());
+  const std::size_t n_at = 8 + 8 + (4 + 8) + 8 + 4 + 1;
+  put_be32(bytes, n_at, 4);  // says 4 samples, carries 3
+  EXPECT_FALSE(view_samples_message(view, bytes.data(), static_cast<std::int64_t>(bytes.size()), &why));
+  EXPECT_EQ(why, fmt::format("sample count 4 does not fit in {} bytes (truncated or damaged)", bytes.size()));
+  put_be32(bytes, n_at, -1);
+  EXPECT_FALSE(view_samples_message(view, bytes.data(), static_cast<std::int64_t>(bytes.size()), &why));
+  EXPECT_NE(why.find("sample count -1"), std::string::npos) << why;
+
+  bytes = encode(make_samples());
+  put_be32(bytes, 16, 1000);  // bench string longer than the message
+  EXPECT_FALSE(view_samples_message(view, bytes.data(), static_cast<std::int64_t>(bytes.size()), &why));
+  EXPECT_EQ(why, fmt::format("bench string length 1000 does not fit in {} bytes", bytes.size()));
+
+  bytes = encode(make_samples());
+  EXPECT_FALSE(view_samples_message(view, bytes.data(), 30, &why));  // cut before the count
+  EXPECT_EQ(why, "truncated: 30 bytes end before the sample count");
+  EXPECT_FALSE(view_samples_message(view, bytes.data(), 12, &why));
+  EXPECT_EQ(why, "12 bytes, too short for samples_t");
+
+  // Not a samples_t at all: decode_message's words.
+  const auto config_bytes = encode(make_config());
+  std::string decoder_why;
+  samples_t m;
+  EXPECT_FALSE(view_samples_message(view, config_bytes.data(), static_cast<std::int64_t>(config_bytes.size()), &why));
+  EXPECT_FALSE(decode_message(m, config_bytes.data(), static_cast<std::int64_t>(config_bytes.size()), &decoder_why));
+  EXPECT_EQ(why, decoder_why);
+  EXPECT_FALSE(view_samples_message(view, config_bytes.data(), 4, &why));
+  EXPECT_EQ(why, "4 bytes, too short for samples_t");
+  EXPECT_FALSE(view_samples_message(view, nullptr, 0, &why));
 }
 
 }  // namespace

@@ -106,12 +106,15 @@ class RunSpool {
 
 std::string indented(const std::string& text, std::size_t spaces) {
   const std::string pad(spaces, ' ');
-  std::string out = pad;
-  out.reserve(text.size() + text.size() / 8);
-  for (char c : text) {
-    out += c;
-    if (c == '\n') out += pad;
+  std::string out;
+  out.reserve(text.size() + text.size() / 4);
+  out += pad;
+  std::size_t from = 0;
+  for (std::size_t nl; (nl = text.find('\n', from)) != std::string::npos; from = nl + 1) {
+    out.append(text, from, nl + 1 - from);
+    out += pad;
   }
+  out.append(text, from);
   return out;
 }
 
@@ -186,7 +189,8 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
                    const RefitRunFn& each_run) {
   LogRefit out;
   out.file.file = path;
-  LcmLogReader reader(path);
+  // The core reads samples in place; a caller that sees each event may want the samples_t.
+  LcmLogReader reader(path, each_event ? LcmSamples::view_and_message : LcmSamples::view_only);
   if (!reader.good()) {
     out.file.failures.push_back(reader.open_error());
     return out;
@@ -194,7 +198,7 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
   RefitSink sink(out, path, each_run);
   FitterCore core(options, sink);
   std::map<std::string, std::size_t, std::less<>> order;
-  std::vector<bool> channel_done;  // by LcmLogEvent::channel_id
+  std::vector<char> channel_done;  // by LcmLogEvent::channel_id: its bench's place is known
   std::int64_t last_utime = 0;
   std::size_t file_problems = 0;
   LcmLogEvent ev;
@@ -212,14 +216,14 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
         out.bench_order.push_back(ev.bench);
       }
       if (ev.channel_id >= 0) {
-        if (id >= channel_done.size()) channel_done.resize(id + 1, false);
-        channel_done[id] = true;
+        if (id >= channel_done.size()) channel_done.resize(id + 1, 0);
+        channel_done[id] = 1;
       }
     }
     switch (ev.kind) {
       // Decoded (and checked) once, by the reader: the core takes the message as it is.
       case LcmLogEvent::Kind::samples:
-        core.on_samples(ev.bench, ev.samples, ev.log_utime);
+        core.on_samples(ev.bench, ev.samples_view, ev.log_utime);
         break;
       case LcmLogEvent::Kind::config:
         core.on_config(ev.bench, ev.config, ev.log_utime);

@@ -17,36 +17,13 @@ namespace spindown {
 
 namespace {
 
-std::uint32_t be32(const unsigned char* p) {
-  return (std::uint32_t(p[0]) << 24) | (std::uint32_t(p[1]) << 16) | (std::uint32_t(p[2]) << 8) | p[3];
+// A sample's time and value from either form of samples_t the core is given.
+std::int64_t device_time_us(const samples_t& m, std::size_t i) { return m.device_time_us[i]; }
+double value_of(const samples_t& m, std::size_t i) { return m.value[i]; }
+std::int64_t device_time_us(const SamplesView& m, std::size_t i) {
+  return m.device_time_us(static_cast<std::int32_t>(i));
 }
-std::uint64_t be64(const unsigned char* p) { return (std::uint64_t(be32(p)) << 32) | be32(p + 4); }
-
-// samples_t's fixed prefix, checked before the generated decoder sizes vectors from a count
-// taken off the wire (the log reader does the same): a damaged n must not allocate gigabytes.
-bool samples_prefix_ok(const unsigned char* d, std::int64_t len, std::string* why) {
-  if (len < 20) {
-    *why = fmt::format("{} bytes, too short for samples_t", len);
-    return false;
-  }
-  const std::int64_t bench_len = static_cast<std::int32_t>(be32(d + 16));
-  if (bench_len < 1 || bench_len > len - 20) {
-    *why = fmt::format("bench string length {} does not fit in {} bytes", bench_len, len);
-    return false;
-  }
-  const std::int64_t n_at = 20 + bench_len + 8 + 4 + 1;
-  if (n_at + 4 > len) {
-    *why = fmt::format("truncated: {} bytes end before the sample count", len);
-    return false;
-  }
-  const std::int64_t n = static_cast<std::int32_t>(be32(d + n_at));
-  if (n < 0 || n * (8 + 8 + 8 + 4) > len - n_at - 4) {
-    *why = fmt::format("sample count {} does not fit in {} bytes (truncated or damaged)", n, len);
-    return false;
-  }
-  return true;
-}
-
+double value_of(const SamplesView& m, std::size_t i) { return m.value(static_cast<std::int32_t>(i)); }
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -85,14 +62,42 @@ struct FitterCore::Bench {
     double value;
     std::int64_t seq;
   };
+  // The detector's buffer again, with sequence numbers, oldest first: a ring that grows to the
+  // largest buffer seen (at most RunOptions::max_buffer + 1) and allocates no more after that.
+  class Mirror {
+   public:
+    std::size_t size() const { return count_; }
+    const Sample& operator[](std::size_t i) const { return slots_[(head_ + i) & mask_]; }
+    void push_back(const Sample& s) {
+      if (count_ == slots_.size()) grow();
+      slots_[(head_ + count_) & mask_] = s;
+      ++count_;
+    }
+    void drop_front(std::size_t n) {
+      head_ = (head_ + n) & mask_;
+      count_ -= n;
+    }
+
+   private:
+    void grow() {
+      std::vector<Sample> bigger(std::max<std::size_t>(256, 2 * slots_.size()));
+      for (std::size_t i = 0; i < count_; ++i) bigger[i] = (*this)[i];
+      slots_.swap(bigger);
+      head_ = 0;
+      mask_ = slots_.size() - 1;
+    }
+    std::vector<Sample> slots_;  // size a power of two
+    std::size_t head_ = 0, count_ = 0, mask_ = 0;
+  };
   Bench(std::string bench_id, const RunOptions& runs)
       : id(std::move(bench_id)), channel(fmt::format("SPINDOWN.{}.SAMPLE", id)), detector(runs, channel) {}
 
   std::string id;
   std::string channel;
   RunDetector detector;
-  std::deque<Sample> mirror;  // the detector's buffer, with sequence numbers: samples of a run
+  Mirror mirror;  // samples of a run, with the sequence numbers a published run names
   std::uint64_t last_active = 0, arrival = 0;
+  Bench* followed_by = nullptr;  // the bench whose message came after this one's last time
 
   std::optional<BenchParams> config;
   std::string config_problem;
@@ -150,9 +155,19 @@ std::vector<std::string> FitterCore::benches() const {
 
 FitterCore::Bench* FitterCore::bench_for(std::string_view id, std::int64_t recv_utime, std::string_view kind) {
   ++activity_;
+  // Benches publish in a steady interleave: the bench that followed the previous one last time
+  // is nearly always the one asked for, found without the map.
+  if (Bench* guess = last_bench_ ? last_bench_->followed_by : nullptr; guess && guess->id == id) {
+    guess->last_active = activity_;
+    last_bench_ = guess;
+    return guess;
+  }
   if (auto it = benches_.find(id); it != benches_.end()) {
-    it->second->last_active = activity_;
-    return it->second.get();
+    Bench* found = it->second.get();
+    found->last_active = activity_;
+    if (last_bench_) last_bench_->followed_by = found;
+    last_bench_ = found;
+    return found;
   }
   std::string why;
   if (!is_valid_bench_id(id, &why)) {
@@ -177,6 +192,9 @@ FitterCore::Bench* FitterCore::bench_for(std::string_view id, std::int64_t recv_
                       "active bench {} evicted",
                       id, kind, id, benches_.size(), v.id),
           recv_utime);
+    for (auto& [other_id, other] : benches_)
+      if (other->followed_by == &v) other->followed_by = nullptr;
+    if (last_bench_ == &v) last_bench_ = nullptr;
     benches_.erase(victim);
   }
   auto b = std::make_unique<Bench>(std::string(id), opt_.runs);
@@ -184,6 +202,8 @@ FitterCore::Bench* FitterCore::bench_for(std::string_view id, std::int64_t recv_
   b->arrival = ++arrivals_;
   Bench* p = b.get();
   benches_.emplace(p->id, std::move(b));
+  if (last_bench_) last_bench_->followed_by = p;
+  last_bench_ = p;
   return p;
 }
 
@@ -213,10 +233,8 @@ void FitterCore::on_message(std::string_view channel, const void* data, std::int
     return;
   }
   if (kind == "SAMPLE") {
-    samples_t msg;
-    const auto* d = static_cast<const unsigned char*>(data);
-    const bool right_type = size >= 8 && be64(d) == static_cast<std::uint64_t>(samples_t::getHash());
-    if ((right_type && !samples_prefix_ok(d, size, &why)) || !decode_message(msg, data, size, &why)) {
+    SamplesView msg;
+    if (!view_samples_message(msg, data, size, &why)) {
       ++counters_.decode_errors;
       error(fmt::format("{}: {}; message skipped", channel, why), recv_utime);
       return;
@@ -258,17 +276,28 @@ void FitterCore::on_samples(std::string_view bench, const samples_t& m, std::int
   ++counters_.sample_messages;
   Bench* bp = bench_for(bench, recv_utime, "SAMPLE");
   if (!bp) return;
-  Bench& b = *bp;
-  const std::string& ch = b.channel;
   const std::size_t n = std::min<std::size_t>(static_cast<std::size_t>(std::max(m.n, 0)),
                                               std::min({m.device_time_us.size(), m.value.size()}));
   if (m.n < 0 || n != static_cast<std::size_t>(m.n)) {
     ++counters_.decode_errors;
-    error(fmt::format("{}: message at seq {} says n = {} but carries {} times and {} values; skipped", ch, m.seq, m.n,
-                      m.device_time_us.size(), m.value.size()),
+    error(fmt::format("{}: message at seq {} says n = {} but carries {} times and {} values; skipped", bp->channel,
+                      m.seq, m.n, m.device_time_us.size(), m.value.size()),
           recv_utime);
     return;
   }
+  take_samples(*bp, m, n, recv_utime);
+}
+
+void FitterCore::on_samples(std::string_view bench, const SamplesView& m, std::int64_t recv_utime) {
+  ++counters_.sample_messages;
+  Bench* bp = bench_for(bench, recv_utime, "SAMPLE");
+  if (!bp) return;
+  take_samples(*bp, m, static_cast<std::size_t>(m.n), recv_utime);  // n checked against the bytes
+}
+
+template <class Message>
+void FitterCore::take_samples(Bench& b, const Message& m, std::size_t n, std::int64_t recv_utime) {
+  const std::string& ch = b.channel;
 
   // Rate cap first: a flood costs one comparison per message.
   if (opt_.max_rate_hz > 0) {
@@ -324,7 +353,7 @@ void FitterCore::on_samples(std::string_view bench, const samples_t& m, std::int
       error(fmt::format("{}: {} samples lost: sequence number jumps from {} to {}", ch, m.seq - b.next_seq,
                         b.next_seq - 1, m.seq),
             recv_utime);
-    } else if (!restart && n > 0 && m.device_time_us[n - 1] <= b.last_t_us) {
+    } else if (!restart && n > 0 && device_time_us(m, n - 1) <= b.last_t_us) {
       ++counters_.duplicates;
       error(fmt::format("{}: samples {} to {} were already received (repeated message); skipped", ch, m.seq,
                         m.seq + std::int64_t(n) - 1),
@@ -332,7 +361,7 @@ void FitterCore::on_samples(std::string_view bench, const samples_t& m, std::int
       return;
     } else {
       ++counters_.seq_restarts;
-      if (n > 0 && m.device_time_us[0] <= b.last_t_us) restart = true;
+      if (n > 0 && device_time_us(m, 0) <= b.last_t_us) restart = true;
     }
   }
   b.have_seq = true;
@@ -346,8 +375,8 @@ void FitterCore::on_samples(std::string_view bench, const samples_t& m, std::int
   b.epoch = m.clock_epoch;
 
   for (std::size_t i = 0; i < n; ++i) {
-    const std::int64_t t = m.device_time_us[i];
-    const double v = m.value[i];
+    const std::int64_t t = device_time_us(m, i);
+    const double v = value_of(m, i);
     if (!std::isfinite(v)) {
       ++counters_.nan_values;
       error(fmt::format("{}: sample {}: value is NaN or infinite; skipped", ch, m.seq + std::int64_t(i)), recv_utime);
@@ -397,7 +426,7 @@ void FitterCore::push_sample(Bench& b, std::int64_t seq, double t_s, double valu
 
 void FitterCore::trim_mirror(Bench& b) {
   const std::size_t keep = b.detector.buffered();
-  while (b.mirror.size() > keep) b.mirror.pop_front();
+  if (b.mirror.size() > keep) b.mirror.drop_front(b.mirror.size() - keep);
 }
 
 void FitterCore::publish_run(Bench& b, const Run& run, std::int8_t state, std::string note, std::int64_t utime) {

@@ -1,7 +1,6 @@
 #include "spindown/lcm_log_reader.hpp"
 
 #include <algorithm>
-#include <bit>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -32,63 +31,6 @@ bool is_bench_char(char c) {
 }
 
 std::string printable(std::string_view s) { return text::quote_line(s); }
-
-// samples_t's fixed prefix, checked before the generated decoder resizes vectors to a count
-// taken from the wire: a damaged n must not become a multi-gigabyte allocation.
-bool samples_prefix_ok(const unsigned char* d, std::int32_t size, std::string* why) {
-  const std::int64_t len = size;
-  if (len < 20) {
-    *why = fmt::format("{} bytes, too short for samples_t", len);
-    return false;
-  }
-  const std::int64_t bench_len = static_cast<std::int32_t>(be32(d + 16));
-  if (bench_len < 1 || bench_len > len - 20) {
-    *why = fmt::format("bench string length {} does not fit in {} bytes", bench_len, len);
-    return false;
-  }
-  const std::int64_t n_at = 20 + bench_len + 8 + 4 + 1;
-  if (n_at + 4 > len) {
-    *why = fmt::format("truncated: {} bytes end before the sample count", len);
-    return false;
-  }
-  const std::int64_t n = static_cast<std::int32_t>(be32(d + n_at));
-  const std::int64_t per_sample = 8 + 8 + 8 + 4;
-  if (n < 0 || n * per_sample > len - n_at - 4) {
-    *why = fmt::format("sample count {} does not fit in {} bytes (truncated or damaged)", n, len);
-    return false;
-  }
-  return true;
-}
-
-// samples_t from bytes that samples_prefix_ok() accepted, field by field into m's existing
-// storage (lcm-gen's decoder, one call per field and array, dominated a one-sample message).
-void decode_samples(const unsigned char* d, samples_t& m) {
-  auto i64 = [](const unsigned char* p) { return static_cast<std::int64_t>(be64(p)); };
-  std::size_t pos = 8;  // after the fingerprint
-  m.utime = i64(d + pos);
-  const auto bench_len = static_cast<std::size_t>(be32(d + pos + 8));
-  pos += 12;
-  m.bench.assign(reinterpret_cast<const char*>(d + pos), bench_len - 1);  // the length counts the NUL
-  pos += bench_len;
-  m.seq = i64(d + pos);
-  m.clock_epoch = static_cast<std::int32_t>(be32(d + pos + 8));
-  m.quantity = static_cast<std::int8_t>(d[pos + 12]);
-  m.n = static_cast<std::int32_t>(be32(d + pos + 13));
-  pos += 17;
-  const auto n = static_cast<std::size_t>(m.n);
-  m.device_time_us.resize(n);
-  m.host_time_us.resize(n);
-  m.value.resize(n);
-  m.raw_adc.resize(n);
-  for (std::size_t i = 0; i < n; ++i) m.device_time_us[i] = i64(d + pos + 8 * i);
-  pos += 8 * n;
-  for (std::size_t i = 0; i < n; ++i) m.host_time_us[i] = i64(d + pos + 8 * i);
-  pos += 8 * n;
-  for (std::size_t i = 0; i < n; ++i) m.value[i] = std::bit_cast<double>(be64(d + pos + 8 * i));
-  pos += 8 * n;
-  for (std::size_t i = 0; i < n; ++i) m.raw_adc[i] = static_cast<std::int32_t>(be32(d + pos + 4 * i));
-}
-
 
 }  // namespace
 
@@ -142,7 +84,7 @@ namespace {
 constexpr std::int64_t block_bytes = 1 << 20;  // one pread(2) per MiB, forward only
 }
 
-LcmLogReader::LcmLogReader(const std::string& path) : path_(path) {
+LcmLogReader::LcmLogReader(const std::string& path, LcmSamples samples) : path_(path), samples_(samples) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) {
     open_error_ = fmt::format("cannot open {}: {}", path, std::strerror(errno));
@@ -170,7 +112,7 @@ LcmLogReader::~LcmLogReader() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-std::int64_t LcmLogReader::fill(std::int64_t n, const unsigned char** p) {
+std::int64_t LcmLogReader::refill(std::int64_t n, const unsigned char** p) {
   const std::int64_t wanted = std::min(n, size_ - pos_);
   if (buffer_offset_ + buffered_ - pos_ < wanted && read_error_.empty()) {
     // Keep the unparsed tail, then read whole blocks behind it up to the size seen at open.
@@ -222,32 +164,13 @@ std::int64_t LcmLogReader::find_marker(std::int64_t from) {
   }
 }
 
-namespace {
-// Length and three 8-byte words of the name (start, middle, end): channel names of one log
-// differ somewhere in there (SPINDOWN.<bench>.<KIND>), so equal keys almost always mean equal names.
-std::uint64_t channel_key(std::string_view c) {
-  auto word = [&](std::size_t at) {
-    std::uint64_t w = 0;
-    std::memcpy(&w, c.data() + at, 8);
-    return w;
-  };
-  std::uint64_t k = c.size() * 0x9E3779B97F4A7C15ull;
-  if (c.size() < 8) {
-    for (char ch : c) k = (k ^ static_cast<unsigned char>(ch)) * 0x100000001B3ull;
-    return k;
-  }
-  return k ^ word(0) ^ word(c.size() - 8) * 0xC2B2AE3D27D4EB4Full ^ word(c.size() / 2 - 4) * 0x165667B19E3779F9ull;
-}
-}  // namespace
-
 const LcmLogReader::ChannelInfo& LcmLogReader::channel_info(std::string_view channel) {
-  const std::uint64_t key = channel_key(channel);
   // Loggers interleave benches in a steady pattern: try the channel that followed the last one.
   if (last_channel_ >= 0) {
     const std::int32_t guess = channels_[static_cast<std::size_t>(last_channel_)].next;
     if (guess >= 0) {
       const ChannelInfo& c = channels_[static_cast<std::size_t>(guess)];
-      if (c.key == key && c.channel == channel) {
+      if (c.channel == channel) {
         last_channel_ = guess;
         return c;
       }
@@ -255,13 +178,12 @@ const LcmLogReader::ChannelInfo& LcmLogReader::channel_info(std::string_view cha
   }
   const ChannelInfo* found = nullptr;
   for (const ChannelInfo& c : channels_)
-    if (c.key == key && c.channel == channel) {
+    if (c.channel == channel) {
       found = &c;
       break;
     }
   if (!found) {
     ChannelInfo& info = channels_.size() < max_channel_ids ? channels_.emplace_back() : uncached_;
-    info.key = key;
     info.channel.assign(channel);
     info.bench.clear();
     info.kind = 0;
@@ -404,16 +326,8 @@ void LcmLogReader::decode(LcmLogEvent& event, const ChannelInfo& info, const voi
   event.bench.assign(info.bench);
   std::string why;
   if (info.kind == 1) {
-    const auto* d = static_cast<const unsigned char*>(data);
-    const bool right_type = size >= 8 && be64(d) == static_cast<std::uint64_t>(samples_t::getHash());
-    // samples_prefix_ok checks samples_t's whole layout (its strings and arrays are all in the
-    // prefix), so the generated decoder is safe without the general layout walk.
-    if (right_type && samples_prefix_ok(d, size, &why)) {
-      decode_samples(d, event.samples);
-      event.kind = LcmLogEvent::Kind::samples;
-      return;
-    }
-    if (why.empty() && decode_message(event.samples, data, size, &why)) {
+    if (view_samples_message(event.samples_view, data, size, &why)) {
+      if (samples_ == LcmSamples::view_and_message) samples_from_view(event.samples_view, event.samples);
       event.kind = LcmLogEvent::Kind::samples;
       return;
     }

@@ -1,6 +1,7 @@
 #include "spindown/message_decode.hpp"
 
 #include <array>
+#include <bit>
 #include <cstddef>
 #include <exception>
 #include <fmt/format.h>
@@ -39,9 +40,7 @@ std::int32_t be32(const unsigned char* p) {
   return static_cast<std::int32_t>((std::uint32_t(p[0]) << 24) | (std::uint32_t(p[1]) << 16) |
                                    (std::uint32_t(p[2]) << 8) | std::uint32_t(p[3]));
 }
-std::uint64_t be64u(const unsigned char* p) {
-  return (std::uint64_t(std::uint32_t(be32(p))) << 32) | std::uint32_t(be32(p + 4));
-}
+std::uint64_t be64u(const unsigned char* p) { return SamplesView::load_be64(p); }
 
 constexpr std::int64_t hash_bytes = 8;
 constexpr std::int64_t string_min_bytes = 5;  // length word and the terminating NUL
@@ -267,6 +266,59 @@ bool decode_impl(Msg& msg, const void* data, std::int64_t size, std::string* why
 }
 
 }  // namespace
+
+bool view_samples_message(SamplesView& view, const void* data, std::int64_t size, std::string* why) {
+  const auto* d = static_cast<const unsigned char*>(data);
+  if (d == nullptr || size < hash_bytes || size > std::numeric_limits<int>::max() ||
+      be64u(d) != static_cast<std::uint64_t>(samples_t::getHash())) {
+    check_impl<samples_t>(data, size, why);  // rejects it, in its own words
+    return false;
+  }
+  // samples_t's strings and arrays all sit in this prefix: checking it checks the whole layout.
+  if (size < 20) return fail(why, fmt::format("{} bytes, too short for samples_t", size));
+  const std::int64_t bench_len = be32(d + 16);
+  if (bench_len < 1 || bench_len > size - 20)
+    return fail(why, fmt::format("bench string length {} does not fit in {} bytes", bench_len, size));
+  const std::int64_t n_at = 20 + bench_len + 8 + 4 + 1;
+  if (n_at + 4 > size) return fail(why, fmt::format("truncated: {} bytes end before the sample count", size));
+  const std::int64_t n = be32(d + n_at);
+  constexpr std::int64_t bytes_per_sample = 8 + 8 + 8 + 4;
+  if (n < 0 || n * bytes_per_sample > size - n_at - 4)
+    return fail(why, fmt::format("sample count {} does not fit in {} bytes (truncated or damaged)", n, size));
+
+  view.utime = static_cast<std::int64_t>(be64u(d + 8));
+  view.bench = std::string_view(reinterpret_cast<const char*>(d + 20), static_cast<std::size_t>(bench_len - 1));
+  const unsigned char* p = d + 20 + bench_len;
+  view.seq = static_cast<std::int64_t>(be64u(p));
+  view.clock_epoch = be32(p + 8);
+  view.quantity = static_cast<std::int8_t>(p[12]);
+  view.n = static_cast<std::int32_t>(n);
+  view.device_time_bytes = d + n_at + 4;
+  view.host_time_bytes = view.device_time_bytes + 8 * n;
+  view.value_bytes = view.host_time_bytes + 8 * n;
+  view.raw_adc_bytes = view.value_bytes + 8 * n;
+  return true;
+}
+
+void samples_from_view(const SamplesView& view, samples_t& m) {
+  m.utime = view.utime;
+  m.bench.assign(view.bench);
+  m.seq = view.seq;
+  m.clock_epoch = view.clock_epoch;
+  m.quantity = view.quantity;
+  m.n = view.n;
+  const auto n = static_cast<std::size_t>(view.n);
+  m.device_time_us.resize(n);
+  m.host_time_us.resize(n);
+  m.value.resize(n);
+  m.raw_adc.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    m.device_time_us[i] = view.device_time_us(static_cast<std::int32_t>(i));
+    m.host_time_us[i] = static_cast<std::int64_t>(be64u(view.host_time_bytes + 8 * i));
+    m.value[i] = view.value(static_cast<std::int32_t>(i));
+    m.raw_adc[i] = be32(view.raw_adc_bytes + 4 * i);
+  }
+}
 
 #define SPINDOWN_DEFINE_MESSAGE_DECODE(T)                                                      \
   template <>                                                                                  \

@@ -14,7 +14,6 @@
 // cap per bench (flooding messages dropped and counted). Nothing in the input throws out of it.
 #include <cstddef>
 #include <cstdint>
-#include <deque>
 #include <map>
 #include <memory>
 #include <optional>
@@ -31,6 +30,7 @@
 
 #include "spindown/bench.hpp"
 #include "spindown/fit.hpp"
+#include "spindown/message_decode.hpp"
 #include "spindown/motor_health.hpp"
 #include "spindown/recording.hpp"
 #include "spindown/run_detector.hpp"
@@ -123,8 +123,9 @@ class FitterCore {
   // channels counted. recv_utime is the host receive time (µs since the epoch; from the log
   // when refitting) used by the rate cap and for latency.
   void on_message(std::string_view channel, const void* data, std::int64_t size, std::int64_t recv_utime);
-  // Already decoded messages (tests, tools); bench is the channel's bench id.
+  // Already decoded messages (tests, tools; a log reader's view); bench is the channel's bench id.
   void on_samples(std::string_view bench, const samples_t& msg, std::int64_t recv_utime);
+  void on_samples(std::string_view bench, const SamplesView& msg, std::int64_t recv_utime);
   void on_config(std::string_view bench, const config_t& msg, std::int64_t recv_utime);
   // End of the stream (refit, shutdown): open coasts are closed and fitted as `spindown fit`
   // does at the end of a file.
@@ -146,6 +147,9 @@ class FitterCore {
   struct Bench;
   Bench* bench_for(std::string_view id, std::int64_t recv_utime, std::string_view kind);
   void error(std::string text, std::int64_t utime);
+  // The per-bench checks and the detector, for n samples of either form of message.
+  template <class Message>
+  void take_samples(Bench& b, const Message& m, std::size_t n, std::int64_t recv_utime);
   void push_sample(Bench& b, std::int64_t seq, double t_s, double value, std::int64_t recv_utime);
   void handle_events(Bench& b, std::int64_t recv_utime);
   void restart_clock(Bench& b, std::int64_t recv_utime);
@@ -157,6 +161,7 @@ class FitterCore {
   FitterSink& sink_;
   std::regex bench_filter_;
   std::map<std::string, std::unique_ptr<Bench>, std::less<>> benches_;
+  Bench* last_bench_ = nullptr;  // the bench of the previous message
   std::uint64_t activity_ = 0;   // increases per message: least recently active = smallest
   std::uint64_t arrivals_ = 0;   // order of first appearance
   FitterCounters counters_;

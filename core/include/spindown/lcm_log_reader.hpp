@@ -25,6 +25,7 @@
 #include <spindown/samples_t.hpp>
 
 #include "spindown/bench.hpp"
+#include "spindown/message_decode.hpp"
 #include "spindown/recording.hpp"
 
 namespace spindown {
@@ -55,16 +56,21 @@ struct LcmLogEvent {
   // per-channel cache needs no string compare); -1 past LcmLogReader::max_channel_ids distinct names.
   std::int32_t channel_id = -1;
   std::string bench;             // for SPINDOWN.<bench>.* channels, else empty
-  samples_t samples;             // Kind::samples
+  SamplesView samples_view;      // Kind::samples: the message in place, valid until the next next()
+  samples_t samples;             // Kind::samples, unless the reader was made with LcmSamples::view_only
   config_t config;               // Kind::config
   const void* data = nullptr;    // Kind::other: the payload, valid until the next next()
   std::int32_t data_size = 0;
   std::string problem;           // Kind::problem: what was wrong and what was done
 };
 
+// What a SAMPLE event carries. A consumer that reads the view only (refit) spares building a
+// samples_t per message, which dominates a one-sample message.
+enum class LcmSamples { view_and_message, view_only };
+
 class LcmLogReader {
  public:
-  explicit LcmLogReader(const std::string& path);
+  explicit LcmLogReader(const std::string& path, LcmSamples samples = LcmSamples::view_and_message);
   ~LcmLogReader();
   LcmLogReader(const LcmLogReader&) = delete;
   LcmLogReader& operator=(const LcmLogReader&) = delete;
@@ -87,7 +93,6 @@ class LcmLogReader {
  private:
   // What a channel name means, worked out once per distinct name (a log has a handful).
   struct ChannelInfo {
-    std::uint64_t key = 0;  // cheap fingerprint of the name: most mismatches cost no memcmp
     std::string channel;
     std::string bench;      // empty: not SPINDOWN.<bench>.<KIND>
     int kind = 0;           // 0 other, 1 SAMPLE, 2 CONFIG
@@ -97,13 +102,21 @@ class LcmLogReader {
   const ChannelInfo& channel_info(std::string_view channel);
   // Makes n bytes from pos_ available in the buffer (fewer only at the end of the file or on a
   // read error); returns how many are and points *p at the first.
-  std::int64_t fill(std::int64_t n, const unsigned char** p);
+  std::int64_t fill(std::int64_t n, const unsigned char** p) {
+    if (pos_ >= buffer_offset_ && buffer_offset_ + buffered_ - pos_ >= n) {  // nearly always
+      *p = buffer_.data() + (pos_ - buffer_offset_);
+      return n;
+    }
+    return refill(n, p);
+  }
+  std::int64_t refill(std::int64_t n, const unsigned char** p);  // fill() when a read is needed
   // Offset of the first event marker at or after from, or -1 when none follows.
   std::int64_t find_marker(std::int64_t from);
   bool find_event_start(LcmLogEvent& event);
   void decode(LcmLogEvent& event, const ChannelInfo& info, const void* data, std::int32_t size);
 
   std::string path_;
+  LcmSamples samples_;
   std::string open_error_;
   int fd_ = -1;
   std::int64_t size_ = 0;

@@ -6,8 +6,12 @@
 // first walks the encoding (fingerprint, every string length, every array count against the
 // bytes left) and only then runs the generated decoder, so nothing it is given can make it
 // allocate more than a small multiple of the message's size, throw or hit undefined behaviour.
+#include <bit>
+#include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <string>
+#include <string_view>
 
 #include <spindown/config_t.hpp>
 #include <spindown/explain_t.hpp>
@@ -28,6 +32,46 @@ bool check_message_encoding(const void* data, std::int64_t size, std::string* wh
 // well-formed Msg; msg is then unspecified (but valid).
 template <class Msg>
 bool decode_message(Msg& msg, const void* data, std::int64_t size, std::string* why = nullptr);
+
+// A samples_t read in place from its encoding (the message the lab bridge sends once per
+// sample): no vectors or strings are built, the arrays are read from the big-endian bytes. Valid
+// while those bytes are.
+struct SamplesView {
+  std::int64_t utime = 0;
+  std::string_view bench;
+  std::int64_t seq = 0;
+  std::int32_t clock_epoch = 0;
+  std::int8_t quantity = 0;
+  std::int32_t n = 0;
+  // The four arrays, n big-endian values each: int64, int64, IEEE double, int32.
+  const unsigned char* device_time_bytes = nullptr;
+  const unsigned char* host_time_bytes = nullptr;
+  const unsigned char* value_bytes = nullptr;
+  const unsigned char* raw_adc_bytes = nullptr;
+
+  std::int64_t device_time_us(std::int32_t i) const {
+    return static_cast<std::int64_t>(load_be64(device_time_bytes + 8 * static_cast<std::size_t>(i)));
+  }
+  double value(std::int32_t i) const {
+    return std::bit_cast<double>(load_be64(value_bytes + 8 * static_cast<std::size_t>(i)));
+  }
+  static std::uint64_t load_be64(const unsigned char* p) {
+    std::uint64_t v;
+    std::memcpy(&v, p, sizeof v);
+    if constexpr (std::endian::native == std::endian::little) v = __builtin_bswap64(v);
+    return v;
+  }
+};
+
+// Checks an encoded samples_t (fingerprint, bench length, sample count against the bytes there)
+// and points view at it. False and *why otherwise, with the words the log reader and the fitter
+// report ("sample count 57 does not fit in 1445 bytes (truncated or damaged)"); a wrong
+// fingerprint or a message shorter than one is worded as decode_message words it.
+bool view_samples_message(SamplesView& view, const void* data, std::int64_t size, std::string* why = nullptr);
+
+// The whole samples_t from a view (for readers that hand on the generated type); m's vectors
+// keep their capacity.
+void samples_from_view(const SamplesView& view, samples_t& m);
 
 #define SPINDOWN_DECLARE_MESSAGE_DECODE(T)                                                        \
   template <>                                                                                     \
