@@ -8,6 +8,7 @@
 
 #include "spindown/bridge_settings.hpp"
 #include "spindown/lcm_channels.hpp"
+#include "spindown/toml_file.hpp"
 
 namespace spindown {
 
@@ -22,7 +23,7 @@ BenchFile load_bench_file(const std::string& path) {
   BridgeSettings s;
   load_bridge_settings(path, s);  // [bench] exactly as spindown-bridge reads it
   f.params = s.params;
-  const toml::table root = toml::parse_file(path);
+  const toml::table root = parse_toml_file(path);
   f.sets_inertia = root.at_path("bench.inertia_kg_m2").node() || root.at_path("bench.flywheel_radius_m").node();
   f.sets_kb = root.at_path("bench.kb_v_s_per_rad").node() || root.at_path("bench.speed_constant_rpm_per_v").node();
   return f;

@@ -7,6 +7,7 @@
 
 #include "spindown/lcm_channels.hpp"
 #include "spindown/serial_port.hpp"
+#include "spindown/toml_file.hpp"
 
 namespace spindown {
 
@@ -73,13 +74,7 @@ struct Reader {
 }  // namespace
 
 void load_bridge_settings(const std::string& path, BridgeSettings& s) {
-  toml::table root;
-  try {
-    root = toml::parse_file(path);
-  } catch (const toml::parse_error& e) {
-    const auto& where = e.source().begin;
-    throw std::runtime_error(fmt::format("{}:{}:{}: {}", path, where.line, where.column, e.description()));
-  }
+  const toml::table root = parse_toml_file(path);
   const Reader r{path, root};
   long long i = 0;
   double d = 0;

@@ -13,6 +13,7 @@
 
 #include "spindown/bench.hpp"
 #include "spindown/fit_report.hpp"
+#include "spindown/toml_file.hpp"
 
 namespace spindown {
 
@@ -461,18 +462,6 @@ struct HealthReader {
     }
   }
 };
-
-toml::table parse_toml_file(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec))
-    throw std::runtime_error(fmt::format("{}: cannot read: not a file or does not exist", path));
-  try {
-    return toml::parse_file(path);
-  } catch (const toml::parse_error& e) {
-    const auto& where = e.source().begin;
-    throw std::runtime_error(fmt::format("{}:{}:{}: {}", path, where.line, where.column, e.description()));
-  }
-}
 
 }  // namespace
 
