@@ -126,13 +126,15 @@ FileFormat detect_format(std::string_view head, const ReadOptions& options) {
   if (options.delimited.names_columns()) return FileFormat::delimited_text;
   // Arduino text when at least half of the first 50 lines with content are lab samples.
   std::size_t content = 0, samples = 0;
-  text::for_each_line(head.substr(0, 64 * 1024), [&](std::int64_t, std::string_view line) {
-    if (content >= 50 || line.starts_with("=~=~=~")) return;
+  text::LineCursor lines(head.substr(0, 64 * 1024));
+  while (content < 50 && !lines.at_end()) {  // stop there: splitting the rest cost as much as parsing it
+    const std::string_view line = lines.next_line();
+    if (line.starts_with("=~=~=~")) continue;
     const LabLine parsed = parse_lab_line(line);
-    if (parsed.kind == LabLine::Kind::blank) return;
+    if (parsed.kind == LabLine::Kind::blank) continue;
     ++content;
     samples += parsed.kind == LabLine::Kind::sample;
-  });
+  }
   if (content == 0 || samples * 2 >= content) return FileFormat::arduino_text;
   return FileFormat::delimited_text;
 }
