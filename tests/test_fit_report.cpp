@@ -325,30 +325,3 @@ TEST(FitReportJsonText, MatchesTheDocumentsDumpByteForByte) {
   }
   EXPECT_EQ(streamed({}, {}), document({}, {}));
 }
-
-// The noise model the fit weighted by is part of the report: σ at rest and as a fraction of the
-// reading in text and JSON; an unweighted fit says so and has nulls.
-TEST(FitReport, SaysWhichNoiseModelTheFitWeightedBy) {
-  RunFit weighted = lab_like_fit();
-  weighted.weighted = true;
-  weighted.noise.a = 0.005 * 0.005;
-  weighted.noise.b = 0.007 * 0.007;
-  weighted.noise.weight_floor = weighted.noise.a;
-  weighted.noise.known = true;
-  const std::string text = format_run_fit(weighted);
-  EXPECT_NE(text.find("fit weights 1/σ², σ² = (0.005 V)² + (0.7 % of the reading)²"), std::string::npos) << text;
-  const FileFit files[] = {one_file(weighted)};
-  const Json report = fit_report_json(files);
-  const Json& noise = report["files"][0]["runs"][0]["noise_model"];
-  EXPECT_EQ(noise["weighted"], true);
-  EXPECT_DOUBLE_EQ(noise["sigma_at_rest"].get<double>(), 0.005);
-  EXPECT_DOUBLE_EQ(noise["relative_sd"].get<double>(), 0.007);
-
-  const RunFit plain = lab_like_fit();  // noise not known: fitted unweighted
-  EXPECT_NE(format_run_fit(plain).find("fit unweighted"), std::string::npos);
-  const FileFit plain_files[] = {one_file(plain)};
-  const Json plain_report = fit_report_json(plain_files);
-  const Json& none = plain_report["files"][0]["runs"][0]["noise_model"];
-  EXPECT_EQ(none["weighted"], false);
-  EXPECT_TRUE(none["sigma_at_rest"].is_null());
-}

@@ -681,10 +681,9 @@ RunFit fit_run(std::span<const double> t_s, std::span<const double> value, Quant
   const std::size_t moving = (run.stopped ? stop : end) - begin;
   const std::string_view runit = quantity_unit(q);
   // Weights from the run's own noise (σ² growing with the reading), shared by every model.
-  NoiseWeights weights = opt.weighted ? weigh_by_noise(y) : NoiseWeights{{}, std::vector<double>(y.size(), 1.0)};
-  out.noise = weights.noise;
-  out.weighted = opt.weighted && weights.noise.known;
-  Evaluator eval(tau, y, weights.sqrt_weight);  // one workspace for every model of the run
+  const std::vector<double> sqrt_weight =
+      opt.weighted ? weigh_by_noise(y).sqrt_weight : std::vector<double>(y.size(), 1.0);
+  Evaluator eval(tau, y, sqrt_weight);  // one workspace for every model of the run
   const IntegralForm form = integral_form(tau, y, moving);
   for (ModelKind kind : opt.models)
     out.models.push_back(fit_model(kind, tau, y, moving, k, opt.bench, runit, &eval, form));

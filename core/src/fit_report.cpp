@@ -168,21 +168,6 @@ std::string format_value_error(double value, double std_error) {
   return fmt::format("({:.{}f} ± {:.{}f})e{:+03d}", value / scale, decimals, std_error / scale, decimals, magnitude);
 }
 
-// The noise model the fit used, in the reading's unit: σ at rest (√a) and σ as a fraction of
-// the reading (√b); NaN when the run's noise could not be estimated (fit unweighted).
-double noise_at_rest(const RunFit& fit) {
-  return fit.noise.known ? std::sqrt(fit.noise.a) : std::numeric_limits<double>::quiet_NaN();
-}
-double noise_relative_sd(const RunFit& fit) {
-  return fit.noise.known ? std::sqrt(fit.noise.b) : std::numeric_limits<double>::quiet_NaN();
-}
-
-Json noise_model_json(const RunFit& fit) {
-  return {{"weighted", fit.weighted},
-          {"sigma_at_rest", number(noise_at_rest(fit))},
-          {"relative_sd", number(noise_relative_sd(fit))}};
-}
-
 std::string explain_best(const RunFit& fit) {
   if (!fit.best_reason.empty()) return fit.best_reason;
   const ModelFit* best = best_model(fit);
@@ -234,7 +219,6 @@ Json run_fit_json(const RunFit& fit, const ReportOptions& opt) {
             {"zero_level", number(run.zero_level)},
             {"noise_level", number(run.noise_level)},
             {"period_s", number(run.period_s)},
-            {"noise_model", noise_model_json(fit)},
             {"quantity", residual_unit},
             {"bench",
              {{"J", number(fit.bench.inertia_kg_m2)},
@@ -450,12 +434,6 @@ void write_run_fit(PrettyJsonWriter& w, const RunFit& fit, const ReportOptions& 
   w.member_number("zero_level", run.zero_level);
   w.member_number("noise_level", run.noise_level);
   w.member_number("period_s", run.period_s);
-  w.key("noise_model");
-  w.begin_object();
-  w.member("weighted", fit.weighted);
-  w.member_number("sigma_at_rest", noise_at_rest(fit));
-  w.member_number("relative_sd", noise_relative_sd(fit));
-  w.end_object();
   w.member("quantity", residual_unit);
   w.key("bench");
   w.begin_object();
@@ -603,11 +581,6 @@ std::string format_run_fit(const RunFit& fit, const ReportOptions& opt) {
   if (!run.lead_in.empty()) out += fmt::format(", lead-in: {}", run.lead_in);
   out += fmt::format("\n  zero level {:.3g} {}, noise {:.2g} {}, period {:.1f} ms\n", run.zero_level, unit,
                      run.noise_level, unit, run.period_s * 1e3);
-  if (fit.weighted)
-    out += fmt::format("  fit weights 1/σ², σ² = ({:.2g} {})² + ({:.2g} % of the reading)², at most 4:1\n",
-                       noise_at_rest(fit), unit, 100 * noise_relative_sd(fit));
-  else
-    out += "  fit unweighted\n";
   out += fmt::format("  bench: J = {:.6g} kg·m² ({}), K_b = {:.6g} V·s/rad ({})", fit.bench.inertia_kg_m2,
                      fit.bench.inertia_source, fit.bench.kb_v_s_per_rad, fit.bench.kb_source);
   if (opt.lab_units) out += fmt::format("; J = {:.6g} g·cm²", inertia_to_g_cm2(fit.bench.inertia_kg_m2));

@@ -44,11 +44,11 @@ ReadingNoise estimate(std::span<const double> y, std::span<const double> mean, d
     if (b < 0) b = 0, a = sv / m;
   }
   if (!(a + b * x_max > 0) || !std::isfinite(a) || !std::isfinite(b)) return out;
-  out.a = std::max(a, 0.0);
+  // (a + b·x_max)/a ≤ max_ratio, also when the regression's a came out ≤ 0.
+  out.a = std::max(a, b * x_max / std::max(max_ratio - 1.0, 1e-9));
+  if (!(out.a > 0)) return out;
   out.b = b;
-  // (floor + b·x_max)/floor ≤ max_ratio, also when the regression's a came out ≤ 0.
-  out.weight_floor = std::max(out.a, b * x_max / std::max(max_ratio - 1.0, 1e-9));
-  out.known = out.weight_floor > 0;
+  out.known = true;
   return out;
 }
 
@@ -62,8 +62,7 @@ NoiseWeights weigh_by_noise(std::span<const double> y, double max_ratio) {
   out.noise = estimate(y, mean, max_ratio);
   if (!out.noise.known) return out;
   double total = 0;
-  const double floor = out.noise.weight_floor, b = out.noise.b;
-  for (std::size_t i = 0; i < y.size(); ++i) total += out.sqrt_weight[i] = 1.0 / (floor + b * mean[i] * mean[i]);
+  for (std::size_t i = 0; i < y.size(); ++i) total += out.sqrt_weight[i] = 1.0 / out.noise.variance(mean[i]);
   const double scale = static_cast<double>(y.size()) / total;
   for (double& w : out.sqrt_weight) w = std::sqrt(w * scale);
   return out;

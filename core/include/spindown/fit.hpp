@@ -11,7 +11,6 @@
 #include <string>
 #include <vector>
 
-#include "spindown/reading_noise.hpp"
 #include "spindown/bench.hpp"
 #include "spindown/recording.hpp"
 #include "spindown/runs.hpp"
@@ -64,8 +63,6 @@ struct RunFit {
   std::vector<ModelFit> models;
   std::string best;         // model name with the lowest BIC among converged fits
   std::string best_reason;  // why, in words (ΔBIC, RMSE)
-  ReadingNoise noise;       // the run's noise model σ²(u) = a + b·u² (reading units)
-  bool weighted = false;    // the fits weighted each sample by 1/σ²(u)
   const ModelFit* model(ModelKind k) const;
 };
 

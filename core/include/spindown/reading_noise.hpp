@@ -14,9 +14,8 @@
 namespace spindown {
 
 struct ReadingNoise {
-  double a = 0;      // variance at zero reading (reading unit²), as estimated
+  double a = 0;      // variance at zero reading (reading unit²)
   double b = 0;      // growth with the reading squared (ripple²/2)
-  double weight_floor = 0;  // a as the weights use it: raised so the weights stay within max_ratio
   bool known = false;  // false: too few samples or no positive variance; fit unweighted
   double variance(double u) const { return a + b * u * u; }
 };
