@@ -28,9 +28,11 @@ struct ReadingNoise {
 // averages out: the lab's 10-bit ADC (4.88 mV) printed with 2 decimals (10 mV) rounds odd
 // counts down, a pattern of up to ±2.5 mV that drifts with the reading, and weighting the
 // slow end 16× (the full σ² range at 1 % ripple) doubles the bias it leaves in c3 and c4.
-// Measured over 300 lab-like runs (bench/monte_carlo.sh; c3 bias, sd in % of the truth):
-// unweighted −0.24, 0.68; cap 2: −0.26, 0.63; cap 4: −0.29, 0.61; cap 8: −0.33, 0.59;
-// no cap: −0.57, 0.66. A cap of 4 gives the smallest mean squared error.
+// Measured over 300 runs from monte_carlo's generator (seed-3v-run1 truth, lab noise, ripple,
+// ADC and printing), fitted with each cap (c3 bias, sd in % of the truth): unweighted −0.24,
+// 0.68; cap 2: −0.26, 0.63; cap 4: −0.29, 0.61; cap 8: −0.33, 0.59; no cap: −0.57, 0.66. A cap
+// of 4 gives the smallest mean squared error; bench/monte_carlo.sh (500 runs) reproduces the
+// cap-4 and unweighted rows.
 struct NoiseWeights {
   ReadingNoise noise;
   std::vector<double> sqrt_weight;  // one per reading
