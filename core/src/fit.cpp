@@ -106,7 +106,7 @@ class Evaluator {
     index_time_steps();
     const auto n = static_cast<Eigen::Index>(tau.size());
     e_.resize(n);
-    moving_.resize(n);
+    row_weight_.resize(n);
     p_.resize(n);
     dp_.resize(n);
     r_.resize(n);
@@ -131,7 +131,7 @@ class Evaluator {
     m_ = static_cast<Eigen::Index>(m);
     const Eigen::Map<const Eigen::ArrayXd> t(tau_.data(), m_), y(y_.data(), m_), sw(sw_.data(), m_);
     auto e = e_.head(m_), p = p_.head(m_), dp = dp_.head(m_), r = r_.head(m_);
-    auto moving = moving_.head(m_);
+    auto row_weight = row_weight_.head(m_);  // √w while moving, 0 once stopped
     const double tau_max = m_ == 0 ? 0.0 : sorted_ ? t[m_ - 1] : t.maxCoeff();
     const bool decaying = f.alpha_free && th.alpha * tau_max >= 1e-3;
     if (decaying) {
@@ -140,13 +140,13 @@ class Evaluator {
       const double c = th.beta / th.alpha;
       decay(th.alpha, m_);
       r = (th.u0 + c) * e - c;
-      moving = (r > 0).cast<double>() * sw;
+      row_weight = (r > 0).cast<double>() * sw;
       r = (y - r.max(0.0)) * sw;
       if (jtj) {
         int j = 0;
-        g_.col(j++).head(m_) = (e * moving).matrix();
-        g_.col(j++).head(m_) = ((c / th.alpha * (1.0 - e) - (th.u0 + c) * t * e) * moving).matrix();
-        if (f.beta_free) g_.col(j++).head(m_) = ((e - 1.0) * (moving / th.alpha)).matrix();
+        g_.col(j++).head(m_) = (e * row_weight).matrix();
+        g_.col(j++).head(m_) = ((c / th.alpha * (1.0 - e) - (th.u0 + c) * t * e) * row_weight).matrix();
+        if (f.beta_free) g_.col(j++).head(m_) = ((e - 1.0) * (row_weight / th.alpha)).matrix();
       }
     } else {
       // α·τ below 10⁻³ everywhere (or α fixed at 0): φ(x) = (1 − e^(−x))/x by its series, which
@@ -163,13 +163,13 @@ class Evaluator {
       }
       // model = max(0, u0·e − β·τ·φ); rounding may leave a sample at the stop just below 0.
       r = th.u0 * e - th.beta * t * p;
-      moving = (r > 0).cast<double>() * sw;
+      row_weight = (r > 0).cast<double>() * sw;
       r = (y - r.max(0.0)) * sw;
       if (jtj) {
         int j = 0;
-        g_.col(j++).head(m_) = (e * moving).matrix();
-        if (f.alpha_free) g_.col(j++).head(m_) = ((-th.u0 * t * e - th.beta * t * t * dp) * moving).matrix();
-        if (f.beta_free) g_.col(j++).head(m_) = (-t * p * moving).matrix();
+        g_.col(j++).head(m_) = (e * row_weight).matrix();
+        if (f.alpha_free) g_.col(j++).head(m_) = ((-th.u0 * t * e - th.beta * t * t * dp) * row_weight).matrix();
+        if (f.beta_free) g_.col(j++).head(m_) = (-t * p * row_weight).matrix();
       }
     }
     const double sse = r.square().sum() + tail_sq_[m];
@@ -242,7 +242,7 @@ class Evaluator {
   std::vector<double> tail_sq_, plain_tail_sq_;
   bool sorted_;
   Eigen::Index m_ = 0;
-  Eigen::ArrayXd e_, p_, dp_, r_, moving_;
+  Eigen::ArrayXd e_, p_, dp_, r_, row_weight_;
   // The last evaluation, so asking again for the same point costs nothing.
   bool same(const Family& f, const Theta& th) const {
     return f.alpha_free == last_f_.alpha_free && f.beta_free == last_f_.beta_free && th.u0 == last_th_.u0 &&
