@@ -90,7 +90,7 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::Range(0.001, 3600.0));
   app.add_flag("--fsync", w.sync_on_flush, "also fdatasync at every flush (always done at rotation and exit)");
-  app.add_option("--queue", r.queue_capacity, "events queued (LCM subscription and writer queue) before drops are counted")
+  app.add_option("--queue", r.queue_capacity, "events queued for the writer before drops are counted")
       ->capture_default_str()
       ->check(CLI::Range(1, 10000000));
   app.add_option("--recv-buf", recv_buf, "udpm receive buffer bytes added to the URL (0 = leave the URL alone)")
@@ -151,8 +151,11 @@ int main(int argc, char** argv) {
     recorder.stop("subscribe failed");
     return 2;
   }
-  // LCM 1.3.1 drops silently past 30 queued messages per subscription.
-  lcm_subscription_set_queue_capacity(sub, static_cast<int>(r.queue_capacity));
+  // LCM 1.3.1 drops silently past a subscription's queue capacity (30 unless set): no limit
+  // there, so every message LCM reads reaches the recorder, whose queue is the one that bounds
+  // memory and counts what it drops. (With the limit at --queue, a main thread that fell that
+  // far behind LCM's receive thread lost the rest of a burst without a trace.)
+  lcm_subscription_set_queue_capacity(sub, 0);
   pthread_sigmask(SIG_UNBLOCK, &stop_signals, nullptr);
   if (!quiet)
     fmt::print(stderr, "spindown-logger: channels '{}' on {} -> {} (flush every {} s{}{})\n", channels, url,

@@ -58,3 +58,17 @@ stop_logger() {
   LOGGER_RC=0
   wait "$pid" || LOGGER_RC=$?
 }
+
+# Datagrams the kernel dropped in this network namespace because a UDP socket's receive buffer
+# was full (Udp RcvbufErrors in /proc/net/snmp, nstat's UdpRcvbufErrors): traffic that never
+# reached any process, as opposed to traffic a process read and then lost.
+udp_rcvbuf_errors() {
+  awk '$1 == "Udp:" { if (!col) { for (i = 2; i <= NF; i++) if ($i == "RcvbufErrors") col = i } else { print $col; exit } }' \
+    /proc/net/snmp
+}
+
+# UDP sockets bound to PORT in this network namespace (/proc/net/udp): with one, the kernel's
+# receive-buffer drops in the namespace are that socket's.
+udp_sockets_on_port() {
+  awk -v port="$(printf '%04X' "$1")" 'NR > 1 { split($2, a, ":"); if (a[2] == port) n++ } END { print n + 0 }' /proc/net/udp
+}
