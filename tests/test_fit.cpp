@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "spindown/fit.hpp"
+#include "spindown/reading_noise.hpp"
 #include "spindown/synthetic_run.hpp"
 
 using namespace spindown;
@@ -311,6 +312,85 @@ TEST(Fit, FewDistinctTimeStepsAndJitteredStepsGiveTheSameFit) {
       const Parameter &pa = a.models[k].params[j], &pb = b.models[k].params[j];
       EXPECT_NEAR(pa.value, pb.value, 1e-3 * pa.std_error) << model_name(a.models[k].kind) << " " << pa.name;
       EXPECT_NEAR(pa.std_error, pb.std_error, 1e-3 * pa.std_error) << model_name(a.models[k].kind) << " " << pa.name;
+    }
+  }
+}
+
+namespace {
+
+// The weighted, clamped SSE that every fit minimises, computed here independently of fit.cpp.
+struct RunData {
+  std::vector<double> tau, y, w;
+};
+
+RunData run_data(const Case& c) {
+  RunData d;
+  for (std::size_t i = c.seg.cut_index; i < c.seg.end_index; ++i) {
+    d.tau.push_back(c.t[i] - c.seg.t_cut_s);
+    d.y.push_back(c.run.volts[i] - c.seg.zero_level);
+  }
+  for (double sw : weigh_by_noise(d.y).sqrt_weight) d.w.push_back(sw * sw);
+  return d;
+}
+
+// Reading model u0·e^(−ατ) − β·τ·φ(ατ), clamped at 0 (α = 0: the straight line).
+double weighted_sse(const RunData& d, double u0, double alpha, double beta) {
+  double s = 0;
+  for (std::size_t i = 0; i < d.tau.size(); ++i) {
+    const double t = d.tau[i];
+    const double m = alpha > 0 ? (u0 + beta / alpha) * std::exp(-alpha * t) - beta / alpha : u0 - beta * t;
+    const double r = d.y[i] - std::max(m, 0.0);
+    s += d.w[i] * r * r;
+  }
+  return s;
+}
+
+}  // namespace
+
+// Viscous and Coulomb are solved directly (projection over α; a scan over the stop), not by LM:
+// each must be the least-squares minimum. Checked against brute-force profiles: Coulomb over
+// the stop time ts on a grid 100× finer than the samples around the stop (best β for each ts in
+// closed form), which also finds a minimum at a kink where a sample sits on the stop; viscous
+// over α within ±2 standard errors (best u0 for each α in closed form).
+TEST(Fit, ViscousAndCoulombAreTheLeastSquaresMinimum) {
+  for (std::uint64_t seed = 1; seed <= 12; ++seed) {
+    SyntheticRunSpec spec;
+    spec.noise_v = 0.004;
+    spec.ripple = 0.01;
+    spec.seed = seed;
+    const Case c = make_case(spec);
+    const RunData d = run_data(c);
+    const double k = spec.bench.kb_v_s_per_rad;
+    const RunFit f = fit_case(c, {ModelKind::viscous, ModelKind::coulomb});
+
+    const ModelFit& co = *f.model(ModelKind::coulomb);
+    ASSERT_TRUE(co.converged) << co.message;
+    const double co_sse = weighted_sse(d, co.omega0 * k, 0, co.decel * k);
+    double profile_min = INFINITY;
+    const double ts_fit = co.t_stop_pred_s, step = 0.0002;  // 0.2 ms: 1/100 of the loop period
+    for (int j = -1000; j <= 1000; ++j) {
+      const double ts = ts_fit + j * step;
+      double num = 0, den = 0;  // y ≈ β·(ts − τ) while τ < ts
+      for (std::size_t i = 0; i < d.tau.size() && d.tau[i] < ts; ++i) {
+        num += d.w[i] * d.y[i] * (ts - d.tau[i]);
+        den += d.w[i] * (ts - d.tau[i]) * (ts - d.tau[i]);
+      }
+      if (den > 0 && num > 0) profile_min = std::min(profile_min, weighted_sse(d, num / den * ts, 0, num / den));
+    }
+    EXPECT_LE(co_sse, profile_min * (1 + 1e-12)) << "seed " << seed;
+
+    const ModelFit& v = *f.model(ModelKind::viscous);
+    ASSERT_TRUE(v.converged) << v.message;
+    const double v_sse = weighted_sse(d, v.omega0 * k, v.rate, 0);
+    const double se_rate = se(v, "B");
+    for (int j = -40; j <= 40; ++j) {
+      const double alpha = v.rate + j * 0.05 * se_rate;
+      double ye = 0, ee = 0;
+      for (std::size_t i = 0; i < d.tau.size(); ++i) {
+        const double e = std::exp(-alpha * d.tau[i]);
+        ye += d.w[i] * d.y[i] * e, ee += d.w[i] * e * e;
+      }
+      EXPECT_LE(v_sse, weighted_sse(d, ye / ee, alpha, 0) * (1 + 1e-12)) << "seed " << seed << " step " << j;
     }
   }
 }

@@ -105,6 +105,8 @@ class Evaluator {
     }
     index_time_steps();
     const auto n = static_cast<Eigen::Index>(tau.size());
+    w_ = Eigen::Map<const Eigen::ArrayXd>(sqrt_weight.data(), n).square();
+    wy_ = w_ * Eigen::Map<const Eigen::ArrayXd>(y.data(), n);
     e_.resize(n);
     row_weight_.resize(n);
     p_.resize(n);
@@ -114,6 +116,33 @@ class Evaluator {
   }
 
   std::size_t size() const { return tau_.size(); }
+  double weighted_sum_sq() const { return tail_sq_[0]; }  // Σw·y²
+
+  // Weighted sums for the viscous model by variable projection: at a given α the best u0 is
+  // Σw·y·e / Σw·e² (e = e^(−ατ)), so the fit is a search over α alone. The τ and τ² moments
+  // give the first and second derivatives of the projected SSE for Newton's method.
+  struct DecaySums {
+    double ee = 0, ye = 0, t_ee = 0, t_ye = 0, tt_ee = 0, tt_ye = 0;
+  };
+  DecaySums decay_sums(double alpha) {
+    const auto n = static_cast<Eigen::Index>(tau_.size());
+    decay(alpha, n);
+    const Eigen::Map<const Eigen::ArrayXd> t(tau_.data(), n);
+    const auto e = e_.head(n);
+    auto wee = p_.head(n), wye = dp_.head(n);  // scratch shared with the model passes
+    wee = w_ * e.square();
+    wye = wy_ * e;
+    DecaySums s;
+    s.ee = wee.sum(), s.t_ee = (t * wee).sum(), s.tt_ee = (t.square() * wee).sum();
+    s.ye = wye.sum(), s.t_ye = (t * wye).sum(), s.tt_ye = (t.square() * wye).sum();
+    return s;
+  }
+
+  // The run as the direct solutions see it: times (sorted or not), weights, weighted readings.
+  std::span<const double> tau() const { return tau_; }
+  bool sorted() const { return sorted_; }
+  std::span<const double> weights() const { return {w_.data(), tau_.size()}; }
+  std::span<const double> weighted_readings() const { return {wy_.data(), tau_.size()}; }
 
   // SSE at θ; with jac, also JᵀJ and Jᵀr (unused rows/columns of a smaller family are left
   // as identity/zero so 3×3 solvers serve every family). Residuals and Jacobian rows of the
@@ -242,6 +271,7 @@ class Evaluator {
   std::vector<double> tail_sq_, plain_tail_sq_;
   bool sorted_;
   Eigen::Index m_ = 0;
+  Eigen::ArrayXd w_, wy_;  // weights and weighted readings, for the direct solutions
   Eigen::ArrayXd e_, p_, dp_, r_, row_weight_;
   // The last evaluation, so asking again for the same point costs nothing.
   bool same(const Family& f, const Theta& th) const {
@@ -422,6 +452,87 @@ LmResult levenberg_marquardt(const Family& f, Theta th, Evaluator& eval) {
   return out;
 }
 
+// The viscous model by variable projection: Newton's method on the one-dimensional projected
+// SSE F(α) = Σw·y² − (Σw·y·e)²/Σw·e², u0 following in closed form. The same minimum as LM over
+// (u0, α), reached with one cheap pass per iteration (no Jacobian matrix). Stops by the same
+// rule as LM: the step is a tiny fraction of α's standard error, whose variance is s²·2/F''.
+// nullopt when Newton is not safe (F'' ≤ 0, α driven to its bound, no convergence): LM then.
+std::optional<Theta> viscous_by_projection(Evaluator& eval, double alpha, int& passes) {
+  const double sum_wyy = eval.weighted_sum_sq();
+  const double dof = static_cast<double>(std::max<std::size_t>(eval.size(), 3) - 2);
+  for (int it = 0; it < 30; ++it) {
+    const Evaluator::DecaySums s = eval.decay_sums(alpha);
+    ++passes;
+    // F = Syy − N²/D with N = Σw·y·e, D = Σw·e²; dN/dα = −Σw·τ·y·e, dD/dα = −2·Σw·τ·e², …
+    const double N = s.ye, D = s.ee, N1 = -s.t_ye, N2 = s.tt_ye, D1 = -2 * s.t_ee, D2 = 4 * s.tt_ee;
+    if (!(D > 0) || !(N > 0)) return std::nullopt;
+    const double u = 2 * N * N1 * D - N * N * D1;
+    const double grad = -u / (D * D);
+    const double hess = -(2 * N1 * N1 * D + 2 * N * N2 * D - N * N * D2) / (D * D) + 2 * D1 * u / (D * D * D);
+    if (!(hess > 0) || !std::isfinite(grad)) return std::nullopt;
+    const double step = -grad / hess;
+    const double var_alpha = 2 * std::max(sum_wyy - N * N / D, 0.0) / dof / hess;
+    if (std::abs(step) <= negligible_step_in_se * std::sqrt(var_alpha) || std::abs(step) <= 1e-12 * alpha)
+      return Theta{N / D, alpha, 0.0};
+    if (alpha + step <= 0) return std::nullopt;  // at the bound α = 0: LM's projection handles it
+    alpha += step;
+  }
+  return std::nullopt;
+}
+
+// The Coulomb model in closed form. While moving it is the straight line u0 − β·τ, and the
+// samples that move are those before its stop ts = u0/β; so for each count m of moving samples
+// the weighted SSE is a quadratic in (u0, β) whose minimum is either the plain line fit over the
+// first m samples (when its own stop falls between τ[m−1] and τ[m]) or on that range's edge
+// ts = τ[m], the line through (τ[m], 0). Running sums give every candidate's SSE in O(1), so
+// one pass over m finds the global minimum of the clamped SSE — where LM from a start could
+// stop at a nearby kink. nullopt when the clock is not sorted or no falling line fits: LM then.
+std::optional<Theta> coulomb_by_line_scan(const Evaluator& eval, int& passes) {
+  const std::span<const double> tau = eval.tau(), w = eval.weights(), wy = eval.weighted_readings();
+  const std::size_t n = tau.size();
+  if (!eval.sorted() || n < 3) return std::nullopt;
+  ++passes;
+  // Each candidate is a least-squares optimum, so its SSE is Σw·y² minus a gain q/d; the best
+  // candidate has the largest gain. Compared as q·d_best > q_best·d (d > 0): no division per m.
+  double sw = 0, st = 0, stt = 0, sy = 0, sty = 0;  // Σw, Σw·τ, Σw·τ², Σw·y, Σw·τ·y over i < m
+  double best_q = 0, best_d = 1;
+  std::size_t best_m = 0;
+  bool best_is_edge = false;
+  const auto better = [&](double q, double d) { return q * best_d > best_q * d; };
+  for (std::size_t m = 1; m <= n; ++m) {
+    const double t = tau[m - 1];
+    sw += w[m - 1], st += w[m - 1] * t, stt += w[m - 1] * t * t, sy += wy[m - 1], sty += wy[m - 1] * t;
+    if (m < 3) continue;
+    // Plain line over the first m: [Σw −Σwτ; −Σwτ Σwτ²]·(u0, β) = (Σwy, −Σwτy), i.e.
+    // u0 = U/det, β = B/det; it counts if it falls (U, B > 0) and stops in (τ[m−1], τ[m]].
+    const double det = sw * stt - st * st;
+    const double U = stt * sy - st * sty, B = st * sy - sw * sty;
+    if (det > 0 && U > 0 && B > 0 && U > B * t && (m == n || U <= B * tau[m])) {
+      const double q = stt * sy * sy - 2 * st * sy * sty + sw * sty * sty;  // gain·det
+      if (better(q, det)) best_q = q, best_d = det, best_m = m, best_is_edge = false;
+    }
+    // The edge: stopped exactly at the next sample, u0 = β·τ[m], one-parameter least squares
+    // with β = num/den; its gain is num²/den.
+    if (m < n) {
+      const double te = tau[m];
+      const double num = te * sy - sty, den = te * te * sw - 2 * te * st + stt;  // Σw·y·(te−τ), Σw·(te−τ)²
+      if (den > 0 && num > 0 && better(num * num, den)) best_q = num * num, best_d = den, best_m = m, best_is_edge = true;
+    }
+  }
+  if (best_m == 0) return std::nullopt;
+  // The winner's parameters from its own sums (one more short pass).
+  sw = st = stt = sy = sty = 0;
+  for (std::size_t i = 0; i < best_m; ++i)
+    sw += w[i], st += w[i] * tau[i], stt += w[i] * tau[i] * tau[i], sy += wy[i], sty += wy[i] * tau[i];
+  if (best_is_edge) {
+    const double te = tau[best_m];
+    const double beta = (te * sy - sty) / (te * te * sw - 2 * te * st + stt);
+    return Theta{beta * te, 0.0, beta};
+  }
+  const double det = sw * stt - st * st;
+  return Theta{(stt * sy - st * sty) / det, 0.0, (st * sy - sw * sty) / det};
+}
+
 struct Covariance {
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
   bool ok = false;
@@ -556,10 +667,20 @@ ModelFit fit_model(ModelKind kind, std::span<const double> tau, std::span<const 
   if (fam.beta_free && !(th.beta > 0)) th.beta = fam.alpha_free ? 1e-3 * th.u0 / span_s : th.u0 / span_s;
 
   Evaluator& eval = *evaluator;
-  const LmResult lm = levenberg_marquardt(fam, th, eval);
-  out.evaluations = lm.evals;
-  th = lm.theta;
-  bool solved = lm.converged;
+  // Viscous and Coulomb have direct solutions (one parameter by Newton, or none); LM for the
+  // combined model and whenever a direct solution declines.
+  std::optional<Theta> direct;
+  if (kind == ModelKind::viscous) direct = viscous_by_projection(eval, th.alpha, out.evaluations);
+  if (kind == ModelKind::coulomb) direct = coulomb_by_line_scan(eval, out.evaluations);
+  bool solved = direct.has_value();
+  if (direct) {
+    th = *direct;
+  } else {
+    const LmResult lm = levenberg_marquardt(fam, th, eval);
+    out.evaluations += lm.evals;
+    th = lm.theta;
+    solved = lm.converged;
+  }
   std::string why;
   if (!solved) {
     // Fallback: NLopt's L-BFGS under bounds on scaled parameters, from LM's best point.
@@ -568,6 +689,7 @@ ModelFit fit_model(ModelKind kind, std::span<const double> tau, std::span<const 
   }
   // The likelihood is the weighted one (weights average 1, so with equal weights it is the
   // classic n·log(SSE/n)); RMSE and R² are in the reading's own unit.
+  const Covariance cv = covariance(fam, th, eval);  // first: its Jacobian pass serves the sums below
   const double wsse = eval(fam, th);
   const double sse = eval.plain_sse(fam, th);
   const double n = static_cast<double>(tau.size());
@@ -584,7 +706,6 @@ ModelFit fit_model(ModelKind kind, std::span<const double> tau, std::span<const 
   out.rate = th.alpha;
   out.decel = th.beta / k;
 
-  const Covariance cv = covariance(fam, th, eval);
   out.converged = solved && cv.ok;
   if (!solved) out.message = why;
   else if (!cv.ok) out.message = "parameters are not identifiable from this run (singular Jacobian)";
