@@ -3,9 +3,11 @@
 //   viscous   T = c1·ω        ω = ω0·e^(−c1 τ/J)                        (never stops)
 //   coulomb   T = c2          ω = max(ω0 − c2 τ/J, 0)
 //   combined  T = c3·ω + c4   ω = max(−c4/c3 + (ω0 + c4/c3)·e^(−c3 τ/J), 0)
-// τ is time since the cut; the reading is zero_level + k·ω (k = K_b for volts). Starting
-// points from separable/linear fits (Eigen), refinement with NLopt under bounds, standard
-// errors from the Jacobian at the optimum (widened when residuals are correlated).
+// τ is time since the cut; the reading is zero_level + k·ω (k = K_b for volts). Weighted least
+// squares: Coulomb in closed form (a scan over the stop), viscous by Newton over c1/J with ω0
+// projected out, combined by Levenberg–Marquardt from the integral form's linear solution (NLopt
+// under bounds as the fallback); standard errors from the Jacobian at the optimum (widened when
+// residuals are correlated).
 #include <optional>
 #include <span>
 #include <string>
