@@ -8,6 +8,9 @@
 #      spindown-logger's default flush interval (0.5 s) and with --flush-interval 0.1. What
 #      spindown-logger must keep: every message sent more than one flush interval before the kill
 #      (counted from the publisher's first/last send time, the burst's rate being uniform).
+# Each line also gives the datagrams the kernel dropped at that logger's socket (its receive
+# buffer full: /proc/net/udp "drops"): traffic the logger never saw, as opposed to traffic it
+# read and lost.
 # Usage: bench/logger_vs_lcm_logger.sh [BIN_DIR]   (default build/bin)
 # ONLY=K runs scenario K alone.
 set -euo pipefail
@@ -29,6 +32,27 @@ count() {  # count FILE...: SAMPLE messages in LCM logs
   "$BIN/spindown-log-summary" "$@" | python3 -c 'import json,sys; print(json.load(sys.stdin)["sample_messages"])'
 }
 cpu_ticks() { awk '{print $14 + $15}' "/proc/$1/stat"; }
+# socket_inodes PID: the inodes of the sockets PID holds (its LCM receive socket among them).
+socket_inodes() {
+  local fd link
+  for fd in /proc/"$1"/fd/*; do
+    link=$(readlink "$fd") || continue
+    if [[ $link == socket:\[*\] ]]; then link=${link#socket:[}; echo "${link%]}"; fi
+  done
+}
+# kernel_drops VAR INODE...: sets VAR to the datagrams the kernel dropped at these UDP sockets
+# (/proc/net/udp "drops"). Read while the sockets exist, before their process ends; no fork, so
+# it delays nothing measurable.
+kernel_drops() {
+  local -n total=$1; shift
+  local f inode
+  total=0
+  while read -r -a f; do
+    for inode in "$@"; do
+      if [[ ${f[9]} == "$inode" ]]; then total=$((total + f[${#f[@]} - 1])); fi
+    done
+  done </proc/net/udp
+}
 start_both() {  # start_both DIR [FLUSH_INTERVAL_S]
   mkdir -p "$1/ours" "$1/theirs"
   "$BIN/spindown-logger" --lcm-url "$URL" --dir "$1/ours" ${2:+--flush-interval "$2"} -q 2>"$1/ours.err" &
@@ -37,6 +61,12 @@ start_both() {  # start_both DIR [FLUSH_INTERVAL_S]
   THEIRS=$!
   PIDS+=("$OURS" "$THEIRS")
   sleep 1
+  mapfile -t OURS_SOCKETS < <(socket_inodes "$OURS")
+  mapfile -t THEIRS_SOCKETS < <(socket_inodes "$THEIRS")
+}
+read_drops() {  # read_drops: OURS_DROPS and THEIRS_DROPS, the kernel's drops at each logger's sockets
+  kernel_drops OURS_DROPS "${OURS_SOCKETS[@]}"
+  kernel_drops THEIRS_DROPS "${THEIRS_SOCKETS[@]}"
 }
 stop_both() {  # stop_both SIGNAL
   kill "-$1" "$OURS" "$THEIRS"
@@ -51,6 +81,7 @@ kill_after_burst() {  # kill_after_burst DIR FLUSH_S (empty = the logger's defau
   local n=${KILL_BURST:-50000} flush=${2:-0.5}
   start_both "$1" "$2"
   "$BIN/spindown-lcm-publish" --lcm-url "$URL" --bench burst --count "$n" --rate 0 >"$1/pub.json"
+  read_drops  # final already: loopback delivers (or drops) each datagram within the sender's call
   sleep 0.2
   local kill_us; kill_us=$(now_us)
   stop_both KILL
@@ -63,8 +94,8 @@ n, first, last, edge = $n, $first, $last, $kill_us - $flush * 1e6
 print(n if edge >= last else max(0, int(n * (edge - first) / max(last - first, 1))))")
   printf '   flush %-4s s  burst %.3f s, kill %.3f s after its end; %d sent > one flush interval before the kill\n' \
     "$flush" "$(awk "BEGIN{print ($last - $first) / 1e6}")" "$(awk "BEGIN{print ($kill_us - $last) / 1e6}")" "$protected"
-  printf '   %-16s %8s of %d\n' spindown-logger "$(count "$1"/ours/*.lcm)" "$n"
-  printf '   %-16s %8s of %d\n' lcm-logger "$(count "$1"/theirs/*)" "$n"
+  printf '   %-16s %8s of %d, %d dropped by the kernel\n' spindown-logger "$(count "$1"/ours/*.lcm)" "$n" "$OURS_DROPS"
+  printf '   %-16s %8s of %d, %d dropped by the kernel\n' lcm-logger "$(count "$1"/theirs/*)" "$n" "$THEIRS_DROPS"
 }
 
 if [[ ${ONLY:-} == K ]]; then
@@ -78,31 +109,34 @@ N=${BURST:-20000}
 echo "A  burst of $((4 * N)) messages (4 benches, publisher at full speed), SIGTERM right after"
 start_both "$WORK/a"
 "$BIN/spindown-lcm-publish" --lcm-url "$URL" --benches 4 --count "$N" --rate 0 >/dev/null
+read_drops
 stop_both TERM
-printf '   %-16s %8s of %d\n' spindown-logger "$(count "$WORK"/a/ours/*.lcm)" $((4 * N))
-printf '   %-16s %8s of %d\n' lcm-logger "$(count "$WORK"/a/theirs/*)" $((4 * N))
+printf '   %-16s %8s of %d, %d dropped by the kernel\n' spindown-logger "$(count "$WORK"/a/ours/*.lcm)" $((4 * N)) "$OURS_DROPS"
+printf '   %-16s %8s of %d, %d dropped by the kernel\n' lcm-logger "$(count "$WORK"/a/theirs/*)" $((4 * N)) "$THEIRS_DROPS"
 
 echo "B  200 messages at 100 Hz, 2 s of silence, then SIGKILL"
 start_both "$WORK/b"
 "$BIN/spindown-lcm-publish" --lcm-url "$URL" --bench quiet --count 200 --rate 100 >/dev/null
 sleep 2
+read_drops
 stop_both KILL
-printf '   %-16s %8s of 200\n' spindown-logger "$(count "$WORK"/b/ours/*.lcm)"
-printf '   %-16s %8s of 200\n' lcm-logger "$(count "$WORK"/b/theirs/*)"
+printf '   %-16s %8s of 200, %d dropped by the kernel\n' spindown-logger "$(count "$WORK"/b/ours/*.lcm)" "$OURS_DROPS"
+printf '   %-16s %8s of 200, %d dropped by the kernel\n' lcm-logger "$(count "$WORK"/b/theirs/*)" "$THEIRS_DROPS"
 
 echo "C  100 benches at 50 Hz for 10 s, SIGTERM after"
 start_both "$WORK/c"
 o0=$(cpu_ticks "$OURS"); t0=$(cpu_ticks "$THEIRS")
 "$BIN/spindown-lcm-publish" --lcm-url "$URL" --benches 100 --count 500 --rate 50 >"$WORK/c/pub.json"
 o1=$(cpu_ticks "$OURS"); t1=$(cpu_ticks "$THEIRS")
+read_drops
 stop_both TERM
 hz=$(getconf CLK_TCK)
 sent=$(python3 -c "import json; print(json.load(open('$WORK/c/pub.json'))['sample_messages'])")
 secs=10
-printf '   %-16s %8s of %s messages, CPU %.1f %% of one core\n' spindown-logger "$(count "$WORK"/c/ours/*.lcm)" "$sent" \
-  "$(awk "BEGIN{print 100 * ($o1 - $o0) / $hz / $secs}")"
-printf '   %-16s %8s of %s messages, CPU %.1f %% of one core\n' lcm-logger "$(count "$WORK"/c/theirs/*)" "$sent" \
-  "$(awk "BEGIN{print 100 * ($t1 - $t0) / $hz / $secs}")"
+printf '   %-16s %8s of %s messages, %d dropped by the kernel, CPU %.1f %% of one core\n' spindown-logger \
+  "$(count "$WORK"/c/ours/*.lcm)" "$sent" "$OURS_DROPS" "$(awk "BEGIN{print 100 * ($o1 - $o0) / $hz / $secs}")"
+printf '   %-16s %8s of %s messages, %d dropped by the kernel, CPU %.1f %% of one core\n' lcm-logger \
+  "$(count "$WORK"/c/theirs/*)" "$sent" "$THEIRS_DROPS" "$(awk "BEGIN{print 100 * ($t1 - $t0) / $hz / $secs}")"
 
 echo "K  ${KILL_BURST:-50000} messages at full speed, 200 ms pause, SIGKILL"
 kill_after_burst "$WORK/k1" ""
