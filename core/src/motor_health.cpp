@@ -340,6 +340,12 @@ bool HealthThresholds::is_valid(std::string* why) const {
   return true;
 }
 
+std::optional<FrictionEstimate> combined_friction(const RunFit& fit) {
+  const auto f = friction_of(fit.model(ModelKind::combined));
+  if (!f) return std::nullopt;
+  return FrictionEstimate{f->viscous.value, f->viscous.se, f->coulomb.value, f->coulomb.se};
+}
+
 HealthVerdict assess_health(const RunFit& fit, const MotorHealthConfig& cfg) {
   HealthVerdict v;
   const HealthThresholds& th = cfg.thresholds;

@@ -103,6 +103,14 @@ struct HealthVerdict {
 
 HealthVerdict assess_health(const RunFit& fit, const MotorHealthConfig& cfg);
 
+// The combined model's friction, as assess_health compares it with a baseline: c_v (c3,
+// N·m·s/rad) and c_c (c4, N·m) with their standard errors (0 when the fit gave none).
+struct FrictionEstimate {
+  double c_viscous = 0, c_viscous_stderr = 0, c_coulomb = 0, c_coulomb_stderr = 0;
+};
+// nullopt when the combined model did not converge or has no finite c3, c4.
+std::optional<FrictionEstimate> combined_friction(const RunFit& fit);
+
 // Reads [motor], [baseline], [health] from the bench's TOML file (keys it does not set keep
 // their defaults; other sections are left to their readers). Throws std::runtime_error naming
 // the file, the key and what was wrong (also for unknown keys in these three sections).

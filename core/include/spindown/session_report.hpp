@@ -142,10 +142,4 @@ void summarize_session(SessionReport& report);
 // time taken as UTC); nullopt when the text does not start with such a header.
 std::optional<double> putty_log_time(std::string_view head);
 
-// The combined model's c_v and c_c with their standard errors, when it converged.
-struct FrictionEstimate {
-  double c_viscous = 0, c_viscous_stderr = 0, c_coulomb = 0, c_coulomb_stderr = 0;
-};
-std::optional<FrictionEstimate> combined_friction(const RunFit& fit);
-
 }  // namespace spindown
