@@ -381,3 +381,19 @@ TEST(ArduinoText, BytesThatAreNotUtf8AreEscapedInMessages) {
   ASSERT_NE(cut, nullptr);
   EXPECT_NE(cut->message.find(std::string(38, 'a') + "\xc2\xb5\xc2\xb5\"…"), std::string::npos) << cut->message;
 }
+
+// Samples far into a file (many blocks of fast-path lines, mixed with lines the slow path takes)
+// are quoted in messages by their own line's text and number.
+TEST(ArduinoText, MessagesQuoteTheirOwnLineDeepInAFile) {
+  std::string text = cadence(1000, 150, 20, "2.50");
+  text += "  4000\t2.50\r\n";  // line 151: slow path (leading blanks), in order
+  text += cadence(4020, 100, 20, "1.25");
+  text += "6000\t7.77\n";      // line 252: repeats the time of line 251
+  text += cadence(6020, 80, 20, "0.50");
+  const Recording r = read_arduino_text(text, "deep.tsv");
+  ASSERT_NE(at_line(r, 252), nullptr) << all_diagnostics(r);
+  EXPECT_NE(at_line(r, 252)->message.find("\"6000\\t7.77\""), std::string::npos) << all_diagnostics(r);
+  EXPECT_NE(at_line(r, 252)->message.find("line 251"), std::string::npos) << all_diagnostics(r);
+  EXPECT_EQ(r.size(), 150u + 1 + 100 + 80);
+  EXPECT_TRUE(strictly_increasing(r.t_s));
+}

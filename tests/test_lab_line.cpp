@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <vector>
+#include <cstdio>
 #include <cstring>
 #include <random>
 #include <string>
@@ -185,5 +186,47 @@ TEST(LabLineFastPath, AgreesWithTheSlowPathOnRandomLines) {
     if (i % 4) line += '.' + digits(std::uniform_int_distribution<int>(0, 8)(rng));
     expect_fast_path_agrees(line, i % 2 ? "\r" : "\n");
     if (HasFatalFailure()) return;
+  }
+}
+
+// The many-lines fast path takes exactly the lines parse_printed_sample takes, one after another,
+// with the same numbers, and stops at the first it does not (or at max_lines).
+TEST(LabLineFastPath, ManyLinesAgreeWithOneLineAtATime) {
+  std::mt19937 rng(11);
+  const char* shapes[] = {"%d\t%d.%02d", "%d %d.%02d", "%d\t-%d.%02d", "%d\t%d.%d", "%d\t%d", "%d\t%d.%02dx", " %d\t%d.%02d"};
+  const char* endings[] = {"\r\n", "\n", "\r"};
+  for (int round = 0; round < 2000; ++round) {
+    std::string text;
+    const int n = std::uniform_int_distribution<int>(0, 40)(rng);
+    for (int k = 0; k < n; ++k) {
+      char line[64];
+      const char* shape = shapes[std::uniform_int_distribution<int>(0, round % 3 ? 1 : 6)(rng)];
+      std::snprintf(line, sizeof line, shape, std::uniform_int_distribution<int>(0, 9999999)(rng),
+                    std::uniform_int_distribution<int>(0, 99)(rng), std::uniform_int_distribution<int>(0, 99)(rng));
+      text += line;
+      text += endings[std::uniform_int_distribution<int>(0, 2)(rng)];
+    }
+    const std::size_t max_lines = round % 5 == 0 ? 7 : 64;
+    std::vector<double> millis, values;
+    const PrintedLines taken = parse_printed_lines(text, max_lines, millis, values);
+    ASSERT_EQ(millis.size(), taken.lines);
+    ASSERT_EQ(values.size(), taken.lines);
+    // One at a time, as the reader did before.
+    std::string_view rest = text;
+    std::size_t lines = 0;
+    while (lines < max_lines) {
+      LabLine one;
+      const std::size_t length = parse_printed_sample(rest, one);
+      if (length == 0) break;
+      ASSERT_LT(lines, taken.lines) << text;
+      EXPECT_EQ(static_cast<double>(one.millis), millis[lines]);
+      EXPECT_EQ(std::memcmp(&one.value, &values[lines], sizeof(double)), 0);
+      std::size_t next = length + 1;
+      if (rest[length] == '\r' && next < rest.size() && rest[next] == '\n') ++next;
+      rest.remove_prefix(next);
+      ++lines;
+    }
+    ASSERT_EQ(lines, taken.lines) << text;
+    EXPECT_EQ(taken.bytes, text.size() - rest.size());
   }
 }

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
-#include <vector>
 
 #include "spindown/lab_line.hpp"
 #include "spindown/read_recording.hpp"
@@ -60,34 +59,36 @@ Recording read_arduino_text(std::string_view text, std::string source, const Ard
   }
 
   text::LineReporter reporter(rec, options.max_line_reports);
-  std::vector<text::RawSample> raw;
-  raw.reserve(text.size() / 10 + 1);
+  text::RawSamples raw(text);
+  raw.reserve(text.size() / 10 + 1);  // the sketch's lines are 10 to 14 bytes
   std::size_t blank = 0, headers = 0, garbled = 0, column_headers = 0;
   bool session_start = true;   // next sample is the first of a logging session
   bool first_content = true;   // next non-blank line is the first of a session
   std::int64_t first_bad_line = 0;
   std::string_view first_bad_why;
 
-  // A line as the sketch prints it takes the fast path: parsed where it lies, no line split
-  // first. Anything else is split off and judged by parse_lab_line, which names what is wrong.
   text::LineCursor cursor(text);
   while (!cursor.at_end()) {
-    LabLine parsed;
-    std::string_view line;
-    if (const std::size_t length = parse_printed_sample(cursor.rest(), parsed)) {
-      line = cursor.rest().substr(0, length);
-      cursor.skip_line(length);
-    } else {
-      line = cursor.next_line();
-      if (is_putty_header(line)) {
-        ++headers;
-        rec.note(cursor.line_number(), text::putty_header_note(line));
-        session_start = first_content = true;
-        continue;
-      }
-      parsed = parse_lab_line(line);
+    // Lines as the sketch prints them take the fast path: a block of them at a time, parsed
+    // where they lie, no line split first.
+    const std::size_t first = raw.size();
+    const PrintedLines printed = parse_printed_lines(cursor.rest(), text::RawSamples::block_lines, raw.t, raw.value);
+    if (printed.lines > 0) {
+      raw.added_lines(first, cursor.line_number() + 1, cursor.rest().data(), session_start);
+      cursor.skip_lines(printed.bytes, printed.lines);
+      session_start = first_content = false;
+      continue;
     }
+    // Anything else is split off and judged by parse_lab_line, which names what is wrong.
+    const std::string_view line = cursor.next_line();
     const std::int64_t n = cursor.line_number();
+    if (is_putty_header(line)) {
+      ++headers;
+      rec.note(n, text::putty_header_note(line));
+      session_start = first_content = true;
+      continue;
+    }
+    const LabLine parsed = parse_lab_line(line);
     if (parsed.kind == LabLine::Kind::blank) {
       ++blank;
       continue;
@@ -113,7 +114,7 @@ Recording read_arduino_text(std::string_view text, std::string source, const Ard
       first_content = false;
       continue;
     }
-    raw.push_back({n, static_cast<double>(parsed.millis), parsed.value, session_start, line});
+    raw.add(n, line.data(), static_cast<double>(parsed.millis), parsed.value, session_start);
     session_start = first_content = false;
   }
   const std::int64_t lines = cursor.line_number();

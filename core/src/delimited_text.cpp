@@ -383,7 +383,7 @@ Recording read_delimited_text(std::string_view text, std::string source, const D
 
   // Rows.
   text::LineReporter reporter(rec, options.max_line_reports);
-  std::vector<text::RawSample> raw;
+  text::RawSamples raw(text);
   raw.reserve(content.size());
   std::size_t bad = 0;
   const std::size_t need = static_cast<std::size_t>(std::max(tcol, vcol)) + 1;
@@ -410,7 +410,7 @@ Recording read_delimited_text(std::string_view text, std::string source, const D
                                              text::escape_invalid_utf8(fields[vcol].substr(0, 40)), w));
       continue;
     }
-    raw.push_back({line.number, t, v, false, line.text});
+    raw.add(line.number, line.text.data(), t, v, false);
   }
 
   // Time unit.
@@ -426,8 +426,8 @@ Recording read_delimited_text(std::string_view text, std::string source, const D
     std::vector<double> steps;
     bool integral = true;
     for (std::size_t i = 0; i < raw.size() && i < 65; ++i) {
-      integral = integral && raw[i].t == std::floor(raw[i].t);
-      if (i > 0 && raw[i].t > raw[i - 1].t) steps.push_back(raw[i].t - raw[i - 1].t);
+      integral = integral && raw.t[i] == std::floor(raw.t[i]);
+      if (i > 0 && raw.t[i] > raw.t[i - 1]) steps.push_back(raw.t[i] - raw.t[i - 1]);
     }
     double step = 0;
     if (!steps.empty()) {

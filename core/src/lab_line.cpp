@@ -157,26 +157,35 @@ std::uint64_t without_byte(std::uint64_t w, int k) {
 
 bool is_line_end(char c) { return c == '\r' || c == '\n'; }
 
-}  // namespace
+// The words and bytes a printed line is read from lie within its first 18 bytes: with less text
+// than this left (a file's last line or two) a line takes the slow path.
+constexpr std::size_t enough_text = 24;
 
-std::size_t parse_printed_sample(std::string_view text, LabLine& sample) {
-  if constexpr (std::endian::native != std::endian::little) return 0;
-  // The words and bytes read below lie within the text's first 18 bytes: with less than this
-  // left (a file's last line or two) the line takes the slow path.
-  constexpr std::size_t enough_text = 24;
-  if (text.size() < enough_text) return 0;
-  const char* const begin = text.data();
-
+// The fast path for the line at begin (at least enough_text bytes readable): its length without
+// the terminator, with ticks and value set; 0 when it is not a line as the sketch prints it.
+// Inlined into both callers so the word constants stay in registers across a file's lines.
+[[gnu::always_inline]] inline std::size_t printed_line(const char* begin, std::uint64_t& ticks, double& value) {
   // Time: 1 to 7 digits (up to 2.7 hours of millis(); later times take the slow path), then a
   // tab or a space.
   const std::uint64_t time_word = load_word(begin);
   const int time_digits = leading_digits(time_word);
   if (time_digits == 0 || time_digits == 8) return 0;
   if (begin[time_digits] != '\t' && begin[time_digits] != ' ') return 0;
+  ticks = digits_value(time_word, time_digits);
+  const char* q = begin + time_digits + 1;
+
+  // The sketch's usual value, "d.dd" (volts from Serial.println(float)): three digits read one
+  // by one, the same mantissa and power of ten as the general case below would take.
+  const unsigned ones = static_cast<unsigned char>(q[0]) - unsigned{'0'};
+  const unsigned tenths = static_cast<unsigned char>(q[2]) - unsigned{'0'};
+  const unsigned hundredths = static_cast<unsigned char>(q[3]) - unsigned{'0'};
+  if (ones <= 9 && q[1] == '.' && tenths <= 9 && hundredths <= 9 && is_line_end(q[4])) {
+    value = plain_decimal_value(ones * 100 + tenths * 10 + hundredths, 2, false);
+    return static_cast<std::size_t>(q + 4 - begin);
+  }
 
   // Value: [-]digits[.digits], 1 to 7 digits in all, then CR or LF. With the point taken out
   // the digits are one run that digits_value reads at once.
-  const char* q = begin + time_digits + 1;
   const bool negative = *q == '-';
   if (negative) ++q;
   std::uint64_t value_word = load_word(q);
@@ -186,10 +195,41 @@ std::size_t parse_printed_sample(std::string_view text, LabLine& sample) {
   const int digits = leading_digits(value_word);  // at most 7 with a point (the top byte is 0)
   const char* const stop = q + digits + (point ? 1 : 0);
   if (digits == 0 || digits == 8 || !is_line_end(*stop)) return 0;
-  const double value = plain_decimal_value(digits_value(value_word, digits), point ? digits - whole_digits : -1, negative);
-
-  sample = sample_line(digits_value(time_word, time_digits), value);
+  value = plain_decimal_value(digits_value(value_word, digits), point ? digits - whole_digits : -1, negative);
   return static_cast<std::size_t>(stop - begin);
+}
+
+}  // namespace
+
+std::size_t parse_printed_sample(std::string_view text, LabLine& sample) {
+  if constexpr (std::endian::native != std::endian::little) return 0;
+  if (text.size() < enough_text) return 0;
+  std::uint64_t ticks = 0;
+  double value = 0;
+  const std::size_t length = printed_line(text.data(), ticks, value);
+  if (length > 0) sample = sample_line(ticks, value);
+  return length;
+}
+
+PrintedLines parse_printed_lines(std::string_view text, std::size_t max_lines, std::vector<double>& millis,
+                                 std::vector<double>& values) {
+  PrintedLines taken;
+  if constexpr (std::endian::native != std::endian::little) return taken;
+  const char* p = text.data();
+  const char* const end = p + text.size();
+  while (taken.lines < max_lines && static_cast<std::size_t>(end - p) >= enough_text) {
+    std::uint64_t ticks = 0;
+    double value = 0;
+    const std::size_t length = printed_line(p, ticks, value);
+    if (length == 0) break;
+    millis.push_back(static_cast<double>(ticks));
+    values.push_back(value);
+    const char* const stop = p + length;  // CR or LF, with enough_text bytes after p
+    p = stop + (stop[0] == '\r' && stop[1] == '\n' ? 2 : 1);
+    ++taken.lines;
+  }
+  taken.bytes = static_cast<std::size_t>(p - text.data());
+  return taken;
 }
 
 }  // namespace spindown

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <fcntl.h>
 #include <fmt/format.h>
+#include <memory>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -66,9 +67,16 @@ struct FdCloser {
   ~FdCloser() { ::close(fd); }
 };
 
-std::optional<std::string> read_fd_bytes(int fd, const struct stat& st, const std::string& path, std::string* why,
-                                         std::size_t max_bytes) {
-  auto fail = [&](std::string msg) -> std::optional<std::string> {
+// A file's bytes, in a buffer that is not zero-filled before the read overwrites it.
+struct FileBytes {
+  std::unique_ptr<char[]> data;
+  std::size_t size = 0;
+  std::string_view view() const { return {data.get(), size}; }
+};
+
+std::optional<FileBytes> read_fd_bytes(int fd, const struct stat& st, const std::string& path, std::string* why,
+                                       std::size_t max_bytes) {
+  auto fail = [&](std::string msg) -> std::optional<FileBytes> {
     if (why) *why = std::move(msg);
     return std::nullopt;
   };
@@ -76,25 +84,25 @@ std::optional<std::string> read_fd_bytes(int fd, const struct stat& st, const st
   if (S_ISREG(st.st_mode) && static_cast<std::size_t>(st.st_size) > max_bytes)
     return fail(fmt::format("cannot read {}: {} bytes is more than the {} bytes a text recording may have", path,
                             st.st_size, max_bytes));
-  std::string bytes;
   // One byte more than the size, so the read that sees the end needs no growth.
-  bytes.resize(S_ISREG(st.st_mode) ? static_cast<std::size_t>(st.st_size) + 1 : 0);
-  std::size_t have = 0;
+  std::size_t capacity = S_ISREG(st.st_mode) ? static_cast<std::size_t>(st.st_size) + 1 : 0;
+  FileBytes bytes{std::make_unique_for_overwrite<char[]>(capacity), 0};
   for (;;) {
-    if (have == bytes.size()) {
-      if (bytes.size() >= max_bytes)
-        return fail(fmt::format("cannot read {}: more than {} bytes", path, max_bytes));
-      bytes.resize(std::min(max_bytes, std::max<std::size_t>(bytes.size() * 2, 64 * 1024)));
+    if (bytes.size == capacity) {
+      if (capacity >= max_bytes) return fail(fmt::format("cannot read {}: more than {} bytes", path, max_bytes));
+      capacity = std::min(max_bytes, std::max<std::size_t>(capacity * 2, 64 * 1024));
+      auto larger = std::make_unique_for_overwrite<char[]>(capacity);
+      if (bytes.size > 0) std::memcpy(larger.get(), bytes.data.get(), bytes.size);
+      bytes.data = std::move(larger);
     }
-    const ssize_t n = ::read(fd, bytes.data() + have, bytes.size() - have);
+    const ssize_t n = ::read(fd, bytes.data.get() + bytes.size, capacity - bytes.size);
     if (n < 0) {
       if (errno == EINTR) continue;
       return fail(fmt::format("cannot read {}: {}", path, std::strerror(errno)));
     }
     if (n == 0) break;
-    have += static_cast<std::size_t>(n);
+    bytes.size += static_cast<std::size_t>(n);
   }
-  bytes.resize(have);
   return bytes;
 }
 
@@ -112,7 +120,9 @@ std::optional<std::string> read_file_bytes(const std::string& path, std::string*
     if (why) *why = fmt::format("cannot read {}: {}", path, std::strerror(errno));
     return std::nullopt;
   }
-  return read_fd_bytes(fd, st, path, why, max_bytes);
+  auto bytes = read_fd_bytes(fd, st, path, why, max_bytes);
+  if (!bytes) return std::nullopt;
+  return std::string(bytes->view());
 }
 
 FileFormat detect_format(std::string_view head, const ReadOptions& options) {
@@ -128,6 +138,13 @@ FileFormat detect_format(std::string_view head, const ReadOptions& options) {
   std::size_t content = 0, samples = 0;
   text::LineCursor lines(head.substr(0, 64 * 1024));
   while (content < 50 && !lines.at_end()) {  // stop there: splitting the rest cost as much as parsing it
+    LabLine printed;
+    if (const std::size_t length = parse_printed_sample(lines.rest(), printed)) {  // the usual line, quickly
+      lines.skip_line(length);
+      ++content;
+      ++samples;
+      continue;
+    }
     const std::string_view line = lines.next_line();
     if (line.starts_with("=~=~=~")) continue;
     const LabLine parsed = parse_lab_line(line);
@@ -169,7 +186,7 @@ std::vector<Recording> read_recordings(const std::string& path, const ReadOption
   // only once, so it is read whole first (an LCM log cannot come that way: lcm::LogFile seeks).
   char head[4] = {};
   std::size_t head_len = 0;
-  std::optional<std::string> text_bytes;
+  std::optional<FileBytes> text_bytes;
   {
     const int fd = open_for_reading(path);
     if (fd < 0) {
@@ -192,7 +209,7 @@ std::vector<Recording> read_recordings(const std::string& path, const ReadOption
         add(failed(path, why), {});
         return out;
       }
-      if (detect_format(*text_bytes, options) == FileFormat::lcm_log || options.format == FileFormat::lcm_log) {
+      if (detect_format(text_bytes->view(), options) == FileFormat::lcm_log || options.format == FileFormat::lcm_log) {
         add(failed(path, fmt::format("cannot read {} as an LCM log: it is a pipe or device, and lcm::LogFile needs a "
                                      "regular file",
                                      path)),
@@ -243,7 +260,7 @@ std::vector<Recording> read_recordings(const std::string& path, const ReadOption
     return out;
   }
 
-  const std::string& bytes = *text_bytes;
+  const std::string_view bytes = text_bytes->view();
   const FileFormat format = detect_format(bytes, options);
   if (format == FileFormat::delimited_text)
     add(read_delimited_text(bytes, path, options.delimited), {FileFormat::delimited_text, {}, {}, 0});

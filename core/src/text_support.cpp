@@ -126,14 +126,33 @@ std::string putty_header_note(std::string_view line) {
   return fmt::format("PuTTY log header skipped: {}", quote_line(line));
 }
 
+const RawSamples::Block& RawSamples::block_of(std::size_t i) const {
+  const auto after = std::upper_bound(blocks_.begin(), blocks_.end(), i,
+                                      [](std::size_t k, const Block& b) { return k < b.first; });
+  return *(after - 1);
+}
+
+std::int64_t RawSamples::line(std::size_t i) const {
+  const Block& b = block_of(i);
+  return b.first_line + static_cast<std::int64_t>(i - b.first);
+}
+
+std::string_view RawSamples::text(std::size_t i) const {
+  const Block& b = block_of(i);
+  LineCursor lines(std::string_view(b.start, static_cast<std::size_t>(text_end_ - b.start)));
+  std::string_view line;
+  for (std::size_t k = b.first; k <= i; ++k) line = lines.next_line();
+  return line;
+}
+
 namespace {
 
-// Median of the positive steps between consecutive times in raw[from, from + count].
-double median_step(const std::vector<RawSample>& raw, std::size_t from, std::size_t count) {
+// Median of the positive steps between consecutive times in t[from, from + count].
+double median_step(const std::vector<double>& t, std::size_t from, std::size_t count) {
   double steps[64];
   std::size_t n = 0;
-  for (std::size_t i = from + 1; i < raw.size() && i <= from + count && n < 64; ++i) {
-    const double d = raw[i].t - raw[i - 1].t;
+  for (std::size_t i = from + 1; i < t.size() && i <= from + count && n < 64; ++i) {
+    const double d = t[i] - t[i - 1];
     if (d > 0) steps[n++] = d;
   }
   if (n == 0) return 0;
@@ -143,19 +162,24 @@ double median_step(const std::vector<RawSample>& raw, std::size_t from, std::siz
 
 }  // namespace
 
-TimelineCounts build_timeline(const std::vector<RawSample>& raw, const TimelineRules& rules,
-                              Recording& rec, LineReporter& reporter) {
+TimelineCounts build_timeline(RawSamples& raw, const TimelineRules& rules, Recording& rec, LineReporter& reporter) {
   using Severity = Diagnostic::Severity;
   TimelineCounts counts;
-  const double period = median_step(raw, 0, 64);
+  const std::vector<double>& t = raw.t;
+  const double period = median_step(t, 0, 64);
   // A step larger than this is a gap in the data, or a garbled time if the next sample
   // continues from the previous one.
   const double jump = period > 0 ? std::max(20 * period, 0.5 * rules.units_per_s) : rules.units_per_s;
   const auto u = rules.unit;
-
-  rec.t_s.reserve(rec.t_s.size() + raw.size());
-  rec.value.reserve(rec.value.size() + raw.size());
   const double units_per_s = rules.units_per_s;
+
+  // Samples kept are written back at kept (never past the one being looked at, so the samples
+  // ahead that the checks read are untouched), then handed to rec.
+  const std::size_t n = raw.size();
+  const std::size_t rec_base = rec.size();
+  std::size_t kept = 0;
+  const auto& blocks = raw.blocks();
+  std::size_t block = 0;
 
   bool have_prev = false;
   double offset = 0;   // wraps so far in this clock epoch, in file units
@@ -163,88 +187,105 @@ TimelineCounts build_timeline(const std::vector<RawSample>& raw, const TimelineR
   std::int64_t prev_line = 0;
   double prev_value = 0;
 
-  for (std::size_t i = 0; i < raw.size(); ++i) {
-    const RawSample& s = raw[i];
-    const RawSample* next = i + 1 < raw.size() ? &raw[i + 1] : nullptr;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (block + 1 < blocks.size() && blocks[block + 1].first == i) ++block;
+    const RawSamples::Block& b = blocks[block];
+    const std::int64_t line = b.first_line + static_cast<std::int64_t>(i - b.first);
+    const double s_t = t[i];
+    const double s_value = raw.value[i];
+    const bool has_next = i + 1 < n;
 
-    if (s.session_start && rules.drop_cut_first && i + 3 < raw.size()) {
-      const double local = median_step(raw, i + 1, 9);
-      const double d = raw[i + 1].t - s.t;
+    if (b.session_start && i == b.first && rules.drop_cut_first && i + 3 < n) {
+      const double local = median_step(t, i + 1, 9);
+      const double d = t[i + 1] - s_t;
       if (local > 0 && (d <= 0 || d > std::max(4 * local, local + 0.1 * rules.units_per_s))) {
         ++counts.cut_first;
-        reporter.report(Severity::note, s.line,
+        reporter.report(Severity::note, line,
                         fmt::format("first sample {} looks cut short (logging started mid-line): its "
                                     "time {} {} does not fit the next samples ({} {}, then every ~{} {}); "
                                     "dropped",
-                                    quote_line(s.text), s.t, u, raw[i + 1].t, u, local, u));
+                                    quote_line(raw.text(i)), s_t, u, t[i + 1], u, local, u));
         continue;
       }
     }
 
-    double cur_u = s.t + offset;
+    double cur_u = s_t + offset;
     const double d = cur_u - prev_u;
     if (have_prev && !(d > 0 && d <= jump)) {  // the usual step forward has nothing to report
-      const double next_u = next ? next->t + offset : 0;
+      const double next_t = has_next ? t[i + 1] : 0;
+      const double next_u = has_next ? next_t + offset : 0;
       if (d == 0) {
         ++counts.duplicates;
-        reporter.warn(s.line, fmt::format("{}: time {} {} repeats line {}{}; skipped", quote_line(s.text), s.t,
-                                          u, prev_line, s.value == prev_value ? " (duplicate line)" : ""));
+        reporter.warn(line, fmt::format("{}: time {} {} repeats line {}{}; skipped", quote_line(raw.text(i)), s_t,
+                                        u, prev_line, s_value == prev_value ? " (duplicate line)" : ""));
         continue;
       }
       if (d > 0) {
-        if (d > jump && next && next_u > prev_u && next_u < cur_u && next_u - prev_u <= jump) {
+        if (d > jump && has_next && next_u > prev_u && next_u < cur_u && next_u - prev_u <= jump) {
           ++counts.ahead;
-          reporter.warn(s.line, fmt::format("{}: time {} {} jumps ahead of its neighbours (line {} has {} {}, "
-                                            "the next sample {} {}); skipped",
-                                            quote_line(s.text), s.t, u, prev_line, prev_u - offset, u, next->t, u));
+          reporter.warn(line, fmt::format("{}: time {} {} jumps ahead of its neighbours (line {} has {} {}, "
+                                          "the next sample {} {}); skipped",
+                                          quote_line(raw.text(i)), s_t, u, prev_line, prev_u - offset, u, next_t, u));
           continue;
         }
         if (d > jump) {
           ++counts.gaps;
-          reporter.report(Severity::note, s.line,
+          reporter.report(Severity::note, line,
                           fmt::format("no samples for {:.3g} s of device time (lines {} to {})",
-                                      d / rules.units_per_s, prev_line, s.line));
+                                      d / rules.units_per_s, prev_line, line));
         }
       } else {  // time went back
         const double prev_raw = prev_u - offset;
         const double window = 600 * rules.units_per_s;
-        if (rules.wrap > 0 && prev_raw > rules.wrap - window && s.t < window && d + rules.wrap > 0 &&
+        if (rules.wrap > 0 && prev_raw > rules.wrap - window && s_t < window && d + rules.wrap > 0 &&
             d + rules.wrap <= std::max(jump, window)) {
           ++counts.wraps;
           offset += rules.wrap;
           cur_u += rules.wrap;
-          reporter.report(Severity::note, s.line,
+          reporter.report(Severity::note, line,
                           fmt::format("device clock wrapped from {} {} to {} {} (counter overflow at {} {}); "
                                       "unwrapped",
-                                      prev_raw, u, s.t, u, rules.wrap, u));
-        } else if (next && next_u > prev_u && next_u - prev_u <= jump) {
+                                      prev_raw, u, s_t, u, rules.wrap, u));
+        } else if (has_next && next_u > prev_u && next_u - prev_u <= jump) {
           ++counts.backwards;
-          reporter.warn(s.line, fmt::format("{}: time goes back from {} {} (line {}) to {} {} and the next "
-                                            "sample continues from {} {}; skipped",
-                                            quote_line(s.text), prev_raw, u, prev_line, s.t, u, next->t, u));
+          reporter.warn(line, fmt::format("{}: time goes back from {} {} (line {}) to {} {} and the next "
+                                          "sample continues from {} {}; skipped",
+                                          quote_line(raw.text(i)), prev_raw, u, prev_line, s_t, u, next_t, u));
           continue;
-        } else if (-d >= rules.reset_min_back && next && next_u >= cur_u && next_u - cur_u <= jump) {
+        } else if (-d >= rules.reset_min_back && has_next && next_u >= cur_u && next_u - cur_u <= jump) {
           ++counts.restarts;
           offset = 0;
-          cur_u = s.t;
-          rec.clock_restarts.push_back(rec.size());
-          reporter.report(Severity::note, s.line,
+          cur_u = s_t;
+          rec.clock_restarts.push_back(rec_base + kept);
+          reporter.report(Severity::note, line,
                           fmt::format("device clock restarted (Arduino reset?): time goes back from {} {} "
                                       "(line {}) to {} {}; a new timeline starts here and no run spans it",
-                                      prev_raw, u, prev_line, s.t, u));
+                                      prev_raw, u, prev_line, s_t, u));
         } else {
           ++counts.backwards;
-          reporter.warn(s.line, fmt::format("{}: time goes back from {} {} (line {}) to {} {}; skipped",
-                                            quote_line(s.text), prev_raw, u, prev_line, s.t, u));
+          reporter.warn(line, fmt::format("{}: time goes back from {} {} (line {}) to {} {}; skipped",
+                                          quote_line(raw.text(i)), prev_raw, u, prev_line, s_t, u));
           continue;
         }
       }
     }
-    rec.push(cur_u / units_per_s, s.value);
+    raw.t[kept] = cur_u / units_per_s;
+    raw.value[kept] = s_value;
+    ++kept;
     have_prev = true;
     prev_u = cur_u;
-    prev_line = s.line;
-    prev_value = s.value;
+    prev_line = line;
+    prev_value = s_value;
+  }
+
+  raw.t.resize(kept);
+  raw.value.resize(kept);
+  if (rec_base == 0) {
+    rec.t_s = std::move(raw.t);
+    rec.value = std::move(raw.value);
+  } else {
+    rec.t_s.insert(rec.t_s.end(), raw.t.begin(), raw.t.end());
+    rec.value.insert(rec.value.end(), raw.value.begin(), raw.value.end());
   }
   return counts;
 }

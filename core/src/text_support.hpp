@@ -47,6 +47,12 @@ class LineCursor {
   // there (at a CR, an LF or the end of text).
   void skip_line(std::size_t length) { step_past(p_ + length); }
 
+  // Takes `lines` whole lines the caller has read, `bytes` long with their terminators.
+  void skip_lines(std::size_t bytes, std::size_t lines) {
+    p_ += bytes;
+    number_ += static_cast<std::int64_t>(lines);
+  }
+
  private:
   void step_past(const char* stop) {
     ++number_;
@@ -117,13 +123,56 @@ void sort_by_line(Recording& rec);
 // "PuTTY log header skipped (log started 2023.09.14 10:21:33)" for a PuTTY header line.
 std::string putty_header_note(std::string_view line);
 
-// One parsed sample before timeline repair; t in the file's own unit (ms for millis()).
-struct RawSample {
-  std::int64_t line = 0;
-  double t = 0;
-  double value = 0;
-  bool session_start = false;  // first sample of the file or after a PuTTY header
-  std::string_view text;       // the line, for messages
+// The parsed samples before timeline repair, as two arrays the readers append to (t in the
+// file's own unit, ms for millis()). Where a sample came from (its line, the line's text, whether
+// it starts a logging session) is needed only for messages, so it is kept per block of samples
+// from consecutive lines rather than per sample.
+class RawSamples {
+ public:
+  // A block's lines are walked to find a sample's text: at most this many.
+  static constexpr std::size_t block_lines = 64;
+
+  // text: the whole file, which the lines' texts point into.
+  explicit RawSamples(std::string_view text) : text_end_(text.data() + text.size()) {}
+
+  std::vector<double> t, value;
+
+  std::size_t size() const { return t.size(); }
+  void reserve(std::size_t n) {
+    t.reserve(n);
+    value.reserve(n);
+  }
+  // Appends one sample, read from line number `line` that starts at line_start.
+  void add(std::int64_t line, const char* line_start, double time, double v, bool session_start) {
+    t.push_back(time);
+    value.push_back(v);
+    const std::size_t i = t.size() - 1;
+    if (blocks_.empty() || session_start || blocks_.back().first_line + static_cast<std::int64_t>(i - blocks_.back().first) != line ||
+        i - blocks_.back().first >= block_lines)
+      blocks_.push_back({i, line, line_start, session_start});
+  }
+  // The samples from index first to the end, appended to t and value by the caller, came from
+  // consecutive lines (at most block_lines) starting with line number `line` at line_start.
+  void added_lines(std::size_t first, std::int64_t line, const char* line_start, bool session_start) {
+    blocks_.push_back({first, line, line_start, session_start});
+  }
+
+  // Where sample i came from.
+  std::int64_t line(std::size_t i) const;
+  std::string_view text(std::size_t i) const;  // the line without its terminator
+
+  struct Block {
+    std::size_t first;          // index of its first sample
+    std::int64_t first_line;    // that sample's line number
+    const char* start;          // that line's first byte
+    bool session_start;         // its first sample is the first of a logging session
+  };
+  const std::vector<Block>& blocks() const { return blocks_; }
+
+ private:
+  const Block& block_of(std::size_t i) const;
+  std::vector<Block> blocks_;
+  const char* text_end_;
 };
 
 struct TimelineRules {
@@ -142,9 +191,9 @@ struct TimelineCounts {
 };
 
 // Appends the usable samples to rec (t_s = unwrapped t / units_per_s) and says what it did
-// about every sample it did not use and every wrap, restart and gap.
-TimelineCounts build_timeline(const std::vector<RawSample>& raw, const TimelineRules& rules,
-                              Recording& rec, LineReporter& reporter);
+// about every sample it did not use and every wrap, restart and gap. Takes raw's arrays: the
+// samples kept are moved down in place and handed to rec, with no copy when rec was empty.
+TimelineCounts build_timeline(RawSamples& raw, const TimelineRules& rules, Recording& rec, LineReporter& reporter);
 
 // A reader's summary: head, then ", N what" for every count that is not zero, in order, then
 // the timeline's (cut first line, time going back, …, clock wrap).

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <string_view>
+#include <vector>
 
 namespace spindown {
 
@@ -27,5 +28,16 @@ LabLine parse_lab_line(std::string_view line);
 // length without its terminator. Returns 0 for anything else (leave it to parse_lab_line).
 // It never looks past the line's terminator.
 std::size_t parse_printed_sample(std::string_view text, LabLine& sample);
+
+// The fast path over many lines at once: parses up to max_lines consecutive lines from the start
+// of text while each is a sample line as parse_printed_sample takes it, appending its millis and
+// value to the two vectors. Returns how many lines it took and their bytes, terminators included
+// (a CR LF pair is one terminator), so text.substr(bytes) starts the first line it did not take.
+struct PrintedLines {
+  std::size_t lines = 0;
+  std::size_t bytes = 0;
+};
+PrintedLines parse_printed_lines(std::string_view text, std::size_t max_lines, std::vector<double>& millis,
+                                 std::vector<double>& values);
 
 }  // namespace spindown
