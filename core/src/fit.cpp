@@ -10,7 +10,6 @@
 #include <fmt/format.h>
 #include <limits>
 #include <nlopt.hpp>
-#include <numeric>
 
 namespace spindown {
 namespace {
@@ -105,6 +104,10 @@ class Evaluator {
     }
     index_time_steps();
     const auto n = static_cast<Eigen::Index>(tau.size());
+    if (n > 0) {
+      const Eigen::Map<const Eigen::ArrayXd> ys(y.data(), n);
+      total_sum_sq_ = (ys - ys.mean()).square().sum();
+    }
     w_ = Eigen::Map<const Eigen::ArrayXd>(sqrt_weight.data(), n).square();
     wy_ = w_ * Eigen::Map<const Eigen::ArrayXd>(y.data(), n);
     e_.resize(n);
@@ -117,6 +120,7 @@ class Evaluator {
 
   std::size_t size() const { return tau_.size(); }
   double weighted_sum_sq() const { return tail_sq_[0]; }  // Σw·y²
+  double total_sum_sq() const { return total_sum_sq_; }   // Σ(y − ȳ)², for R²
 
   // Weighted sums for the viscous model by variable projection: at a given α the best u0 is
   // Σw·y·e / Σw·e² (e = e^(−ατ)), so the fit is a search over α alone. The τ and τ² moments
@@ -269,6 +273,7 @@ class Evaluator {
 
   std::span<const double> tau_, y_, sw_;
   std::vector<double> tail_sq_, plain_tail_sq_;
+  double total_sum_sq_ = 0;
   bool sorted_;
   Eigen::Index m_ = 0;
   Eigen::ArrayXd w_, wy_;  // weights and weighted readings, for the direct solutions
@@ -498,6 +503,7 @@ std::optional<Theta> coulomb_by_line_scan(const Evaluator& eval, int& passes) {
   double best_q = 0, best_d = 1;
   std::size_t best_m = 0;
   bool best_is_edge = false;
+  double best_sums[5] = {};
   const auto better = [&](double q, double d) { return q * best_d > best_q * d; };
   for (std::size_t m = 1; m <= n; ++m) {
     const double t = tau[m - 1];
@@ -509,21 +515,25 @@ std::optional<Theta> coulomb_by_line_scan(const Evaluator& eval, int& passes) {
     const double U = stt * sy - st * sty, B = st * sy - sw * sty;
     if (det > 0 && U > 0 && B > 0 && U > B * t && (m == n || U <= B * tau[m])) {
       const double q = stt * sy * sy - 2 * st * sy * sty + sw * sty * sty;  // gain·det
-      if (better(q, det)) best_q = q, best_d = det, best_m = m, best_is_edge = false;
+      if (better(q, det)) {
+        best_q = q, best_d = det, best_m = m, best_is_edge = false;
+        best_sums[0] = sw, best_sums[1] = st, best_sums[2] = stt, best_sums[3] = sy, best_sums[4] = sty;
+      }
     }
     // The edge: stopped exactly at the next sample, u0 = β·τ[m], one-parameter least squares
     // with β = num/den; its gain is num²/den.
     if (m < n) {
       const double te = tau[m];
       const double num = te * sy - sty, den = te * te * sw - 2 * te * st + stt;  // Σw·y·(te−τ), Σw·(te−τ)²
-      if (den > 0 && num > 0 && better(num * num, den)) best_q = num * num, best_d = den, best_m = m, best_is_edge = true;
+      if (den > 0 && num > 0 && better(num * num, den)) {
+        best_q = num * num, best_d = den, best_m = m, best_is_edge = true;
+        best_sums[0] = sw, best_sums[1] = st, best_sums[2] = stt, best_sums[3] = sy, best_sums[4] = sty;
+      }
     }
   }
   if (best_m == 0) return std::nullopt;
-  // The winner's parameters from its own sums (one more short pass).
-  sw = st = stt = sy = sty = 0;
-  for (std::size_t i = 0; i < best_m; ++i)
-    sw += w[i], st += w[i] * tau[i], stt += w[i] * tau[i] * tau[i], sy += wy[i], sty += wy[i] * tau[i];
+  // The winner's parameters from its sums.
+  sw = best_sums[0], st = best_sums[1], stt = best_sums[2], sy = best_sums[3], sty = best_sums[4];
   if (best_is_edge) {
     const double te = tau[best_m];
     const double beta = (te * sy - sty) / (te * te * sw - 2 * te * st + stt);
@@ -563,14 +573,22 @@ Covariance covariance(const Family& f, const Theta& th, Evaluator& eval) {
   const auto r = eval.residuals();
   const Eigen::Index m = r.size();
   Eigen::Vector3d widen = Eigen::Vector3d::Ones();
+  Eigen::ArrayXd z(m);
   for (int j = 0; j < p; ++j) {
     // z = (g·v_j)∘r, as column sums: Eigen's general matrix–vector product is slow at p ≤ 3.
-    Eigen::ArrayXd z = g.col(0).array() * inv(0, j);
+    z = g.col(0).array() * inv(0, j);
     for (int c = 1; c < p; ++c) z += g.col(c).array() * inv(c, j);
     z *= r;
-    double omega = z.square().sum();
-    for (int l = 1; l <= lags && l < m; ++l)
-      omega += 2.0 * (1.0 - l / (lags + 1.0)) * (z.head(m - l) * z.tail(m - l)).sum();
+    // The Bartlett-weighted sum γ0 + 2·Σ_{l=1..L} (1 − l/(L+1))·γ_l equals, exactly, the sum of
+    // squares of the moving sums S_t = z_t + … + z_(t−L) over every t where S_t is not empty,
+    // divided by L + 1 (each product z_i·z_(i−l) lies in L + 1 − l windows): one pass, not L.
+    double window = 0, sum_sq = 0;
+    for (Eigen::Index t = 0; t < m + lags; ++t) {
+      if (t < m) window += z[t];
+      if (t > lags) window -= z[t - lags - 1];
+      sum_sq += window * window;
+    }
+    const double omega = sum_sq / (lags + 1.0);
     widen[j] = std::sqrt(std::max(1.0, dof * omega / classic(j, j)));
   }
   // Keep the correlation structure of the classic estimate, widened per parameter.
@@ -693,9 +711,7 @@ ModelFit fit_model(ModelKind kind, std::span<const double> tau, std::span<const 
   const double wsse = eval(fam, th);
   const double sse = eval.plain_sse(fam, th);
   const double n = static_cast<double>(tau.size());
-  const double mean = std::accumulate(y.begin(), y.end(), 0.0) / n;
-  double sst = 0;
-  for (double v : y) sst += (v - mean) * (v - mean);
+  const double sst = eval.total_sum_sq();
   out.rmse = std::sqrt(sse / n);
   out.r2 = sst > 0 ? 1.0 - sse / sst : nan;
   const double ll = n * std::log(std::max(wsse / n, 1e-300));
