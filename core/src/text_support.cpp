@@ -165,8 +165,7 @@ double median_step(const std::vector<double>& t, std::size_t from, std::size_t c
 TimelineCounts build_timeline(RawSamples& raw, const TimelineRules& rules, Recording& rec, LineReporter& reporter) {
   using Severity = Diagnostic::Severity;
   TimelineCounts counts;
-  const std::vector<double>& t = raw.t;
-  const double period = median_step(t, 0, 64);
+  const double period = median_step(raw.t, 0, 64);
   // A step larger than this is a gap in the data, or a garbled time if the next sample
   // continues from the previous one.
   const double jump = period > 0 ? std::max(20 * period, 0.5 * rules.units_per_s) : rules.units_per_s;
@@ -174,44 +173,54 @@ TimelineCounts build_timeline(RawSamples& raw, const TimelineRules& rules, Recor
   const double units_per_s = rules.units_per_s;
 
   // Samples kept are written back at kept (never past the one being looked at, so the samples
-  // ahead that the checks read are untouched), then handed to rec.
+  // ahead that the checks read are untouched), then handed to rec. The arrays do not change size
+  // in the loop: plain pointers, which stay in registers.
   const std::size_t n = raw.size();
   const std::size_t rec_base = rec.size();
+  const double* const t = raw.t.data();
+  const double* const values = raw.value.data();
+  double* const t_out = raw.t.data();
+  double* const v_out = raw.value.data();
   std::size_t kept = 0;
   const auto& blocks = raw.blocks();
-  std::size_t block = 0;
+  std::size_t next_block = 0;  // blocks[next_block] is the next to start, at sample next_first
+  std::size_t next_first = blocks.empty() ? n : blocks.front().first;
 
   bool have_prev = false;
   double offset = 0;   // wraps so far in this clock epoch, in file units
   double prev_u = 0;   // unwrapped time of the last accepted sample
-  std::int64_t prev_line = 0;
+  std::size_t prev_i = 0;  // its index (its line, for messages)
   double prev_value = 0;
 
   for (std::size_t i = 0; i < n; ++i) {
-    if (block + 1 < blocks.size() && blocks[block + 1].first == i) ++block;
-    const RawSamples::Block& b = blocks[block];
-    const std::int64_t line = b.first_line + static_cast<std::int64_t>(i - b.first);
     const double s_t = t[i];
-    const double s_value = raw.value[i];
+    const double s_value = values[i];
     const bool has_next = i + 1 < n;
 
-    if (b.session_start && i == b.first && rules.drop_cut_first && i + 3 < n) {
-      const double local = median_step(t, i + 1, 9);
-      const double d = t[i + 1] - s_t;
-      if (local > 0 && (d <= 0 || d > std::max(4 * local, local + 0.1 * rules.units_per_s))) {
-        ++counts.cut_first;
-        reporter.report(Severity::note, line,
-                        fmt::format("first sample {} looks cut short (logging started mid-line): its "
-                                    "time {} {} does not fit the next samples ({} {}, then every ~{} {}); "
-                                    "dropped",
-                                    quote_line(raw.text(i)), s_t, u, t[i + 1], u, local, u));
-        continue;
+    if (i == next_first) {  // a block's first sample: a new session's may have been cut short
+      const bool session_start = blocks[next_block].session_start;
+      ++next_block;
+      next_first = next_block < blocks.size() ? blocks[next_block].first : n;
+      if (session_start && rules.drop_cut_first && i + 3 < n) {
+        const double local = median_step(raw.t, i + 1, 9);
+        const double d = t[i + 1] - s_t;
+        if (local > 0 && (d <= 0 || d > std::max(4 * local, local + 0.1 * rules.units_per_s))) {
+          ++counts.cut_first;
+          reporter.report(Severity::note, raw.line(i),
+                          fmt::format("first sample {} looks cut short (logging started mid-line): its "
+                                      "time {} {} does not fit the next samples ({} {}, then every ~{} {}); "
+                                      "dropped",
+                                      quote_line(raw.text(i)), s_t, u, t[i + 1], u, local, u));
+          continue;
+        }
       }
     }
 
     double cur_u = s_t + offset;
     const double d = cur_u - prev_u;
     if (have_prev && !(d > 0 && d <= jump)) {  // the usual step forward has nothing to report
+      const std::int64_t line = raw.line(i);
+      const std::int64_t prev_line = raw.line(prev_i);
       const double next_t = has_next ? t[i + 1] : 0;
       const double next_u = has_next ? next_t + offset : 0;
       if (d == 0) {
@@ -269,12 +278,12 @@ TimelineCounts build_timeline(RawSamples& raw, const TimelineRules& rules, Recor
         }
       }
     }
-    raw.t[kept] = cur_u / units_per_s;
-    raw.value[kept] = s_value;
+    t_out[kept] = cur_u / units_per_s;
+    v_out[kept] = s_value;
     ++kept;
     have_prev = true;
     prev_u = cur_u;
-    prev_line = line;
+    prev_i = i;
     prev_value = s_value;
   }
 
