@@ -325,3 +325,54 @@ TEST(FitReportJsonText, MatchesTheDocumentsDumpByteForByte) {
   }
   EXPECT_EQ(streamed({}, {}), document({}, {}));
 }
+
+// The refit's run text (tagged, nested eight spaces deep in {"files":[{"runs":[…]}]}) must be the
+// tagged document's dump, whatever the run holds; numbers as dump() writes them.
+TEST(FitReportJsonText, RunTextMatchesTheTaggedDocumentsDump) {
+  RunFit odd = lab_like_fit();
+  odd.run.stopped = false;
+  odd.best.clear();
+  odd.models[0].message = "did not converge: \"λ\" grew \\ past 1e10\n";
+  odd.models[1].params.clear();
+  odd.models[2].rmse = not_a_number;
+  odd.models[2].bic = -inf;
+  odd.bench.inertia_source = "bench file (caf\xe9.toml)";
+  RunFit numbers = lab_like_fit();
+  const double samples[] = {0.0, -0.0, 0.1, 1.0, -1.5, 1e300, 5e-324, 2.2250738585072014e-308, 123456789012345678.0,
+                            1.0 / 3.0, 6.02214076e23, -9.87654321e-12};
+  std::size_t k = 0;
+  for (auto& m : numbers.models)
+    for (auto& p : m.params) {
+      p.value = samples[k++ % std::size(samples)];
+      p.std_error = samples[k++ % std::size(samples)];
+    }
+  numbers.run.zero_level = -0.0;
+  numbers.run.noise_level = 5e-324;
+  RunFit repeated = lab_like_fit();  // a repeated key: the document keeps one member
+  repeated.models[0].params.push_back(param("c1", 9.0, 1.0, "N*m*s/rad"));
+
+  for (const bool lab_units : {false, true})
+    for (const RunFit* fit : {&odd, &numbers, &repeated}) {
+      ReportOptions opt;
+      opt.lab_units = lab_units;
+      const RunTags tags{"bench \"7\"", -3, 1234567890123};
+      for (const std::size_t indent : {0, 8}) {
+        std::string expected(indent, ' ');
+        for (char c : tagged_run_fit_json(*fit, tags, opt).dump(2, ' ', false, Json::error_handler_t::replace)) {
+          expected += c;
+          if (c == '\n') expected.append(indent, ' ');
+        }
+        std::string got(indent, ' ');
+        append_run_fit_json_text(got, *fit, opt, indent, &tags);
+        EXPECT_EQ(got, expected) << lab_units << " " << indent;
+        std::string untagged(indent, ' ');
+        append_run_fit_json_text(untagged, *fit, opt, indent);
+        std::string untagged_expected(indent, ' ');
+        for (char c : run_fit_json(*fit, opt).dump(2, ' ', false, Json::error_handler_t::replace)) {
+          untagged_expected += c;
+          if (c == '\n') untagged_expected.append(indent, ' ');
+        }
+        EXPECT_EQ(untagged, untagged_expected) << lab_units << " " << indent;
+      }
+    }
+}

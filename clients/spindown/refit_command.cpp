@@ -120,15 +120,6 @@ std::string indented(const std::string& text, std::size_t spaces) {
 
 std::string dump_json(const Json& j) { return j.dump(2, ' ', false, Json::error_handler_t::replace); }
 
-// A run as refit_file_json() lists it.
-Json refit_run_json(const RefitRun& run, const ReportOptions& opt) {
-  Json j = run_fit_json(run.fit, opt);
-  j["bench"]["id"] = run.bench;
-  j["first_seq"] = run.first_seq;
-  j["last_seq"] = run.last_seq;
-  return j;
-}
-
 // The first place two JSON values differ ("" when equal).
 std::string first_difference(const Json& a, const Json& b, const std::string& path) {
   if (a.type() != b.type()) return fmt::format("{}: {} vs {}", path, a.dump(), b.dump());
@@ -369,16 +360,22 @@ int run_refit(const RefitCommandOptions& o) {
     // Each bench's runs, formatted as they are fitted; printed by bench (first appearance) once
     // the log is done, as the order contract wants.
     std::vector<std::pair<std::string, std::unique_ptr<RunSpool>>> spools;
+    std::string run_text;  // reused: one run's JSON at a time
     auto each_run = [&](RefitRun&& run) {
       RunSpool* spool = nullptr;
       for (auto& [bench, sp] : spools)
         if (bench == run.bench) spool = sp.get();
       if (!spool) spool = spools.emplace_back(run.bench, std::make_unique<RunSpool>()).second.get();
-      if (o.json)
-        spool->add(",\n" + indented(dump_json(refit_run_json(run, report)), 8));
-      else
+      if (o.json) {
+        // The run as refit_file_json() lists it, written straight to text (no document).
+        const RunTags tags{run.bench, run.first_seq, run.last_seq};
+        run_text.assign(",\n        ");
+        append_run_fit_json_text(run_text, run.fit, report, 8, &tags);
+        spool->add(run_text);
+      } else {
         spool->add(fmt::format("\n-- bench {} (J/K_b: {})\n", run.bench, run.bench_source) +
                    format_run_fit(run.fit, report));
+      }
     };
     LogRefit r = refit_log(
         path, fopt, o.live || o.compare, {},

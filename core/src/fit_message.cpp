@@ -208,10 +208,7 @@ std::optional<HealthVerdict> health_from_fit_message(const fit_t& m, std::string
 std::optional<Json> fit_message_json(const fit_t& msg, const ReportOptions& opt, std::string* why) {
   auto fit = from_fit_message(msg, why);
   if (!fit) return std::nullopt;
-  Json j = run_fit_json(*fit, opt);
-  j["bench"]["id"] = msg.bench;
-  j["first_seq"] = msg.first_seq;
-  j["last_seq"] = msg.last_seq;
+  Json j = tagged_run_fit_json(*fit, {msg.bench, msg.first_seq, msg.last_seq}, opt);
   if (!msg.verdict.empty()) {
     auto health = health_from_fit_message(msg, why);
     if (!health) return std::nullopt;

@@ -1,6 +1,7 @@
 #include "spindown/fit_report.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <optional>
@@ -309,8 +310,15 @@ class PrettyJsonWriter {
     }
   }
   void number(double x) {  // non-finite is null, as the document's number() makes it
-    if (std::isfinite(x)) out_ += Json(x).dump();
-    else out_ += "null";
+    if (!std::isfinite(x)) {
+      out_ += "null";
+      return;
+    }
+    // The shortest digits that read back as x: what dump() writes for a double (the same
+    // function), without building a Json and a string per number.
+    std::array<char, 64> digits;
+    const char* end = nlohmann::detail::to_chars(digits.data(), digits.data() + digits.size(), x);
+    out_.append(digits.data(), static_cast<std::size_t>(end - digits.data()));
   }
   void integer(std::int64_t n) { out_ += fmt::format_int(n).c_str(); }
   void unsigned_integer(std::size_t n) { out_ += fmt::format_int(n).c_str(); }
@@ -366,18 +374,23 @@ class PrettyJsonWriter {
 
 // A Json object keeps one member per key (a repeated key overwrites the first in place); the
 // writer does not, so a run with repeated parameter names goes through the document.
-bool has_repeated_param_names(const FileFit& file) {
-  for (const auto& run : file.runs)
-    for (const auto& m : run.models)
-      for (std::size_t i = 0; i < m.params.size(); ++i)
-        for (std::size_t j = 0; j < i; ++j)
-          if (m.params[i].name == m.params[j].name) return true;
+
+bool has_repeated_param_names(const RunFit& run) {
+  for (const auto& m : run.models)
+    for (std::size_t i = 0; i < m.params.size(); ++i)
+      for (std::size_t j = 0; j < i; ++j)
+        if (m.params[i].name == m.params[j].name) return true;
   return false;
 }
 
-// run_fit_json(fit, opt), member for member; leaves the run's object open (file_fit_json adds
-// "health" last).
-void write_run_fit(PrettyJsonWriter& w, const RunFit& fit, const ReportOptions& opt) {
+bool has_repeated_param_names(const FileFit& file) {
+  return std::any_of(file.runs.begin(), file.runs.end(),
+                     [](const RunFit& run) { return has_repeated_param_names(run); });
+}
+
+// run_fit_json(fit, opt) (with the tags when given), member for member; leaves the run's object
+// open (file_fit_json adds "health" last).
+void write_run_fit(PrettyJsonWriter& w, const RunFit& fit, const ReportOptions& opt, const RunTags* tags = nullptr) {
   const std::string_view residual_unit = quantity_unit(fit.quantity);
   const Run& run = fit.run;
   w.begin_object();
@@ -450,7 +463,12 @@ void write_run_fit(PrettyJsonWriter& w, const RunFit& fit, const ReportOptions& 
     w.member("unit", "g*cm^2");
     w.end_object();
   }
+  if (tags) w.member("id", tags->bench_id);
   w.end_object();
+  if (tags) {
+    w.key("first_seq"); w.integer(tags->first_seq);
+    w.key("last_seq"); w.integer(tags->last_seq);
+  }
 }
 
 // health_json(v), member for member.
@@ -533,6 +551,29 @@ std::string file_fit_json_text(const FileFit& file, const ReportOptions& opt) {
   w.end_array();
   w.end_object();
   return out;
+}
+
+Json tagged_run_fit_json(const RunFit& fit, const RunTags& tags, const ReportOptions& opt) {
+  Json j = run_fit_json(fit, opt);
+  j["bench"]["id"] = tags.bench_id;
+  j["first_seq"] = tags.first_seq;
+  j["last_seq"] = tags.last_seq;
+  return j;
+}
+
+void append_run_fit_json_text(std::string& out, const RunFit& fit, const ReportOptions& opt, std::size_t indent,
+                              const RunTags* tags) {
+  if (has_repeated_param_names(fit)) {
+    const Json j = tags ? tagged_run_fit_json(fit, *tags, opt) : run_fit_json(fit, opt);
+    for (char c : j.dump(2, ' ', false, Json::error_handler_t::replace)) {
+      out += c;
+      if (c == '\n') out.append(indent, ' ');  // a raw newline in a dump is always layout
+    }
+    return;
+  }
+  PrettyJsonWriter w(out, indent);
+  write_run_fit(w, fit, opt, tags);
+  w.end_object();
 }
 
 void FitReportJsonText::add(std::string_view file_json, std::string& out) {

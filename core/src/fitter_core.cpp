@@ -10,6 +10,7 @@
 #include "spindown/fit_message.hpp"
 #include "spindown/lcm_channels.hpp"
 #include "spindown/lcm_log_reader.hpp"
+#include "short_string_equal.hpp"
 #include "spindown/message_decode.hpp"
 #include "text_support.hpp"
 
@@ -105,6 +106,7 @@ struct FitterCore::Bench {
   // The log reader's per-bench checks (lcm_log_reader.cpp take_samples), so refit == fit.
   bool quantity_known = false;
   Quantity quantity = Quantity::back_emf_volts;
+  std::int8_t quantity_code = 0;  // the samples_t code that gave quantity
   bool have_seq = false, have_epoch = false;
   std::int64_t next_seq = 0;
   std::int32_t epoch = 0;
@@ -157,7 +159,7 @@ FitterCore::Bench* FitterCore::bench_for(std::string_view id, std::int64_t recv_
   ++activity_;
   // Benches publish in a steady interleave: the bench that followed the previous one last time
   // is nearly always the one asked for, found without the map.
-  if (Bench* guess = last_bench_ ? last_bench_->followed_by : nullptr; guess && guess->id == id) {
+  if (Bench* guess = last_bench_ ? last_bench_->followed_by : nullptr; guess && short_string_equal(guess->id, id)) {
     guess->last_active = activity_;
     last_bench_ = guess;
     return guess;
@@ -321,28 +323,32 @@ void FitterCore::take_samples(Bench& b, const Message& m, std::size_t n, std::in
     b.tokens -= double(n);
   }
 
-  if (m.bench != b.id) {
+  if (!short_string_equal(m.bench, b.id)) {
     ++counters_.bench_mismatch;
     error(fmt::format("{}: message names bench '{}'; the channel's bench is used", ch,
                       text::escape_invalid_utf8(m.bench.substr(0, 40))),
           recv_utime);
   }
-  const auto q = quantity_from_samples_code(m.quantity);
-  if (!q) {
-    ++counters_.quantity_errors;
-    error(fmt::format("{}: unknown quantity code {} at seq {}; message skipped", ch, int(m.quantity), m.seq),
-          recv_utime);
-    return;
-  }
-  if (!b.quantity_known) {
-    b.quantity = *q;
-    b.quantity_known = true;
-  } else if (*q != b.quantity) {
-    ++counters_.quantity_errors;
-    error(fmt::format("{}: quantity changes from {} to {} at seq {}; message skipped", ch, quantity_unit(b.quantity),
-                      quantity_unit(*q), m.seq),
-          recv_utime);
-    return;
+  // The bench's own quantity code again (nearly always): nothing to check.
+  if (!b.quantity_known || m.quantity != b.quantity_code) {
+    const auto q = quantity_from_samples_code(m.quantity);
+    if (!q) {
+      ++counters_.quantity_errors;
+      error(fmt::format("{}: unknown quantity code {} at seq {}; message skipped", ch, int(m.quantity), m.seq),
+            recv_utime);
+      return;
+    }
+    if (!b.quantity_known) {
+      b.quantity = *q;
+      b.quantity_code = m.quantity;
+      b.quantity_known = true;
+    } else if (*q != b.quantity) {
+      ++counters_.quantity_errors;
+      error(fmt::format("{}: quantity changes from {} to {} at seq {}; message skipped", ch,
+                        quantity_unit(b.quantity), quantity_unit(*q), m.seq),
+            recv_utime);
+      return;
+    }
   }
 
   bool restart = b.have_epoch && m.clock_epoch != b.epoch;

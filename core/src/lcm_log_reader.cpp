@@ -11,6 +11,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "short_string_equal.hpp"
 #include "spindown/message_decode.hpp"
 #include "text_support.hpp"
 
@@ -170,7 +171,7 @@ const LcmLogReader::ChannelInfo& LcmLogReader::channel_info(std::string_view cha
     const std::int32_t guess = channels_[static_cast<std::size_t>(last_channel_)].next;
     if (guess >= 0) {
       const ChannelInfo& c = channels_[static_cast<std::size_t>(guess)];
-      if (c.channel == channel) {
+      if (short_string_equal(c.channel, channel)) {
         last_channel_ = guess;
         return c;
       }
@@ -178,7 +179,7 @@ const LcmLogReader::ChannelInfo& LcmLogReader::channel_info(std::string_view cha
   }
   const ChannelInfo* found = nullptr;
   for (const ChannelInfo& c : channels_)
-    if (c.channel == channel) {
+    if (short_string_equal(c.channel, channel)) {
       found = &c;
       break;
     }

@@ -3,6 +3,7 @@
 // (model | curve constants | coefficients ± standard error | RMSE | R² | BIC | predicted
 // stop), plus which model fits best and why. Shared by `spindown fit` and the live fitter.
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <span>
 #include <string>
@@ -52,6 +53,21 @@ Json run_fit_json(const RunFit& fit, const ReportOptions& opt = {});
 Json health_json(const HealthVerdict& verdict);
 Json file_fit_json(const FileFit& file, const ReportOptions& opt = {});
 Json fit_report_json(std::span<const FileFit> files, const ReportOptions& opt = {});
+
+// How `spindown refit` and a live FIT message tag a run beside run_fit_json(): "bench" -> "id"
+// (the last member of "bench"), then "first_seq" and "last_seq" (the last members of the run).
+struct RunTags {
+  std::string_view bench_id;
+  std::int64_t first_seq = 0, last_seq = 0;
+};
+Json tagged_run_fit_json(const RunFit& fit, const RunTags& tags, const ReportOptions& opt = {});
+
+// run_fit_json(fit, opt) (tagged_run_fit_json when tags are given) exactly as
+// dump(2, ' ', false, Json::error_handler_t::replace) lays it out nested indent spaces deep,
+// appended to out without building the document; its first line is not indented (the caller
+// places the opening brace).
+void append_run_fit_json_text(std::string& out, const RunFit& fit, const ReportOptions& opt, std::size_t indent,
+                              const RunTags* tags = nullptr);
 
 // `spindown fit --json` without a document: one entry of fit_report_json(files)'s "files"
 // array exactly as dump(2, ' ', false, Json::error_handler_t::replace) lays it out there
