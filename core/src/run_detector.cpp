@@ -73,31 +73,71 @@ void RunDetector::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
   rebuild(w, from, end);
 }
 
-void RunDetector::advance(WindowFit& w, std::size_t i) {
+// Per sample for every live window, so inlined into its callers; the usual step (sample i
+// follows the window's last, exactly one old sample expires) is one slide().
+inline void RunDetector::advance(WindowFit& w, std::size_t i) {
   const Sample* ring = ring_.get();
   const std::size_t mask = mask_;
   const Sample s = ring[i & mask];
-  if (w.end != i) w.clear(i, s.t);  // not contiguous (after a reset): start again from i
-  if (w.n == 0) w.t0 = s.t;
+  if (w.end != i || w.n == 0) [[unlikely]] {
+    if (w.end != i) w.clear(i, s.t);  // not contiguous (after a reset): start again from i
+    w.t0 = s.t;
+  }
   // Add sample i, then drop the oldest while the window is longer than its span (keeping at
   // least 3). At a steady rate exactly one drops: that add and remove are one slide().
   std::size_t first = w.first;
-  const auto expired = [&](std::size_t k) { return i + 1 - k > 2 && s.t - ring[k & mask].t > w.span_s; };
-  if (expired(first)) {
+  const double span = w.span_s;
+  const auto expired = [&](std::size_t k) { return i + 1 - k > 2 && s.t - ring[k & mask].t > span; };
+  if (expired(first)) [[likely]] {
     const Sample old = ring[first & mask];
     w.slide(s.t, s.v, old.t, old.v);
     ++first;
+    while (expired(first)) [[unlikely]] {
+      const Sample o = ring[first & mask];
+      w.remove(o.t, o.v);
+      ++first;
+    }
   } else {
     w.add(s.t, s.v);
   }
-  while (expired(first)) {
-    const Sample old = ring[first & mask];
-    w.remove(old.t, old.v);
-    ++first;
-  }
   w.first = first;
   w.end = i + 1;
-  if (w.updates > refresh_every) rebuild(w, w.first, w.end);
+  if (w.updates > refresh_every) [[unlikely]] rebuild(w, w.first, w.end);
+}
+
+inline void RunDetector::coast_step(std::size_t i) {
+  advance(hold_, i);
+  if (hold_long_live_) advance(hold_long_, i);
+  coast_checks(i);
+}
+
+// Per coasting sample; kept small (the rare outcomes are calls) since it runs for every sample.
+inline void RunDetector::coast_checks(std::size_t i, bool at_end) {
+  const double t_i = t(i);
+  if (buffered() > opt_.max_buffer || t_i - run_.t_cut_s > opt_.max_coast_s) {
+    coast_too_long(i);
+    return;
+  }
+  if (hold_.n < 3 || hold_.first < run_.cut_index) return;
+  const double dur = duration(hold_);
+  const double mu = hold_.mean();
+
+  // Power back before standstill: the reading climbs well above the coast's lowest level.
+  if (dur >= 0.5 * hold_.span_s) level_min_ = std::min(level_min_, mu);
+  if (v(i) > level_min_ + rise_jump_) {
+    if (rising_++ == 0) rise_start_ = i;
+    if (rising_ >= 3) {
+      power_back();
+      return;
+    }
+  } else {
+    rising_ = 0;
+  }
+
+  // Standstill: the hold window is flat and low.
+  if (dur < 0.9 * hold_.span_s) return;
+  if (v0_ > 0 && mu > standstill_max_fraction * v0_) return;  // still high: the usual case, cheap
+  standstill_checks(i, at_end, (v0_ - mu) / std::max(t_i - run_.t_cut_s, 1e-9));
 }
 
 // ---- detector ----------------------------------------------------------------------------
@@ -154,11 +194,11 @@ double RunDetector::median_of(std::size_t from, std::size_t to) {
 }
 
 void RunDetector::push(double t_s, double value) {
-  if (!std::isfinite(t_s) || !std::isfinite(value)) {
+  if (!std::isfinite(t_s) || !std::isfinite(value)) [[unlikely]] {
     ++non_finite_;  // reported by finish(); not a sample, so it takes no index
     return;
   }
-  if (have_last_t_ && t_s < last_t_) {
+  if (have_last_t_ && t_s < last_t_) [[unlikely]] {
     emit_diag(Diagnostic::Severity::note,
               fmt::format("time went back from {} to {} at sample {}: taken as a clock restart", fmt_s(last_t_),
                           fmt_s(t_s), next_index_));
@@ -167,7 +207,7 @@ void RunDetector::push(double t_s, double value) {
   have_last_t_ = true;
   last_t_ = t_s;
   const std::size_t i = next_index_++;
-  if (next_index_ - base_ > ring_size()) grow_ring();
+  if (next_index_ - base_ > ring_size()) [[unlikely]] grow_ring();
   ring_[i & mask_] = {t_s, value};
   // Track readings pinned at one positive value (a clipped converter) so the lead-in before
   // a long clip is still buffered when the coast leaves it.
@@ -539,41 +579,6 @@ bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
   creeping_ = false;
   coast_checks(i);
   return true;
-}
-
-void RunDetector::coast_step(std::size_t i) {
-  advance(hold_, i);
-  if (hold_long_live_) advance(hold_long_, i);
-  coast_checks(i);
-}
-
-// Per coasting sample; kept small (the rare outcomes are calls) since it runs for every sample.
-void RunDetector::coast_checks(std::size_t i, bool at_end) {
-  const double t_i = t(i);
-  if (buffered() > opt_.max_buffer || t_i - run_.t_cut_s > opt_.max_coast_s) {
-    coast_too_long(i);
-    return;
-  }
-  if (hold_.n < 3 || hold_.first < run_.cut_index) return;
-  const double dur = duration(hold_);
-  const double mu = hold_.mean();
-
-  // Power back before standstill: the reading climbs well above the coast's lowest level.
-  if (dur >= 0.5 * hold_.span_s) level_min_ = std::min(level_min_, mu);
-  if (v(i) > level_min_ + rise_jump_) {
-    if (rising_++ == 0) rise_start_ = i;
-    if (rising_ >= 3) {
-      power_back();
-      return;
-    }
-  } else {
-    rising_ = 0;
-  }
-
-  // Standstill: the hold window is flat and low.
-  if (dur < 0.9 * hold_.span_s) return;
-  if (v0_ > 0 && mu > standstill_max_fraction * v0_) return;  // still high: the usual case, cheap
-  standstill_checks(i, at_end, (v0_ - mu) / std::max(t_i - run_.t_cut_s, 1e-9));
 }
 
 void RunDetector::coast_too_long(std::size_t i) {
