@@ -485,6 +485,27 @@ std::optional<Theta> viscous_by_projection(Evaluator& eval, double alpha, int& p
   return std::nullopt;
 }
 
+// Weighted sums of the straight line y ≈ u0 − β·τ over the samples added so far, and the two
+// least-squares lines they give. Each is an optimum, so its SSE is Σw·y² minus a gain q/d.
+struct LineSums {
+  double w = 0, t = 0, tt = 0, y = 0, ty = 0;  // Σw, Σw·τ, Σw·τ², Σw·y, Σw·τ·y
+
+  void add(double wi, double wyi, double ti) { w += wi, t += wi * ti, tt += wi * ti * ti, y += wyi, ty += wyi * ti; }
+  // Both parameters free: [Σw −Σwτ; −Σwτ Σwτ²]·(u0, β) = (Σwy, −Σwτy), u0 = U/det, β = B/det.
+  double det() const { return w * tt - t * t; }
+  double u() const { return tt * y - t * ty; }
+  double b() const { return t * y - w * ty; }
+  double plain_gain_times_det() const { return tt * y * y - 2 * t * y * ty + w * ty * ty; }
+  Theta plain() const { return {u() / det(), 0.0, b() / det()}; }
+  // Stopped exactly at te (u0 = β·te): β = Σw·y·(te−τ) / Σw·(te−τ)², gain num²/den.
+  double edge_num(double te) const { return te * y - ty; }
+  double edge_den(double te) const { return te * te * w - 2 * te * t + tt; }
+  Theta edge(double te) const {
+    const double beta = edge_num(te) / edge_den(te);
+    return {beta * te, 0.0, beta};
+  }
+};
+
 // The Coulomb model in closed form. While moving it is the straight line u0 − β·τ, and the
 // samples that move are those before its stop ts = u0/β; so for each count m of moving samples
 // the weighted SSE is a quadratic in (u0, β) whose minimum is either the plain line fit over the
@@ -497,50 +518,30 @@ std::optional<Theta> coulomb_by_line_scan(const Evaluator& eval, int& passes) {
   const std::size_t n = tau.size();
   if (!eval.sorted() || n < 3) return std::nullopt;
   ++passes;
-  // Each candidate is a least-squares optimum, so its SSE is Σw·y² minus a gain q/d; the best
-  // candidate has the largest gain. Compared as q·d_best > q_best·d (d > 0): no division per m.
-  double sw = 0, st = 0, stt = 0, sy = 0, sty = 0;  // Σw, Σw·τ, Σw·τ², Σw·y, Σw·τ·y over i < m
-  double best_q = 0, best_d = 1;
-  std::size_t best_m = 0;
-  bool best_is_edge = false;
-  double best_sums[5] = {};
-  const auto better = [&](double q, double d) { return q * best_d > best_q * d; };
+  // The best candidate has the largest gain q/d, compared as q·d_best > q_best·d (d > 0): no
+  // division per m. The winner's sums are kept; its parameters come from them at the end.
+  LineSums sums, best;
+  double best_q = 0, best_d = 1, best_edge = nan;  // best_edge: the stop te if the winner is an edge
+  bool found = false;
+  const auto take = [&](double q, double d, double edge) {
+    if (q * best_d > best_q * d) best_q = q, best_d = d, best = sums, best_edge = edge, found = true;
+  };
   for (std::size_t m = 1; m <= n; ++m) {
     const double t = tau[m - 1];
-    sw += w[m - 1], st += w[m - 1] * t, stt += w[m - 1] * t * t, sy += wy[m - 1], sty += wy[m - 1] * t;
+    sums.add(w[m - 1], wy[m - 1], t);
     if (m < 3) continue;
-    // Plain line over the first m: [Σw −Σwτ; −Σwτ Σwτ²]·(u0, β) = (Σwy, −Σwτy), i.e.
-    // u0 = U/det, β = B/det; it counts if it falls (U, B > 0) and stops in (τ[m−1], τ[m]].
-    const double det = sw * stt - st * st;
-    const double U = stt * sy - st * sty, B = st * sy - sw * sty;
-    if (det > 0 && U > 0 && B > 0 && U > B * t && (m == n || U <= B * tau[m])) {
-      const double q = stt * sy * sy - 2 * st * sy * sty + sw * sty * sty;  // gain·det
-      if (better(q, det)) {
-        best_q = q, best_d = det, best_m = m, best_is_edge = false;
-        best_sums[0] = sw, best_sums[1] = st, best_sums[2] = stt, best_sums[3] = sy, best_sums[4] = sty;
-      }
-    }
-    // The edge: stopped exactly at the next sample, u0 = β·τ[m], one-parameter least squares
-    // with β = num/den; its gain is num²/den.
+    // The plain line over the first m counts if it falls (U, B > 0) and stops in (τ[m−1], τ[m]].
+    const double det = sums.det(), U = sums.u(), B = sums.b();
+    if (det > 0 && U > 0 && B > 0 && U > B * t && (m == n || U <= B * tau[m]))
+      take(sums.plain_gain_times_det(), det, nan);
+    // The edge: stopped exactly at the next sample.
     if (m < n) {
-      const double te = tau[m];
-      const double num = te * sy - sty, den = te * te * sw - 2 * te * st + stt;  // Σw·y·(te−τ), Σw·(te−τ)²
-      if (den > 0 && num > 0 && better(num * num, den)) {
-        best_q = num * num, best_d = den, best_m = m, best_is_edge = true;
-        best_sums[0] = sw, best_sums[1] = st, best_sums[2] = stt, best_sums[3] = sy, best_sums[4] = sty;
-      }
+      const double num = sums.edge_num(tau[m]), den = sums.edge_den(tau[m]);
+      if (den > 0 && num > 0) take(num * num, den, tau[m]);
     }
   }
-  if (best_m == 0) return std::nullopt;
-  // The winner's parameters from its sums.
-  sw = best_sums[0], st = best_sums[1], stt = best_sums[2], sy = best_sums[3], sty = best_sums[4];
-  if (best_is_edge) {
-    const double te = tau[best_m];
-    const double beta = (te * sy - sty) / (te * te * sw - 2 * te * st + stt);
-    return Theta{beta * te, 0.0, beta};
-  }
-  const double det = sw * stt - st * st;
-  return Theta{(stt * sy - st * sty) / det, 0.0, (st * sy - sw * sty) / det};
+  if (!found) return std::nullopt;
+  return std::isnan(best_edge) ? best.plain() : best.edge(best_edge);
 }
 
 struct Covariance {
