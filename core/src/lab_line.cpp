@@ -216,6 +216,13 @@ PrintedLines parse_printed_lines(std::string_view text, std::size_t max_lines, s
                                  std::vector<double>& values) {
   PrintedLines taken;
   if constexpr (std::endian::native != std::endian::little) return taken;
+  const char* p = text.data();
+  const char* const end = p + text.size();
+  std::uint64_t ticks = 0;
+  double value = 0;
+  // A line the fast path does not take (a header, garble) costs only this one try: no room made.
+  std::size_t length = max_lines > 0 && text.size() >= enough_text ? printed_line(p, ticks, value) : 0;
+  if (length == 0) return taken;
   // Room for every line that can be taken (each is at least 4 bytes, "0 0\n"), written through
   // plain pointers, then cut to what was taken: cheaper than a push_back per line.
   const std::size_t room = std::min(max_lines, text.size() / 4);
@@ -224,18 +231,15 @@ PrintedLines parse_printed_lines(std::string_view text, std::size_t max_lines, s
   values.resize(base + room);
   double* const millis_out = millis.data() + base;
   double* const values_out = values.data() + base;
-  const char* p = text.data();
-  const char* const end = p + text.size();
-  while (taken.lines < room && static_cast<std::size_t>(end - p) >= enough_text) {
-    std::uint64_t ticks = 0;
-    double value = 0;
-    const std::size_t length = printed_line(p, ticks, value);
-    if (length == 0) break;
+  while (true) {
     millis_out[taken.lines] = static_cast<double>(ticks);
     values_out[taken.lines] = value;
     const char* const stop = p + length;  // CR or LF, with enough_text bytes after p
     p = stop + (stop[0] == '\r' && stop[1] == '\n' ? 2 : 1);
     ++taken.lines;
+    if (taken.lines == room || static_cast<std::size_t>(end - p) < enough_text) break;
+    length = printed_line(p, ticks, value);
+    if (length == 0) break;
   }
   millis.resize(base + taken.lines);
   values.resize(base + taken.lines);
