@@ -292,11 +292,8 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
 Json refit_file_json(const LogRefit& refit, const ReportOptions& opt) {
   Json j = file_fit_json(refit.file, opt);
   Json& runs = j["runs"];
-  for (std::size_t i = 0; i < refit.runs.size() && i < runs.size(); ++i) {
-    runs[i]["bench"]["id"] = refit.runs[i].bench;
-    runs[i]["first_seq"] = refit.runs[i].first_seq;
-    runs[i]["last_seq"] = refit.runs[i].last_seq;
-  }
+  for (std::size_t i = 0; i < refit.runs.size() && i < runs.size(); ++i)
+    tag_run_json(runs[i], {refit.runs[i].bench, refit.runs[i].first_seq, refit.runs[i].last_seq});
   return j;
 }
 

@@ -553,11 +553,15 @@ std::string file_fit_json_text(const FileFit& file, const ReportOptions& opt) {
   return out;
 }
 
+void tag_run_json(Json& run, const RunTags& tags) {
+  run["bench"]["id"] = tags.bench_id;
+  run["first_seq"] = tags.first_seq;
+  run["last_seq"] = tags.last_seq;
+}
+
 Json tagged_run_fit_json(const RunFit& fit, const RunTags& tags, const ReportOptions& opt) {
   Json j = run_fit_json(fit, opt);
-  j["bench"]["id"] = tags.bench_id;
-  j["first_seq"] = tags.first_seq;
-  j["last_seq"] = tags.last_seq;
+  tag_run_json(j, tags);
   return j;
 }
 

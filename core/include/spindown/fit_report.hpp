@@ -60,6 +60,7 @@ struct RunTags {
   std::string_view bench_id;
   std::int64_t first_seq = 0, last_seq = 0;
 };
+void tag_run_json(Json& run, const RunTags& tags);  // adds the tags to run_fit_json()'s document
 Json tagged_run_fit_json(const RunFit& fit, const RunTags& tags, const ReportOptions& opt = {});
 
 // run_fit_json(fit, opt) (tagged_run_fit_json when tags are given) exactly as
