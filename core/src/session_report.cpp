@@ -40,35 +40,9 @@ std::string file_head(const std::string& path, std::size_t n) {
   return s;
 }
 
-// The first event's receive time (seconds since the epoch) from the file's first bytes, when
-// its header (the layout in lcm_log_reader.hpp) is one LcmLogReader accepts as an event of this
-// file and the time is set: then it is what the reader would find first. nullopt otherwise.
-std::optional<double> first_event_time(std::string_view head, std::uintmax_t file_size) {
-  constexpr std::size_t header_bytes = 28;        // magic, event number, timestamp, 2 lengths
-  constexpr std::int64_t max_channel_bytes = 1000;  // lcm_eventlog's limit, LcmLogReader's too
-  if (head.size() < header_bytes) return std::nullopt;
-  const auto* p = reinterpret_cast<const unsigned char*>(head.data());
-  const auto big_endian = [p](std::size_t at, int bytes) {
-    std::uint64_t v = 0;
-    for (int i = 0; i < bytes; ++i) v = v << 8 | p[at + static_cast<std::size_t>(i)];
-    return v;
-  };
-  const auto utime = static_cast<std::int64_t>(big_endian(12, 8));
-  const auto channel_bytes = static_cast<std::int32_t>(big_endian(20, 4));
-  const auto data_bytes = static_cast<std::int32_t>(big_endian(24, 4));
-  if (big_endian(0, 4) != lcm_log_magic || channel_bytes <= 0 || channel_bytes >= max_channel_bytes ||
-      data_bytes < 0 || utime <= 0)
-    return std::nullopt;
-  if (header_bytes + static_cast<std::uintmax_t>(channel_bytes) + static_cast<std::uintmax_t>(data_bytes) > file_size)
-    return std::nullopt;
-  return static_cast<double>(utime) * 1e-6;
-}
-
-// Receive time of the log's first event (seconds since the epoch). From the head already read
-// when it tells (nearly always); else (damage at the start, an event without a time) an
-// LcmLogReader looks at the first few events.
-std::optional<double> lcm_log_start(const std::string& path, std::string_view head, std::uintmax_t file_size) {
-  if (const auto t = first_event_time(head, file_size)) return t;
+// Receive time of the log's first event with a time set (seconds since the epoch), as
+// LcmLogReader finds it among the first few events (it resynchronises past damage at the start).
+std::optional<double> lcm_log_start(const std::string& path) {
   LcmLogReader reader(path);
   if (!reader.good()) return std::nullopt;
   LcmLogEvent ev;
@@ -299,7 +273,7 @@ SessionReport build_session_report(std::span<const std::string> paths, const Ses
     const FileFormat format = head.empty() ? FileFormat::automatic : detect_format(head, options.read);
     f.format = format;
     if (format == FileFormat::lcm_log)
-      f.start_unix_s = lcm_log_start(path, head, f.bytes);
+      f.start_unix_s = lcm_log_start(path);
     else if (format == FileFormat::arduino_text)
       f.start_unix_s = putty_log_time(head);
     report.files.push_back(std::move(f));
