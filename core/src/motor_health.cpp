@@ -355,15 +355,15 @@ HealthVerdict assess_health(const RunFit& fit, const MotorHealthConfig& cfg) {
 
   const ModelFit* best = best_of(fit);
   const ModelFit* combined = fit.model(ModelKind::combined);
-  const auto combined_friction = friction_of(combined);
+  const auto combined_fr = friction_of(combined);
 
   if (!best) {
     v.findings.push_back(note_finding("fit", HealthLevel::check,
                                       "no model converged: the run cannot be judged — repeat the run"));
   }
   if (cfg.baseline) {
-    if (combined_friction)
-      compare_with_baseline(*combined_friction, J, *cfg.baseline, th, v.findings);
+    if (combined_fr)
+      compare_with_baseline(*combined_fr, J, *cfg.baseline, th, v.findings);
     else if (best)
       v.findings.push_back(note_finding("baseline", HealthLevel::check,
                                         "the combined model did not converge, so the friction cannot be compared "
@@ -371,7 +371,7 @@ HealthVerdict assess_health(const RunFit& fit, const MotorHealthConfig& cfg) {
   }
   if (datasheet_torque) {
     // The datasheet gives one torque, so the best model alone can be compared when the combined one failed.
-    if (auto fr = combined_friction ? combined_friction : friction_of(best))
+    if (auto fr = combined_fr ? combined_fr : friction_of(best))
       compare_with_datasheet(*fr, J, *cfg.datasheet, th, v.findings);
   }
   if (cfg.datasheet && cfg.datasheet->rotor_inertia_kg_m2 && J < *cfg.datasheet->rotor_inertia_kg_m2) {

@@ -69,6 +69,6 @@ for attempt in 1 2 3; do
       echo " (burst $attempt; the earlier ones lost only what the kernel dropped)")"
     exit 0
   fi
-  echo "burst $attempt: the kernel's receive buffer overflowed (the logger lost nothing it received); again"
+  echo "burst $attempt: the kernel's receive buffer overflowed (the logger lost no more than the kernel dropped); again"
 done
 fail "the kernel dropped datagrams in each of 3 bursts (receive buffer too small for this machine's load?)"
