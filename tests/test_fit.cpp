@@ -329,7 +329,7 @@ RunData run_data(const Case& c) {
     d.tau.push_back(c.t[i] - c.seg.t_cut_s);
     d.y.push_back(c.run.volts[i] - c.seg.zero_level);
   }
-  for (double sw : weigh_by_noise(d.y).sqrt_weight) d.w.push_back(sw * sw);
+  d.w = weigh_by_noise(d.y).weight;
   return d;
 }
 

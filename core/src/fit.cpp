@@ -84,38 +84,73 @@ double stop_time(const Theta& th) {
   return std::log1p(th.alpha * th.u0 / th.beta) / th.alpha;
 }
 
-// One pass of the model over the run, vectorised with Eigen: the closed form is decreasing, so
-// every sample after the predicted stop reads exactly 0 and only the moving samples need the
-// exponential; the stopped tail contributes Σw·y² from a precomputed suffix sum. Residuals and
-// Jacobian rows carry the square roots of the samples' weights (reading_noise.hpp), so every
-// sum of squares, JᵀJ and the covariance below are the weighted ones.
+// The model's value and partial derivatives at one sample, in the family's parameter order
+// (u0, then α and β where free). Two forms of the same closed form, chosen once per pass.
+//
+// DecayingRow, where α·τ reaches 10⁻³: with c = β/α the model is (u0 + c)·e − c, no division
+// per sample. Its α-derivative, −(u0 + c)·τ·e + (c/α)·(1 − e), loses only ~ε·βτ/α to
+// cancellation where ατ is small.
+struct DecayingRow {
+  double a, c, c_over_alpha, inv_alpha;
+  template <int P>
+  double operator()(double t, double e, double* g) const {
+    g[0] = e;
+    g[1] = c_over_alpha * (1.0 - e) - a * t * e;
+    if constexpr (P == 3) g[2] = (e - 1.0) * inv_alpha;
+    return a * e - c;
+  }
+};
+
+// SeriesRow, where α·τ stays below 10⁻³ (or α is held at 0): φ(x) = (1 − e^(−x))/x by its
+// series, exact to rounding there, with the Coulomb limit φ = 1 (α = 0 gives x = 0, φ = 1 and
+// φ' = −1/2 exactly). A two-parameter family's second column is α's or β's, whichever is free.
+struct SeriesRow {
+  Theta th;
+  bool alpha_free;
+  template <int P>
+  double operator()(double t, double e, double* g) const {
+    const double x = th.alpha * t;
+    const double p = 1.0 - x / 2 + x * x / 6 - x * x * x / 24, dp = -0.5 + x / 3 - x * x / 8;
+    const double d_alpha = -th.u0 * t * e - th.beta * t * t * dp, d_beta = -t * p;
+    g[0] = e;
+    if constexpr (P == 2) g[1] = alpha_free ? d_alpha : d_beta;
+    if constexpr (P == 3) g[1] = d_alpha, g[2] = d_beta;
+    return th.u0 * e - th.beta * t * p;
+  }
+};
+
+// One pass of the model over the run: the closed form is decreasing, so every sample after
+// the predicted stop reads exactly 0 and only the moving samples need the model; the stopped
+// tail contributes Σw·y² from a precomputed suffix sum. Each pass is one scalar loop that
+// gathers the weighted SSE, the plain SSE, JᵀJ and Jᵀr together (w the samples' weights,
+// reading_noise.hpp) and, when the covariance asks, the Newey–West matrix as well.
 class Evaluator {
  public:
-  Evaluator(std::span<const double> tau, std::span<const double> y, std::span<const double> sqrt_weight)
+  Evaluator(std::span<const double> tau, std::span<const double> y, std::span<const double> weight)
       : tau_(tau),
         y_(y),
-        sw_(sqrt_weight),
+        w_(weight),
+        wy_(tau.size()),
         tail_sq_(tau.size() + 1, 0.0),
         plain_tail_sq_(tau.size() + 1, 0.0),
+        e_(tau.size()),
+        scores_(3 * tau.size()),
+        lags_(newey_west_lags(tau.size())),
         sorted_(std::is_sorted(tau.begin(), tau.end())) {
-    for (std::size_t i = tau.size(); i-- > 0;) {
-      tail_sq_[i] = tail_sq_[i + 1] + sqrt_weight[i] * sqrt_weight[i] * y[i] * y[i];
-      plain_tail_sq_[i] = plain_tail_sq_[i + 1] + y[i] * y[i];
+    const std::size_t n = tau.size();
+    double sum_y = 0;
+    for (std::size_t i = n; i-- > 0;) {
+      const double yy = y[i] * y[i];
+      tail_sq_[i] = tail_sq_[i + 1] + weight[i] * yy;
+      plain_tail_sq_[i] = plain_tail_sq_[i + 1] + yy;
+      wy_[i] = weight[i] * y[i];
+      sum_y += y[i];
+    }
+    if (n > 0) {
+      const double mean = sum_y / static_cast<double>(n);
+      for (double v : y) total_sum_sq_ += (v - mean) * (v - mean);
     }
     index_time_steps();
-    const auto n = static_cast<Eigen::Index>(tau.size());
-    if (n > 0) {
-      const Eigen::Map<const Eigen::ArrayXd> ys(y.data(), n);
-      total_sum_sq_ = (ys - ys.mean()).square().sum();
-    }
-    w_ = Eigen::Map<const Eigen::ArrayXd>(sqrt_weight.data(), n).square();
-    wy_ = w_ * Eigen::Map<const Eigen::ArrayXd>(y.data(), n);
-    e_.resize(n);
-    row_weight_.resize(n);
-    p_.resize(n);
-    dp_.resize(n);
-    r_.resize(n);
-    g_.resize(n, 3);
   }
 
   std::size_t size() const { return tau_.size(); }
@@ -129,167 +164,195 @@ class Evaluator {
     double ee = 0, ye = 0, t_ee = 0, t_ye = 0, tt_ee = 0, tt_ye = 0;
   };
   DecaySums decay_sums(double alpha) {
-    const auto n = static_cast<Eigen::Index>(tau_.size());
+    const std::size_t n = tau_.size();
     decay(alpha, n);
-    const Eigen::Map<const Eigen::ArrayXd> t(tau_.data(), n);
-    const auto e = e_.head(n);
-    auto wee = p_.head(n), wye = dp_.head(n);  // scratch shared with the model passes
-    wee = w_ * e.square();
-    wye = wy_ * e;
-    DecaySums s;
-    s.ee = wee.sum(), s.t_ee = (t * wee).sum(), s.tt_ee = (t.square() * wee).sum();
-    s.ye = wye.sum(), s.t_ye = (t * wye).sum(), s.tt_ye = (t.square() * wye).sum();
-    return s;
+    double ee = 0, ye = 0, t_ee = 0, t_ye = 0, tt_ee = 0, tt_ye = 0;
+    const double *tau = tau_.data(), *ex = e_.data(), *w = w_.data(), *wy = wy_.data();
+#pragma omp simd reduction(+ : ee, ye, t_ee, t_ye, tt_ee, tt_ye)
+    for (std::size_t i = 0; i < n; ++i) {
+      const double e = ex[i], t = tau[i], wee = w[i] * e * e, wye = wy[i] * e;
+      ee += wee, t_ee += t * wee, tt_ee += t * t * wee;
+      ye += wye, t_ye += t * wye, tt_ye += t * t * wye;
+    }
+    return {ee, ye, t_ee, t_ye, tt_ee, tt_ye};
   }
 
   // The run as the direct solutions see it: times (sorted or not), weights, weighted readings.
   std::span<const double> tau() const { return tau_; }
   bool sorted() const { return sorted_; }
-  std::span<const double> weights() const { return {w_.data(), tau_.size()}; }
-  std::span<const double> weighted_readings() const { return {wy_.data(), tau_.size()}; }
+  std::span<const double> weights() const { return w_; }
+  std::span<const double> weighted_readings() const { return wy_; }
 
-  // SSE at θ; with jac, also JᵀJ and Jᵀr (unused rows/columns of a smaller family are left
-  // as identity/zero so 3×3 solvers serve every family). Residuals and Jacobian rows of the
-  // moving samples stay in r() and jacobian() until the next call.
-  double operator()(const Family& f, const Theta& th, Eigen::Matrix3d* jtj = nullptr, Eigen::Vector3d* jtr = nullptr) {
-    // LM ends on an accepted point that the covariance and the statistics ask for again.
-    if (last_valid_ && same(f, th) && (!jtj || last_has_jac_)) {
-      if (jtj) *jtj = last_jtj_, *jtr = last_jtr_;
-      return last_sse_;
+  // Weighted SSE at θ; with jtj, also JᵀJ and Jᵀr (unused rows/columns of a smaller family
+  // are left as identity/zero so 3×3 solvers serve every family); with omega, also
+  // Σ_t S_t·S_tᵀ, S_t = s_t + … + s_(t−L) the moving sums of the scores s_t = g_t·w_t·r_t over
+  // L + 1 samples (L = lags()): the Bartlett-weighted Newey–West sum γ0 + 2·Σ_l (1 −
+  // l/(L+1))·γ_l is exactly this divided by L + 1, since each product s_i·s_(i−l)ᵀ lies in
+  // L + 1 − l windows. So the long-run covariance costs one pass over the scores the
+  // evaluation kept, not L passes, and no second evaluation at LM's last point.
+  double operator()(const Family& f, const Theta& th, Eigen::Matrix3d* jtj = nullptr, Eigen::Vector3d* jtr = nullptr,
+                    Eigen::Matrix3d* omega = nullptr) {
+    if (!(last_valid_ && same(f, th))) evaluate(f, th);
+    if (jtj) *jtj = last_jtj_, *jtr = last_jtr_;
+    if (omega) {
+      if (!last_has_omega_) f.size() == 3 ? moving_sums<3>() : moving_sums<2>();
+      *omega = last_omega_;
     }
+    return last_sse_;
+  }
+  int lags() const { return lags_; }
+
+  // Σ(y − model)² without the weights at θ (for RMSE and R², in the reading's unit).
+  double plain_sse(const Family& f, const Theta& th) {
+    (*this)(f, th);
+    return last_plain_sse_;
+  }
+
+  // Newey–West's bandwidth for n samples: L = ⌈4·(n/100)^(2/9)⌉.
+  static int newey_west_lags(std::size_t n) {
+    return static_cast<int>(std::ceil(4.0 * std::pow(static_cast<double>(n) / 100.0, 2.0 / 9.0)));
+  }
+
+ private:
+  void evaluate(const Family& f, const Theta& th) {
     const std::size_t n = tau_.size();
     std::size_t m = n;
     const double ts = stop_time(th);
     if (sorted_ && std::isfinite(ts)) m = static_cast<std::size_t>(std::upper_bound(tau_.begin(), tau_.end(), ts) - tau_.begin());
-    m_ = static_cast<Eigen::Index>(m);
-    const Eigen::Map<const Eigen::ArrayXd> t(tau_.data(), m_), y(y_.data(), m_), sw(sw_.data(), m_);
-    auto e = e_.head(m_), p = p_.head(m_), dp = dp_.head(m_), r = r_.head(m_);
-    auto row_weight = row_weight_.head(m_);  // √w while moving, 0 once stopped
-    const double tau_max = m_ == 0 ? 0.0 : sorted_ ? t[m_ - 1] : t.maxCoeff();
+    m_ = m;
+    const double tau_max = m == 0 ? 0.0 : sorted_ ? tau_[m - 1] : *std::max_element(tau_.begin(), tau_.begin() + m);
     const bool decaying = f.alpha_free && th.alpha * tau_max >= 1e-3;
+    if (f.alpha_free && th.alpha != 0) decay(th.alpha, m);
+    else std::fill(e_.begin(), e_.begin() + m, 1.0);
     if (decaying) {
-      // With c = β/α the model is (u0 + c)·e − c: no division per sample. Its α-derivative,
-      // −(u0 + c)·τ·e + (c/α)·(1 − e), loses only ~ε·βτ/α to cancellation where ατ is small.
       const double c = th.beta / th.alpha;
-      decay(th.alpha, m_);
-      r = (th.u0 + c) * e - c;
-      row_weight = (r > 0).cast<double>() * sw;
-      r = (y - r.max(0.0)) * sw;
-      if (jtj) {
-        int j = 0;
-        g_.col(j++).head(m_) = (e * row_weight).matrix();
-        g_.col(j++).head(m_) = ((c / th.alpha * (1.0 - e) - (th.u0 + c) * t * e) * row_weight).matrix();
-        if (f.beta_free) g_.col(j++).head(m_) = ((e - 1.0) * (row_weight / th.alpha)).matrix();
-      }
+      const DecayingRow row{th.u0 + c, c, c / th.alpha, 1.0 / th.alpha};
+      f.beta_free ? accumulate<3>(row) : accumulate<2>(row);
     } else {
-      // α·τ below 10⁻³ everywhere (or α fixed at 0): φ(x) = (1 − e^(−x))/x by its series, which
-      // is exact to rounding there and has the Coulomb limit φ = 1.
-      if (f.alpha_free && th.alpha != 0) {
-        e = (-th.alpha * t).exp();
-        const auto x = t * th.alpha;
-        p = 1.0 - x / 2 + x * x / 6 - x * x * x / 24;
-        dp = -0.5 + x / 3 - x * x / 8;
-      } else {
-        e.setOnes();
-        p.setOnes();
-        dp.setConstant(-0.5);
-      }
-      // model = max(0, u0·e − β·τ·φ); rounding may leave a sample at the stop just below 0.
-      r = th.u0 * e - th.beta * t * p;
-      row_weight = (r > 0).cast<double>() * sw;
-      r = (y - r.max(0.0)) * sw;
-      if (jtj) {
-        int j = 0;
-        g_.col(j++).head(m_) = (e * row_weight).matrix();
-        if (f.alpha_free) g_.col(j++).head(m_) = ((-th.u0 * t * e - th.beta * t * t * dp) * row_weight).matrix();
-        if (f.beta_free) g_.col(j++).head(m_) = (-t * p * row_weight).matrix();
-      }
+      const SeriesRow row{th, f.alpha_free};
+      f.size() == 3 ? accumulate<3>(row) : accumulate<2>(row);
     }
-    const double sse = r.square().sum() + tail_sq_[m];
-    last_f_ = f, last_th_ = th, last_sse_ = sse, last_valid_ = true, last_has_jac_ = jtj != nullptr;
-    if (jtj) {
-      const int np = f.size();
-      jtj->setIdentity();
-      jtr->setZero();
-      // p ≤ 3 columns: vectorised dot products beat a general matrix product here.
-      for (int a = 0; a < np; ++a) {
-        const auto ga = g_.col(a).head(m_);
-        (*jtr)[a] = ga.dot(r.matrix());
-        for (int b = 0; b <= a; ++b) (*jtj)(a, b) = (*jtj)(b, a) = ga.dot(g_.col(b).head(m_));
-      }
-      last_jtj_ = *jtj, last_jtr_ = *jtr;
-    }
-    return sse;
+    last_f_ = f, last_th_ = th, last_valid_ = true, last_has_omega_ = false;
   }
 
-  // Σr² without the weights at θ (for RMSE and R², which speak in the reading's unit).
-  double plain_sse(const Family& f, const Theta& th) {
-    (*this)(f, th);
-    const Eigen::Map<const Eigen::ArrayXd> sw(sw_.data(), m_);
-    return (r_.head(m_) / sw).square().sum() + plain_tail_sq_[static_cast<std::size_t>(m_)];
+  // The pass itself for a family of P parameters, branch-free so that it vectorises (the
+  // sums' order then differs from a plain loop's only in rounding). Samples before the stop
+  // where the model already reads 0 (rounding at the stop) count as stopped: residual y, no
+  // gradient. Each sample's score g·w·r is kept for the moving sums, should the covariance ask.
+  template <int P, class Row>
+  void accumulate(const Row& row) {
+    static_assert(P == 2 || P == 3);
+    double sse = 0, plain = 0, r0 = 0, r1 = 0, r2 = 0, j00 = 0, j10 = 0, j11 = 0, j20 = 0, j21 = 0, j22 = 0;
+    const double *tau = tau_.data(), *e = e_.data(), *w = w_.data(), *y = y_.data();
+    double* score = scores_.data();
+    const std::size_t m = m_;
+#pragma omp simd reduction(+ : sse, plain, r0, r1, r2, j00, j10, j11, j20, j21, j22)
+    for (std::size_t i = 0; i < m; ++i) {
+      double g[3];
+      const double model = row.template operator()<P>(tau[i], e[i], g);
+      const bool moving = model > 0;
+      const double d = y[i] - (moving ? model : 0.0), wd = w[i] * d;
+      const double gw = moving ? w[i] : 0.0, gwd = moving ? wd : 0.0;  // the gradient's weights
+      sse += wd * d, plain += d * d;
+      r0 += g[0] * gwd, r1 += g[1] * gwd;
+      j00 += gw * g[0] * g[0], j10 += gw * g[1] * g[0], j11 += gw * g[1] * g[1];
+      if constexpr (P == 3) r2 += g[2] * gwd, j20 += gw * g[2] * g[0], j21 += gw * g[2] * g[1], j22 += gw * g[2] * g[2];
+      for (int a = 0; a < P; ++a) score[P * i + a] = g[a] * gwd;
+    }
+    last_sse_ = sse + tail_sq_[m];
+    last_plain_sse_ = plain + plain_tail_sq_[m];
+    last_jtj_ << j00, j10, j20, j10, j11, j21, j20, j21, j22;
+    last_jtr_ << r0, r1, r2;
+    if constexpr (P == 2) last_jtj_(2, 2) = 1;
   }
 
-  // After a call with jac: the moving samples' weighted residuals and Jacobian rows.
-  auto residuals() const { return r_.head(m_); }
-  auto jacobian(int p) const { return g_.topLeftCorner(m_, p); }
+  // Σ_t S_t·S_tᵀ over the scores of the last pass, S_t = s_t + … + s_(t−L), t running on L
+  // samples past the stop while windows still hold scores.
+  template <int P>
+  void moving_sums() {
+    double window[P] = {}, omega[P][P] = {};
+    const std::size_t m = m_, lags = static_cast<std::size_t>(lags_);
+    for (std::size_t t = 0; t < m + lags; ++t) {
+#pragma GCC unroll 3
+      for (int a = 0; a < P; ++a) {
+        if (t < m) window[a] += scores_[P * t + a];
+        if (t > lags) window[a] -= scores_[P * (t - lags - 1) + a];
+      }
+#pragma GCC unroll 3
+      for (int a = 0; a < P; ++a)
+#pragma GCC unroll 3
+        for (int b = 0; b <= a; ++b) omega[a][b] += window[a] * window[b];
+    }
+    last_omega_.setZero();
+    for (int a = 0; a < P; ++a)
+      for (int b = 0; b <= a; ++b) last_omega_(a, b) = last_omega_(b, a) = omega[a][b];
+    last_has_omega_ = true;
+  }
 
- private:
   // e_i = exp(−α·τ_i) for the first m samples. A device clock ticks in whole units, so the
   // steps τ_i − τ_(i−1) take a handful of values: then e_i = e_(i−1)·exp(−α·Δ) needs one
   // exponential per distinct step instead of one per sample. Exact anchors every
   // anchor_every samples keep the product's rounding drift below 10⁻¹³.
-  void decay(double alpha, Eigen::Index m) {
+  void decay(double alpha, std::size_t m) {
     if (step_code_.empty() || m < 2 * anchor_every) {
-      e_.head(m) = (-alpha * Eigen::Map<const Eigen::ArrayXd>(tau_.data(), m)).exp();
+      const auto k = static_cast<Eigen::Index>(m);
+      Eigen::Map<Eigen::ArrayXd>(e_.data(), k) = (-alpha * Eigen::Map<const Eigen::ArrayXd>(tau_.data(), k)).exp();
       return;
     }
     for (std::size_t d = 0; d < steps_.size(); ++d) step_factor_[d] = std::exp(-alpha * steps_[d]);
-    for (Eigen::Index i = 0; i < m; ++i)
-      e_[i] = i % anchor_every == 0 ? std::exp(-alpha * tau_[i]) : e_[i - 1] * step_factor_[step_code_[i]];
+    for (std::size_t anchor = 0; anchor < m; anchor += anchor_every) {
+      double e = e_[anchor] = std::exp(-alpha * tau_[anchor]);
+      for (std::size_t i = anchor + 1; i < std::min(m, anchor + anchor_every); ++i) e_[i] = e *= step_factor_[step_code_[i]];
+    }
   }
 
   void index_time_steps() {
     constexpr std::size_t max_steps = 32;
     if (!sorted_ || tau_.size() < 2) return;
     std::vector<std::uint8_t> code(tau_.size(), 0);
+    std::size_t last = 0;  // consecutive steps are usually equal: try the previous one first
     for (std::size_t i = 1; i < tau_.size(); ++i) {
       const double step = tau_[i] - tau_[i - 1];
-      auto it = std::find(steps_.begin(), steps_.end(), step);
-      if (it == steps_.end()) {
-        if (steps_.size() == max_steps) {  // jittered clock: one exponential per sample
-          steps_.clear();
-          return;
+      if (steps_.empty() || steps_[last] != step) {
+        const auto it = std::find(steps_.begin(), steps_.end(), step);
+        if (it == steps_.end()) {
+          if (steps_.size() == max_steps) {  // jittered clock: one exponential per sample
+            steps_.clear();
+            return;
+          }
+          steps_.push_back(step);
+          last = steps_.size() - 1;
+        } else {
+          last = static_cast<std::size_t>(it - steps_.begin());
         }
-        it = steps_.insert(steps_.end(), step);
       }
-      code[i] = static_cast<std::uint8_t>(it - steps_.begin());
+      code[i] = static_cast<std::uint8_t>(last);
     }
     step_code_ = std::move(code);
     step_factor_.resize(steps_.size());
   }
-  static constexpr Eigen::Index anchor_every = 64;
+  static constexpr std::size_t anchor_every = 64;
   std::vector<double> steps_, step_factor_;
   std::vector<std::uint8_t> step_code_;
 
-  std::span<const double> tau_, y_, sw_;
-  std::vector<double> tail_sq_, plain_tail_sq_;
+  std::span<const double> tau_, y_, w_;
+  std::vector<double> wy_, tail_sq_, plain_tail_sq_;
+  std::vector<double> e_, scores_;
+  int lags_;
   double total_sum_sq_ = 0;
   bool sorted_;
-  Eigen::Index m_ = 0;
-  Eigen::ArrayXd w_, wy_;  // weights and weighted readings, for the direct solutions
-  Eigen::ArrayXd e_, p_, dp_, r_, row_weight_;
+  std::size_t m_ = 0;
   // The last evaluation, so asking again for the same point costs nothing.
   bool same(const Family& f, const Theta& th) const {
     return f.alpha_free == last_f_.alpha_free && f.beta_free == last_f_.beta_free && th.u0 == last_th_.u0 &&
            th.alpha == last_th_.alpha && th.beta == last_th_.beta;
   }
-  bool last_valid_ = false, last_has_jac_ = false;
+  bool last_valid_ = false, last_has_omega_ = false;
   Family last_f_{false, false};
   Theta last_th_;
-  double last_sse_ = 0;
-  Eigen::Matrix3d last_jtj_;
+  double last_sse_ = 0, last_plain_sse_ = 0;
+  Eigen::Matrix3d last_jtj_, last_omega_;
   Eigen::Vector3d last_jtr_;
-  Eigen::MatrixXd g_;
 };
 
 struct Problem {
@@ -556,9 +619,9 @@ struct Covariance {
 // which is the long-run variance of the scalar series z_i = (g_i·v_j)·r_i.
 Covariance covariance(const Family& f, const Theta& th, Evaluator& eval) {
   const int p = f.size();
-  Eigen::Matrix3d jtj;
+  Eigen::Matrix3d jtj, omega;
   Eigen::Vector3d jtr;
-  const double sse = eval(f, th, &jtj, &jtr);
+  const double sse = eval(f, th, &jtj, &jtr, &omega);
   const auto n = static_cast<Eigen::Index>(eval.size());
   Covariance out;
   const Eigen::LDLT<Eigen::Matrix3d> ldlt(jtj);
@@ -567,30 +630,13 @@ Covariance covariance(const Family& f, const Theta& th, Evaluator& eval) {
   if (!inv.allFinite()) return out;
   const double s2 = sse / static_cast<double>(std::max<Eigen::Index>(1, n - p));
   const Eigen::Matrix3d classic = s2 * inv;
-
-  const int lags = static_cast<int>(std::ceil(4.0 * std::pow(n / 100.0, 2.0 / 9.0)));
+  // Ω from the evaluation's moving sums of the scores (Evaluator::operator()).
   const double dof = static_cast<double>(n) / static_cast<double>(std::max<Eigen::Index>(1, n - p));
-  const auto g = eval.jacobian(p);  // rows of the moving samples; the stopped tail scores zero
-  const auto r = eval.residuals();
-  const Eigen::Index m = r.size();
   Eigen::Vector3d widen = Eigen::Vector3d::Ones();
-  Eigen::ArrayXd z(m);
   for (int j = 0; j < p; ++j) {
-    // z = (g·v_j)∘r, as column sums: Eigen's general matrix–vector product is slow at p ≤ 3.
-    z = g.col(0).array() * inv(0, j);
-    for (int c = 1; c < p; ++c) z += g.col(c).array() * inv(c, j);
-    z *= r;
-    // The Bartlett-weighted sum γ0 + 2·Σ_{l=1..L} (1 − l/(L+1))·γ_l equals, exactly, the sum of
-    // squares of the moving sums S_t = z_t + … + z_(t−L) over every t where S_t is not empty,
-    // divided by L + 1 (each product z_i·z_(i−l) lies in L + 1 − l windows): one pass, not L.
-    double window = 0, sum_sq = 0;
-    for (Eigen::Index t = 0; t < m + lags; ++t) {
-      if (t < m) window += z[t];
-      if (t > lags) window -= z[t - lags - 1];
-      sum_sq += window * window;
-    }
-    const double omega = sum_sq / (lags + 1.0);
-    widen[j] = std::sqrt(std::max(1.0, dof * omega / classic(j, j)));
+    const auto v = inv.col(j).head(p);
+    const double long_run = v.dot(omega.topLeftCorner(p, p) * v) / (eval.lags() + 1.0);
+    widen[j] = std::sqrt(std::max(1.0, dof * long_run / classic(j, j)));
   }
   // Keep the correlation structure of the classic estimate, widened per parameter.
   out.cov = widen.asDiagonal() * classic * widen.asDiagonal();
@@ -819,9 +865,8 @@ RunFit fit_run(std::span<const double> t_s, std::span<const double> value, Quant
   const std::size_t moving = (run.stopped ? stop : end) - begin;
   const std::string_view runit = quantity_unit(q);
   // Weights from the run's own noise (σ² growing with the reading), shared by every model.
-  const std::vector<double> sqrt_weight =
-      opt.weighted ? weigh_by_noise(y).sqrt_weight : std::vector<double>(y.size(), 1.0);
-  Evaluator eval(tau, y, sqrt_weight);  // one workspace for every model of the run
+  const std::vector<double> weight = opt.weighted ? weigh_by_noise(y).weight : std::vector<double>(y.size(), 1.0);
+  Evaluator eval(tau, y, weight);  // one workspace for every model of the run
   const IntegralForm form = integral_form(tau, y, moving);
   for (ModelKind kind : opt.models)
     out.models.push_back(fit_model(kind, tau, y, moving, k, opt.bench, runit, &eval, form));

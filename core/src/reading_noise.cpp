@@ -56,15 +56,17 @@ ReadingNoise estimate(std::span<const double> y, std::span<const double> mean, d
 
 NoiseWeights weigh_by_noise(std::span<const double> y, double max_ratio) {
   NoiseWeights out;
-  out.sqrt_weight.assign(y.size(), 1.0);
+  out.weight.assign(y.size(), 1.0);
   if (y.size() < 32) return out;
-  const std::vector<double> mean = local_means(y);
+  std::vector<double> mean = local_means(y);
   out.noise = estimate(y, mean, max_ratio);
   if (!out.noise.known) return out;
+  // The local means become the weights in place: one buffer, no second allocation.
   double total = 0;
-  for (std::size_t i = 0; i < y.size(); ++i) total += out.sqrt_weight[i] = 1.0 / out.noise.variance(mean[i]);
+  for (double& u : mean) total += u = 1.0 / out.noise.variance(u);
   const double scale = static_cast<double>(y.size()) / total;
-  for (double& w : out.sqrt_weight) w = std::sqrt(w * scale);
+  for (double& w : mean) w *= scale;
+  out.weight = std::move(mean);
   return out;
 }
 

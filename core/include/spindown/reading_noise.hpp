@@ -20,8 +20,8 @@ struct ReadingNoise {
   double variance(double u) const { return a + b * u * u; }
 };
 
-// σ²(u) from readings y (zero level removed) of one run, cut to end, and the square roots of
-// the fit weights 1/σ²(ū_i), ū the local mean around sample i, scaled so the weights average 1
+// σ²(u) from readings y (zero level removed) of one run, cut to end, and the fit weights
+// 1/σ²(ū_i), ū the local mean around sample i, scaled so the weights average 1
 // over the run (weighted and plain sums of squares stay comparable); all ones when the noise
 // is not known (fewer than 32 samples, no variance).
 // The ratio of the largest to the smallest variance is capped at max_ratio. Not all error
@@ -35,7 +35,7 @@ struct ReadingNoise {
 // cap-4 and unweighted rows.
 struct NoiseWeights {
   ReadingNoise noise;
-  std::vector<double> sqrt_weight;  // one per reading
+  std::vector<double> weight;  // one per reading
 };
 NoiseWeights weigh_by_noise(std::span<const double> y, double max_ratio = 4.0);
 
