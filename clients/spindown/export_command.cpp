@@ -154,14 +154,14 @@ int run_export(const ExportCommandOptions& o) {
   std::fputs("bench,seq,device_time_s,host_time_s,value,unit,raw_adc,clock_epoch\n", f);
   std::size_t rows = 0;
   auto each = [&](const LcmLogEvent& ev) {
-    if (ev.kind != LcmLogEvent::Kind::samples || !std::regex_match(ev.bench, wanted)) return;
+    if (ev.kind != LcmLogEvent::Kind::samples || !std::regex_match(ev.bench.begin(), ev.bench.end(), wanted)) return;
     const samples_t& m = ev.samples;
     const auto q = quantity_from_samples_code(m.quantity);
     const std::string unit = q ? std::string(quantity_unit(*q)) : fmt::format("code {}", int(m.quantity));
     for (std::int32_t i = 0; i < m.n; ++i) {
       const std::int32_t adc = i < std::int32_t(m.raw_adc.size()) ? m.raw_adc[i] : -1;
       const double host = i < std::int32_t(m.host_time_us.size()) ? 1e-6 * double(m.host_time_us[i]) : NAN;
-      fmt::print(f, "{},{},{:.6f},{},{},{},{},{}\n", field(ev.bench), m.seq + i, 1e-6 * double(m.device_time_us[i]),
+      fmt::print(f, "{},{},{:.6f},{},{},{},{},{}\n", field(std::string(ev.bench)), m.seq + i, 1e-6 * double(m.device_time_us[i]),
                  std::isfinite(host) ? fmt::format("{:.6f}", host) : std::string("NaN"), number(m.value[i]),
                  field(unit), adc >= 0 ? std::to_string(adc) : std::string(), m.clock_epoch);
       ++rows;

@@ -204,7 +204,7 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
       if (!ev.bench.empty() && (ev.channel.ends_with(".SAMPLE") || ev.channel.ends_with(".CONFIG")) &&
           !order.contains(ev.bench)) {
         order.emplace(ev.bench, order.size());
-        out.bench_order.push_back(ev.bench);
+        out.bench_order.emplace_back(ev.bench);
       }
       if (ev.channel_id >= 0) {
         if (id >= channel_done.size()) channel_done.resize(id + 1, 0);

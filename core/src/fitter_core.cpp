@@ -98,7 +98,6 @@ struct FitterCore::Bench {
   RunDetector detector;
   Mirror mirror;  // samples of a run, with the sequence numbers a published run names
   std::uint64_t last_active = 0, arrival = 0;
-  Bench* followed_by = nullptr;  // the bench whose message came after this one's last time
 
   std::optional<BenchParams> config;
   std::string config_problem;
@@ -157,18 +156,19 @@ std::vector<std::string> FitterCore::benches() const {
 
 FitterCore::Bench* FitterCore::bench_for(std::string_view id, std::int64_t recv_utime, std::string_view kind) {
   ++activity_;
-  // Benches publish in a steady interleave: the bench that followed the previous one last time
-  // is nearly always the one asked for, found without the map.
-  if (Bench* guess = last_bench_ ? last_bench_->followed_by : nullptr; guess && short_string_equal(guess->id, id)) {
-    guess->last_active = activity_;
-    last_bench_ = guess;
-    return guess;
+  // Nearly always a bench already held, found by its cache slot without the map.
+  if (Bench* cached = bench_cache_.slot(id); cached && short_string_equal(cached->id, id)) {
+    cached->last_active = activity_;
+    return cached;
   }
+  return find_bench(id, recv_utime, kind);
+}
+
+FitterCore::Bench* FitterCore::find_bench(std::string_view id, std::int64_t recv_utime, std::string_view kind) {
   if (auto it = benches_.find(id); it != benches_.end()) {
     Bench* found = it->second.get();
     found->last_active = activity_;
-    if (last_bench_) last_bench_->followed_by = found;
-    last_bench_ = found;
+    bench_cache_.slot(id) = found;
     return found;
   }
   std::string why;
@@ -194,9 +194,7 @@ FitterCore::Bench* FitterCore::bench_for(std::string_view id, std::int64_t recv_
                       "active bench {} evicted",
                       id, kind, id, benches_.size(), v.id),
           recv_utime);
-    for (auto& [other_id, other] : benches_)
-      if (other->followed_by == &v) other->followed_by = nullptr;
-    if (last_bench_ == &v) last_bench_ = nullptr;
+    bench_cache_.forget(&v);
     benches_.erase(victim);
   }
   auto b = std::make_unique<Bench>(std::string(id), opt_.runs);
@@ -204,8 +202,7 @@ FitterCore::Bench* FitterCore::bench_for(std::string_view id, std::int64_t recv_
   b->arrival = ++arrivals_;
   Bench* p = b.get();
   benches_.emplace(p->id, std::move(b));
-  if (last_bench_) last_bench_->followed_by = p;
-  last_bench_ = p;
+  bench_cache_.slot(id) = p;
   return p;
 }
 
@@ -420,14 +417,16 @@ void FitterCore::push_sample(Bench& b, std::int64_t seq, double t_s, double valu
     ++counters_.internal_errors;
     error(fmt::format("{}: internal error at seq {}: {}", b.channel, seq, e.what()), recv_utime);
   }
-  // A provisional stop the detector took back: the run is coasting again.
-  if (b.open_state == 2 && b.detector.state() == RunDetector::State::coasting) {
-    b.open_run.stopped = false;
-    b.open_run.t_stop_s = std::numeric_limits<double>::quiet_NaN();
-    publish_run(b, b.open_run, run_t::STATE_COASTING, "standstill retracted: the reading kept falling", recv_utime);
-    b.open_state = 1;
-  }
+  if (b.open_state == 2 && b.detector.state() == RunDetector::State::coasting) retract_stop(b, recv_utime);
   trim_mirror(b);
+}
+
+// A provisional stop the detector took back: the run is coasting again.
+void FitterCore::retract_stop(Bench& b, std::int64_t recv_utime) {
+  b.open_run.stopped = false;
+  b.open_run.t_stop_s = std::numeric_limits<double>::quiet_NaN();
+  publish_run(b, b.open_run, run_t::STATE_COASTING, "standstill retracted: the reading kept falling", recv_utime);
+  b.open_state = 1;
 }
 
 void FitterCore::trim_mirror(Bench& b) {
@@ -493,12 +492,14 @@ void FitterCore::fit_and_publish(Bench& b, const Run& run, std::int64_t recv_uti
   publish_run(b, run, run.stopped ? run_t::STATE_STOPPED : run_t::STATE_ABANDONED, note, recv_utime);
 
   // The run's samples as contiguous arrays, indices relative to the cut.
-  scratch_t_.clear();
-  scratch_v_.clear();
   const std::size_t base = b.base();
-  for (std::size_t k = run.cut_index; k < run.end_index; ++k) {
-    scratch_t_.push_back(b.mirror[k - base].t_s);
-    scratch_v_.push_back(b.mirror[k - base].value);
+  const std::size_t count = run.end_index > run.cut_index ? run.end_index - run.cut_index : 0;
+  scratch_t_.resize(count);
+  scratch_v_.resize(count);
+  for (std::size_t k = 0; k < count; ++k) {
+    const Bench::Sample& s = b.mirror[run.cut_index + k - base];
+    scratch_t_[k] = s.t_s;
+    scratch_v_[k] = s.value;
   }
   Run local = run;
   local.cut_index = 0;

@@ -166,17 +166,12 @@ std::int64_t LcmLogReader::find_marker(std::int64_t from) {
 }
 
 const LcmLogReader::ChannelInfo& LcmLogReader::channel_info(std::string_view channel) {
-  // Loggers interleave benches in a steady pattern: try the channel that followed the last one.
-  if (last_channel_ >= 0) {
-    const std::int32_t guess = channels_[static_cast<std::size_t>(last_channel_)].next;
-    if (guess >= 0) {
-      const ChannelInfo& c = channels_[static_cast<std::size_t>(guess)];
-      if (short_string_equal(c.channel, channel)) {
-        last_channel_ = guess;
-        return c;
-      }
-    }
-  }
+  const ChannelInfo* cached = channel_cache_.slot(channel);
+  if (cached && short_string_equal(cached->channel, channel)) return *cached;  // nearly always
+  return find_channel(channel);
+}
+
+const LcmLogReader::ChannelInfo& LcmLogReader::find_channel(std::string_view channel) {
   const ChannelInfo* found = nullptr;
   for (const ChannelInfo& c : channels_)
     if (short_string_equal(c.channel, channel)) {
@@ -188,7 +183,6 @@ const LcmLogReader::ChannelInfo& LcmLogReader::channel_info(std::string_view cha
     info.channel.assign(channel);
     info.bench.clear();
     info.kind = 0;
-    info.next = -1;
     info.id = &info == &uncached_ ? -1 : static_cast<std::int32_t>(channels_.size() - 1);
     if (const auto name = split_spindown_channel(channel)) {
       info.bench.assign(name->bench);
@@ -196,8 +190,7 @@ const LcmLogReader::ChannelInfo& LcmLogReader::channel_info(std::string_view cha
     }
     found = &info;
   }
-  if (last_channel_ >= 0 && found->id >= 0) channels_[static_cast<std::size_t>(last_channel_)].next = found->id;
-  last_channel_ = found->id;
+  if (found->id >= 0) channel_cache_.slot(channel) = found;
   return *found;
 }
 
@@ -211,8 +204,8 @@ bool LcmLogReader::find_event_start(LcmLogEvent& event) {
   event.log_utime = 0;
   event.file_offset = from;
   event.channel_id = -1;
-  event.channel.clear();
-  event.bench.clear();
+  event.channel = {};
+  event.bench = {};
   event.data = nullptr;
   event.data_size = 0;
   if (at < 0) {
@@ -231,6 +224,38 @@ bool LcmLogReader::find_event_start(LcmLogEvent& event) {
 }
 
 bool LcmLogReader::next(LcmLogEvent& event) {
+  // Nearly every event: whole in the buffer with a sound header. The rest (the end, a refill,
+  // damage) takes next_checked(), which reads this same event the same way when it is sound.
+  const std::int64_t in_buffer = buffer_offset_ + buffered_ - pos_;
+  if (fd_ >= 0 && !done_ && pos_ >= buffer_offset_ && in_buffer >= event_header_bytes) {
+    const unsigned char* p = buffer_.data() + (pos_ - buffer_offset_);
+    const std::int32_t channel_len = static_cast<std::int32_t>(be32(p + 20));
+    const std::int32_t data_len = static_cast<std::int32_t>(be32(p + 24));
+    if (be32(p) == lcm_log_magic && channel_len > 0 && channel_len < max_channel_bytes && data_len >= 0 &&
+        event_header_bytes + channel_len + data_len <= in_buffer) {
+      accept(event, p, channel_len, data_len);
+      return true;
+    }
+  }
+  return next_checked(event);
+}
+
+// A sound event whose bytes (header at p) are all in the buffer: kept, whatever follows it
+// (another event, the end, or garbage that the next call skips and reports).
+void LcmLogReader::accept(LcmLogEvent& event, const unsigned char* p, std::int32_t channel_len,
+                          std::int32_t data_len) {
+  event.file_offset = pos_;
+  pos_ += event_header_bytes + channel_len + data_len;
+  ++events_;
+  event.number = events_;
+  event.log_utime = static_cast<std::int64_t>(be64(p + 12));
+  event.channel = std::string_view(reinterpret_cast<const char*>(p + event_header_bytes),
+                                   static_cast<std::size_t>(channel_len));
+  event.problem.clear();
+  decode(event, channel_info(event.channel), p + event_header_bytes + channel_len, data_len);
+}
+
+bool LcmLogReader::next_checked(LcmLogEvent& event) {
   if (fd_ < 0 || done_) return false;
   const std::int64_t at = pos_;
   auto problem = [&](std::string text) {
@@ -251,14 +276,14 @@ bool LcmLogReader::next(LcmLogEvent& event) {
   const std::int64_t got = fill(event_header_bytes, &h);
   if (!read_error_.empty() && got < std::min(event_header_bytes, size_ - at)) {
     done_ = true;
-    event.channel.clear();
-    event.bench.clear();
+    event.channel = {};
+    event.bench = {};
     return problem(fmt::format("{} (after event {}); the rest of the log is not read", read_error_, events_));
   }
   if (got < 4 || be32(h) != lcm_log_magic) return find_event_start(event);
 
-  event.channel.clear();
-  event.bench.clear();
+  event.channel = {};
+  event.bench = {};
   if (got < event_header_bytes) {
     done_ = true;
     pos_ = size_;
@@ -266,7 +291,6 @@ bool LcmLogReader::next(LcmLogEvent& event) {
                                "after event {})",
                                at, got, event_header_bytes, events_));
   }
-  const std::int64_t utime = static_cast<std::int64_t>(be64(h + 12));
   const std::int32_t channel_len = static_cast<std::int32_t>(be32(h + 20));
   const std::int32_t data_len = static_cast<std::int32_t>(be32(h + 24));
   if (channel_len <= 0 || channel_len >= max_channel_bytes || data_len < 0) {
@@ -303,18 +327,7 @@ bool LcmLogReader::next(LcmLogEvent& event) {
     return problem(fmt::format("{} inside event {} at offset {}; the rest of the log is not read", read_error_,
                                events_ + 1, at));
   }
-  // Whatever follows (another event, the end, or garbage that the next call skips and
-  // reports), this event is sound: it is kept.
-  pos_ = end;
-  ++events_;
-  event.number = events_;
-  event.log_utime = utime;
-  event.file_offset = at;
-  const std::string_view channel(reinterpret_cast<const char*>(p + event_header_bytes),
-                                 static_cast<std::size_t>(channel_len));
-  event.channel.assign(channel);
-  event.problem.clear();
-  decode(event, channel_info(channel), p + event_header_bytes + channel_len, data_len);
+  accept(event, p, channel_len, data_len);
   return true;
 }
 
@@ -323,18 +336,20 @@ void LcmLogReader::decode(LcmLogEvent& event, const ChannelInfo& info, const voi
   event.data_size = size;
   event.channel_id = info.id;
   event.kind = LcmLogEvent::Kind::other;
+  event.bench = info.bench;
   if (info.bench.empty()) return;
-  event.bench.assign(info.bench);
-  std::string why;
   if (info.kind == 1) {
-    if (view_samples_message(event.samples_view, data, size, &why)) {
+    if (view_samples_message(event.samples_view, data, size)) {  // no words needed: nearly always
       if (samples_ == LcmSamples::view_and_message) samples_from_view(event.samples_view, event.samples);
       event.kind = LcmLogEvent::Kind::samples;
       return;
     }
+    std::string why;
+    view_samples_message(event.samples_view, data, size, &why);  // the same check, in words
     event.kind = LcmLogEvent::Kind::problem;
     event.problem = fmt::format("event {} on {}: {}; skipped", event.number, event.channel, why);
   } else if (info.kind == 2) {
+    std::string why;
     if (decode_message(event.config, data, size, &why)) {
       event.kind = LcmLogEvent::Kind::config;
       return;
@@ -492,10 +507,10 @@ LcmLogContents read_lcm_log(const std::string& path, const LcmLogOptions& option
     return out;
   }
   std::vector<std::unique_ptr<BenchState>> benches;
-  auto bench = [&](const std::string& id) -> BenchState& {
+  auto bench = [&](std::string_view id) -> BenchState& {
     for (auto& b : benches)
       if (b->log.bench == id) return *b;
-    benches.push_back(std::make_unique<BenchState>(id, path, options.max_event_reports));
+    benches.push_back(std::make_unique<BenchState>(std::string(id), path, options.max_event_reports));
     return *benches.back();
   };
   std::size_t file_problems = 0;
@@ -504,7 +519,7 @@ LcmLogContents read_lcm_log(const std::string& path, const LcmLogOptions& option
     switch (ev.kind) {
       case LcmLogEvent::Kind::samples: take_samples(bench(ev.bench), ev); break;
       case LcmLogEvent::Kind::config: take_config(bench(ev.bench), ev); break;
-      case LcmLogEvent::Kind::other: ++out.other_channels[ev.channel]; break;
+      case LcmLogEvent::Kind::other: ++out.other_channels[std::string(ev.channel)]; break;
       case LcmLogEvent::Kind::problem:
         if (!ev.bench.empty() && ev.number > 0) {
           BenchState& st = bench(ev.bench);

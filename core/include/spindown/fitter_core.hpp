@@ -35,6 +35,7 @@
 #include "spindown/recording.hpp"
 #include "spindown/run_detector.hpp"
 #include "spindown/runs.hpp"
+#include "spindown/short_name_cache.hpp"
 
 namespace spindown {
 
@@ -146,11 +147,13 @@ class FitterCore {
  private:
   struct Bench;
   Bench* bench_for(std::string_view id, std::int64_t recv_utime, std::string_view kind);
+  Bench* find_bench(std::string_view id, std::int64_t recv_utime, std::string_view kind);  // past the cache
   void error(std::string text, std::int64_t utime);
   // The per-bench checks and the detector, for n samples of either form of message.
   template <class Message>
   void take_samples(Bench& b, const Message& m, std::size_t n, std::int64_t recv_utime);
   void push_sample(Bench& b, std::int64_t seq, double t_s, double value, std::int64_t recv_utime);
+  void retract_stop(Bench& b, std::int64_t recv_utime);
   void handle_events(Bench& b, std::int64_t recv_utime);
   void restart_clock(Bench& b, std::int64_t recv_utime);
   void fit_and_publish(Bench& b, const Run& run, std::int64_t recv_utime);
@@ -161,7 +164,7 @@ class FitterCore {
   FitterSink& sink_;
   std::regex bench_filter_;
   std::map<std::string, std::unique_ptr<Bench>, std::less<>> benches_;
-  Bench* last_bench_ = nullptr;  // the bench of the previous message
+  ShortNameCache<Bench> bench_cache_;  // bench id -> bench, before the map
   std::uint64_t activity_ = 0;   // increases per message: least recently active = smallest
   std::uint64_t arrivals_ = 0;   // order of first appearance
   FitterCounters counters_;

@@ -14,6 +14,7 @@
 // number, channel and byte offset) and reading goes on.
 #include <cstddef>
 #include <cstdint>
+#include <deque>
 #include <map>
 #include <memory>
 #include <optional>
@@ -27,6 +28,7 @@
 #include "spindown/bench.hpp"
 #include "spindown/message_decode.hpp"
 #include "spindown/recording.hpp"
+#include "spindown/short_name_cache.hpp"
 
 namespace spindown {
 
@@ -51,11 +53,14 @@ struct LcmLogEvent {
   std::int64_t number = 0;       // 1-based position of the event in the file (0: file damage)
   std::int64_t log_utime = 0;    // receive time the logger wrote (µs since the Unix epoch)
   std::int64_t file_offset = 0;  // byte offset of the event (or of the damage)
-  std::string channel;
+  // Views into the reader (no copy per event), valid until the next next(): the channel name as
+  // the event has it (empty for damage in the file) and, for SPINDOWN.<bench>.* channels, the
+  // bench id (else empty).
+  std::string_view channel;
   // The channel name's index in this reader, the same for every event on it (a consumer's
   // per-channel cache needs no string compare); -1 past LcmLogReader::max_channel_ids distinct names.
   std::int32_t channel_id = -1;
-  std::string bench;             // for SPINDOWN.<bench>.* channels, else empty
+  std::string_view bench;
   SamplesView samples_view;      // Kind::samples: the message in place, valid until the next next()
   samples_t samples;             // Kind::samples, unless the reader was made with LcmSamples::view_only
   config_t config;               // Kind::config
@@ -97,9 +102,11 @@ class LcmLogReader {
     std::string bench;      // empty: not SPINDOWN.<bench>.<KIND>
     int kind = 0;           // 0 other, 1 SAMPLE, 2 CONFIG
     std::int32_t id = -1;
-    std::int32_t next = -1;  // id of the channel that followed this one last time
   };
   const ChannelInfo& channel_info(std::string_view channel);
+  const ChannelInfo& find_channel(std::string_view channel);  // channel_info() past the cache
+  bool next_checked(LcmLogEvent& event);  // next() for all but a whole, sound, buffered event
+  void accept(LcmLogEvent& event, const unsigned char* p, std::int32_t channel_len, std::int32_t data_len);
   // Makes n bytes from pos_ available in the buffer (fewer only at the end of the file or on a
   // read error); returns how many are and points *p at the first.
   std::int64_t fill(std::int64_t n, const unsigned char** p) {
@@ -127,9 +134,9 @@ class LcmLogReader {
   std::int64_t buffered_ = 0;
   std::int64_t pos_ = 0;               // file offset of the next byte to parse
   std::string read_error_;             // a failed read(2), reported once as a problem
-  std::vector<ChannelInfo> channels_;
+  std::deque<ChannelInfo> channels_;   // a deque: entries stay put as it grows
   ChannelInfo uncached_;               // the name being read when channels_ is full
-  std::int32_t last_channel_ = -1;     // id of the previous event's channel
+  ShortNameCache<const ChannelInfo> channel_cache_;  // entries of channels_ only
 };
 
 struct LcmLogOptions {

@@ -82,9 +82,9 @@ int main(int argc, char** argv) {
         continue;
       }
       ++events;
-      ++channels[ev.channel];
+      ++channels[std::string(ev.channel)];
       if (ev.kind == spindown::LcmLogEvent::Kind::samples) {
-        BenchSeq& b = benches[ev.bench];
+        BenchSeq& b = benches[std::string(ev.bench)];
         const auto& s = ev.samples;
         if (b.messages > 0) {
           if (s.seq > b.next_seq) {
