@@ -6,6 +6,7 @@
 #include <fstream>
 #include <random>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "spindown/arduino_text.hpp"
@@ -396,4 +397,71 @@ TEST(ArduinoText, MessagesQuoteTheirOwnLineDeepInAFile) {
   EXPECT_NE(at_line(r, 252)->message.find("line 251"), std::string::npos) << all_diagnostics(r);
   EXPECT_EQ(r.size(), 150u + 1 + 100 + 80);
   EXPECT_TRUE(strictly_increasing(r.t_s));
+}
+
+TEST(ArduinoText, TimelineProblemsDeepInLongBlocksAreFoundWhereTheyAre) {
+  // build_timeline takes the usual steps in a tight loop: a problem anywhere in a block of 64
+  // lines, at a block's first or last line or right after another, still gets the full checks.
+  std::string text;
+  std::vector<double> expected_ms;
+  long long t = 5000;
+  std::int64_t line = 0;
+  std::vector<std::int64_t> skipped_lines;
+  auto sample = [&](long long ms, bool kept) {
+    text += std::to_string(ms) + "\t1.23\r\n";
+    ++line;
+    if (kept) expected_ms.push_back(static_cast<double>(ms));
+    else skipped_lines.push_back(line);
+  };
+  for (int i = 1; i <= 400; ++i) {
+    sample(t, true);
+    if (i == 63 || i == 64 || i == 65 || i == 128 || i == 200 || i == 201) sample(t, false);  // repeats
+    if (i == 100 || i == 300) sample(t - 40, false);                                           // back
+    if (i == 150 || i == 250) sample(t + 100000, false);                                       // ahead
+    t += 20;
+  }
+  const Recording r = read_arduino_text(text, "long.tsv");
+  ASSERT_EQ(r.size(), expected_ms.size()) << all_diagnostics(r);
+  for (std::size_t i = 0; i < expected_ms.size(); ++i) EXPECT_DOUBLE_EQ(r.t_s[i], expected_ms[i] / 1000) << i;
+  for (const std::int64_t l : skipped_lines) {
+    ASSERT_NE(at_line(r, l), nullptr) << l << "\n" << all_diagnostics(r);
+    EXPECT_EQ(at_line(r, l)->severity, Severity::warning);
+  }
+  EXPECT_EQ(with(r, Severity::warning).size(), skipped_lines.size()) << all_diagnostics(r);
+}
+
+TEST(ArduinoText, BinaryVerdictIsTheFirst8KibsWhateverPathReadsThem) {
+  // The reader counts control bytes only in what its slow path reads (the fast path's lines have
+  // none): the verdict and its numbers must be those of the first 8 KiB as a whole.
+  auto control_in_first_8k = [](const std::string& s) {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < std::min<std::size_t>(s.size(), 8192); ++i) {
+      const auto c = static_cast<unsigned char>(s[i]);
+      n += (c < 0x20 || c == 0x7F) && c != '\t' && c != '\n' && c != '\r';
+    }
+    return n;
+  };
+  const std::string header = "=~=~=~=~ PuTTY log 2023.09.14 10:21:33 =~=~=~=~\r\n";
+  for (const auto& [good_lines, junk_bytes, junk_char] :
+       std::vector<std::tuple<int, std::size_t, char>>{{200, 6000, '\0'}, {600, 2000, '\x01'}, {700, 500, '\0'},
+                                                      {700, 800, '\x7f'}, {900, 3000, '\0'}, {30, 100, '\0'}}) {
+    std::string text = header + cadence(1000, good_lines);
+    text += std::string(junk_bytes, junk_char) + "\r\n" + cadence(1000 + 20 * good_lines, 50);
+    const std::size_t control = control_in_first_8k(text);
+    const std::size_t looked = std::min<std::size_t>(text.size(), 8192);
+    const Recording r = read_arduino_text(text, "mixed.txt");
+    const bool binary = control * 10 > looked;
+    SCOPED_TRACE(::testing::Message() << good_lines << " lines, " << junk_bytes << " junk: " << control << " of "
+                                      << looked);
+    if (binary) {
+      ASSERT_EQ(r.diagnostics.size(), 1u) << all_diagnostics(r);
+      EXPECT_EQ(r.diagnostics.front().message,
+                "no samples: binary data, not Arduino text (" + std::to_string(control) + " of the first " +
+                    std::to_string(looked) + " bytes are control characters or NUL)");
+      EXPECT_TRUE(r.empty());
+    } else {
+      EXPECT_FALSE(mentions(r, "binary data")) << all_diagnostics(r);
+      EXPECT_EQ(r.size(), static_cast<std::size_t>(good_lines + 50));
+    }
+  }
 }

@@ -50,13 +50,18 @@ Recording read_arduino_text(std::string_view text, std::string source, const Ard
     rec.error(0, "no samples: the file is empty");
     return rec;
   }
-  std::size_t control = 0, looked = 0;
-  if (text::looks_binary(text, &control, &looked)) {
-    rec.error(0, fmt::format("no samples: binary data, not Arduino text ({} of the first {} bytes are control "
-                             "characters or NUL)",
-                             control, looked));
-    return rec;
-  }
+  // Binary data is refused as soon as the first 8 KiB are read, with only this error.
+  text::BinaryCheck binary(text);
+  bool binary_decided = false;
+  auto refuse_binary = [&] {
+    Recording junk;
+    junk.source = std::move(rec.source);
+    junk.quantity = rec.quantity;
+    junk.error(0, fmt::format("no samples: binary data, not Arduino text ({} of the first {} bytes are control "
+                              "characters or NUL)",
+                              binary.control_bytes(), binary.looked_at()));
+    return junk;
+  };
 
   text::LineReporter reporter(rec, options.max_line_reports);
   text::RawSamples raw(text);
@@ -70,6 +75,10 @@ Recording read_arduino_text(std::string_view text, std::string source, const Ard
 
   text::LineCursor cursor(text);
   while (!cursor.at_end()) {
+    if (!binary_decided && binary.decided(cursor.rest().data())) {
+      if (binary.binary()) return refuse_binary();
+      binary_decided = true;
+    }
     // Lines as the sketch prints them take the fast path: a block of them at a time, parsed
     // where they lie, no line split first.
     const std::size_t first = raw.size();
@@ -82,6 +91,7 @@ Recording read_arduino_text(std::string_view text, std::string source, const Ard
     }
     // Anything else is split off and judged by parse_lab_line, which names what is wrong.
     const std::string_view line = cursor.next_line();
+    binary.count(line.data(), cursor.rest().data());  // the fast path's bytes are never control bytes
     const std::int64_t n = cursor.line_number();
     if (is_putty_header(line)) {
       ++headers;
@@ -118,6 +128,7 @@ Recording read_arduino_text(std::string_view text, std::string source, const Ard
     raw.add(n, line.data(), static_cast<double>(parsed.millis), parsed.value, session_start);
     session_start = first_content = false;
   }
+  if (!binary_decided && binary.binary()) return refuse_binary();  // all of it read: decided
   const std::int64_t lines = cursor.line_number();
 
   text::TimelineRules rules;

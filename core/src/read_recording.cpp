@@ -52,14 +52,16 @@ bool ReadOptions::is_valid(std::string* why) const {
 namespace {
 
 // Opens path for reading without blocking on a FIFO that has no writer yet (which would hang
-// forever), then makes reads blocking again so a pipe with a slow writer is read to its end.
-// A FIFO without a writer then reads as empty.
-int open_for_reading(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
-  if (fd < 0) return fd;
+// forever). Call reads_blocking once fstat has said what it is.
+int open_for_reading(const std::string& path) { return ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK); }
+
+// Makes reads of anything but a regular file blocking again, so a pipe with a slow writer is
+// read to its end (a FIFO without a writer then reads as empty). A regular file's reads never
+// block: its two fcntl calls are saved (a quarter of a small file's system calls).
+void reads_blocking(int fd, const struct stat& st) {
+  if (S_ISREG(st.st_mode)) return;
   const int flags = ::fcntl(fd, F_GETFL);
   if (flags >= 0) ::fcntl(fd, F_SETFL, flags & ~O_NONBLOCK);
-  return fd;
 }
 
 struct FdCloser {
@@ -120,6 +122,7 @@ std::optional<std::string> read_file_bytes(const std::string& path, std::string*
     if (why) *why = fmt::format("cannot read {}: {}", path, std::strerror(errno));
     return std::nullopt;
   }
+  reads_blocking(fd, st);
   auto bytes = read_fd_bytes(fd, st, path, why, max_bytes);
   if (!bytes) return std::nullopt;
   return std::string(bytes->view());
@@ -199,6 +202,7 @@ std::vector<Recording> read_recordings(const std::string& path, const ReadOption
       add(failed(path, fmt::format("cannot read {}: {}", path, std::strerror(errno))), {});
       return out;
     }
+    reads_blocking(fd, st);
     if (S_ISDIR(st.st_mode)) {
       add(failed(path, fmt::format("cannot read {}: it is a directory", path)), {});
       return out;

@@ -32,10 +32,23 @@ std::size_t count_control_bytes(const unsigned char* p, std::size_t n) {
   return control;
 }
 
+// looks_binary looks at this many bytes from the start.
+constexpr std::size_t binary_window = 8 * 1024;
+
 }  // namespace
 
+BinaryCheck::BinaryCheck(std::string_view text)
+    : begin_(text.data()), looked_at_(std::min(text.size(), binary_window)) {}
+
+void BinaryCheck::count(const char* from, const char* to) {
+  const char* const window_end = begin_ + looked_at_;
+  if (to > window_end) to = window_end;
+  if (from >= to) return;
+  control_bytes_ += count_control_bytes(reinterpret_cast<const unsigned char*>(from), static_cast<std::size_t>(to - from));
+}
+
 bool looks_binary(std::string_view bytes, std::size_t* control_bytes, std::size_t* looked_at) {
-  const std::size_t n = std::min<std::size_t>(bytes.size(), 8 * 1024);
+  const std::size_t n = std::min<std::size_t>(bytes.size(), binary_window);
   const std::size_t control = count_control_bytes(reinterpret_cast<const unsigned char*>(bytes.data()), n);
   if (control_bytes) *control_bytes = control;
   if (looked_at) *looked_at = n;
@@ -193,6 +206,29 @@ TimelineCounts build_timeline(RawSamples& raw, const TimelineRules& rules, Recor
   double prev_value = 0;
 
   for (std::size_t i = 0; i < n; ++i) {
+    // The usual sample, up to the next block's first: a step forward no longer than a jump, kept
+    // with nothing to check or report. A tight loop; the first sample it does not take (a
+    // block's first, or a step that is not the usual one) goes on to the full checks below.
+    if (have_prev && i < next_first) {
+      double last_u = prev_u;
+      std::size_t j = i;
+      for (; j < next_first; ++j) {
+        const double cur_u = t[j] + offset;
+        const double d = cur_u - last_u;
+        if (!(d > 0 && d <= jump)) break;
+        t_out[kept] = cur_u / units_per_s;
+        v_out[kept] = values[j];
+        ++kept;
+        last_u = cur_u;
+      }
+      if (j > i) {
+        prev_u = last_u;
+        prev_i = j - 1;
+        prev_value = v_out[kept - 1];
+        i = j;
+        if (i == n) break;
+      }
+    }
     const double s_t = t[i];
     const double s_value = values[i];
     const bool has_next = i + 1 < n;

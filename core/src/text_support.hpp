@@ -87,6 +87,28 @@ std::int64_t for_each_line(std::string_view text, OnLine&& on_line) {
 bool looks_binary(std::string_view bytes, std::size_t* control_bytes = nullptr,
                   std::size_t* looked_at = nullptr);
 
+// looks_binary's verdict, reached while a reader walks the text from its start and hands in
+// only the bytes its slow path reads. Its fast path takes lines of digits, signs, points, blanks
+// and line ends, never control bytes, so a lab file's PuTTY header is counted instead of its
+// first 8 KiB (which cost as much as parsing 140 lines).
+class BinaryCheck {
+ public:
+  explicit BinaryCheck(std::string_view text);
+  // The bytes [from, to) of the text were read some other way than the fast path.
+  void count(const char* from, const char* to);
+  // True once the reader at `at` has passed every byte looks_binary looks at.
+  bool decided(const char* at) const { return static_cast<std::size_t>(at - begin_) >= looked_at_; }
+  // Valid once decided: what looks_binary(text, &control_bytes, &looked_at) gives.
+  bool binary() const { return looked_at_ > 0 && control_bytes_ * 10 > looked_at_; }
+  std::size_t control_bytes() const { return control_bytes_; }
+  std::size_t looked_at() const { return looked_at_; }
+
+ private:
+  const char* begin_;
+  std::size_t looked_at_;
+  std::size_t control_bytes_ = 0;
+};
+
 // A line for a message: quoted, control bytes and bytes that are not UTF-8 escaped (\xNN),
 // cut to 40 characters (never inside one). Messages stay valid UTF-8, which JSON needs.
 std::string quote_line(std::string_view line);
