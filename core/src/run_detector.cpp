@@ -74,12 +74,13 @@ void RunDetector::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
 }
 
 // Per sample for every live window, so inlined into its callers; the usual step (sample i
-// follows the window's last, exactly one old sample expires) is one slide().
-inline void RunDetector::advance(WindowFit& w, std::size_t i) {
+// follows the window's last, exactly one old sample expires) is one slide(). s is sample i,
+// passed in so that it is not reloaded from the ring after the stores to the sums.
+inline void RunDetector::advance(WindowFit& w, std::size_t i, Sample s) {
   const Sample* ring = ring_.get();
   const std::size_t mask = mask_;
-  const Sample s = ring[i & mask];
-  if (w.end != i || w.n == 0) [[unlikely]] {
+  // w.n always equals w.end - w.first: an empty window contiguous with i has first == i.
+  if (w.end != i || w.first == i) [[unlikely]] {
     if (w.end != i) w.clear(i, s.t);  // not contiguous (after a reset): start again from i
     w.t0 = s.t;
   }
@@ -105,26 +106,27 @@ inline void RunDetector::advance(WindowFit& w, std::size_t i) {
   if (w.updates > refresh_every) [[unlikely]] rebuild(w, w.first, w.end);
 }
 
-inline void RunDetector::coast_step(std::size_t i) {
-  advance(hold_, i);
-  if (hold_long_live_) advance(hold_long_, i);
-  coast_checks(i);
+inline void RunDetector::coast_step(std::size_t i, Sample s) {
+  advance(hold_, i, s);
+  if (hold_long_live_) [[unlikely]] advance(hold_long_, i, s);
+  coast_checks(i, s);
 }
 
 // Per coasting sample; kept small (the rare outcomes are calls) since it runs for every sample.
-inline void RunDetector::coast_checks(std::size_t i, bool at_end) {
-  const double t_i = t(i);
-  if (buffered() > opt_.max_buffer || t_i - run_.t_cut_s > opt_.max_coast_s) {
+// s is sample i, and hold_ ends at i (it was advanced to it, or rebuilt up to it).
+inline void RunDetector::coast_checks(std::size_t i, Sample s, bool at_end) {
+  const double t_i = s.t;
+  if (buffered() > opt_.max_buffer || t_i - run_.t_cut_s > opt_.max_coast_s) [[unlikely]] {
     coast_too_long(i);
     return;
   }
   if (hold_.n < 3 || hold_.first < run_.cut_index) return;
-  const double dur = duration(hold_);
-  const double mu = hold_.mean();
+  const double dur = t_i - t(hold_.first);  // duration(hold_), its last sample being i
+  const double mu = hold_.sv / hold_.n;     // hold_.mean(), n being at least 3
 
   // Power back before standstill: the reading climbs well above the coast's lowest level.
   if (dur >= 0.5 * hold_.span_s) level_min_ = std::min(level_min_, mu);
-  if (v(i) > level_min_ + rise_jump_) {
+  if (s.v > level_min_ + rise_jump_) [[unlikely]] {
     if (rising_++ == 0) rise_start_ = i;
     if (rising_ >= 3) {
       power_back();
@@ -137,7 +139,10 @@ inline void RunDetector::coast_checks(std::size_t i, bool at_end) {
   // Standstill: the hold window is flat and low.
   if (dur < 0.9 * hold_.span_s) return;
   if (v0_ > 0 && mu > standstill_max_fraction * v0_) return;  // still high: the usual case, cheap
-  standstill_checks(i, at_end, (v0_ - mu) / std::max(t_i - run_.t_cut_s, 1e-9));
+  // Low: while the coast still falls the hold window is not level, and nothing else is to do.
+  double sxx = 0, e = 0;
+  if (!level(hold_, dur, mu, sxx, e)) return;
+  standstill_checks(i, at_end, mu, sxx, e);
 }
 
 // ---- detector ----------------------------------------------------------------------------
@@ -193,35 +198,76 @@ double RunDetector::median_of(std::size_t from, std::size_t to) {
   return m;
 }
 
+double RunDetector::median_period(std::size_t from, std::size_t to) {
+  const std::size_t n = to - from - 1, h = n / 2;
+  // A steady clock gives few distinct periods (timestamps on a grid, rounded), one of them most
+  // of the time, so the median of a few periods spread over the coast usually is the median of
+  // all. It is exactly when fewer than h + 1 periods are below it and more than h at or below it:
+  // one counting pass, instead of copying and partially sorting them all.
+  constexpr std::size_t probes = 9;
+  if (n >= probes) {
+    double probe[probes];
+    for (std::size_t j = 0; j < probes; ++j) {
+      const std::size_t k = from + (n - 1) * j / (probes - 1);
+      probe[j] = t(k + 1) - t(k);
+    }
+    std::nth_element(probe, probe + probes / 2, probe + probes);
+    const double guess = probe[probes / 2];
+    std::size_t below = 0, at_or_below = 0;
+    double prev = t(from);
+    // Over the ring in stretches that do not wrap, so the loop needs no index masking.
+    for (std::size_t k = from + 1; k < to;) {
+      const std::size_t stretch_end = std::min(to, (k | mask_) + 1);
+      const Sample* p = ring_.get() + (k & mask_);
+      for (std::size_t j = 0; j < stretch_end - k; ++j) {
+        const double d = p[j].t - prev;
+        below += d < guess;
+        at_or_below += d <= guess;
+        prev = p[j].t;
+      }
+      k = stretch_end;
+    }
+    if (below <= h && h < at_or_below) return guess;
+  }
+  double* dt = scratch(n);
+  for (std::size_t k = 0; k < n; ++k) dt[k] = t(from + 1 + k) - t(from + k);
+  std::nth_element(dt, dt + h, dt + n);
+  return dt[h];
+}
+
 void RunDetector::push(double t_s, double value) {
   if (!std::isfinite(t_s) || !std::isfinite(value)) [[unlikely]] {
     ++non_finite_;  // reported by finish(); not a sample, so it takes no index
     return;
   }
-  if (have_last_t_ && t_s < last_t_) [[unlikely]] {
-    emit_diag(Diagnostic::Severity::note,
-              fmt::format("time went back from {} to {} at sample {}: taken as a clock restart", fmt_s(last_t_),
-                          fmt_s(t_s), next_index_));
-    clock_restart();
-  }
-  have_last_t_ = true;
+  if (t_s < last_t_) [[unlikely]] time_went_back(t_s);  // never for the first sample: last_t_ is -inf
   last_t_ = t_s;
   const std::size_t i = next_index_++;
   if (next_index_ - base_ > ring_size()) [[unlikely]] grow_ring();
-  ring_[i & mask_] = {t_s, value};
+  const Sample s{t_s, value};
+  ring_[i & mask_] = s;
   // Track readings pinned at one positive value (a clipped converter) so the lead-in before
-  // a long clip is still buffered when the coast leaves it.
-  if (i == base_ || v(i) != v(i - 1)) same_start_ = i;
+  // a long clip is still buffered when the coast leaves it. (last_v_ is v(i - 1) when i > base_.)
+  if (i == base_ || value != last_v_) same_start_ = i;
+  last_v_ = value;
   if (value > 0 && i + 1 - same_start_ >= 5) {
     plateau_start_ = same_start_;
     plateau_end_ = i;
     have_plateau_ = true;
   }
   switch (state_) {
-    case State::idle: idle_step(i); break;
-    case State::coasting: coast_step(i); break;
-    case State::tail: tail_step(i); break;
+    case State::idle: idle_step(i, s); break;
+    case State::coasting: coast_step(i, s); break;
+    case State::tail: tail_step(i, s); break;
   }
+}
+
+// Out of line and cold: formatting the note inside push() would cost every sample a stack frame.
+[[gnu::cold, gnu::noinline]] void RunDetector::time_went_back(double t_s) {
+  emit_diag(Diagnostic::Severity::note,
+            fmt::format("time went back from {} to {} at sample {}: taken as a clock restart", fmt_s(last_t_),
+                        fmt_s(t_s), next_index_));
+  clock_restart();
 }
 
 void RunDetector::clock_restart() {
@@ -232,7 +278,7 @@ void RunDetector::clock_restart() {
   have_plateau_ = false;
   need_rise_ = false;
   stream_start_ = next_index_;
-  have_last_t_ = false;
+  last_t_ = -std::numeric_limits<double>::infinity();
   state_ = State::idle;
   lo_ = next_index_;
   need_quiet_ = false;
@@ -246,7 +292,8 @@ void RunDetector::clock_restart() {
 
 void RunDetector::finish() {
   // A recording that ends soon after the stop: the hold window alone decides.
-  if (state_ == State::coasting && next_index_ > base_) coast_checks(next_index_ - 1, true);
+  if (state_ == State::coasting && next_index_ > base_)
+    coast_checks(next_index_ - 1, ring_[(next_index_ - 1) & mask_], true);
   if (state_ == State::coasting) close_unstopped(next_index_, "the recording ends mid-coast (never reached standstill)");
   else if (state_ == State::tail) complete_run(next_index_);
   if (state_ != State::idle) to_idle(next_index_, false);
@@ -315,10 +362,10 @@ bool RunDetector::confirms_decline(const WindowFit& w) const {
   return -s * std::sqrt(w.sxx()) >= confirm_t_stat * sd;
 }
 
-void RunDetector::idle_step(std::size_t i) {
-  advance(short_, i);
-  advance(long_, i);
-  advance(vlong_, i);
+void RunDetector::idle_step(std::size_t i, Sample s) {
+  advance(short_, i, s);
+  advance(long_, i, s);
+  advance(vlong_, i, s);
   if (need_quiet_) {
     // After a coast closed without a stop the decline may go on: wait for it to pause.
     const bool full = long_.n >= 8 && duration(long_) >= 0.8 * long_.span_s;
@@ -577,7 +624,7 @@ bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
   reset_window(hold_, run_.cut_index, i + 1);
   hold_long_live_ = false;  // built when the coast gets low (saves work on the way down)
   creeping_ = false;
-  coast_checks(i);
+  coast_checks(i, ring_[i & mask_]);
   return true;
 }
 
@@ -605,37 +652,49 @@ void RunDetector::power_back() {
   to_idle(at, false);
 }
 
-void RunDetector::standstill_checks(std::size_t i, bool at_end, double mean_rate) {
-  // The hold window is flat and low, and either its slope is resolved well below the coast's
-  // mean rate or a three times longer window is flat too (noisy, slow coasts).
+void RunDetector::standstill_checks(std::size_t i, bool at_end, double mu, double sxx, double e) {
+  // The hold window is flat and low (coast_checks has shown it: mu is its mean, sxx and e its
+  // Sxx and residual sd), and either its slope is resolved well below the coast's mean rate or
+  // a three times longer window is flat too (noisy, slow coasts).
   bool resolved = at_end;
-  if (!flat(hold_, mean_rate, at_end ? nullptr : &resolved)) return;
+  if (!at_end) {
+    const double mean_rate = (v0_ - mu) / std::max(t(i) - run_.t_cut_s, 1e-9);
+    resolved = sxx > 0 && e / std::sqrt(sxx) <= slope_resolution * mean_rate;
+  }
   if (creeping_ && !at_end) resolved = false;  // an asymptotic coast ends when the long window is flat
   if (!resolved) {
     if (!hold_long_live_) {
       reset_window(hold_long_, run_.cut_index, i + 1);
       hold_long_live_ = true;
     }
-    if (!flat(hold_long_, mean_rate, nullptr)) return;
+    if (!flat(hold_long_)) return;
   }
   found_standstill(i, at_end);
 }
 
-bool RunDetector::flat(const WindowFit& w, double mean_rate, bool* resolved) const {
+bool RunDetector::flat(const WindowFit& w) const {
   if (w.n < 3 || w.first < run_.cut_index) return false;
   const double d = duration(w);
   if (d < 0.9 * w.span_s) return false;
-  const double m = w.mean();
+  double sxx = 0, e = 0;
+  return level(w, d, w.mean(), sxx, e);
+}
+
+bool RunDetector::level(const WindowFit& w, double d, double m, double& sxx, double& e) const {
   const bool low = v0_ > 0 ? m <= standstill_max_fraction * v0_ : true;
   if (!low) return false;
-  const double s = w.slope(), e = w.resid_sd(), sxx = w.sxx();
+  // w.slope() and w.resid_sd() (n >= 3), sharing Sxx and Sxy: the same operations, done once.
+  sxx = w.sxx();
+  const double sxy = w.stv - w.st * w.sv / w.n;
+  const double s = sxx > 0 ? sxy / sxx : 0.0;
+  const double syy = w.svv - w.sv * w.sv / w.n;
+  const double sse = sxx > 0 ? syy - sxy * sxy / sxx : syy;
+  e = std::sqrt(std::max(sse, 0.0) / (w.n - 2));
   const double scale = std::max(std::abs(v0_), std::abs(m));
   const double tiny = 1e-12 * (scale > 0 ? scale : 1.0);
   const bool no_slope = std::abs(s) * std::sqrt(sxx) <= flat_t_stat * e + tiny;
   const bool small_drop = std::abs(s) * d <= std::max(3.0 * e, 0.01 * std::abs(v0_)) + tiny;
-  if (!(no_slope && small_drop)) return false;
-  if (resolved) *resolved = sxx > 0 && e / std::sqrt(sxx) <= slope_resolution * mean_rate;
-  return true;
+  return no_slope && small_drop;
 }
 
 void RunDetector::found_standstill(std::size_t i, bool at_end) {
@@ -756,7 +815,7 @@ void RunDetector::tail_ends_by_time(std::size_t upto) {
   }
 }
 
-void RunDetector::tail_step(std::size_t i) {
+void RunDetector::tail_step(std::size_t i, Sample s) {
   if (buffered() > opt_.max_buffer) {
     complete_run(i);
     to_idle(i, false);
@@ -764,11 +823,13 @@ void RunDetector::tail_step(std::size_t i) {
   }
   // Still falling: the "standstill" was a noisy stretch of a slow coast. Retract the stop and
   // keep coasting (the stop event was provisional; only complete runs are final).
-  advance(hold_, i);
-  if (hold_long_live_) advance(hold_long_, i);
+  advance(hold_, i, s);
+  if (hold_long_live_) advance(hold_long_, i, s);
   if (hold_.n >= 3 && hold_.first >= run_.stop_index) {
     const double drop = run_.zero_level - hold_.mean();
-    if (drop > std::max(4.0 * run_.noise_level / std::sqrt(hold_.n), retract_fraction * (v0_ - run_.zero_level))) {
+    // drop <= 0 never exceeds the band (its first term is >= 0): the usual case, without a sqrt.
+    if (drop > 0 &&
+        drop > std::max(4.0 * run_.noise_level / std::sqrt(hold_.n), retract_fraction * (v0_ - run_.zero_level))) {
       emit_diag(Diagnostic::Severity::note,
                 fmt::format("run cut at {}: standstill at {} retracted, the reading kept falling", fmt_s(run_.t_cut_s),
                             fmt_s(run_.t_stop_s)));
@@ -777,12 +838,12 @@ void RunDetector::tail_step(std::size_t i) {
       state_ = State::coasting;
       level_min_ = std::numeric_limits<double>::infinity();
       rising_ = 0;
-      coast_checks(i);
+      coast_checks(i, s);
       return;
     }
   }
   // A new spin-up (the next run's lead-in) ends the tail.
-  if (v(i) - run_.zero_level > depart_band_) {
+  if (s.v - run_.zero_level > depart_band_) {
     if (departing_++ == 0) depart_start_ = i;
     if (departing_ >= 2) {
       const std::size_t at = depart_start_;
@@ -793,7 +854,7 @@ void RunDetector::tail_step(std::size_t i) {
   } else {
     departing_ = 0;
   }
-  if (t(i) >= run_.t_stop_s + opt_.tail_s) {
+  if (s.t >= run_.t_stop_s + opt_.tail_s) {
     const std::size_t end = departing_ > 0 ? depart_start_ : i;
     complete_run(end);
     to_idle(end, false);
@@ -825,14 +886,7 @@ void RunDetector::complete_run(std::size_t end) {
     r.t_stop_s = std::numeric_limits<double>::quiet_NaN();
   }
   const std::size_t coast_end = r.stopped ? r.stop_index : end;
-  // Median sample period within the coast.
-  if (coast_end > r.cut_index + 1) {
-    const std::size_t n = coast_end - r.cut_index - 1;
-    double* dt = scratch(n);
-    for (std::size_t k = 0; k < n; ++k) dt[k] = t(r.cut_index + 1 + k) - t(r.cut_index + k);
-    std::nth_element(dt, dt + n / 2, dt + n);
-    r.period_s = dt[n / 2];
-  }
+  if (coast_end > r.cut_index + 1) r.period_s = median_period(r.cut_index, coast_end);
   const std::size_t coast_n = coast_end - r.cut_index;
   const double coast_s = (r.stopped ? r.t_stop_s : (end > r.cut_index ? t(end - 1) : r.t_cut_s)) - r.t_cut_s;
 

@@ -140,22 +140,25 @@ class RunDetector {
   void grow_ring();
   // The ring's first size: a lab run (30 s at 50 Hz) fits without growing.
   static constexpr std::size_t initial_ring_size = 2048;
-  void advance(WindowFit& w, std::size_t i);
+  void advance(WindowFit& w, std::size_t i, Sample s);
   void rebuild(WindowFit& w, std::size_t from, std::size_t to);
   void reset_window(WindowFit& w, std::size_t lo, std::size_t end);
   double duration(const WindowFit& w) const;
   void trim_idle();
-  void idle_step(std::size_t i);
-  void coast_step(std::size_t i);
-  void coast_checks(std::size_t i, bool at_end = false);
+  void idle_step(std::size_t i, Sample s);
+  void coast_step(std::size_t i, Sample s);
+  void coast_checks(std::size_t i, Sample s, bool at_end = false);
+  void time_went_back(double t_s);     // the note, then clock_restart()
   void coast_too_long(std::size_t i);  // max_buffer or max_coast_s reached
   void power_back();                   // the reading rose again before standstill
-  void standstill_checks(std::size_t i, bool at_end, double mean_rate);
-  void tail_step(std::size_t i);
+  void standstill_checks(std::size_t i, bool at_end, double mu, double sxx, double e);
+  void tail_step(std::size_t i, Sample s);
   bool confirms_decline(const WindowFit& w) const;
-  // Whether w shows a standstill: full, low, and no significant slope or drop. *resolved (if
-  // given and w is flat) says whether its slope is resolved well below the coast's mean rate.
-  bool flat(const WindowFit& w, double mean_rate, bool* resolved) const;
+  // Whether w shows a standstill: full, low, and no significant slope or drop.
+  bool flat(const WindowFit& w) const;
+  // The part of flat() after "full": low, no significant slope or drop, for w of duration d and
+  // mean m. Sets sxx and e (w.sxx(), w.resid_sd()) for the caller's resolution test.
+  bool level(const WindowFit& w, double d, double m, double& sxx, double& e) const;
   // Where the cut lies in [a, b] (b = newest sample), and what came before it.
   struct CutSplit {
     std::size_t a = 0, cut_index = 0, pre_end = 0, npre = 0;
@@ -177,6 +180,8 @@ class RunDetector {
   void to_idle(std::size_t lo, bool need_quiet);
   void emit_diag(Diagnostic::Severity sev, std::string msg);
   double median_of(std::size_t from, std::size_t to);
+  // The median of the sample periods in [from, to) (at least two samples), as nth_element picks it.
+  double median_period(std::size_t from, std::size_t to);
 
   RunOptions opt_;
   std::string source_;
@@ -191,8 +196,8 @@ class RunDetector {
   bool need_quiet_ = false;     // after a closed coast: no new run until the decline pauses
   bool need_rise_ = false;      // after a stop: a new coast must start above rise_level_
   double rise_level_ = 0;
-  bool have_last_t_ = false;
-  double last_t_ = 0;
+  double last_t_ = -std::numeric_limits<double>::infinity();  // -inf: no sample since the (re)start
+  double last_v_ = 0;  // the last sample's value
   std::size_t non_finite_ = 0;
   std::size_t same_start_ = 0;  // first of the current run of identical readings
   std::size_t plateau_start_ = 0, plateau_end_ = 0;  // last long positive plateau (clipping?)

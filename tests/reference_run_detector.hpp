@@ -1,0 +1,1051 @@
+#pragma once
+// The run detector as it was before the per-sample speed-ups of issue 6 (a verbatim copy of
+// core/src/run_detector.cpp and its header at commit 44f0366, renamed): the reference that
+// test_run_detector_reference.cpp checks the optimised detector against, bit for bit.
+// Do not edit it to follow the detector: it is the old behaviour by definition.
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <fmt/format.h>
+#include <limits>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "spindown/recording.hpp"
+#include "spindown/run_detector.hpp"
+#include "spindown/runs.hpp"
+
+namespace spindown::reference {
+
+using spindown::RunEvent;
+
+class RunDetector {
+ public:
+  enum class State { idle, coasting, tail };
+
+  explicit RunDetector(RunOptions opt = {}, std::string source = {});
+
+  // One sample; its index is the number of push() calls before it. Non-finite samples are
+  // counted (reported by finish()) and otherwise ignored; time going backwards is taken as
+  // a clock restart.
+  void push(double t_s, double value);
+  // The device clock restarted before the next sample: an open run is closed there.
+  void clock_restart();
+  // End of the stream: an open coast is closed (never stopped), a tail is cut short.
+  void finish();
+
+  // Events since the last call, oldest first.
+  std::vector<RunEvent> take_events();
+  bool has_events() const { return !events_.empty(); }
+
+  State state() const { return state_; }
+  std::size_t samples_seen() const { return next_index_; }
+  std::size_t buffered() const { return next_index_ - base_; }
+
+ private:
+  // Least-squares line over a sliding time window of the buffer, O(1) per sample.
+  struct WindowFit {
+    double span_s = 1.0;
+    std::size_t first = 0, end = 0;  // absolute indices [first, end)
+    double t0 = 0;                   // time origin for the sums (precision)
+    double n = 0, st = 0, stt = 0, sv = 0, svv = 0, stv = 0;
+    unsigned updates = 0;
+    void clear(std::size_t at, double t_origin);
+    void add(double t, double v) {
+      t -= t0;
+      n += 1;
+      st += t;
+      stt += t * t;
+      sv += v;
+      svv += v * v;
+      stv += t * v;
+      ++updates;
+    }
+    void remove(double t, double v) {
+      t -= t0;
+      n -= 1;
+      st -= t;
+      stt -= t * t;
+      sv -= v;
+      svv -= v * v;
+      stv -= t * v;
+      ++updates;
+    }
+    // add(t_in, v_in) then remove(t_out, v_out), bit for bit, in one pass over the sums.
+    void slide(double t_in, double v_in, double t_out, double v_out) {
+      t_in -= t0;
+      t_out -= t0;
+      st = st + t_in - t_out;
+      stt = stt + t_in * t_in - t_out * t_out;
+      sv = sv + v_in - v_out;
+      svv = svv + v_in * v_in - v_out * v_out;
+      stv = stv + t_in * v_in - t_out * v_out;
+      updates += 2;
+    }
+    double mean() const { return n > 0 ? sv / n : 0.0; }
+    double sxx() const { return stt - st * st / n; }
+    double slope() const {
+      if (n < 2) return 0.0;
+      const double sxx_ = sxx();
+      if (!(sxx_ > 0)) return 0.0;
+      return (stv - st * sv / n) / sxx_;
+    }
+    double resid_sd() const {
+      if (n < 3) return 0.0;
+      const double syy = svv - sv * sv / n;
+      const double sxy = stv - st * sv / n;
+      const double sxx_ = sxx();
+      const double sse = sxx_ > 0 ? syy - sxy * sxy / sxx_ : syy;
+      return std::sqrt(std::max(sse, 0.0) / (n - 2));
+    }
+  };
+
+  // The buffer: a ring indexed by absolute sample index, holding [base_, next_index_).
+  struct Sample {  // no initializers: a new ring is not written before it is used
+    double t, v;
+  };
+  double t(std::size_t i) const { return ring_[i & mask_].t; }
+  double v(std::size_t i) const { return ring_[i & mask_].v; }
+  std::size_t ring_size() const { return mask_ + 1; }
+  void grow_ring();
+  // The ring's first size: a lab run (30 s at 50 Hz) fits without growing.
+  static constexpr std::size_t initial_ring_size = 2048;
+  void advance(WindowFit& w, std::size_t i);
+  void rebuild(WindowFit& w, std::size_t from, std::size_t to);
+  void reset_window(WindowFit& w, std::size_t lo, std::size_t end);
+  double duration(const WindowFit& w) const;
+  void trim_idle();
+  void idle_step(std::size_t i);
+  void coast_step(std::size_t i);
+  void coast_checks(std::size_t i, bool at_end = false);
+  void coast_too_long(std::size_t i);  // max_buffer or max_coast_s reached
+  void power_back();                   // the reading rose again before standstill
+  void standstill_checks(std::size_t i, bool at_end, double mean_rate);
+  void tail_step(std::size_t i);
+  bool confirms_decline(const WindowFit& w) const;
+  // Whether w shows a standstill: full, low, and no significant slope or drop. *resolved (if
+  // given and w is flat) says whether its slope is resolved well below the coast's mean rate.
+  bool flat(const WindowFit& w, double mean_rate, bool* resolved) const;
+  // Where the cut lies in [a, b] (b = newest sample), and what came before it.
+  struct CutSplit {
+    std::size_t a = 0, cut_index = 0, pre_end = 0, npre = 0;
+    double t_cut_s = 0, v0 = 0, sd_post = 0, post_slope = 0;
+    double pre_mean = 0, pre_sd = 0, pre_max = 0;
+    bool pre_declining = false;
+    bool pre_flat = false;  // lead-in slope shown to be well below the coast's
+    bool clipped = false;
+    std::size_t pin_first = 0, pin_last = 0;
+    double pin_level = 0;
+  };
+  CutSplit split_at_cut(std::size_t a, std::size_t b, const WindowFit& w);
+  std::string classify_lead_in(const CutSplit& sp) const;
+  bool try_start_coast(std::size_t i, const WindowFit& w);
+  void found_standstill(std::size_t i, bool at_end);
+  void tail_ends_by_time(std::size_t upto);
+  void close_unstopped(std::size_t end, const std::string& why);
+  void complete_run(std::size_t end);
+  void to_idle(std::size_t lo, bool need_quiet);
+  void emit_diag(Diagnostic::Severity sev, std::string msg);
+  double median_of(std::size_t from, std::size_t to);
+
+  RunOptions opt_;
+  std::string source_;
+  State state_ = State::idle;
+  std::unique_ptr<Sample[]> ring_;
+  std::size_t mask_ = 0;
+  std::size_t base_ = 0;        // absolute index of the oldest buffered sample
+  std::size_t next_index_ = 0;  // absolute index of the next sample
+  std::size_t time_cursor_ = 0;  // first buffered sample within the idle keep time
+  std::size_t lo_ = 0;          // earliest index the current lead-in search may use
+  std::size_t stream_start_ = 0;  // first index after the stream start / last clock restart
+  bool need_quiet_ = false;     // after a closed coast: no new run until the decline pauses
+  bool need_rise_ = false;      // after a stop: a new coast must start above rise_level_
+  double rise_level_ = 0;
+  bool have_last_t_ = false;
+  double last_t_ = 0;
+  std::size_t non_finite_ = 0;
+  std::size_t same_start_ = 0;  // first of the current run of identical readings
+  std::size_t plateau_start_ = 0, plateau_end_ = 0;  // last long positive plateau (clipping?)
+  bool have_plateau_ = false;
+  int accepted_ = 0;
+
+  WindowFit short_{0.25}, long_{1.0}, vlong_{4.0};  // confirm a decline
+  WindowFit hold_{1.0}, hold_long_{3.0};            // confirm a standstill
+  bool hold_long_live_ = false;
+  bool creeping_ = false;  // the coast was seen approaching standstill asymptotically
+  double quiet_until_s_ = -std::numeric_limits<double>::infinity();  // after a rejected cut
+
+  // The open run.
+  Run run_;
+  double v0_ = 0;          // reading at the cut (start of the coast line)
+  double coast_sd_ = 0;    // coast noise near the cut
+  double rise_jump_ = 0;   // a reading this far above level_min_ is power coming back
+  double level_min_ = 0;   // lowest hold-window mean seen in this coast
+  int rising_ = 0;         // consecutive samples far above level_min_ (power back?)
+  std::size_t rise_start_ = 0;
+  double depart_band_ = 0; // tail: how far from zero_level counts as leaving standstill
+  int departing_ = 0;
+  std::size_t depart_start_ = 0;
+  std::string run_note_;   // note attached to the completed run
+
+  std::vector<RunEvent> events_;
+  // Work space for medians and the cut search, grown (never shrunk, never zeroed) as needed.
+  double* scratch(std::size_t size);
+  std::unique_ptr<double[]> scratch_;
+  std::size_t scratch_size_ = 0;
+};
+
+
+namespace detail {
+
+// Seconds of lead-in searched for the cut before the window that confirmed the coast.
+constexpr double back_search_s = 2.0;
+// Seconds of lead-in kept while idle.
+constexpr double idle_keep_s = 40.0;
+// Samples searched at least, for slow loops.
+constexpr std::size_t back_search_min_samples = 16;
+// A coast is confirmed by a decline this many standard errors strong …
+constexpr double confirm_t_stat = 6.0;
+// … whose residual roughness is at most this fraction of its level (rejects a floating pin).
+constexpr double confirm_max_roughness = 0.05;
+// Standstill: slope within this many standard errors of zero.
+constexpr double flat_t_stat = 3.0;
+// Standstill must be below this fraction of the reading at the cut.
+constexpr double standstill_max_fraction = 0.3;
+// A real stop arrives with a finite slope: the last quarter of the amplitude is crossed at
+// least this fast relative to the coast's mean rate (Coulomb ≈ 1, lab's combined ≈ 0.8,
+// pure viscous ≈ 0.3–0.45, depending on the noise that decides "flat").
+constexpr double stop_min_end_rate = 0.5;
+// … or the last stop_hold_s before the stop still falls with this t-statistic (an exponential
+// that has become "flat" shows ~3–6 there, a Coulomb stop tens).
+constexpr double stop_min_approach_t = 10.0;
+// A 1 s hold window decides alone when its slope error is this fraction of the mean rate.
+constexpr double slope_resolution = 0.05;
+// In the tail, a hold-window mean this fraction of the amplitude below the zero level retracts
+// the stop.
+constexpr double retract_fraction = 0.01;
+// Recompute sliding sums from scratch this often (rounding drift).
+constexpr unsigned refresh_every = 4096;
+
+inline std::string fmt_s(double t) { return fmt::format("{:.3f} s", t); }
+
+}  // namespace detail
+using namespace detail;
+
+// ---- sliding least-squares line ----------------------------------------------------------
+
+inline void RunDetector::WindowFit::clear(std::size_t at, double t_origin) {
+  first = end = at;
+  t0 = t_origin;
+  n = st = stt = sv = svv = stv = 0;
+  updates = 0;
+}
+
+inline double RunDetector::duration(const WindowFit& w) const {
+  return w.end > w.first ? t(w.end - 1) - t(w.first) : 0.0;
+}
+
+inline void RunDetector::rebuild(WindowFit& w, std::size_t from, std::size_t to) {
+  w.clear(from, from < to ? t(from) : 0.0);
+  for (std::size_t k = from; k < to; ++k) w.add(t(k), v(k));
+  w.end = to;
+  w.updates = 0;
+}
+
+inline void RunDetector::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
+  lo = std::max(lo, base_);
+  if (lo >= end) {
+    w.clear(end, 0.0);
+    return;
+  }
+  std::size_t from = lo;
+  while (from + 1 < end && t(end - 1) - t(from) > w.span_s) ++from;
+  rebuild(w, from, end);
+}
+
+// Per sample for every live window, so inlined into its callers; the usual step (sample i
+// follows the window's last, exactly one old sample expires) is one slide().
+inline void RunDetector::advance(WindowFit& w, std::size_t i) {
+  const Sample* ring = ring_.get();
+  const std::size_t mask = mask_;
+  const Sample s = ring[i & mask];
+  if (w.end != i || w.n == 0) [[unlikely]] {
+    if (w.end != i) w.clear(i, s.t);  // not contiguous (after a reset): start again from i
+    w.t0 = s.t;
+  }
+  // Add sample i, then drop the oldest while the window is longer than its span (keeping at
+  // least 3). At a steady rate exactly one drops: that add and remove are one slide().
+  std::size_t first = w.first;
+  const double span = w.span_s;
+  const auto expired = [&](std::size_t k) { return i + 1 - k > 2 && s.t - ring[k & mask].t > span; };
+  if (expired(first)) [[likely]] {
+    const Sample old = ring[first & mask];
+    w.slide(s.t, s.v, old.t, old.v);
+    ++first;
+    while (expired(first)) [[unlikely]] {
+      const Sample o = ring[first & mask];
+      w.remove(o.t, o.v);
+      ++first;
+    }
+  } else {
+    w.add(s.t, s.v);
+  }
+  w.first = first;
+  w.end = i + 1;
+  if (w.updates > refresh_every) [[unlikely]] rebuild(w, w.first, w.end);
+}
+
+inline void RunDetector::coast_step(std::size_t i) {
+  advance(hold_, i);
+  if (hold_long_live_) advance(hold_long_, i);
+  coast_checks(i);
+}
+
+// Per coasting sample; kept small (the rare outcomes are calls) since it runs for every sample.
+inline void RunDetector::coast_checks(std::size_t i, bool at_end) {
+  const double t_i = t(i);
+  if (buffered() > opt_.max_buffer || t_i - run_.t_cut_s > opt_.max_coast_s) {
+    coast_too_long(i);
+    return;
+  }
+  if (hold_.n < 3 || hold_.first < run_.cut_index) return;
+  const double dur = duration(hold_);
+  const double mu = hold_.mean();
+
+  // Power back before standstill: the reading climbs well above the coast's lowest level.
+  if (dur >= 0.5 * hold_.span_s) level_min_ = std::min(level_min_, mu);
+  if (v(i) > level_min_ + rise_jump_) {
+    if (rising_++ == 0) rise_start_ = i;
+    if (rising_ >= 3) {
+      power_back();
+      return;
+    }
+  } else {
+    rising_ = 0;
+  }
+
+  // Standstill: the hold window is flat and low.
+  if (dur < 0.9 * hold_.span_s) return;
+  if (v0_ > 0 && mu > standstill_max_fraction * v0_) return;  // still high: the usual case, cheap
+  standstill_checks(i, at_end, (v0_ - mu) / std::max(t_i - run_.t_cut_s, 1e-9));
+}
+
+// ---- detector ----------------------------------------------------------------------------
+
+inline RunDetector::RunDetector(RunOptions opt, std::string source) : opt_(std::move(opt)), source_(std::move(source)) {
+  hold_.span_s = opt_.stop_hold_s;
+  hold_long_.span_s = 3.0 * opt_.stop_hold_s;
+  ring_ = std::make_unique_for_overwrite<Sample[]>(initial_ring_size);
+  mask_ = initial_ring_size - 1;
+}
+
+inline void RunDetector::grow_ring() {
+  // Keep [base_, next_index_) at the same positions modulo the new, doubled size.
+  const std::size_t size = 2 * ring_size();
+  auto bigger = std::make_unique_for_overwrite<Sample[]>(size);
+  const std::size_t mask = size - 1;
+  for (std::size_t k = base_; k + 1 < next_index_; ++k) bigger[k & mask] = ring_[k & mask_];
+  ring_ = std::move(bigger);
+  mask_ = mask;
+}
+
+inline std::vector<RunEvent> RunDetector::take_events() {
+  std::vector<RunEvent> out;
+  out.swap(events_);
+  return out;
+}
+
+inline void RunDetector::emit_diag(Diagnostic::Severity sev, std::string msg) {
+  RunEvent e;
+  e.kind = RunEvent::Kind::diagnostic;
+  e.diagnostic = {sev, source_, 0, std::move(msg)};
+  e.has_diagnostic = true;
+  events_.push_back(std::move(e));
+}
+
+inline double* RunDetector::scratch(std::size_t size) {
+  if (size > scratch_size_) {
+    scratch_size_ = std::max(size, 2 * scratch_size_);
+    scratch_ = std::make_unique_for_overwrite<double[]>(scratch_size_);
+  }
+  return scratch_.get();
+}
+
+inline double RunDetector::median_of(std::size_t from, std::size_t to) {
+  if (to <= from) return 0.0;
+  const std::size_t n = to - from;
+  double* x = scratch(n);
+  for (std::size_t k = from; k < to; ++k) x[k - from] = v(k);
+  double* mid = x + n / 2;
+  std::nth_element(x, mid, x + n);
+  double m = *mid;
+  if (n % 2 == 0) m = 0.5 * (m + *std::max_element(x, mid));
+  return m;
+}
+
+inline void RunDetector::push(double t_s, double value) {
+  if (!std::isfinite(t_s) || !std::isfinite(value)) [[unlikely]] {
+    ++non_finite_;  // reported by finish(); not a sample, so it takes no index
+    return;
+  }
+  if (have_last_t_ && t_s < last_t_) [[unlikely]] {
+    emit_diag(Diagnostic::Severity::note,
+              fmt::format("time went back from {} to {} at sample {}: taken as a clock restart", fmt_s(last_t_),
+                          fmt_s(t_s), next_index_));
+    clock_restart();
+  }
+  have_last_t_ = true;
+  last_t_ = t_s;
+  const std::size_t i = next_index_++;
+  if (next_index_ - base_ > ring_size()) [[unlikely]] grow_ring();
+  ring_[i & mask_] = {t_s, value};
+  // Track readings pinned at one positive value (a clipped converter) so the lead-in before
+  // a long clip is still buffered when the coast leaves it.
+  if (i == base_ || v(i) != v(i - 1)) same_start_ = i;
+  if (value > 0 && i + 1 - same_start_ >= 5) {
+    plateau_start_ = same_start_;
+    plateau_end_ = i;
+    have_plateau_ = true;
+  }
+  switch (state_) {
+    case State::idle: idle_step(i); break;
+    case State::coasting: coast_step(i); break;
+    case State::tail: tail_step(i); break;
+  }
+}
+
+inline void RunDetector::clock_restart() {
+  if (state_ == State::coasting) close_unstopped(next_index_, "the device clock restarted mid-coast");
+  else if (state_ == State::tail) complete_run(next_index_);
+  base_ = next_index_;
+  time_cursor_ = next_index_;
+  have_plateau_ = false;
+  need_rise_ = false;
+  stream_start_ = next_index_;
+  have_last_t_ = false;
+  state_ = State::idle;
+  lo_ = next_index_;
+  need_quiet_ = false;
+  short_.clear(next_index_, 0.0);
+  long_.clear(next_index_, 0.0);
+  vlong_.clear(next_index_, 0.0);
+  hold_long_.clear(next_index_, 0.0);
+  quiet_until_s_ = -std::numeric_limits<double>::infinity();
+  hold_.clear(next_index_, 0.0);
+}
+
+inline void RunDetector::finish() {
+  // A recording that ends soon after the stop: the hold window alone decides.
+  if (state_ == State::coasting && next_index_ > base_) coast_checks(next_index_ - 1, true);
+  if (state_ == State::coasting) close_unstopped(next_index_, "the recording ends mid-coast (never reached standstill)");
+  else if (state_ == State::tail) complete_run(next_index_);
+  if (state_ != State::idle) to_idle(next_index_, false);
+  if (non_finite_ > 0) {
+    emit_diag(Diagnostic::Severity::warning,
+              fmt::format("{} non-finite sample(s) (NaN/inf time or value) ignored", non_finite_));
+    non_finite_ = 0;
+  }
+}
+
+inline void RunDetector::to_idle(std::size_t lo, bool need_quiet) {
+  // After a stop, a new coast must start above the standstill: a slow coast's last creep
+  // after a premature stop is not a new run.
+  need_rise_ = state_ == State::tail && run_.stopped;
+  rise_level_ = run_.zero_level + depart_band_;
+  state_ = State::idle;
+  lo_ = lo;
+  need_quiet_ = need_quiet;
+  rising_ = departing_ = 0;
+  reset_window(short_, lo, next_index_);
+  reset_window(long_, lo, next_index_);
+  reset_window(vlong_, lo, next_index_);
+  trim_idle();
+}
+
+inline void RunDetector::trim_idle() {
+  if (next_index_ == base_) return;
+  // Enough for the longest window and a few doublings of the back-search.
+  const double keep_s = idle_keep_s;
+  const double t_now = t(next_index_ - 1);
+  // The first sample within keep_s only moves forward: amortized O(1) per sample.
+  time_cursor_ = std::max({time_cursor_, lo_, base_});
+  while (time_cursor_ + 1 < next_index_ && t_now - t(time_cursor_) > keep_s) ++time_cursor_;
+  std::size_t keep_from = time_cursor_;
+  // Keep enough samples for a slow loop's back-search, and what the windows still use.
+  const std::size_t min_keep = back_search_min_samples + 16;
+  if (next_index_ - keep_from < min_keep) keep_from = next_index_ > min_keep ? next_index_ - min_keep : 0;
+  keep_from = std::max(keep_from, base_);
+  keep_from = std::min({keep_from, short_.first, long_.first, vlong_.first});
+  // A recent pinned stretch shorter than keep_s may be a clip the coast has yet to leave.
+  if (have_plateau_ && plateau_end_ >= base_ && plateau_start_ >= base_ && t_now - t(plateau_end_) <= keep_s &&
+      t(plateau_end_) - t(plateau_start_) <= keep_s)
+    keep_from = std::min(keep_from, std::max(base_, plateau_start_ >= back_search_min_samples
+                                                        ? plateau_start_ - back_search_min_samples
+                                                        : std::size_t{0}));
+  // Bounded memory whatever the timing.
+  if (next_index_ - keep_from > opt_.max_buffer) keep_from = next_index_ - opt_.max_buffer;
+  base_ = std::max(base_, keep_from);
+  if (short_.first < base_) reset_window(short_, base_, next_index_);
+  if (long_.first < base_) reset_window(long_, base_, next_index_);
+  if (vlong_.first < base_) reset_window(vlong_, base_, next_index_);
+}
+
+inline bool RunDetector::confirms_decline(const WindowFit& w) const {
+  // Cheapest tests first: an idle lead-in (zeros, a steady supply) fails one of them.
+  if (w.n < 6 || w.first < lo_) return false;
+  const double mu = w.mean();
+  if (!(mu > 0)) return false;
+  const double dur = duration(w);
+  if (dur < 0.8 * w.span_s) return false;
+  const double s = w.slope();
+  if (!(s < 0)) return false;
+  const double sd = w.resid_sd();
+  if (sd > confirm_max_roughness * mu) return false;
+  if (-s * dur < 0.002 * mu) return false;
+  return -s * std::sqrt(w.sxx()) >= confirm_t_stat * sd;
+}
+
+inline void RunDetector::idle_step(std::size_t i) {
+  advance(short_, i);
+  advance(long_, i);
+  advance(vlong_, i);
+  if (need_quiet_) {
+    // After a coast closed without a stop the decline may go on: wait for it to pause.
+    const bool full = long_.n >= 8 && duration(long_) >= 0.8 * long_.span_s;
+    if (full) {
+      const double sd = long_.resid_sd();
+      const double s = long_.slope();
+      const bool declining = s < 0 && -s * std::sqrt(long_.sxx()) > 2.0 * sd;
+      if (!declining) need_quiet_ = false;
+    }
+    trim_idle();
+    return;
+  }
+  if (t(i) >= quiet_until_s_) {
+    bool tried = false;
+    for (const WindowFit* w : {&short_, &long_, &vlong_}) {
+      if (confirms_decline(*w)) {
+        tried = true;
+        if (try_start_coast(i, *w)) return;
+      }
+    }
+    if (tried) quiet_until_s_ = t(i) + 2.0 * short_.span_s;  // look again once the windows moved on
+  }
+  trim_idle();
+}
+
+inline RunDetector::CutSplit RunDetector::split_at_cut(std::size_t a, std::size_t b, const WindowFit& w) {
+  const std::size_t lower = std::max(lo_, base_);
+  CutSplit sp;
+  sp.a = a;
+
+  // A reading pinned at its maximum and left without a step: the converter's top.
+  double m = v(a);
+  for (std::size_t k = a; k <= b; ++k) m = std::max(m, v(k));
+  std::size_t p = b + 1;  // last pinned sample
+  for (std::size_t k = b; k >= a + 2 && k <= b; --k) {
+    if (v(k) == m && v(k - 1) == m && v(k - 2) == m) {
+      p = k;
+      break;
+    }
+  }
+  if (p < b) {
+    std::size_t q = p;  // first pinned sample
+    while (q > lower && v(q - 1) == m) --q;
+    // Quantized data plateaus too; a clipped reading is pinned much longer than the longest
+    // plateau of the coast after it.
+    std::size_t longest = 1, cur = 1;
+    for (std::size_t k = p + 2; k <= b; ++k) {
+      cur = v(k) == v(k - 1) ? cur + 1 : 1;
+      longest = std::max(longest, cur);
+    }
+    const std::size_t pinned = p - q + 1;
+    const double leave = m - v(p + 1);
+    if (q > lower && pinned >= 5 && pinned >= 3 * longest && leave > 0 &&
+        leave <= 0.02 * std::abs(m) + 3.0 * w.resid_sd()) {
+      sp.clipped = true;
+      sp.pin_first = q;
+      sp.pin_last = p;
+      sp.pin_level = m;
+      sp.a = std::max(lower, std::min(a, q >= back_search_min_samples ? q - back_search_min_samples : 0));
+      sp.cut_index = p + 1;
+      sp.t_cut_s = 0.5 * (t(q - 1) + t(q));
+      sp.pre_end = q;
+      sp.v0 = m;
+      sp.sd_post = w.resid_sd();
+    }
+  }
+
+  if (!sp.clipped) {
+    // Two-segment least squares over [a, b]: constant lead-in [a, c), linear coast [c, b].
+    const std::size_t n = b - a + 1;
+    double* pv = scratch(6 * (n + 1));  // prefix Σv, Σv² of [a, a+k)
+    double* pvv = pv + (n + 1);
+    double* ss = pvv + (n + 1);  // suffix Σt, Σt², Σv, Σtv of [a+k, b] (t relative to t(b))
+    double* stt_ = ss + (n + 1);
+    double* sv_ = stt_ + (n + 1);
+    double* stv_ = sv_ + (n + 1);
+    pv[0] = pvv[0] = 0.0;
+    ss[n] = stt_[n] = sv_[n] = stv_[n] = 0.0;
+    for (std::size_t k = 0; k < n; ++k) {
+      const double x = v(a + k);
+      pv[k + 1] = pv[k] + x;
+      pvv[k + 1] = pvv[k] + x * x;
+    }
+    const double tr = t(b);
+    for (std::size_t k = n; k-- > 0;) {
+      const double tt = t(a + k) - tr, x = v(a + k);
+      ss[k] = ss[k + 1] + tt;
+      stt_[k] = stt_[k + 1] + tt * tt;
+      sv_[k] = sv_[k + 1] + x;
+      stv_[k] = stv_[k + 1] + tt * x;
+    }
+    const double svv_all = pvv[n];
+    struct Line {
+      double v0 = 0, slope = 0, sd = 0;
+    };
+    auto post_line = [&](std::size_t k) {
+      const double np = double(n - k);
+      const double sxx = stt_[k] - ss[k] * ss[k] / np;
+      const double sxy = stv_[k] - ss[k] * sv_[k] / np;
+      const double syy = (svv_all - pvv[k]) - sv_[k] * sv_[k] / np;
+      Line l;
+      l.slope = sxx > 0 ? sxy / sxx : 0.0;
+      l.v0 = sv_[k] / np + l.slope * ((t(a + k) - tr) - ss[k] / np);
+      l.sd = np > 2 ? std::sqrt(std::max(syy - l.slope * sxy, 0.0) / (np - 2)) : 0.0;
+      return l;
+    };
+    // Best split with the lead-in starting at kb. The confirming window may straddle a small
+    // step (supply → back-EMF), so the split may fall anywhere that leaves a few samples for
+    // the line.
+    auto best_split = [&](std::size_t kb) {
+      double best = std::numeric_limits<double>::infinity();
+      std::size_t best_k = kb;
+      for (std::size_t k = kb; k + 3 <= n; ++k) {
+        const double m = double(k - kb);
+        const double sp_ = pv[k] - pv[kb];
+        const double sse_pre = k > kb ? (pvv[k] - pvv[kb]) - sp_ * sp_ / m : 0.0;
+        const double np = double(n - k);
+        const double sxx = stt_[k] - ss[k] * ss[k] / np;
+        const double sxy = stv_[k] - ss[k] * sv_[k] / np;
+        const double syy = (svv_all - pvv[k]) - sv_[k] * sv_[k] / np;
+        const double sse_post = sxx > 0 ? syy - sxy * sxy / sxx : syy;
+        const double sse = std::max(sse_pre, 0.0) + std::max(sse_post, 0.0);
+        if (sse < best) {
+          best = sse;
+          best_k = k;
+        }
+      }
+      return best_k;
+    };
+    std::size_t kb = 0;
+    std::size_t k = best_split(0);
+    // Two steps in reach (zeros → supply → back-EMF): the coast follows the later one, taken
+    // when it splits a flat plateau from the coast by a clear step.
+    for (int again = 0; again < 3; ++again) {
+      const std::size_t k2 = best_split(k);
+      if (k2 < k + 3) break;
+      const double m = double(k2 - k);
+      const double mean = (pv[k2] - pv[k]) / m;
+      const double sd = std::sqrt(std::max((pvv[k2] - pvv[k]) / m - mean * mean, 0.0));
+      const Line l = post_line(k2);
+      const double scale = std::abs(l.v0);
+      if (std::abs(l.v0 - mean) <= std::max(5.0 * l.sd, 0.03 * scale) || sd > std::max(3.0 * l.sd, 0.02 * scale))
+        break;
+      kb = k;
+      k = k2;
+    }
+    const Line l = post_line(k);
+    const std::size_t c = a + k;
+    sp.a = a + kb;
+    sp.v0 = l.v0;
+    sp.post_slope = l.slope;
+    sp.sd_post = l.sd;
+    sp.cut_index = c;
+    sp.pre_end = c;
+    const bool sample_before = c > base_ && c > stream_start_ && c - 1 >= lo_;
+    sp.t_cut_s = sample_before ? 0.5 * (t(c - 1) + t(c)) : t(c);
+  }
+
+  // The lead-in [a, pre_end): level, roughness, maximum and trend.
+  sp.npre = sp.pre_end - sp.a;
+  if (sp.npre >= 3) {
+    WindowFit f;
+    f.clear(sp.a, t(sp.a));
+    sp.pre_max = v(sp.a);
+    for (std::size_t k = sp.a; k < sp.pre_end; ++k) {
+      f.add(t(k), v(k));
+      sp.pre_max = std::max(sp.pre_max, v(k));
+    }
+    sp.pre_mean = f.mean();
+    sp.pre_sd = std::sqrt(std::max(f.svv / f.n - sp.pre_mean * sp.pre_mean, 0.0));
+    // A lead-in falling at a good part of the coast's own rate is more coast: the cut lies
+    // further back.
+    const double s = f.slope(), sd = f.resid_sd();
+    const double s_err = f.sxx() > 0 ? sd / std::sqrt(f.sxx()) : 0.0;
+    const bool smooth = sd <= std::max(3.0 * sp.sd_post, 0.02 * std::abs(sp.v0));  // not a wandering pin
+    sp.pre_declining = sp.npre >= 8 && smooth && s < 0 && -s > 3.0 * s_err &&
+                       (sp.clipped || sp.post_slope >= 0 || s <= 0.3 * sp.post_slope);
+    sp.pre_flat = sp.npre >= 8 && std::abs(s) + 2.0 * s_err <= 0.3 * std::abs(sp.post_slope);
+  }
+  return sp;
+}
+
+inline std::string RunDetector::classify_lead_in(const CutSplit& sp) const {
+  if (sp.npre < 3) return "none";
+  const double scale = std::abs(sp.v0);
+  const double step = sp.v0 - sp.pre_mean;
+  // No step beyond the noise of either side: a powered motor whose speed is the reading.
+  if (std::abs(step) <= std::max({3.0 * sp.sd_post, 4.0 * sp.pre_sd, 0.01 * scale})) return "powered";
+  if (step < 0) return "supply";
+  if (sp.pre_sd > std::max(0.02 * scale, 3.0 * sp.sd_post)) return "floating";
+  if (std::abs(sp.pre_mean) <= 0.1 * scale) return "zeros";
+  return "floating";
+}
+
+inline bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
+  const std::size_t b = i;
+  const std::size_t w0 = w.first;
+  const std::size_t lower = std::max(lo_, base_);
+  double span = std::max(back_search_s, 2.0 * w.span_s);
+  CutSplit sp;
+  std::string lead;
+  for (int attempt = 0;; ++attempt) {
+    std::size_t a = w0;
+    while (a > lower && t(w0) - t(a - 1) <= span) --a;
+    if (w0 - a < back_search_min_samples) a = w0 - std::min(w0 - lower, back_search_min_samples);
+    sp = split_at_cut(a, b, w);
+    lead = classify_lead_in(sp);
+    // Search further back when the lead-in seen is too short to judge, is itself part of the
+    // decline, or is a "plateau" not shown to be flatter than the coast.
+    const bool unsure = sp.npre < 8 || sp.pre_declining || (lead == "powered" && !sp.pre_flat);
+    if (unsure && a > lower && attempt < 5) {
+      span *= 2;
+      continue;
+    }
+    break;
+  }
+
+  // Whether this is a cut at all.
+  bool plausible = sp.v0 > 0;
+  const double scale = std::abs(sp.v0);
+  if (lead == "none") plausible = plausible && sp.a <= stream_start_;  // only a stream that starts mid-coast
+  if (lead == "powered" && sp.pre_sd > 0.05 * scale) plausible = false;  // a rough "plateau"
+  if ((lead == "zeros" || lead == "floating") && sp.v0 < 1.5 * sp.pre_max) plausible = false;
+  if (sp.pre_declining) plausible = false;  // a decline with no cut in reach
+  // A cut without a step (a kink, or a stream that starts mid-coast) rests on the slope alone:
+  // a quarter-second window of noise can fake it, so it needs a window of a second or more.
+  if ((lead == "powered" || lead == "none") && w.span_s < 1.0) plausible = false;
+  if (need_rise_ && sp.v0 < rise_level_) plausible = false;  // the last coast, still creeping down
+  if (!plausible) return false;
+
+  run_ = Run{};
+  run_.number = accepted_ + 1;
+  run_.cut_index = sp.cut_index;
+  run_.t_cut_s = sp.t_cut_s;
+  run_.lead_in = lead;
+  run_note_.clear();
+  if (sp.clipped) {
+    emit_diag(Diagnostic::Severity::warning,
+              fmt::format("run {}: reading pinned at {:g} (converter's top?) from {} to {} ({} samples): "
+                          "the coast is taken from where it leaves it",
+                          run_.number, sp.pin_level, fmt_s(t(sp.pin_first)), fmt_s(t(sp.pin_last)),
+                          sp.pin_last - sp.pin_first + 1));
+  }
+  v0_ = sp.v0;
+  coast_sd_ = sp.sd_post;
+  rise_jump_ = std::max(0.1 * std::abs(v0_), 8.0 * coast_sd_);
+  level_min_ = std::numeric_limits<double>::infinity();
+  rising_ = 0;
+  state_ = State::coasting;
+  {
+    RunEvent e;
+    e.kind = RunEvent::Kind::cut;
+    e.run = run_;
+    events_.push_back(std::move(e));
+  }
+  reset_window(hold_, run_.cut_index, i + 1);
+  hold_long_live_ = false;  // built when the coast gets low (saves work on the way down)
+  creeping_ = false;
+  coast_checks(i);
+  return true;
+}
+
+inline void RunDetector::coast_too_long(std::size_t i) {
+  if (buffered() > opt_.max_buffer) {
+    RunEvent e;
+    e.kind = RunEvent::Kind::ignored;
+    e.run = run_;
+    e.has_diagnostic = true;
+    e.diagnostic = {Diagnostic::Severity::warning, source_, 0,
+                    fmt::format("run cut at {}: coast longer than max_buffer ({} samples) abandoned",
+                                fmt_s(run_.t_cut_s), opt_.max_buffer)};
+    events_.push_back(std::move(e));
+    to_idle(i + 1, true);
+    return;
+  }
+  close_unstopped(i + 1, fmt::format("no standstill within max_coast_s ({:g} s): closed as never stopped",
+                                     opt_.max_coast_s));
+  to_idle(i + 1, true);
+}
+
+inline void RunDetector::power_back() {
+  const std::size_t at = rise_start_;
+  close_unstopped(at, fmt::format("the reading rose again at {} before standstill (power restored?)", fmt_s(t(at))));
+  to_idle(at, false);
+}
+
+inline void RunDetector::standstill_checks(std::size_t i, bool at_end, double mean_rate) {
+  // The hold window is flat and low, and either its slope is resolved well below the coast's
+  // mean rate or a three times longer window is flat too (noisy, slow coasts).
+  bool resolved = at_end;
+  if (!flat(hold_, mean_rate, at_end ? nullptr : &resolved)) return;
+  if (creeping_ && !at_end) resolved = false;  // an asymptotic coast ends when the long window is flat
+  if (!resolved) {
+    if (!hold_long_live_) {
+      reset_window(hold_long_, run_.cut_index, i + 1);
+      hold_long_live_ = true;
+    }
+    if (!flat(hold_long_, mean_rate, nullptr)) return;
+  }
+  found_standstill(i, at_end);
+}
+
+inline bool RunDetector::flat(const WindowFit& w, double mean_rate, bool* resolved) const {
+  if (w.n < 3 || w.first < run_.cut_index) return false;
+  const double d = duration(w);
+  if (d < 0.9 * w.span_s) return false;
+  const double m = w.mean();
+  const bool low = v0_ > 0 ? m <= standstill_max_fraction * v0_ : true;
+  if (!low) return false;
+  const double s = w.slope(), e = w.resid_sd(), sxx = w.sxx();
+  const double scale = std::max(std::abs(v0_), std::abs(m));
+  const double tiny = 1e-12 * (scale > 0 ? scale : 1.0);
+  const bool no_slope = std::abs(s) * std::sqrt(sxx) <= flat_t_stat * e + tiny;
+  const bool small_drop = std::abs(s) * d <= std::max(3.0 * e, 0.01 * std::abs(v0_)) + tiny;
+  if (!(no_slope && small_drop)) return false;
+  if (resolved) *resolved = sxx > 0 && e / std::sqrt(sxx) <= slope_resolution * mean_rate;
+  return true;
+}
+
+inline void RunDetector::found_standstill(std::size_t i, bool at_end) {
+  const std::size_t h0 = hold_.first;
+  const double z = median_of(h0, i + 1);
+  double var = 0;
+  for (std::size_t k = h0; k <= i; ++k) var += (v(k) - z) * (v(k) - z);
+  const double sd_z = std::sqrt(var / double(i + 1 - h0));
+  const double amp = v0_ - z;
+  const double band = std::max(3.0 * sd_z, 1e-9 * std::max(std::abs(amp), 1e-300));
+
+  // First sample of the standstill that contains the hold window (an isolated sample outside
+  // the band is noise; two in a row are the coast).
+  std::size_t first_in = i + 1;
+  while (first_in > run_.cut_index + 1) {
+    if (std::abs(v(first_in - 1) - z) <= band) {
+      --first_in;
+    } else if (first_in - 1 > run_.cut_index + 1 && std::abs(v(first_in - 2) - z) <= band && first_in - 1 < i + 1) {
+      first_in -= 2;  // lone outlier
+    } else {
+      break;
+    }
+  }
+  first_in = std::min(first_in, i);
+
+  // Where the coast crossed the last quarter of its amplitude.
+  const double quarter = z + 0.25 * amp;
+  std::size_t k = first_in;
+  while (k > run_.cut_index && v(k - 1) <= quarter) --k;
+  double t_quarter = t(k);
+  if (k > run_.cut_index) {
+    const double va = v(k - 1), vb = v(k);
+    t_quarter = va > vb ? t(k - 1) + (t(k) - t(k - 1)) * (va - quarter) / (va - vb) : t(k);
+  }
+
+  // Stop time: the approach line (the last ≤2 s above the band) meets the zero level.
+  double t_hit = t(first_in);
+  {
+    std::size_t from = first_in;
+    while (from > k && t(first_in) - t(from - 1) <= 2.0) --from;
+    if (first_in >= from + 3) {
+      WindowFit f;
+      f.clear(from, t(from));
+      for (std::size_t j = from; j < first_in; ++j) f.add(t(j), v(j));
+      const double sl = f.slope();
+      if (sl < 0) {
+        const double tb = f.st / f.n, vb = f.mean();
+        const double th = f.t0 + tb + (z - vb) / sl;
+        if (std::isfinite(th)) t_hit = std::clamp(th, t_quarter, t(i));
+      }
+    }
+  }
+  // The first sample at or after t_hit (times never decrease within a stream), at most i.
+  std::size_t lo = run_.cut_index + 1, hi = std::max(lo, i);
+  while (lo < hi) {
+    const std::size_t mid = lo + (hi - lo) / 2;
+    if (t(mid) < t_hit) lo = mid + 1;
+    else hi = mid;
+  }
+  const std::size_t stop = lo;
+
+  // A real stop arrives with a finite slope; an exponential creeps in.
+  const double t_stop = t(stop);
+  const double coast = t_stop - run_.t_cut_s;
+  const double last_quarter = t_stop - t_quarter;
+  const double end_rate = last_quarter > 0 ? 0.25 * coast / last_quarter : std::numeric_limits<double>::infinity();
+
+  run_.zero_level = z;
+  run_.noise_level = sd_z;
+  // … and right before it the reading still falls clearly (an exponential has flattened).
+  double approach_t = std::numeric_limits<double>::infinity();
+  {
+    std::size_t from = stop;
+    while (from > run_.cut_index && t_stop - t(from - 1) <= opt_.stop_hold_s) --from;
+    if (stop >= from + 3) {
+      WindowFit f;
+      f.clear(from, t(from));
+      for (std::size_t j = from; j < stop; ++j) f.add(t(j), v(j));
+      const double e = f.resid_sd();
+      approach_t = e > 0 ? -f.slope() * std::sqrt(f.sxx()) / e : (f.slope() < 0 ? approach_t : 0.0);
+    }
+  }
+  if (end_rate >= stop_min_end_rate || approach_t >= stop_min_approach_t || amp <= 0) {
+    run_.stopped = true;
+    run_.stop_index = stop;
+    run_.t_stop_s = t_stop;
+    depart_band_ = std::max(6.0 * sd_z, 0.05 * std::abs(amp));
+    departing_ = 0;
+    state_ = State::tail;
+    RunEvent e;
+    e.kind = RunEvent::Kind::stop;
+    e.run = run_;
+    events_.push_back(std::move(e));
+    tail_ends_by_time(i);
+  } else if (!creeping_ && !at_end) {
+    // Keep the coast until the decay is lost in the noise even over the long window: the
+    // exponential's tail still carries information for the fit.
+    creeping_ = true;
+  } else {
+    run_note_ = fmt::format(
+        "run cut at {}: the coast approaches its floor ({:g}) asymptotically (last quarter {:.2f}x slower than "
+        "the mean rate), as pure viscous friction does: treated as never stopped, coast closed at {}",
+        fmt_s(run_.t_cut_s), z, end_rate > 0 ? 1.0 / end_rate : 0.0, fmt_s(t(i)));
+    run_.stopped = false;
+    complete_run(i + 1);
+    to_idle(i + 1, true);
+  }
+}
+
+inline void RunDetector::tail_ends_by_time(std::size_t upto) {
+  const double t_end = run_.t_stop_s + opt_.tail_s;
+  for (std::size_t e = run_.stop_index + 1; e <= upto; ++e) {
+    if (t(e) >= t_end) {
+      complete_run(e);
+      to_idle(e, false);
+      return;
+    }
+  }
+}
+
+inline void RunDetector::tail_step(std::size_t i) {
+  if (buffered() > opt_.max_buffer) {
+    complete_run(i);
+    to_idle(i, false);
+    return;
+  }
+  // Still falling: the "standstill" was a noisy stretch of a slow coast. Retract the stop and
+  // keep coasting (the stop event was provisional; only complete runs are final).
+  advance(hold_, i);
+  if (hold_long_live_) advance(hold_long_, i);
+  if (hold_.n >= 3 && hold_.first >= run_.stop_index) {
+    const double drop = run_.zero_level - hold_.mean();
+    if (drop > std::max(4.0 * run_.noise_level / std::sqrt(hold_.n), retract_fraction * (v0_ - run_.zero_level))) {
+      emit_diag(Diagnostic::Severity::note,
+                fmt::format("run cut at {}: standstill at {} retracted, the reading kept falling", fmt_s(run_.t_cut_s),
+                            fmt_s(run_.t_stop_s)));
+      run_.stopped = false;
+      run_.t_stop_s = std::numeric_limits<double>::quiet_NaN();
+      state_ = State::coasting;
+      level_min_ = std::numeric_limits<double>::infinity();
+      rising_ = 0;
+      coast_checks(i);
+      return;
+    }
+  }
+  // A new spin-up (the next run's lead-in) ends the tail.
+  if (v(i) - run_.zero_level > depart_band_) {
+    if (departing_++ == 0) depart_start_ = i;
+    if (departing_ >= 2) {
+      const std::size_t at = depart_start_;
+      complete_run(at);
+      to_idle(at, false);
+      return;
+    }
+  } else {
+    departing_ = 0;
+  }
+  if (t(i) >= run_.t_stop_s + opt_.tail_s) {
+    const std::size_t end = departing_ > 0 ? depart_start_ : i;
+    complete_run(end);
+    to_idle(end, false);
+  }
+}
+
+inline void RunDetector::close_unstopped(std::size_t end, const std::string& why) {
+  run_.stopped = false;
+  run_.zero_level = 0;
+  run_.noise_level = coast_sd_;
+  run_note_ = fmt::format("run cut at {}: {}", fmt_s(run_.t_cut_s), why);
+  complete_run(end);
+}
+
+inline void RunDetector::complete_run(std::size_t end) {
+  Run r = run_;
+  end = std::max(end, r.cut_index);
+  r.end_index = end;
+  if (r.stopped) {
+    r.stop_index = std::min(r.stop_index, end);
+    if (end > r.stop_index) {
+      r.zero_level = median_of(r.stop_index, end);
+      double var = 0;
+      for (std::size_t k = r.stop_index; k < end; ++k) var += (v(k) - r.zero_level) * (v(k) - r.zero_level);
+      r.noise_level = std::sqrt(var / double(end - r.stop_index));
+    }
+  } else {
+    r.stop_index = end;
+    r.t_stop_s = std::numeric_limits<double>::quiet_NaN();
+  }
+  const std::size_t coast_end = r.stopped ? r.stop_index : end;
+  // Median sample period within the coast.
+  if (coast_end > r.cut_index + 1) {
+    const std::size_t n = coast_end - r.cut_index - 1;
+    double* dt = scratch(n);
+    for (std::size_t k = 0; k < n; ++k) dt[k] = t(r.cut_index + 1 + k) - t(r.cut_index + k);
+    std::nth_element(dt, dt + n / 2, dt + n);
+    r.period_s = dt[n / 2];
+  }
+  const std::size_t coast_n = coast_end - r.cut_index;
+  const double coast_s = (r.stopped ? r.t_stop_s : (end > r.cut_index ? t(end - 1) : r.t_cut_s)) - r.t_cut_s;
+
+  RunEvent e;
+  e.run = r;
+  if (coast_s < opt_.min_coast_s || coast_n < opt_.min_samples) {
+    e.kind = RunEvent::Kind::ignored;
+    e.has_diagnostic = true;
+    e.diagnostic = {Diagnostic::Severity::note, source_, 0,
+                    fmt::format("coast cut at {} ignored: {} and {} samples (need {:g} s and {})", fmt_s(r.t_cut_s),
+                                fmt_s(coast_s), coast_n, opt_.min_coast_s, opt_.min_samples)};
+  } else {
+    e.kind = RunEvent::Kind::complete;
+    e.run.number = ++accepted_;
+    if (!run_note_.empty()) {
+      e.has_diagnostic = true;
+      e.diagnostic = {Diagnostic::Severity::note, source_, 0, fmt::format("run {}: {}", e.run.number, run_note_)};
+    }
+  }
+  events_.push_back(std::move(e));
+  run_note_.clear();
+}
+
+}  // namespace spindown::reference
