@@ -9,6 +9,7 @@
 #include <exception>
 #include <fmt/format.h>
 #include <limits>
+#include <memory>
 #include <nlopt.hpp>
 
 namespace spindown {
@@ -90,14 +91,15 @@ double stop_time(const Theta& th) {
 // DecayingRow, where α·τ reaches 10⁻³: with c = β/α the model is (u0 + c)·e − c, no division
 // per sample. Its α-derivative, −(u0 + c)·τ·e + (c/α)·(1 − e), loses only ~ε·βτ/α to
 // cancellation where ατ is small.
+struct ModelRow {
+  double model, g0, g1, g2;
+};
+
 struct DecayingRow {
   double a, c, c_over_alpha, inv_alpha;
   template <int P>
-  double operator()(double t, double e, double* g) const {
-    g[0] = e;
-    g[1] = c_over_alpha * (1.0 - e) - a * t * e;
-    if constexpr (P == 3) g[2] = (e - 1.0) * inv_alpha;
-    return a * e - c;
+  ModelRow operator()(double t, double e) const {
+    return {a * e - c, e, c_over_alpha * (1.0 - e) - a * t * e, P == 3 ? (e - 1.0) * inv_alpha : 0.0};
   }
 };
 
@@ -108,14 +110,13 @@ struct SeriesRow {
   Theta th;
   bool alpha_free;
   template <int P>
-  double operator()(double t, double e, double* g) const {
+  ModelRow operator()(double t, double e) const {
     const double x = th.alpha * t;
     const double p = 1.0 - x / 2 + x * x / 6 - x * x * x / 24, dp = -0.5 + x / 3 - x * x / 8;
     const double d_alpha = -th.u0 * t * e - th.beta * t * t * dp, d_beta = -t * p;
-    g[0] = e;
-    if constexpr (P == 2) g[1] = alpha_free ? d_alpha : d_beta;
-    if constexpr (P == 3) g[1] = d_alpha, g[2] = d_beta;
-    return th.u0 * e - th.beta * t * p;
+    const double model = th.u0 * e - th.beta * t * p;
+    if constexpr (P == 2) return {model, e, alpha_free ? d_alpha : d_beta, 0.0};
+    return {model, e, d_alpha, d_beta};
   }
 };
 
@@ -133,8 +134,8 @@ class Evaluator {
         wy_(tau.size()),
         tail_sq_(tau.size() + 1, 0.0),
         plain_tail_sq_(tau.size() + 1, 0.0),
-        e_(tau.size()),
-        scores_(3 * tau.size()),
+        e_(std::make_unique_for_overwrite<double[]>(tau.size())),
+        scores_(std::make_unique_for_overwrite<double[]>(3 * tau.size())),
         lags_(newey_west_lags(tau.size())),
         sorted_(std::is_sorted(tau.begin(), tau.end())) {
     const std::size_t n = tau.size();
@@ -167,7 +168,7 @@ class Evaluator {
     const std::size_t n = tau_.size();
     decay(alpha, n);
     double ee = 0, ye = 0, t_ee = 0, t_ye = 0, tt_ee = 0, tt_ye = 0;
-    const double *tau = tau_.data(), *ex = e_.data(), *w = w_.data(), *wy = wy_.data();
+    const double *tau = tau_.data(), *ex = e_.get(), *w = w_.data(), *wy = wy_.data();
 #pragma omp simd reduction(+ : ee, ye, t_ee, t_ye, tt_ee, tt_ye)
     for (std::size_t i = 0; i < n; ++i) {
       const double e = ex[i], t = tau[i], wee = w[i] * e * e, wye = wy[i] * e;
@@ -223,7 +224,7 @@ class Evaluator {
     const double tau_max = m == 0 ? 0.0 : sorted_ ? tau_[m - 1] : *std::max_element(tau_.begin(), tau_.begin() + m);
     const bool decaying = f.alpha_free && th.alpha * tau_max >= 1e-3;
     if (f.alpha_free && th.alpha != 0) decay(th.alpha, m);
-    else std::fill(e_.begin(), e_.begin() + m, 1.0);
+    else std::fill(e_.get(), e_.get() + m, 1.0);
     if (decaying) {
       const double c = th.beta / th.alpha;
       const DecayingRow row{th.u0 + c, c, c / th.alpha, 1.0 / th.alpha};
@@ -243,21 +244,21 @@ class Evaluator {
   void accumulate(const Row& row) {
     static_assert(P == 2 || P == 3);
     double sse = 0, plain = 0, r0 = 0, r1 = 0, r2 = 0, j00 = 0, j10 = 0, j11 = 0, j20 = 0, j21 = 0, j22 = 0;
-    const double *tau = tau_.data(), *e = e_.data(), *w = w_.data(), *y = y_.data();
-    double* score = scores_.data();
+    const double *tau = tau_.data(), *e = e_.get(), *w = w_.data(), *y = y_.data();
+    double *score0 = score(0), *score1 = score(1), *score2 = score(2);
     const std::size_t m = m_;
 #pragma omp simd reduction(+ : sse, plain, r0, r1, r2, j00, j10, j11, j20, j21, j22)
     for (std::size_t i = 0; i < m; ++i) {
-      double g[3];
-      const double model = row.template operator()<P>(tau[i], e[i], g);
-      const bool moving = model > 0;
-      const double d = y[i] - (moving ? model : 0.0), wd = w[i] * d;
-      const double gw = moving ? w[i] : 0.0, gwd = moving ? wd : 0.0;  // the gradient's weights
+      const auto [model, g0, g1, g2] = row.template operator()<P>(tau[i], e[i]);
+      const double moving = model > 0 ? 1.0 : 0.0;
+      const double d = y[i] - std::max(model, 0.0), wd = w[i] * d;
+      const double gw = moving * w[i], gwd = moving * wd;  // the gradient's weights
       sse += wd * d, plain += d * d;
-      r0 += g[0] * gwd, r1 += g[1] * gwd;
-      j00 += gw * g[0] * g[0], j10 += gw * g[1] * g[0], j11 += gw * g[1] * g[1];
-      if constexpr (P == 3) r2 += g[2] * gwd, j20 += gw * g[2] * g[0], j21 += gw * g[2] * g[1], j22 += gw * g[2] * g[2];
-      for (int a = 0; a < P; ++a) score[P * i + a] = g[a] * gwd;
+      r0 += g0 * gwd, r1 += g1 * gwd;
+      j00 += gw * g0 * g0, j10 += gw * g1 * g0, j11 += gw * g1 * g1;
+      if constexpr (P == 3) r2 += g2 * gwd, j20 += gw * g2 * g0, j21 += gw * g2 * g1, j22 += gw * g2 * g2;
+      score0[i] = g0 * gwd, score1[i] = g1 * gwd;
+      if constexpr (P == 3) score2[i] = g2 * gwd;
     }
     last_sse_ = sse + tail_sq_[m];
     last_plain_sse_ = plain + plain_tail_sq_[m];
@@ -275,8 +276,8 @@ class Evaluator {
     for (std::size_t t = 0; t < m + lags; ++t) {
 #pragma GCC unroll 3
       for (int a = 0; a < P; ++a) {
-        if (t < m) window[a] += scores_[P * t + a];
-        if (t > lags) window[a] -= scores_[P * (t - lags - 1) + a];
+        if (t < m) window[a] += score(a)[t];
+        if (t > lags) window[a] -= score(a)[t - lags - 1];
       }
 #pragma GCC unroll 3
       for (int a = 0; a < P; ++a)
@@ -296,7 +297,7 @@ class Evaluator {
   void decay(double alpha, std::size_t m) {
     if (step_code_.empty() || m < 2 * anchor_every) {
       const auto k = static_cast<Eigen::Index>(m);
-      Eigen::Map<Eigen::ArrayXd>(e_.data(), k) = (-alpha * Eigen::Map<const Eigen::ArrayXd>(tau_.data(), k)).exp();
+      Eigen::Map<Eigen::ArrayXd>(e_.get(), k) = (-alpha * Eigen::Map<const Eigen::ArrayXd>(tau_.data(), k)).exp();
       return;
     }
     for (std::size_t d = 0; d < steps_.size(); ++d) step_factor_[d] = std::exp(-alpha * steps_[d]);
@@ -337,7 +338,9 @@ class Evaluator {
 
   std::span<const double> tau_, y_, w_;
   std::vector<double> wy_, tail_sq_, plain_tail_sq_;
-  std::vector<double> e_, scores_;
+  // Scratch the passes overwrite before reading: e^(−ατ), and each column's scores g_j·w·r.
+  std::unique_ptr<double[]> e_, scores_;
+  double* score(int j) const { return scores_.get() + static_cast<std::size_t>(j) * tau_.size(); }
   int lags_;
   double total_sum_sq_ = 0;
   bool sorted_;
