@@ -4,7 +4,9 @@
 // themselves (their coverage over many noisy runs).
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 #include <vector>
@@ -394,3 +396,111 @@ TEST(Fit, ViscousAndCoulombAreTheLeastSquaresMinimum) {
     }
   }
 }
+
+namespace spindown {
+namespace {
+
+// Standard errors by the textbook recipe, from scratch: a numerical Jacobian of the clamped
+// model, classic s²(JᵀWJ)⁻¹, and for each parameter the Newey–West long-run variance of
+// z_i = w_i·r_i·(g_i·v_j) as γ0 + 2·Σ_{l≤L} (1 − l/(L+1))·γ_l with L = ⌈4·(n/100)^(2/9)⌉, the
+// variance widened to the larger of the two. θ = (u0, α, β) in reading units; free marks the
+// family's parameters.
+struct TextbookErrors {
+  std::vector<double> se, widen;  // per free parameter; widen: long-run over classic variance, ≥ 1
+};
+
+TextbookErrors textbook_std_errors(const RunData& d, std::array<double, 3> theta, std::array<bool, 3> free) {
+  const auto model = [&](const std::array<double, 3>& th, double t) {
+    const double u0 = th[0], alpha = th[1], beta = th[2];
+    const double m = alpha > 0 ? (u0 + beta / alpha) * std::exp(-alpha * t) - beta / alpha : u0 - beta * t;
+    return std::max(m, 0.0);
+  };
+  std::vector<int> cols;
+  for (int j = 0; j < 3; ++j)
+    if (free[j]) cols.push_back(j);
+  const std::size_t n = d.tau.size(), p = cols.size();
+  std::vector<std::vector<double>> g(n, std::vector<double>(p));
+  std::vector<double> r(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    r[i] = d.y[i] - model(theta, d.tau[i]);
+    for (std::size_t c = 0; c < p; ++c) {
+      const int j = cols[c];
+      const double h = 1e-6 * std::max(std::abs(theta[j]), 1e-6);
+      auto up = theta, down = theta;
+      up[j] += h, down[j] -= h;
+      g[i][c] = (model(up, d.tau[i]) - model(down, d.tau[i])) / (2 * h);
+    }
+  }
+  Eigen::MatrixXd jtj = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(p), static_cast<Eigen::Index>(p));
+  double sse = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    sse += d.w[i] * r[i] * r[i];
+    for (std::size_t a = 0; a < p; ++a)
+      for (std::size_t b = 0; b < p; ++b)
+        jtj(static_cast<Eigen::Index>(a), static_cast<Eigen::Index>(b)) += d.w[i] * g[i][a] * g[i][b];
+  }
+  const Eigen::MatrixXd inv = jtj.inverse();
+  const double s2 = sse / static_cast<double>(n - p);
+  const int lags = static_cast<int>(std::ceil(4.0 * std::pow(static_cast<double>(n) / 100.0, 2.0 / 9.0)));
+  TextbookErrors out;
+  for (std::size_t j = 0; j < p; ++j) {
+    std::vector<double> z(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      double gv = 0;
+      for (std::size_t c = 0; c < p; ++c) gv += g[i][c] * inv(static_cast<Eigen::Index>(c), static_cast<Eigen::Index>(j));
+      z[i] = d.w[i] * r[i] * gv;
+    }
+    double omega = 0;
+    for (int l = 0; l <= lags; ++l) {
+      double gamma = 0;
+      for (std::size_t i = static_cast<std::size_t>(l); i < n; ++i) gamma += z[i] * z[i - static_cast<std::size_t>(l)];
+      omega += (l == 0 ? 1.0 : 2.0 * (1.0 - l / (lags + 1.0))) * gamma;
+    }
+    const double classic = s2 * inv(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(j));
+    const double widen = std::max(1.0, static_cast<double>(n) / static_cast<double>(n - p) * omega / classic);
+    out.se.push_back(std::sqrt(widen * classic));
+    out.widen.push_back(widen);
+  }
+  return out;
+}
+
+}  // namespace
+
+// The fit's standard errors (Jacobian and Newey–West moving sums gathered inside the fit's
+// passes) agree with the textbook computation above, for every model, on runs with ripple
+// (correlated residuals, so the Newey–West widening is in play).
+TEST(Fit, StandardErrorsMatchTheTextbookNeweyWestComputation) {
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    SyntheticRunSpec spec;
+    spec.noise_v = 0.004;
+    spec.ripple = 0.01;
+    spec.seed = seed;
+    const Case c = make_case(spec);
+    const RunData d = run_data(c);
+    const double k = spec.bench.kb_v_s_per_rad, J = spec.bench.inertia_kg_m2;
+    const RunFit f = fit_case(c);
+    const ModelFit &v = *f.model(ModelKind::viscous), &co = *f.model(ModelKind::coulomb),
+                   &cb = *f.model(ModelKind::combined);
+    ASSERT_TRUE(v.converged && co.converged && cb.converged);
+    constexpr double tol = 1e-5;  // relative: the numerical Jacobian's error is far below
+
+    const auto sv = textbook_std_errors(d, {v.omega0 * k, v.rate, 0}, {true, true, false}).se;
+    EXPECT_NEAR(se(v, "A"), sv[0], tol * sv[0]) << "seed " << seed;  // u0
+    EXPECT_NEAR(se(v, "B"), sv[1], tol * sv[1]) << "seed " << seed;  // α
+
+    const auto sc = textbook_std_errors(d, {co.omega0 * k, 0, co.decel * k}, {true, false, true}).se;
+    EXPECT_NEAR(se(co, "B"), sc[0], tol * sc[0]) << "seed " << seed;  // u0
+    EXPECT_NEAR(se(co, "A"), sc[1], tol * sc[1]) << "seed " << seed;  // β
+
+    const TextbookErrors tb = textbook_std_errors(d, {cb.omega0 * k, cb.rate, cb.decel * k}, {true, true, true});
+    const auto& sb = tb.se;
+    EXPECT_NEAR(se(cb, "omega0") * k, sb[0], tol * sb[0]) << "seed " << seed;  // u0
+    EXPECT_NEAR(se(cb, "C"), sb[1], tol * sb[1]) << "seed " << seed;           // α
+    EXPECT_NEAR(se(cb, "c4") * k / J, sb[2], tol * sb[2]) << "seed " << seed;  // β
+    // The ripple's correlated residuals: the long-run variance exceeds the classic one here,
+    // so the comparison covers the Newey–West part, not only s²(JᵀWJ)⁻¹.
+    EXPECT_GT(*std::max_element(tb.widen.begin(), tb.widen.end()), 1.02) << "seed " << seed;
+  }
+}
+
+}  // namespace spindown

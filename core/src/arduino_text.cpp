@@ -65,8 +65,10 @@ Recording read_arduino_text(std::string_view text, std::string source, const Ard
 
   text::LineReporter reporter(rec, options.max_line_reports);
   text::RawSamples raw(text);
-  // The sketch's lines are 10 to 14 bytes; a block's room beyond that needs no reallocation.
-  raw.reserve(text.size() / 10 + text::RawSamples::block_lines);
+  // The sketch's lines are 10 to 14 bytes; a block's room beyond that needs no reallocation. Capped,
+  // so that a large file refused as binary after its first 8 KiB has not reserved much for it.
+  constexpr std::size_t reserve_text_bytes = 1 << 20;
+  raw.reserve(std::min(text.size(), reserve_text_bytes) / 10 + text::RawSamples::block_lines);
   std::size_t blank = 0, headers = 0, garbled = 0, column_headers = 0;
   bool session_start = true;   // next sample is the first of a logging session
   bool first_content = true;   // next non-blank line is the first of a session

@@ -86,15 +86,15 @@ double stop_time(const Theta& th) {
 }
 
 // The model's value and partial derivatives at one sample, in the family's parameter order
-// (u0, then α and β where free). Two forms of the same closed form, chosen once per pass.
-//
-// DecayingRow, where α·τ reaches 10⁻³: with c = β/α the model is (u0 + c)·e − c, no division
-// per sample. Its α-derivative, −(u0 + c)·τ·e + (c/α)·(1 − e), loses only ~ε·βτ/α to
-// cancellation where ατ is small.
+// (u0, then α and β where free; g2 is 0 for two parameters). Two forms of the same closed form,
+// chosen once per pass: DecayingRow and SeriesRow.
 struct ModelRow {
   double model, g0, g1, g2;
 };
 
+// DecayingRow, where α·τ reaches 10⁻³: with c = β/α the model is (u0 + c)·e − c, no division
+// per sample. Its α-derivative, −(u0 + c)·τ·e + (c/α)·(1 − e), loses only ~ε·βτ/α to
+// cancellation where ατ is small.
 struct DecayingRow {
   double a, c, c_over_alpha, inv_alpha;
   template <int P>
@@ -122,9 +122,10 @@ struct SeriesRow {
 
 // One pass of the model over the run: the closed form is decreasing, so every sample after
 // the predicted stop reads exactly 0 and only the moving samples need the model; the stopped
-// tail contributes Σw·y² from a precomputed suffix sum. Each pass is one scalar loop that
-// gathers the weighted SSE, the plain SSE, JᵀJ and Jᵀr together (w the samples' weights,
-// reading_noise.hpp) and, when the covariance asks, the Newey–West matrix as well.
+// tail contributes Σw·y² from a precomputed suffix sum. Each pass is one branch-free, vectorised
+// loop that gathers the weighted SSE, the plain SSE, JᵀJ and Jᵀr together (w the samples'
+// weights, reading_noise.hpp) and keeps each sample's score for the Newey–West matrix, which the
+// covariance asks for.
 class Evaluator {
  public:
   Evaluator(std::span<const double> tau, std::span<const double> y, std::span<const double> weight)

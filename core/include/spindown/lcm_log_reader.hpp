@@ -55,7 +55,8 @@ struct LcmLogEvent {
   std::int64_t file_offset = 0;  // byte offset of the event (or of the damage)
   // Views into the reader (no copy per event), valid until the next next(): the channel name as
   // the event has it (empty for damage in the file) and, for SPINDOWN.<bench>.* channels, the
-  // bench id (else empty).
+  // bench id (else empty). The bench views the reader's channel table, not the file buffer; it
+  // happens to outlive next() for channels within max_channel_ids, but callers copy it anyway.
   std::string_view channel;
   // The channel name's index in this reader, the same for every event on it (a consumer's
   // per-channel cache needs no string compare); -1 past LcmLogReader::max_channel_ids distinct names.
