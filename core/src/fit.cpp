@@ -132,15 +132,16 @@ class Evaluator {
       : tau_(tau),
         y_(y),
         w_(weight),
-        wy_(tau.size()),
-        tail_sq_(tau.size() + 1, 0.0),
-        plain_tail_sq_(tau.size() + 1, 0.0),
+        wy_(std::make_unique_for_overwrite<double[]>(tau.size())),
+        tail_sq_(std::make_unique_for_overwrite<double[]>(tau.size() + 1)),
+        plain_tail_sq_(std::make_unique_for_overwrite<double[]>(tau.size() + 1)),
         e_(std::make_unique_for_overwrite<double[]>(tau.size())),
         scores_(std::make_unique_for_overwrite<double[]>(3 * tau.size())),
         lags_(newey_west_lags(tau.size())),
         sorted_(std::is_sorted(tau.begin(), tau.end())) {
     const std::size_t n = tau.size();
     double sum_y = 0;
+    tail_sq_[n] = plain_tail_sq_[n] = 0;
     for (std::size_t i = n; i-- > 0;) {
       const double yy = y[i] * y[i];
       tail_sq_[i] = tail_sq_[i + 1] + weight[i] * yy;
@@ -169,7 +170,7 @@ class Evaluator {
     const std::size_t n = tau_.size();
     decay(alpha, n);
     double ee = 0, ye = 0, t_ee = 0, t_ye = 0, tt_ee = 0, tt_ye = 0;
-    const double *tau = tau_.data(), *ex = e_.get(), *w = w_.data(), *wy = wy_.data();
+    const double *tau = tau_.data(), *ex = e_.get(), *w = w_.data(), *wy = wy_.get();
 #pragma omp simd reduction(+ : ee, ye, t_ee, t_ye, tt_ee, tt_ye)
     for (std::size_t i = 0; i < n; ++i) {
       const double e = ex[i], t = tau[i], wee = w[i] * e * e, wye = wy[i] * e;
@@ -183,7 +184,7 @@ class Evaluator {
   std::span<const double> tau() const { return tau_; }
   bool sorted() const { return sorted_; }
   std::span<const double> weights() const { return w_; }
-  std::span<const double> weighted_readings() const { return wy_; }
+  std::span<const double> weighted_readings() const { return {wy_.get(), tau_.size()}; }
 
   // Weighted SSE at θ; with jtj, also JᵀJ and Jᵀr (unused rows/columns of a smaller family
   // are left as identity/zero so 3×3 solvers serve every family); with omega, also
@@ -338,7 +339,8 @@ class Evaluator {
   std::vector<std::uint8_t> step_code_;
 
   std::span<const double> tau_, y_, w_;
-  std::vector<double> wy_, tail_sq_, plain_tail_sq_;
+  // Weighted readings, and the suffix sums Σ_(j≥i) w·y² and Σ_(j≥i) y² (n + 1 each).
+  std::unique_ptr<double[]> wy_, tail_sq_, plain_tail_sq_;
   // Scratch the passes overwrite before reading: e^(−ατ), and each column's scores g_j·w·r.
   std::unique_ptr<double[]> e_, scores_;
   double* score(int j) const { return scores_.get() + static_cast<std::size_t>(j) * tau_.size(); }
@@ -861,7 +863,10 @@ RunFit fit_run(std::span<const double> t_s, std::span<const double> value, Quant
   const std::size_t stop = std::clamp(run.stop_index, begin, end);
   const double k = value_per_rad_per_s(q, opt.bench.kb_v_s_per_rad);
 
-  std::vector<double> tau(end - begin), y(end - begin);
+  const std::size_t n = end - begin;
+  const auto tau_buffer = std::make_unique_for_overwrite<double[]>(n);
+  const auto y_buffer = std::make_unique_for_overwrite<double[]>(n);
+  const std::span<double> tau(tau_buffer.get(), n), y(y_buffer.get(), n);
   for (std::size_t i = begin; i < end; ++i) {
     tau[i - begin] = t_s[i] - run.t_cut_s;
     y[i - begin] = value[i] - run.zero_level;
