@@ -1,0 +1,71 @@
+// The run detector says exactly what it said when its last speed-up was checked, on the shared
+// sample data read as files and each damaged in the corpus's seven ways under varied options
+// (tests/run_detector_corpus.hpp): every event and when it came, every Run field to the last bit,
+// every diagnostic, and a hash of buffered()/state() after every sample. Together with
+// test_run_detector_corpus.cpp (the same data plain and 400 generated recordings) this pins the
+// detector's behaviour.
+//
+// The recorded hash is what the detector gives today and what the detector of 44f0366 gave (its
+// copy: git show 1ebc11f:tests/reference_run_detector.hpp, which was also compared with today's
+// event for event on 1,456 recordings and 2.06 M samples, plain and damaged). If this fails after
+// a change to the detector, its output changed: a behaviour change, not a speed-up. If it fails
+// after a change to the sample data or the damage, check the detector against a copy of itself
+// from before the change (the corpus header takes any detector class), then record the new hash:
+// SPINDOWN_PRINT_CORPUS_HASH=1 prints it.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "run_detector_corpus.hpp"
+#include "spindown/read_recording.hpp"
+
+namespace spindown {
+namespace {
+
+constexpr std::uint64_t recorded_hash = 0xdfb42f4014578905ull;
+
+// Each recording of the shared data as read, then damaged in each of the corpus's ways.
+std::vector<corpus::Case> plain_and_damaged() {
+  std::vector<std::string> files;
+  for (const auto& e : std::filesystem::directory_iterator(SPINDOWN_SHARED_DATA))
+    if (e.is_regular_file() && (e.path().extension() == ".tsv" || e.path().extension() == ".txt"))
+      files.push_back(e.path().string());
+  std::sort(files.begin(), files.end());
+  std::vector<corpus::Case> cases;
+  std::mt19937_64 rng(7);
+  for (const std::string& f : files) {
+    for (Recording& r : read_recordings(f)) {
+      r.source = std::filesystem::path(f).filename().string();
+      for (int k = 0; k < 7; ++k) {
+        corpus::Case c{fmt::format("{} damage {}", r.source, k), r, corpus::varied_options(k == 0 ? 0 : 3 * k + 1)};
+        corpus::mangle(c.rec, k, rng);
+        cases.push_back(std::move(c));
+      }
+    }
+  }
+  return cases;
+}
+
+TEST(RunDetectorCorpus, DamagedSharedDataGivesTheRecordedOutput) {
+  const auto cases = plain_and_damaged();
+  ASSERT_GT(cases.size(), 7u);  // the shared data holds several recordings
+  std::uint64_t h = 1469598103934665603ull;
+  std::size_t samples = 0;
+  for (const auto& c : cases) {
+    samples += c.rec.size();
+    h = corpus::fnv1a(h, c.name + "\n" + corpus::stream_events<RunDetector>(c.rec, c.opt));
+  }
+  if (std::getenv("SPINDOWN_PRINT_CORPUS_HASH"))
+    std::printf("damaged shared data: %zu recordings, %zu samples, hash %016llx\n", cases.size(), samples,
+                (unsigned long long)h);
+  EXPECT_EQ(h, recorded_hash) << "the run detector's output changed (see the comment at the top of this file)";
+}
+
+}  // namespace
+}  // namespace spindown
