@@ -336,15 +336,27 @@ RunData run_data(const Case& c) {
 }
 
 // Reading model u0·e^(−ατ) − β·τ·φ(ατ), clamped at 0 (α = 0: the straight line).
+double clamped_reading(double u0, double alpha, double beta, double t) {
+  const double m = alpha > 0 ? (u0 + beta / alpha) * std::exp(-alpha * t) - beta / alpha : u0 - beta * t;
+  return std::max(m, 0.0);
+}
+
 double weighted_sse(const RunData& d, double u0, double alpha, double beta) {
   double s = 0;
   for (std::size_t i = 0; i < d.tau.size(); ++i) {
-    const double t = d.tau[i];
-    const double m = alpha > 0 ? (u0 + beta / alpha) * std::exp(-alpha * t) - beta / alpha : u0 - beta * t;
-    const double r = d.y[i] - std::max(m, 0.0);
+    const double r = d.y[i] - clamped_reading(u0, alpha, beta, d.tau[i]);
     s += d.w[i] * r * r;
   }
   return s;
+}
+
+// A lab-like run with commutator ripple (correlated residuals), by seed.
+Case ripple_case(std::uint64_t seed) {
+  SyntheticRunSpec spec;
+  spec.noise_v = 0.004;
+  spec.ripple = 0.01;
+  spec.seed = seed;
+  return make_case(spec);
 }
 
 }  // namespace
@@ -356,13 +368,9 @@ double weighted_sse(const RunData& d, double u0, double alpha, double beta) {
 // over α within ±2 standard errors (best u0 for each α in closed form).
 TEST(Fit, ViscousAndCoulombAreTheLeastSquaresMinimum) {
   for (std::uint64_t seed = 1; seed <= 12; ++seed) {
-    SyntheticRunSpec spec;
-    spec.noise_v = 0.004;
-    spec.ripple = 0.01;
-    spec.seed = seed;
-    const Case c = make_case(spec);
+    const Case c = ripple_case(seed);
     const RunData d = run_data(c);
-    const double k = spec.bench.kb_v_s_per_rad;
+    const double k = c.spec.bench.kb_v_s_per_rad;
     const RunFit f = fit_case(c, {ModelKind::viscous, ModelKind::coulomb});
 
     const ModelFit& co = *f.model(ModelKind::coulomb);
@@ -410,11 +418,7 @@ struct TextbookErrors {
 };
 
 TextbookErrors textbook_std_errors(const RunData& d, std::array<double, 3> theta, std::array<bool, 3> free) {
-  const auto model = [&](const std::array<double, 3>& th, double t) {
-    const double u0 = th[0], alpha = th[1], beta = th[2];
-    const double m = alpha > 0 ? (u0 + beta / alpha) * std::exp(-alpha * t) - beta / alpha : u0 - beta * t;
-    return std::max(m, 0.0);
-  };
+  const auto model = [](const std::array<double, 3>& th, double t) { return clamped_reading(th[0], th[1], th[2], t); };
   std::vector<int> cols;
   for (int j = 0; j < 3; ++j)
     if (free[j]) cols.push_back(j);
@@ -471,13 +475,9 @@ TextbookErrors textbook_std_errors(const RunData& d, std::array<double, 3> theta
 // (correlated residuals, so the Newey–West widening is in play).
 TEST(Fit, StandardErrorsMatchTheTextbookNeweyWestComputation) {
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
-    SyntheticRunSpec spec;
-    spec.noise_v = 0.004;
-    spec.ripple = 0.01;
-    spec.seed = seed;
-    const Case c = make_case(spec);
+    const Case c = ripple_case(seed);
     const RunData d = run_data(c);
-    const double k = spec.bench.kb_v_s_per_rad, J = spec.bench.inertia_kg_m2;
+    const double k = c.spec.bench.kb_v_s_per_rad, J = c.spec.bench.inertia_kg_m2;
     const RunFit f = fit_case(c);
     const ModelFit &v = *f.model(ModelKind::viscous), &co = *f.model(ModelKind::coulomb),
                    &cb = *f.model(ModelKind::combined);
