@@ -275,17 +275,25 @@ class Evaluator {
   void moving_sums() {
     double window[P] = {}, omega[P][P] = {};
     const std::size_t m = m_, lags = static_cast<std::size_t>(lags_);
-    for (std::size_t t = 0; t < m + lags; ++t) {
+    // Step t adds s_t while t < m and takes out s_(t−L−1) once t > L; the ranges below run t
+    // in order with those two tests decided per range instead of per sample.
+    const auto step = [&]<bool Enters, bool Leaves>(std::size_t t) {
 #pragma GCC unroll 3
       for (int a = 0; a < P; ++a) {
-        if (t < m) window[a] += score(a)[t];
-        if (t > lags) window[a] -= score(a)[t - lags - 1];
+        if constexpr (Enters) window[a] += score(a)[t];
+        if constexpr (Leaves) window[a] -= score(a)[t - lags - 1];
       }
 #pragma GCC unroll 3
       for (int a = 0; a < P; ++a)
 #pragma GCC unroll 3
         for (int b = 0; b <= a; ++b) omega[a][b] += window[a] * window[b];
-    }
+    };
+    const std::size_t first_leave = lags + 1, end = m + lags;
+    std::size_t t = 0;
+    for (; t < std::min(m, first_leave); ++t) step.template operator()<true, false>(t);
+    for (; t < m; ++t) step.template operator()<true, true>(t);            // when m > L + 1
+    for (; t < std::min(first_leave, end); ++t) step.template operator()<false, false>(t);  // when m < L + 1
+    for (; t < end; ++t) step.template operator()<false, true>(t);
     last_omega_.setZero();
     for (int a = 0; a < P; ++a)
       for (int b = 0; b <= a; ++b) last_omega_(a, b) = last_omega_(b, a) = omega[a][b];
