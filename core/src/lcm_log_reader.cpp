@@ -339,13 +339,12 @@ void LcmLogReader::decode(LcmLogEvent& event, const ChannelInfo& info, const voi
   event.bench = info.bench;
   if (info.bench.empty()) return;
   if (info.kind == 1) {
-    if (view_samples_message(event.samples_view, data, size)) {  // no words needed: nearly always
+    std::string why;  // written only for a rejected message
+    if (view_samples_message(event.samples_view, data, size, &why)) {
       if (samples_ == LcmSamples::view_and_message) samples_from_view(event.samples_view, event.samples);
       event.kind = LcmLogEvent::Kind::samples;
       return;
     }
-    std::string why;
-    view_samples_message(event.samples_view, data, size, &why);  // the same check, in words
     event.kind = LcmLogEvent::Kind::problem;
     event.problem = fmt::format("event {} on {}: {}; skipped", event.number, event.channel, why);
   } else if (info.kind == 2) {

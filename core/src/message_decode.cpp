@@ -3,7 +3,6 @@
 #include <array>
 #include <bit>
 #include <cstddef>
-#include <cstring>
 #include <exception>
 #include <fmt/format.h>
 #include <limits>
@@ -38,10 +37,8 @@ constexpr std::int64_t fixed_bytes(Wire w) {
 }
 
 std::int32_t be32(const unsigned char* p) {
-  std::uint32_t v;
-  std::memcpy(&v, p, sizeof v);
-  if constexpr (std::endian::native == std::endian::little) v = __builtin_bswap32(v);
-  return static_cast<std::int32_t>(v);
+  return static_cast<std::int32_t>((std::uint32_t(p[0]) << 24) | (std::uint32_t(p[1]) << 16) |
+                                   (std::uint32_t(p[2]) << 8) | std::uint32_t(p[3]));
 }
 std::uint64_t be64u(const unsigned char* p) { return SamplesView::load_be64(p); }
 
@@ -270,47 +267,24 @@ bool decode_impl(Msg& msg, const void* data, std::int64_t size, std::string* why
 
 }  // namespace
 
-namespace {
-
-// samples_t's layout up to its arrays: fingerprint, utime, bench (length word, bytes), seq,
-// clock_epoch, quantity, n.
-constexpr std::int64_t samples_bench_at = 16;
-constexpr std::int64_t samples_bytes_per_sample = 8 + 8 + 8 + 4;
-
-bool samples_fingerprint_ok(const unsigned char* d, std::int64_t size) {
-  return d != nullptr && size >= hash_bytes && size <= std::numeric_limits<int>::max() &&
-         be64u(d) == static_cast<std::uint64_t>(samples_t::getHash());
-}
-
-// Why view_samples_message() rejected these bytes, check by check in its order.
-bool samples_view_problem(const unsigned char* d, std::int64_t size, std::string* why) {
-  if (!samples_fingerprint_ok(d, size)) {
-    check_impl<samples_t>(d, size, why);  // rejects it, in its own words
+bool view_samples_message(SamplesView& view, const void* data, std::int64_t size, std::string* why) {
+  const auto* d = static_cast<const unsigned char*>(data);
+  if (d == nullptr || size < hash_bytes || size > std::numeric_limits<int>::max() ||
+      be64u(d) != static_cast<std::uint64_t>(samples_t::getHash())) {
+    check_impl<samples_t>(data, size, why);  // rejects it, in its own words
     return false;
   }
+  // samples_t's strings and arrays all sit in this prefix: checking it checks the whole layout.
   if (size < 20) return fail(why, fmt::format("{} bytes, too short for samples_t", size));
-  const std::int64_t bench_len = be32(d + samples_bench_at);
+  const std::int64_t bench_len = be32(d + 16);
   if (bench_len < 1 || bench_len > size - 20)
     return fail(why, fmt::format("bench string length {} does not fit in {} bytes", bench_len, size));
   const std::int64_t n_at = 20 + bench_len + 8 + 4 + 1;
   if (n_at + 4 > size) return fail(why, fmt::format("truncated: {} bytes end before the sample count", size));
   const std::int64_t n = be32(d + n_at);
-  return fail(why, fmt::format("sample count {} does not fit in {} bytes (truncated or damaged)", n, size));
-}
-
-}  // namespace
-
-bool view_samples_message(SamplesView& view, const void* data, std::int64_t size, std::string* why) {
-  const auto* d = static_cast<const unsigned char*>(data);
-  // samples_t's strings and arrays all sit in this prefix: checking it checks the whole layout.
-  // Any failure is put in words by samples_view_problem(), off this once-per-message path.
-  if (!samples_fingerprint_ok(d, size) || size < 20) return samples_view_problem(d, size, why);
-  const std::int64_t bench_len = be32(d + samples_bench_at);
-  if (bench_len < 1 || bench_len > size - 20) return samples_view_problem(d, size, why);
-  const std::int64_t n_at = 20 + bench_len + 8 + 4 + 1;
-  if (n_at + 4 > size) return samples_view_problem(d, size, why);
-  const std::int64_t n = be32(d + n_at);
-  if (n < 0 || n * samples_bytes_per_sample > size - n_at - 4) return samples_view_problem(d, size, why);
+  constexpr std::int64_t bytes_per_sample = 8 + 8 + 8 + 4;
+  if (n < 0 || n * bytes_per_sample > size - n_at - 4)
+    return fail(why, fmt::format("sample count {} does not fit in {} bytes (truncated or damaged)", n, size));
 
   view.utime = static_cast<std::int64_t>(be64u(d + 8));
   view.bench = std::string_view(reinterpret_cast<const char*>(d + 20), static_cast<std::size_t>(bench_len - 1));
