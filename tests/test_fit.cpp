@@ -405,6 +405,29 @@ TEST(Fit, ViscousAndCoulombAreTheLeastSquaresMinimum) {
   }
 }
 
+// The Coulomb scan weighs only stop counts that could beat the candidates at the detector's stop
+// (a bound from the readings' sum of squares), so where the detector put the stop must not change
+// the result: early in the coast, late in the tail, or no stop at all.
+TEST(Fit, CoulombDoesNotDependOnWhereTheDetectorPutTheStop) {
+  for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+    const Case c = ripple_case(seed);
+    const RunFit ref = fit_case(c, {ModelKind::coulomb});
+    const ModelFit& co = *ref.model(ModelKind::coulomb);
+    ASSERT_TRUE(co.converged) << co.message;
+    const std::size_t cut = c.seg.cut_index, stop = c.seg.stop_index, end = c.seg.end_index;
+    for (const std::size_t hint : {cut + (stop - cut) / 4, cut + (stop - cut) / 2, stop - 3, stop + 5, end - 1, end}) {
+      Case moved = c;
+      moved.seg.stop_index = hint;
+      moved.seg.stopped = hint < end;
+      const ModelFit& m = *fit_case(moved, {ModelKind::coulomb}).model(ModelKind::coulomb);
+      ASSERT_TRUE(m.converged) << "seed " << seed << " hint " << hint << ": " << m.message;
+      EXPECT_NEAR(m.omega0, co.omega0, 1e-10 * co.omega0) << "seed " << seed << " hint " << hint;
+      EXPECT_NEAR(m.decel, co.decel, 1e-10 * co.decel) << "seed " << seed << " hint " << hint;
+      EXPECT_NEAR(m.t_stop_pred_s, co.t_stop_pred_s, 1e-10 * co.t_stop_pred_s) << "seed " << seed << " hint " << hint;
+    }
+  }
+}
+
 namespace spindown {
 namespace {
 

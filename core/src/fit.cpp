@@ -1,6 +1,7 @@
 #include "spindown/fit.hpp"
 
 #include "spindown/reading_noise.hpp"
+#include "vector_clones.hpp"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -103,20 +104,30 @@ struct DecayingRow {
   }
 };
 
-// SeriesRow, where α·τ stays below 10⁻³ (or α is held at 0): φ(x) = (1 − e^(−x))/x by its
-// series, exact to rounding there, with the Coulomb limit φ = 1 (α = 0 gives x = 0, φ = 1 and
-// φ' = −1/2 exactly). A two-parameter family's second column is α's or β's, whichever is free.
+// SeriesRow, where α·τ stays below 10⁻³ (α free): φ(x) = (1 − e^(−x))/x by its series, exact to
+// rounding there (α = 0 gives x = 0, φ = 1 and φ' = −1/2 exactly). The two-parameter family is
+// the viscous one: its second column is α's.
 struct SeriesRow {
   Theta th;
-  bool alpha_free;
   template <int P>
   ModelRow operator()(double t, double e) const {
     const double x = th.alpha * t;
     const double p = 1.0 - x / 2 + x * x / 6 - x * x * x / 24, dp = -0.5 + x / 3 - x * x / 8;
     const double d_alpha = -th.u0 * t * e - th.beta * t * t * dp, d_beta = -t * p;
     const double model = th.u0 * e - th.beta * t * p;
-    if constexpr (P == 2) return {model, e, alpha_free ? d_alpha : d_beta, 0.0};
+    if constexpr (P == 2) return {model, e, d_alpha, 0.0};
     return {model, e, d_alpha, d_beta};
+  }
+};
+
+// LineRow, the Coulomb family (α held at 0): the straight line u0 − β·τ. Exactly what SeriesRow
+// gives at x = 0 (φ = 1, e = 1), without the series.
+struct LineRow {
+  double u0, beta;
+  template <int P>
+  ModelRow operator()(double t, double) const {
+    static_assert(P == 2);
+    return {u0 - beta * t, 1.0, -t, 0.0};
   }
 };
 
@@ -158,6 +169,7 @@ class Evaluator {
 
   std::size_t size() const { return tau_.size(); }
   double weighted_sum_sq() const { return tail_sq_[0]; }  // Σw·y²
+  double weighted_sum_sq_from(std::size_t i) const { return tail_sq_[i]; }  // Σ_(j≥i) w·y²
   double total_sum_sq() const { return total_sum_sq_; }   // Σ(y − ȳ)², for R²
 
   // Weighted sums for the viscous model by variable projection: at a given α the best u0 is
@@ -166,7 +178,7 @@ class Evaluator {
   struct DecaySums {
     double ee = 0, ye = 0, t_ee = 0, t_ye = 0, tt_ee = 0, tt_ye = 0;
   };
-  DecaySums decay_sums(double alpha) {
+  SPINDOWN_VECTOR_CLONES DecaySums decay_sums(double alpha) {
     const std::size_t n = tau_.size();
     decay(alpha, n);
     double ee = 0, ye = 0, t_ee = 0, t_ye = 0, tt_ee = 0, tt_ye = 0;
@@ -223,17 +235,24 @@ class Evaluator {
     const double ts = stop_time(th);
     if (sorted_ && std::isfinite(ts)) m = static_cast<std::size_t>(std::upper_bound(tau_.begin(), tau_.end(), ts) - tau_.begin());
     m_ = m;
-    const double tau_max = m == 0 ? 0.0 : sorted_ ? tau_[m - 1] : *std::max_element(tau_.begin(), tau_.begin() + m);
-    const bool decaying = f.alpha_free && th.alpha * tau_max >= 1e-3;
-    if (f.alpha_free && th.alpha != 0) decay(th.alpha, m);
-    else std::fill(e_.get(), e_.get() + m, 1.0);
-    if (decaying) {
-      const double c = th.beta / th.alpha;
-      const DecayingRow row{th.u0 + c, c, c / th.alpha, 1.0 / th.alpha};
-      f.beta_free ? accumulate<3>(row) : accumulate<2>(row);
+    if (!f.alpha_free) {
+      accumulate<2>(LineRow{th.u0, th.beta});
     } else {
-      const SeriesRow row{th, f.alpha_free};
-      f.size() == 3 ? accumulate<3>(row) : accumulate<2>(row);
+      const double tau_max = m == 0 ? 0.0 : sorted_ ? tau_[m - 1] : *std::max_element(tau_.begin(), tau_.begin() + m);
+      if (th.alpha != 0) {
+        decay(th.alpha, m);
+      } else {
+        std::fill(e_.get(), e_.get() + m, 1.0);
+        decay_m_ = 0;
+      }
+      if (th.alpha * tau_max >= 1e-3) {
+        const double c = th.beta / th.alpha;
+        const DecayingRow row{th.u0 + c, c, c / th.alpha, 1.0 / th.alpha};
+        f.beta_free ? accumulate<3>(row) : accumulate<2>(row);
+      } else {
+        const SeriesRow row{th};
+        f.beta_free ? accumulate<3>(row) : accumulate<2>(row);
+      }
     }
     last_f_ = f, last_th_ = th, last_valid_ = true, last_has_omega_ = false;
   }
@@ -243,7 +262,7 @@ class Evaluator {
   // where the model already reads 0 (rounding at the stop) count as stopped: residual y, no
   // gradient. Each sample's score g·w·r is kept for the moving sums, should the covariance ask.
   template <int P, class Row>
-  void accumulate(const Row& row) {
+  SPINDOWN_VECTOR_CLONES void accumulate(const Row& row) {
     static_assert(P == 2 || P == 3);
     double sse = 0, plain = 0, r0 = 0, r1 = 0, r2 = 0, j00 = 0, j10 = 0, j11 = 0, j20 = 0, j21 = 0, j22 = 0;
     const double *tau = tau_.data(), *e = e_.get(), *w = w_.data(), *y = y_.data();
@@ -269,51 +288,91 @@ class Evaluator {
     if constexpr (P == 2) last_jtj_(2, 2) = 1;
   }
 
-  // Σ_t S_t·S_tᵀ over the scores of the last pass, S_t = s_t + … + s_(t−L), t running on L
-  // samples past the stop while windows still hold scores.
+  // Σ_t S_t·S_tᵀ over the scores of the last pass, S_t = s_t + … + s_(t−L) for t from 0 to
+  // m + L − 1 (while a window still holds a score). With the running totals C_t = s_0 + … + s_t
+  // (C_t = C_(m−1) past the stop, 0 before the start) each window is S_t = C_t − C_(t−L−1): one
+  // sequential pass turns the scores into their totals in place, then branch-free passes over
+  // four ranges of t (which of C_t and C_(t−L−1) are real decided per range) add the products.
   template <int P>
   void moving_sums() {
-    double window[P] = {}, omega[P][P] = {};
-    const std::size_t m = m_, lags = static_cast<std::size_t>(lags_);
-    // Step t adds s_t while t < m and takes out s_(t−L−1) once t > L; the ranges below run t
-    // in order with those two tests decided per range instead of per sample.
-    const auto step = [&]<bool Enters, bool Leaves>(std::size_t t) {
-#pragma GCC unroll 3
-      for (int a = 0; a < P; ++a) {
-        if constexpr (Enters) window[a] += score(a)[t];
-        if constexpr (Leaves) window[a] -= score(a)[t - lags - 1];
+    const std::size_t m = m_, span = static_cast<std::size_t>(lags_) + 1;
+    double omega[6] = {};  // the lower triangle, row by row: 00, 10, 11, 20, 21, 22
+    if (m > 0) {
+      double *c0 = score(0), *c1 = score(1), *c2 = score(2);
+      for (std::size_t i = 1; i < m; ++i) {
+        c0[i] += c0[i - 1], c1[i] += c1[i - 1];
+        if constexpr (P == 3) c2[i] += c2[i - 1];
       }
-#pragma GCC unroll 3
-      for (int a = 0; a < P; ++a)
-#pragma GCC unroll 3
-        for (int b = 0; b <= a; ++b) omega[a][b] += window[a] * window[b];
-    };
-    const std::size_t first_leave = lags + 1, end = m + lags;
-    std::size_t t = 0;
-    for (; t < std::min(m, first_leave); ++t) step.template operator()<true, false>(t);
-    for (; t < m; ++t) step.template operator()<true, true>(t);            // when m > L + 1
-    for (; t < std::min(first_leave, end); ++t) step.template operator()<false, false>(t);  // when m < L + 1
-    for (; t < end; ++t) step.template operator()<false, true>(t);
+      const std::size_t end = m + span - 1;
+      add_window_products<P, false, false>(0, std::min(m, span), m, span, omega);
+      add_window_products<P, false, true>(span, m, m, span, omega);
+      add_window_products<P, true, false>(m, std::min(span, end), m, span, omega);
+      add_window_products<P, true, true>(std::max(m, span), end, m, span, omega);
+    }
     last_omega_.setZero();
-    for (int a = 0; a < P; ++a)
-      for (int b = 0; b <= a; ++b) last_omega_(a, b) = last_omega_(b, a) = omega[a][b];
+    for (int a = 0, k = 0; a < P; ++a)
+      for (int b = 0; b <= a; ++b, ++k) last_omega_(a, b) = last_omega_(b, a) = omega[k];
     last_has_omega_ = true;
+  }
+
+  // Adds S_t·S_tᵀ for t in [lo, hi) to omega: S_t = C_t, or C_(m−1) once Stopped, minus
+  // C_(t−span) where Leaves.
+  template <int P, bool Stopped, bool Leaves>
+  SPINDOWN_VECTOR_CLONES void add_window_products(std::size_t lo, std::size_t hi, std::size_t m, std::size_t span,
+                                                  double* omega) const {
+    const double *c0 = score(0), *c1 = score(1), *c2 = score(2);
+    double o00 = 0, o10 = 0, o11 = 0, o20 = 0, o21 = 0, o22 = 0;
+#pragma omp simd reduction(+ : o00, o10, o11, o20, o21, o22)
+    for (std::size_t t = lo; t < hi; ++t) {
+      const std::size_t in = Stopped ? m - 1 : t;
+      double s0 = c0[in], s1 = c1[in], s2 = P == 3 ? c2[in] : 0.0;
+      if constexpr (Leaves) {
+        s0 -= c0[t - span], s1 -= c1[t - span];
+        if constexpr (P == 3) s2 -= c2[t - span];
+      }
+      o00 += s0 * s0, o10 += s1 * s0, o11 += s1 * s1;
+      if constexpr (P == 3) o20 += s2 * s0, o21 += s2 * s1, o22 += s2 * s2;
+    }
+    omega[0] += o00, omega[1] += o10, omega[2] += o11, omega[3] += o20, omega[4] += o21, omega[5] += o22;
   }
 
   // e_i = exp(−α·τ_i) for the first m samples. A device clock ticks in whole units, so the
   // steps τ_i − τ_(i−1) take a handful of values: then e_i = e_(i−1)·exp(−α·Δ) needs one
   // exponential per distinct step instead of one per sample. Exact anchors every
-  // anchor_every samples keep the product's rounding drift below 10⁻¹³.
+  // anchor_every samples keep the product's rounding drift below 10⁻¹³; four blocks are worked
+  // side by side so that their chains of products overlap instead of waiting on each other.
+  // Which way e_i is computed depends on the run, not on m, so e_ is kept for the next call
+  // with the same α (the viscous solution's covariance asks for the α it was found at).
   void decay(double alpha, std::size_t m) {
-    if (step_code_.empty() || m < 2 * anchor_every) {
+    if (alpha == decay_alpha_ && m <= decay_m_) return;
+    decay_alpha_ = alpha, decay_m_ = m;
+    if (step_code_.empty() || tau_.size() < 2 * anchor_every) {
       const auto k = static_cast<Eigen::Index>(m);
       Eigen::Map<Eigen::ArrayXd>(e_.get(), k) = (-alpha * Eigen::Map<const Eigen::ArrayXd>(tau_.data(), k)).exp();
       return;
     }
     for (std::size_t d = 0; d < steps_.size(); ++d) step_factor_[d] = std::exp(-alpha * steps_[d]);
-    for (std::size_t anchor = 0; anchor < m; anchor += anchor_every) {
-      double e = e_[anchor] = std::exp(-alpha * tau_[anchor]);
-      for (std::size_t i = anchor + 1; i < std::min(m, anchor + anchor_every); ++i) e_[i] = e *= step_factor_[step_code_[i]];
+    const double* factor = step_factor_.data();
+    const std::uint8_t* code = step_code_.data();
+    double* out = e_.get();
+    constexpr std::size_t group = 4 * anchor_every;
+    std::size_t anchor = 0;
+    for (; anchor + group <= m; anchor += group) {
+      double *o0 = out + anchor, *o1 = o0 + anchor_every, *o2 = o1 + anchor_every, *o3 = o2 + anchor_every;
+      const std::uint8_t *c0 = code + anchor, *c1 = c0 + anchor_every, *c2 = c1 + anchor_every, *c3 = c2 + anchor_every;
+      const double* t = tau_.data() + anchor;
+      double e0 = o0[0] = std::exp(-alpha * t[0]), e1 = o1[0] = std::exp(-alpha * t[anchor_every]);
+      double e2 = o2[0] = std::exp(-alpha * t[2 * anchor_every]), e3 = o3[0] = std::exp(-alpha * t[3 * anchor_every]);
+      for (std::size_t j = 1; j < anchor_every; ++j) {
+        o0[j] = e0 *= factor[c0[j]];
+        o1[j] = e1 *= factor[c1[j]];
+        o2[j] = e2 *= factor[c2[j]];
+        o3[j] = e3 *= factor[c3[j]];
+      }
+    }
+    for (; anchor < m; anchor += anchor_every) {
+      double e = out[anchor] = std::exp(-alpha * tau_[anchor]);
+      for (std::size_t i = anchor + 1; i < std::min(m, anchor + anchor_every); ++i) out[i] = e *= factor[code[i]];
     }
   }
 
@@ -345,6 +404,8 @@ class Evaluator {
   static constexpr std::size_t anchor_every = 64;
   std::vector<double> steps_, step_factor_;
   std::vector<std::uint8_t> step_code_;
+  double decay_alpha_ = nan;  // e_ holds e^(−α·τ) for this α over the first decay_m_ samples
+  std::size_t decay_m_ = 0;
 
   std::span<const double> tau_, y_, w_;
   // Weighted readings, and the suffix sums Σ_(j≥i) w·y² and Σ_(j≥i) y² (n + 1 each).
@@ -583,6 +644,20 @@ struct LineSums {
   }
 };
 
+// LineSums over samples [lo, hi) in one vectorised pass (the order of the additions differs from
+// adding them one by one only in rounding).
+SPINDOWN_VECTOR_CLONES LineSums line_sums(std::span<const double> tau, std::span<const double> w,
+                                          std::span<const double> wy, std::size_t lo, std::size_t hi) {
+  double sw = 0, st = 0, stt = 0, sy = 0, sty = 0;
+  const double *t = tau.data(), *ws = w.data(), *wys = wy.data();
+#pragma omp simd reduction(+ : sw, st, stt, sy, sty)
+  for (std::size_t i = lo; i < hi; ++i) {
+    const double wt = ws[i] * t[i];
+    sw += ws[i], st += wt, stt += wt * t[i], sy += wys[i], sty += wys[i] * t[i];
+  }
+  return {sw, st, stt, sy, sty};
+}
+
 // The Coulomb model in closed form. While moving it is the straight line u0 − β·τ, and the
 // samples that move are those before its stop ts = u0/β; so for each count m of moving samples
 // the weighted SSE is a quadratic in (u0, β) whose minimum is either the plain line fit over the
@@ -590,7 +665,12 @@ struct LineSums {
 // ts = τ[m], the line through (τ[m], 0). Running sums give every candidate's SSE in O(1), so
 // one pass over m finds the global minimum of the clamped SSE — where LM from a start could
 // stop at a nearby kink. nullopt when the clock is not sorted or no falling line fits: LM then.
-std::optional<Theta> coulomb_by_line_scan(const Evaluator& eval, int& passes) {
+//
+// A candidate's gain (Σw·y² minus its SSE) is at most P(m) = Σ_(i<m) w·y², as its SSE over the
+// moving samples is not negative, and P grows with m. So once the candidates at the detector's
+// stop (`hint` moving samples) give a gain G, no count with P(m) < G can win: the scan gathers
+// those samples' sums in one vectorised pass and weighs candidates only after them.
+std::optional<Theta> coulomb_by_line_scan(const Evaluator& eval, std::size_t hint, int& passes) {
   const std::span<const double> tau = eval.tau(), w = eval.weights(), wy = eval.weighted_readings();
   const std::size_t n = tau.size();
   if (!eval.sorted() || n < 3) return std::nullopt;
@@ -603,19 +683,38 @@ std::optional<Theta> coulomb_by_line_scan(const Evaluator& eval, int& passes) {
   const auto take = [&](double q, double d, double edge) {
     if (q * best_d > best_q * d) best_q = q, best_d = d, best = sums, best_edge = edge, found = true;
   };
-  for (std::size_t m = 1; m <= n; ++m) {
+  // The candidates with m moving samples, given their sums.
+  const auto weigh = [&](std::size_t m) {
     const double t = tau[m - 1];
-    sums.add(w[m - 1], wy[m - 1], t);
-    if (m < 3) continue;
     // The plain line over the first m counts if it falls (U, B > 0) and stops in (τ[m−1], τ[m]].
     const double det = sums.det(), U = sums.u(), B = sums.b();
-    if (det > 0 && U > 0 && B > 0 && U > B * t && (m == n || U <= B * tau[m]))
-      take(sums.plain_gain_times_det(), det, nan);
+    if (det > 0 && U > 0 && B > 0 && U > B * t && (m == n || U <= B * tau[m])) take(sums.plain_gain_times_det(), det, nan);
     // The edge: stopped exactly at the next sample.
     if (m < n) {
       const double num = sums.edge_num(tau[m]), den = sums.edge_den(tau[m]);
       if (den > 0 && num > 0) take(num * num, den, tau[m]);
     }
+  };
+  // The bound from the candidates at the hint; they are weighed again in the scan.
+  std::size_t first = 3;
+  if (hint >= 3 && hint <= n) {
+    sums = line_sums(tau, w, wy, 0, hint);
+    weigh(hint);
+    if (found) {
+      // The first count with P(m) ≥ G (P is monotone: a suffix sum of non-negative terms).
+      const double gain = best_q / best_d * (1 - 1e-9), total = eval.weighted_sum_sq();
+      for (std::size_t hi = hint; first < hi;) {
+        const std::size_t mid = first + (hi - first) / 2;
+        if (total - eval.weighted_sum_sq_from(mid) < gain) first = mid + 1;
+        else hi = mid;
+      }
+    }
+    sums = LineSums{}, best = LineSums{}, best_q = 0, best_d = 1, best_edge = nan, found = false;
+  }
+  sums = line_sums(tau, w, wy, 0, first - 1);
+  for (std::size_t m = first; m <= n; ++m) {
+    sums.add(w[m - 1], wy[m - 1], tau[m - 1]);
+    weigh(m);
   }
   if (!found) return std::nullopt;
   return std::isnan(best_edge) ? best.plain() : best.edge(best_edge);
@@ -750,7 +849,7 @@ ModelFit fit_model(ModelKind kind, std::span<const double> tau, std::span<const 
   // combined model and whenever a direct solution declines.
   std::optional<Theta> direct;
   if (kind == ModelKind::viscous) direct = viscous_by_projection(eval, th.alpha, out.evaluations);
-  if (kind == ModelKind::coulomb) direct = coulomb_by_line_scan(eval, out.evaluations);
+  if (kind == ModelKind::coulomb) direct = coulomb_by_line_scan(eval, moving, out.evaluations);
   bool solved = direct.has_value();
   if (direct) {
     th = *direct;

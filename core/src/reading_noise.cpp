@@ -10,16 +10,28 @@ namespace {
 // of it), narrow next to the coast's curvature at 50 Hz.
 constexpr std::size_t half_window = 8;
 
-// ū_i: mean of y over [i − h, i + h] clipped to the run, as a sliding window sum.
+// ū_i: mean of y over [i − h, i + h] clipped to the run, as a sliding window sum. Each step
+// adds y_(i+h) while there is one, then takes out y_(i−h−1) once there is one; the loops below
+// are those steps with the two tests decided per range of i (same sums, same order).
 std::vector<double> local_means(std::span<const double> y) {
-  const std::size_t n = y.size();
+  const std::size_t n = y.size(), h = half_window;  // n ≥ 2h + 2 here
   std::vector<double> mean(n);
   double sum = 0;
-  std::size_t lo = 0, hi = 0;  // the window is [lo, hi)
-  for (std::size_t i = 0; i < n; ++i) {
-    for (; hi < std::min(n, i + half_window + 1); ++hi) sum += y[hi];
-    for (; lo + half_window < i; ++lo) sum -= y[lo];
-    mean[i] = sum / static_cast<double>(hi - lo);
+  for (std::size_t j = 0; j < h; ++j) sum += y[j];
+  std::size_t i = 0;
+  for (; i <= h; ++i) {  // the window grows: [0, i + h]
+    sum += y[i + h];
+    mean[i] = sum / static_cast<double>(i + h + 1);
+  }
+  constexpr double full = 2 * half_window + 1;
+  for (; i + h < n; ++i) {  // full width
+    sum += y[i + h];
+    sum -= y[i - h - 1];
+    mean[i] = sum / full;
+  }
+  for (; i < n; ++i) {  // the window shrinks: [i − h, n)
+    sum -= y[i - h - 1];
+    mean[i] = sum / static_cast<double>(n - i + h);
   }
   return mean;
 }
@@ -35,7 +47,8 @@ ReadingNoise estimate(std::span<const double> y, std::span<const double> mean, d
     const double v = d * d / 6, x = mean[i] * mean[i];
     sx += x, sv += v, sxx += x * x, sxv += x * v;
   }
-  for (double u : mean) x_max = std::max(x_max, u * u);  // every sample gets a weight
+#pragma omp simd reduction(max : x_max)
+  for (std::size_t i = 0; i < n; ++i) x_max = std::max(x_max, mean[i] * mean[i]);  // every sample gets a weight
   const double m = static_cast<double>(n - 2);
   const double det = m * sxx - sx * sx;
   double a = sv / m, b = 0;  // constant variance unless the reading explains it
@@ -57,11 +70,16 @@ ReadingNoise estimate(std::span<const double> y, std::span<const double> mean, d
 
 NoiseWeights weigh_by_noise(std::span<const double> y, double max_ratio) {
   NoiseWeights out;
-  out.weight.assign(y.size(), 1.0);
-  if (y.size() < 32) return out;
+  if (y.size() < 32) {
+    out.weight.assign(y.size(), 1.0);
+    return out;
+  }
   std::vector<double> mean = local_means(y);
   out.noise = estimate(y, mean, max_ratio);
-  if (!out.noise.known) return out;
+  if (!out.noise.known) {
+    out.weight.assign(y.size(), 1.0);
+    return out;
+  }
   // The local means become the weights in place: one buffer, no second allocation.
   double total = 0;
   double* w = mean.data();
