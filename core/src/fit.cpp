@@ -5,6 +5,8 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <exception>
@@ -162,7 +164,10 @@ class Evaluator {
     }
     if (n > 0) {
       const double mean = sum_y / static_cast<double>(n);
-      for (double v : y) total_sum_sq_ += (v - mean) * (v - mean);
+      double sst = 0;
+#pragma omp simd reduction(+ : sst)
+      for (std::size_t i = 0; i < n; ++i) sst += (y[i] - mean) * (y[i] - mean);
+      total_sum_sq_ = sst;
     }
     index_time_steps();
   }
@@ -376,27 +381,41 @@ class Evaluator {
     }
   }
 
+  // Codes each sample's step τ_i − τ_(i−1) by its distinct value, bit for bit. The steps of a
+  // run are a few clock periods, each in a few rounding variants (~15 in a PuTTY log), so they are
+  // found through a small open-addressed table instead of a search along the list.
   void index_time_steps() {
-    constexpr std::size_t max_steps = 32;
-    if (!sorted_ || tau_.size() < 2) return;
-    std::vector<std::uint8_t> code(tau_.size(), 0);
-    std::size_t last = 0;  // consecutive steps are usually equal: try the previous one first
-    for (std::size_t i = 1; i < tau_.size(); ++i) {
+    constexpr std::size_t max_steps = 32, slots = 64;  // at most half full: probes stay short
+    const std::size_t n = tau_.size();
+    if (!sorted_ || n < 2) return;
+    std::array<std::uint64_t, slots> key{};
+    std::array<std::uint8_t, slots> code_plus_one{};  // 0: the slot is free
+    std::vector<std::uint8_t> code(n);
+    std::uint64_t last_bits = 0;
+    std::uint8_t last_code = 0;
+    bool have_last = false;
+    for (std::size_t i = 1; i < n; ++i) {
       const double step = tau_[i] - tau_[i - 1];
-      if (steps_.empty() || steps_[last] != step) {
-        const auto it = std::find(steps_.begin(), steps_.end(), step);
-        if (it == steps_.end()) {
+      const auto bits = std::bit_cast<std::uint64_t>(step);
+      if (!have_last || bits != last_bits) {
+        if (!std::isfinite(step)) {  // no product chain through a step that is not a number
+          steps_.clear();
+          return;
+        }
+        std::size_t slot = static_cast<std::size_t>((bits * 0x9E3779B97F4A7C15ull) >> 58);
+        while (code_plus_one[slot] != 0 && key[slot] != bits) slot = (slot + 1) % slots;
+        if (code_plus_one[slot] == 0) {
           if (steps_.size() == max_steps) {  // jittered clock: one exponential per sample
             steps_.clear();
             return;
           }
           steps_.push_back(step);
-          last = steps_.size() - 1;
-        } else {
-          last = static_cast<std::size_t>(it - steps_.begin());
+          key[slot] = bits;
+          code_plus_one[slot] = static_cast<std::uint8_t>(steps_.size());
         }
+        last_bits = bits, last_code = static_cast<std::uint8_t>(code_plus_one[slot] - 1), have_last = true;
       }
-      code[i] = static_cast<std::uint8_t>(last);
+      code[i] = last_code;
     }
     step_code_ = std::move(code);
     step_factor_.resize(steps_.size());
