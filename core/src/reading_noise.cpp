@@ -1,5 +1,7 @@
 #include "spindown/reading_noise.hpp"
 
+#include "vector_clones.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -37,7 +39,8 @@ std::vector<double> local_means(std::span<const double> y) {
 }
 
 // Least squares of v_i = d_i²/6 on x_i = ū_i², d the second difference.
-ReadingNoise estimate(std::span<const double> y, std::span<const double> mean, double max_ratio) {
+SPINDOWN_VECTOR_CLONES ReadingNoise estimate(std::span<const double> y, std::span<const double> mean,
+                                             double max_ratio) {
   ReadingNoise out;
   const std::size_t n = y.size();
   double sx = 0, sv = 0, sxx = 0, sxv = 0, x_max = 0;
@@ -66,6 +69,18 @@ ReadingNoise estimate(std::span<const double> y, std::span<const double> mean, d
   return out;
 }
 
+// The local means ū_i become the weights 1/σ²(ū_i) in place, scaled to average 1.
+SPINDOWN_VECTOR_CLONES void means_to_weights(std::span<double> w, const ReadingNoise& noise) {
+  double total = 0;
+  double* x = w.data();
+  const std::size_t n = w.size();
+#pragma omp simd reduction(+ : total)
+  for (std::size_t i = 0; i < n; ++i) total += x[i] = 1.0 / noise.variance(x[i]);
+  const double scale = static_cast<double>(n) / total;
+#pragma omp simd
+  for (std::size_t i = 0; i < n; ++i) x[i] *= scale;
+}
+
 }  // namespace
 
 NoiseWeights weigh_by_noise(std::span<const double> y, double max_ratio) {
@@ -80,14 +95,7 @@ NoiseWeights weigh_by_noise(std::span<const double> y, double max_ratio) {
     out.weight.assign(y.size(), 1.0);
     return out;
   }
-  // The local means become the weights in place: one buffer, no second allocation.
-  double total = 0;
-  double* w = mean.data();
-  const std::size_t n = mean.size();
-#pragma omp simd reduction(+ : total)
-  for (std::size_t i = 0; i < n; ++i) total += w[i] = 1.0 / out.noise.variance(w[i]);
-  const double scale = static_cast<double>(n) / total;
-  for (std::size_t i = 0; i < n; ++i) w[i] *= scale;
+  means_to_weights(mean, out.noise);  // one buffer, no second allocation
   out.weight = std::move(mean);
   return out;
 }
