@@ -920,13 +920,16 @@ ModelFit fit_model(ModelKind kind, std::span<const double> tau, std::span<const 
                     make_param("A", -th.beta, se(0, 0, 1), rate_unit), make_param("B", th.u0, se(1, 0, 0), ru)};
       break;
     case ModelKind::combined: {
-      // y = A + B·e^(Cτ): A = −β/α, B = u0 + β/α, C = −α (the lab's seed curve).
-      const double a = std::max(th.alpha, 1e-300);
+      // y = A + B·e^(Cτ): A = −β/α, B = u0 + β/α, C = −α (the lab's seed curve). With α at its
+      // bound 0 the curve is Coulomb's straight line and A, B are infinite: no number to give.
+      const double a = th.alpha;
+      const bool curve = a > 0;
+      const auto curve_se = [&](double du0, double dal, double dbe) { return curve ? se(du0, dal, dbe) : nan; };
       out.params = {make_param("c3", th.alpha * J, se(0, J, 0), "N*m*s/rad"),
                     make_param("c4", th.beta * J / k, se(0, 0, J / k), "N*m"),
                     make_param("omega0", out.omega0, se(1 / k, 0, 0), "rad/s"),
-                    make_param("A", -th.beta / a, se(0, th.beta / (a * a), -1 / a), ru),
-                    make_param("B", th.u0 + th.beta / a, se(1, -th.beta / (a * a), 1 / a), ru),
+                    make_param("A", curve ? -th.beta / a : -inf, curve_se(0, th.beta / (a * a), -1 / a), ru),
+                    make_param("B", curve ? th.u0 + th.beta / a : inf, curve_se(1, -th.beta / (a * a), 1 / a), ru),
                     make_param("C", -th.alpha, se(0, -1, 0), "1/s")};
       break;
     }
