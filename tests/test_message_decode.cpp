@@ -307,5 +307,54 @@ TEST(MessageDecode, SamplesViewRefusesWhatTheDecoderRefusesInTheReadersWords) {
   EXPECT_FALSE(view_samples_message(view, nullptr, 0, &why));
 }
 
+// The inline checks of view_samples_message and the worded ones agree byte for byte on damaged
+// messages: every truncation, and every byte of the header, bench length and sample count set
+// to values that break them. Both also accept exactly what the generated decoder's walk accepts.
+TEST(MessageDecode, SamplesViewInlineChecksAgreeWithTheWordedOnes) {
+  const auto sound = encode(make_samples());
+  const std::size_t n_at = 8 + 8 + (4 + 8) + 8 + 4 + 1;
+  std::vector<std::vector<std::uint8_t>> cases;
+  for (std::size_t size = 0; size <= sound.size(); ++size)
+    cases.emplace_back(sound.begin(), sound.begin() + static_cast<std::ptrdiff_t>(size));
+  for (std::size_t at = 0; at < n_at + 4; ++at)
+    for (std::uint8_t v : {std::uint8_t{0}, std::uint8_t{1}, std::uint8_t{0x7f}, std::uint8_t{0x80},
+                           std::uint8_t{0xff}, std::uint8_t(sound[at] ^ 1)}) {
+      auto bytes = sound;
+      bytes[at] = v;
+      cases.push_back(bytes);
+    }
+  for (std::int32_t n : {-1, 0, 1, 2, 3, 4, 1 << 30}) {
+    auto bytes = sound;
+    put_be32(bytes, n_at, n);
+    cases.push_back(bytes);
+  }
+  std::size_t accepted = 0;
+  for (const auto& bytes : cases) {
+    const auto size = static_cast<std::int64_t>(bytes.size());
+    SamplesView fast, worded;
+    std::string fast_why = "unset", worded_why = "unset";
+    const bool ok = view_samples_message(fast, bytes.data(), size, &fast_why);
+    ASSERT_EQ(ok, view_samples_message_worded(worded, bytes.data(), size, &worded_why)) << size;
+    ASSERT_EQ(fast_why, worded_why);
+    SamplesView silent;
+    ASSERT_EQ(view_samples_message(silent, bytes.data(), size), ok);  // no words asked for
+    EXPECT_EQ(check_message_encoding<samples_t>(bytes.data(), size), ok) << fast_why;
+    if (!ok) continue;
+    ++accepted;
+    EXPECT_EQ(fast.utime, worded.utime);
+    EXPECT_EQ(fast.bench, worded.bench);
+    EXPECT_EQ(fast.seq, worded.seq);
+    EXPECT_EQ(fast.clock_epoch, worded.clock_epoch);
+    EXPECT_EQ(fast.quantity, worded.quantity);
+    EXPECT_EQ(fast.n, worded.n);
+    EXPECT_EQ(fast.device_time_bytes, worded.device_time_bytes);
+    EXPECT_EQ(fast.host_time_bytes, worded.host_time_bytes);
+    EXPECT_EQ(fast.value_bytes, worded.value_bytes);
+    EXPECT_EQ(fast.raw_adc_bytes, worded.raw_adc_bytes);
+  }
+  EXPECT_GT(accepted, 20u);                 // the bytes that do not matter to the layout
+  EXPECT_LT(accepted, cases.size() - 100);  // and plenty that do
+}
+
 }  // namespace
 }  // namespace spindown

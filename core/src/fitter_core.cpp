@@ -154,7 +154,7 @@ std::vector<std::string> FitterCore::benches() const {
   return ids;
 }
 
-FitterCore::Bench* FitterCore::bench_for(std::string_view id, std::int64_t recv_utime, std::string_view kind) {
+inline FitterCore::Bench* FitterCore::bench_for(std::string_view id, std::int64_t recv_utime, std::string_view kind) {
   ++activity_;
   // Nearly always a bench already held, found by its cache slot without the map.
   if (Bench* cached = bench_cache_.slot(id); cached && short_string_equal(cached->id, id)) {
@@ -406,7 +406,8 @@ void FitterCore::restart_clock(Bench& b, std::int64_t recv_utime) {
   trim_mirror(b);
 }
 
-void FitterCore::push_sample(Bench& b, std::int64_t seq, double t_s, double value, std::int64_t recv_utime) {
+// Small enough to inline into the per-sample loop: everything rare is a call.
+inline void FitterCore::push_sample(Bench& b, std::int64_t seq, double t_s, double value, std::int64_t recv_utime) {
   if (b.pending_restart) restart_clock(b, recv_utime);
   ++counters_.samples;
   b.mirror.push_back({t_s, value, seq});
@@ -414,11 +415,15 @@ void FitterCore::push_sample(Bench& b, std::int64_t seq, double t_s, double valu
     b.detector.push(t_s, value);
     if (b.detector.has_events()) handle_events(b, recv_utime);
   } catch (const std::exception& e) {  // never let one bench's trouble stop the others
-    ++counters_.internal_errors;
-    error(fmt::format("{}: internal error at seq {}: {}", b.channel, seq, e.what()), recv_utime);
+    internal_error(b, seq, e, recv_utime);
   }
   if (b.open_state == 2 && b.detector.state() == RunDetector::State::coasting) retract_stop(b, recv_utime);
   trim_mirror(b);
+}
+
+void FitterCore::internal_error(const Bench& b, std::int64_t seq, const std::exception& e, std::int64_t recv_utime) {
+  ++counters_.internal_errors;
+  error(fmt::format("{}: internal error at seq {}: {}", b.channel, seq, e.what()), recv_utime);
 }
 
 // A provisional stop the detector took back: the run is coasting again.
@@ -429,7 +434,7 @@ void FitterCore::retract_stop(Bench& b, std::int64_t recv_utime) {
   b.open_state = 1;
 }
 
-void FitterCore::trim_mirror(Bench& b) {
+inline void FitterCore::trim_mirror(Bench& b) {
   const std::size_t keep = b.detector.buffered();
   if (b.mirror.size() > keep) b.mirror.drop_front(b.mirror.size() - keep);
 }

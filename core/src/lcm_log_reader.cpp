@@ -119,18 +119,20 @@ std::int64_t LcmLogReader::refill(std::int64_t n, const unsigned char** p) {
     // Keep the unparsed tail, then read whole blocks behind it up to the size seen at open.
     const std::int64_t keep = std::max<std::int64_t>(buffer_offset_ + buffered_ - pos_, 0);
     const std::int64_t need = std::max(wanted, std::min(block_bytes, size_ - pos_));
-    if (static_cast<std::int64_t>(buffer_.size()) < need) {
-      std::vector<unsigned char> bigger(static_cast<std::size_t>(std::max(need, block_bytes)));
-      if (keep > 0) std::memcpy(bigger.data(), buffer_.data() + (pos_ - buffer_offset_), static_cast<std::size_t>(keep));
-      buffer_.swap(bigger);
+    if (buffer_capacity_ < need) {
+      const std::int64_t capacity = std::max(need, block_bytes);
+      auto bigger = std::make_unique_for_overwrite<unsigned char[]>(static_cast<std::size_t>(capacity));
+      if (keep > 0) std::memcpy(bigger.get(), buffer_.get() + (pos_ - buffer_offset_), static_cast<std::size_t>(keep));
+      buffer_ = std::move(bigger);
+      buffer_capacity_ = capacity;
     } else if (keep > 0 && pos_ != buffer_offset_) {
-      std::memmove(buffer_.data(), buffer_.data() + (pos_ - buffer_offset_), static_cast<std::size_t>(keep));
+      std::memmove(buffer_.get(), buffer_.get() + (pos_ - buffer_offset_), static_cast<std::size_t>(keep));
     }
     buffer_offset_ = pos_;
     buffered_ = keep;
-    const std::int64_t room = std::min<std::int64_t>(static_cast<std::int64_t>(buffer_.size()), size_ - pos_);
+    const std::int64_t room = std::min<std::int64_t>(buffer_capacity_, size_ - pos_);
     while (buffered_ < room) {
-      const ssize_t got = ::pread(fd_, buffer_.data() + buffered_, static_cast<std::size_t>(room - buffered_),
+      const ssize_t got = ::pread(fd_, buffer_.get() + buffered_, static_cast<std::size_t>(room - buffered_),
                                   static_cast<off_t>(buffer_offset_ + buffered_));
       if (got > 0) {
         buffered_ += got;
@@ -145,7 +147,7 @@ std::int64_t LcmLogReader::refill(std::int64_t n, const unsigned char** p) {
       }
     }
   }
-  *p = buffer_.data() + (pos_ - buffer_offset_);
+  *p = buffer_.get() + (pos_ - buffer_offset_);
   return std::clamp<std::int64_t>(buffer_offset_ + buffered_ - pos_, 0, std::max<std::int64_t>(wanted, 0));
 }
 
@@ -165,7 +167,7 @@ std::int64_t LcmLogReader::find_marker(std::int64_t from) {
   }
 }
 
-const LcmLogReader::ChannelInfo& LcmLogReader::channel_info(std::string_view channel) {
+inline const LcmLogReader::ChannelInfo& LcmLogReader::channel_info(std::string_view channel) {
   const ChannelInfo* cached = channel_cache_.slot(channel);
   if (cached && short_string_equal(cached->channel, channel)) return *cached;  // nearly always
   return find_channel(channel);
@@ -228,7 +230,7 @@ bool LcmLogReader::next(LcmLogEvent& event) {
   // damage) takes next_checked(), which reads this same event the same way when it is sound.
   const std::int64_t in_buffer = buffer_offset_ + buffered_ - pos_;
   if (fd_ >= 0 && !done_ && pos_ >= buffer_offset_ && in_buffer >= event_header_bytes) {
-    const unsigned char* p = buffer_.data() + (pos_ - buffer_offset_);
+    const unsigned char* p = buffer_.get() + (pos_ - buffer_offset_);
     const std::int32_t channel_len = static_cast<std::int32_t>(be32(p + 20));
     const std::int32_t data_len = static_cast<std::int32_t>(be32(p + 24));
     if (be32(p) == lcm_log_magic && channel_len > 0 && channel_len < max_channel_bytes && data_len >= 0 &&
@@ -242,7 +244,7 @@ bool LcmLogReader::next(LcmLogEvent& event) {
 
 // A sound event whose bytes (header at p) are all in the buffer: kept, whatever follows it
 // (another event, the end, or garbage that the next call skips and reports).
-void LcmLogReader::accept(LcmLogEvent& event, const unsigned char* p, std::int32_t channel_len,
+inline void LcmLogReader::accept(LcmLogEvent& event, const unsigned char* p, std::int32_t channel_len,
                           std::int32_t data_len) {
   event.file_offset = pos_;
   pos_ += event_header_bytes + channel_len + data_len;
@@ -331,7 +333,7 @@ bool LcmLogReader::next_checked(LcmLogEvent& event) {
   return true;
 }
 
-void LcmLogReader::decode(LcmLogEvent& event, const ChannelInfo& info, const void* data, std::int32_t size) {
+inline void LcmLogReader::decode(LcmLogEvent& event, const ChannelInfo& info, const void* data, std::int32_t size) {
   event.data = data;
   event.data_size = size;
   event.channel_id = info.id;
@@ -339,14 +341,12 @@ void LcmLogReader::decode(LcmLogEvent& event, const ChannelInfo& info, const voi
   event.bench = info.bench;
   if (info.bench.empty()) return;
   if (info.kind == 1) {
-    std::string why;  // written only for a rejected message
-    if (view_samples_message(event.samples_view, data, size, &why)) {
+    if (view_samples_message(event.samples_view, data, size)) {  // nearly always: no words needed
       if (samples_ == LcmSamples::view_and_message) samples_from_view(event.samples_view, event.samples);
       event.kind = LcmLogEvent::Kind::samples;
       return;
     }
-    event.kind = LcmLogEvent::Kind::problem;
-    event.problem = fmt::format("event {} on {}: {}; skipped", event.number, event.channel, why);
+    reject_samples(event, data, size);
   } else if (info.kind == 2) {
     std::string why;
     if (decode_message(event.config, data, size, &why)) {
@@ -356,6 +356,14 @@ void LcmLogReader::decode(LcmLogEvent& event, const ChannelInfo& info, const voi
     event.kind = LcmLogEvent::Kind::problem;
     event.problem = fmt::format("event {} on {}: {}; skipped", event.number, event.channel, why);
   }
+}
+
+// A SAMPLE message that view_samples_message rejects: the problem in its words.
+void LcmLogReader::reject_samples(LcmLogEvent& event, const void* data, std::int32_t size) {
+  std::string why;
+  view_samples_message_worded(event.samples_view, data, size, &why);
+  event.kind = LcmLogEvent::Kind::problem;
+  event.problem = fmt::format("event {} on {}: {}; skipped", event.number, event.channel, why);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -267,7 +267,7 @@ bool decode_impl(Msg& msg, const void* data, std::int64_t size, std::string* why
 
 }  // namespace
 
-bool view_samples_message(SamplesView& view, const void* data, std::int64_t size, std::string* why) {
+bool view_samples_message_worded(SamplesView& view, const void* data, std::int64_t size, std::string* why) {
   const auto* d = static_cast<const unsigned char*>(data);
   if (d == nullptr || size < hash_bytes || size > std::numeric_limits<int>::max() ||
       be64u(d) != static_cast<std::uint64_t>(samples_t::getHash())) {

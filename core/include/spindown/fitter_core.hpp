@@ -14,6 +14,7 @@
 // cap per bench (flooding messages dropped and counted). Nothing in the input throws out of it.
 #include <cstddef>
 #include <cstdint>
+#include <exception>
 #include <map>
 #include <memory>
 #include <optional>
@@ -153,6 +154,7 @@ class FitterCore {
   template <class Message>
   void take_samples(Bench& b, const Message& m, std::size_t n, std::int64_t recv_utime);
   void push_sample(Bench& b, std::int64_t seq, double t_s, double value, std::int64_t recv_utime);
+  void internal_error(const Bench& b, std::int64_t seq, const std::exception& e, std::int64_t recv_utime);
   void retract_stop(Bench& b, std::int64_t recv_utime);
   void handle_events(Bench& b, std::int64_t recv_utime);
   void restart_clock(Bench& b, std::int64_t recv_utime);

@@ -112,7 +112,7 @@ class LcmLogReader {
   // read error); returns how many are and points *p at the first.
   std::int64_t fill(std::int64_t n, const unsigned char** p) {
     if (pos_ >= buffer_offset_ && buffer_offset_ + buffered_ - pos_ >= n) {  // nearly always
-      *p = buffer_.data() + (pos_ - buffer_offset_);
+      *p = buffer_.get() + (pos_ - buffer_offset_);
       return n;
     }
     return refill(n, p);
@@ -122,6 +122,7 @@ class LcmLogReader {
   std::int64_t find_marker(std::int64_t from);
   bool find_event_start(LcmLogEvent& event);
   void decode(LcmLogEvent& event, const ChannelInfo& info, const void* data, std::int32_t size);
+  void reject_samples(LcmLogEvent& event, const void* data, std::int32_t size);  // decode()'s rare path
 
   std::string path_;
   LcmSamples samples_;
@@ -130,7 +131,10 @@ class LcmLogReader {
   std::int64_t size_ = 0;
   std::int64_t events_ = 0;
   bool done_ = false;
-  std::vector<unsigned char> buffer_;  // file bytes [buffer_offset_, buffer_offset_ + buffered_)
+  // File bytes [buffer_offset_, buffer_offset_ + buffered_) in buffer_capacity_ bytes, never
+  // zero-filled (read(2) writes them before they are parsed).
+  std::unique_ptr<unsigned char[]> buffer_;
+  std::int64_t buffer_capacity_ = 0;
   std::int64_t buffer_offset_ = 0;
   std::int64_t buffered_ = 0;
   std::int64_t pos_ = 0;               // file offset of the next byte to parse

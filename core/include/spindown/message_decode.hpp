@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <string>
 #include <string_view>
 
@@ -61,17 +62,57 @@ struct SamplesView {
     if constexpr (std::endian::native == std::endian::little) v = __builtin_bswap64(v);
     return v;
   }
+  static std::int32_t load_be32(const unsigned char* p) {
+    std::uint32_t v;
+    std::memcpy(&v, p, sizeof v);
+    if constexpr (std::endian::native == std::endian::little) v = __builtin_bswap32(v);
+    return static_cast<std::int32_t>(v);
+  }
 };
 
 // Checks an encoded samples_t (fingerprint, bench length, sample count against the bytes there)
 // and points view at it. False and *why otherwise, with the words the log reader and the fitter
 // report ("sample count 57 does not fit in 1445 bytes (truncated or damaged)"); a wrong
 // fingerprint or a message shorter than one is worded as decode_message words it.
-bool view_samples_message(SamplesView& view, const void* data, std::int64_t size, std::string* why = nullptr);
+// Inline, as a reader makes it once per message: a sound message passes the checks here; any
+// other is handed to view_samples_message_worded, which checks again and says what is wrong.
+inline bool view_samples_message(SamplesView& view, const void* data, std::int64_t size, std::string* why = nullptr);
+
+// view_samples_message step by step, each failed check in words (out of line: the rare path).
+bool view_samples_message_worded(SamplesView& view, const void* data, std::int64_t size, std::string* why);
 
 // The whole samples_t from a view (for readers that hand on the generated type); m's vectors
 // keep their capacity.
 void samples_from_view(const SamplesView& view, samples_t& m);
+
+inline bool view_samples_message(SamplesView& view, const void* data, std::int64_t size, std::string* why) {
+  // Fingerprint, utime and the bench string's length take the first 20 bytes; after the bench
+  // come seq, clock_epoch, quantity (13 bytes) and n, then n samples of 8 + 8 + 8 + 4 bytes.
+  constexpr std::int64_t bytes_per_sample = 8 + 8 + 8 + 4;
+  const auto* d = static_cast<const unsigned char*>(data);
+  if (d == nullptr || size < 20 || size > std::numeric_limits<int>::max() ||
+      SamplesView::load_be64(d) != static_cast<std::uint64_t>(samples_t::getHash()))
+    return view_samples_message_worded(view, data, size, why);
+  const std::int64_t bench_len = SamplesView::load_be32(d + 16);
+  if (bench_len < 1 || bench_len > size - 20) return view_samples_message_worded(view, data, size, why);
+  const std::int64_t n_at = 20 + bench_len + 13;
+  if (n_at + 4 > size) return view_samples_message_worded(view, data, size, why);
+  const std::int64_t n = SamplesView::load_be32(d + n_at);
+  if (n < 0 || n * bytes_per_sample > size - n_at - 4) return view_samples_message_worded(view, data, size, why);
+
+  view.utime = static_cast<std::int64_t>(SamplesView::load_be64(d + 8));
+  view.bench = std::string_view(reinterpret_cast<const char*>(d + 20), static_cast<std::size_t>(bench_len - 1));
+  const unsigned char* p = d + 20 + bench_len;
+  view.seq = static_cast<std::int64_t>(SamplesView::load_be64(p));
+  view.clock_epoch = SamplesView::load_be32(p + 8);
+  view.quantity = static_cast<std::int8_t>(p[12]);
+  view.n = static_cast<std::int32_t>(n);
+  view.device_time_bytes = d + n_at + 4;
+  view.host_time_bytes = view.device_time_bytes + 8 * n;
+  view.value_bytes = view.host_time_bytes + 8 * n;
+  view.raw_adc_bytes = view.value_bytes + 8 * n;
+  return true;
+}
 
 #define SPINDOWN_DECLARE_MESSAGE_DECODE(T)                                                        \
   template <>                                                                                     \

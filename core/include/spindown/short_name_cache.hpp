@@ -25,7 +25,8 @@ class ShortNameCache {
   }
 
   // The top bits of a multiplicative hash over the name eight bytes at a time (the last word
-  // overlapping the one before, as short_string_equal reads it).
+  // overlapping the one before, as short_string_equal reads it); a name of 4 to 7 bytes (a
+  // bench id) is two overlapping 4-byte halves in one word.
   static std::size_t index(std::string_view name) {
     constexpr std::uint64_t k = 0x9E3779B97F4A7C15ull;
     const char* p = name.data();
@@ -36,8 +37,15 @@ class ShortNameCache {
       std::memcpy(&w, s, sizeof w);
       return w;
     };
-    if (n < 8) {
+    auto half = [](const char* s) {
+      std::uint32_t w;
+      std::memcpy(&w, s, sizeof w);
+      return std::uint64_t{w};
+    };
+    if (n < 4) {
       for (std::size_t i = 0; i < n; ++i) h = (h ^ static_cast<unsigned char>(p[i])) * k;
+    } else if (n < 8) {
+      h = (h ^ (half(p) | half(p + n - 4) << 32)) * k;
     } else {
       for (std::size_t i = 0; i + 8 < n; i += 8) h = (h ^ word(p + i)) * k;
       h = (h ^ word(p + n - 8)) * k;
