@@ -230,3 +230,83 @@ TEST(LabLineFastPath, ManyLinesAgreeWithOneLineAtATime) {
     EXPECT_EQ(taken.bytes, text.size() - rest.size());
   }
 }
+
+// Long runs of lines printed alike (the shape fast path), each with a chance of one damaged byte:
+// every line parse_printed_lines takes gives exactly what the general parser parse_lab_line gives
+// (whose value is strtod-exact: PlainDecimalsMatchFromCharsBitForBit), and it takes the same
+// lines and bytes as the one-line-at-a-time fast path. Lines it declines go to the reader's slow path.
+namespace {
+
+void expect_many_lines_agree(const std::string& text, std::size_t max_lines) {
+  std::vector<double> millis, values;
+  const PrintedLines taken = parse_printed_lines(text, max_lines, millis, values);
+  ASSERT_EQ(millis.size(), taken.lines);
+  ASSERT_EQ(values.size(), taken.lines);
+  std::string_view rest = text;
+  std::size_t lines = 0;
+  while (lines < max_lines) {
+    LabLine one;
+    const std::size_t length = parse_printed_sample(rest, one);
+    if (length == 0) break;
+    ASSERT_LT(lines, taken.lines) << text;
+    const LabLine general = parse_lab_line(rest.substr(0, length));
+    ASSERT_EQ(general.kind, Kind::sample) << rest.substr(0, length);
+    EXPECT_EQ(static_cast<double>(general.millis), millis[lines]) << rest.substr(0, length);
+    EXPECT_EQ(std::memcmp(&general.value, &values[lines], sizeof(double)), 0)
+        << rest.substr(0, length) << " read as " << values[lines];
+    std::size_t next = length + 1;
+    if (rest[length] == '\r' && next < rest.size() && rest[next] == '\n') ++next;
+    rest.remove_prefix(next);
+    ++lines;
+  }
+  ASSERT_EQ(lines, taken.lines) << text;
+  EXPECT_EQ(taken.bytes, text.size() - rest.size());
+}
+
+}  // namespace
+
+TEST(LabLineFastPath, RunsOfAlikeLinesWithDamageAgreeWithTheGeneralParser) {
+  std::mt19937 rng(23);
+  const std::string damage = "0123456789 \t\r\n.-+eE0x\v";
+  const char* endings[] = {"\r\n", "\n", "\r"};
+  const char* odd_values[] = {"-0.00", "0.00", "-0.01", "00.50", "2.8", "2.800", "+2.80", "2.80e0", "1e2", "3.",
+                              ".25", "-.25", "12.5", "-1.5", "1234", "0000000002.81", "123456789012345678",
+                              "4294967040", "4294967041", "9.99", "10.00", "2.81 ", " 2.81", "2.81\t"};
+  const char* odd_times[] = {"0", "00005000", "+5000", "-5000", "5000.0", "1e3", "4294967295", "4294967296",
+                             "9999999", "10000000", "0000000", " 5000"};
+  for (int round = 0; round < 3000; ++round) {
+    std::string text;
+    const int n = std::uniform_int_distribution<int>(0, 150)(rng);
+    const char* ending = endings[std::uniform_int_distribution<int>(0, round % 4 ? 1 : 2)(rng)];
+    const char separator = round % 7 == 0 ? ' ' : '\t';
+    int t = std::uniform_int_distribution<int>(0, round % 3 ? 20000 : 9999900)(rng);
+    for (int k = 0; k < n; ++k, t += 20) {
+      std::string line = std::to_string(t) + separator;
+      char value[16];
+      std::snprintf(value, sizeof value, "%d.%02d", std::uniform_int_distribution<int>(0, 9)(rng),
+                    std::uniform_int_distribution<int>(0, 99)(rng));
+      line += value;
+      const int odd = std::uniform_int_distribution<int>(0, 99)(rng);
+      if (odd < 3) line = std::to_string(t) + separator + odd_values[std::uniform_int_distribution<std::size_t>(0, std::size(odd_values) - 1)(rng)];
+      else if (odd < 5) line = odd_times[std::uniform_int_distribution<std::size_t>(0, std::size(odd_times) - 1)(rng)] + (separator + std::string(value));
+      else if (odd < 7) line[std::uniform_int_distribution<std::size_t>(0, line.size() - 1)(rng)] = damage[std::uniform_int_distribution<std::size_t>(0, damage.size() - 1)(rng)];
+      else if (odd < 8) line.insert(std::uniform_int_distribution<std::size_t>(0, line.size())(rng), 1, damage[std::uniform_int_distribution<std::size_t>(0, damage.size() - 1)(rng)]);
+      else if (odd < 9) line.erase(std::uniform_int_distribution<std::size_t>(0, line.size() - 1)(rng), 1);
+      text += line;
+      text += odd == 9 ? endings[std::uniform_int_distribution<int>(0, 2)(rng)] : ending;
+    }
+    // As the reader calls it: a block of lines at a time, each call where the last one stopped
+    // (past the line it declined, which the slow path takes).
+    std::string_view rest = text;
+    while (!rest.empty()) {
+      expect_many_lines_agree(std::string(rest), round % 5 == 0 ? 7 : 64);
+      if (HasFatalFailure()) return;
+      std::vector<double> millis, values;
+      const PrintedLines taken = parse_printed_lines(rest, round % 5 == 0 ? 7 : 64, millis, values);
+      rest.remove_prefix(taken.bytes);
+      const std::size_t nl = rest.find_first_of("\r\n");
+      rest.remove_prefix(taken.lines > 0 || nl == std::string_view::npos ? 0 : nl + 1);
+      if (taken.lines == 0 && nl == std::string_view::npos) break;
+    }
+  }
+}

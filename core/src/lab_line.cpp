@@ -8,6 +8,11 @@
 #include <cstring>
 #include <system_error>
 
+// The shape fast path uses SSE2, always there on x86-64; elsewhere each line takes printed_line.
+#if defined(__x86_64__)
+#include <emmintrin.h>
+#endif
+
 namespace spindown {
 
 namespace {
@@ -141,14 +146,16 @@ int leading_digits(std::uint64_t w) {
   return not_digit == 0 ? 8 : std::countr_zero(not_digit) / 8;
 }
 
-// The number the word's first n (1 to 8) digit bytes spell: they are moved to the top so the
-// bytes below read as leading zeros, then pairs, fours and eights are combined.
-std::uint64_t digits_value(std::uint64_t w, int n) {
-  w = (w & every_byte(0x0F)) << (8 * (8 - n));
+// The number eight digit values (0 to 9, one a byte, the first in byte 0) spell.
+std::uint64_t eight_digits_value(std::uint64_t w) {
   w = (w * 10 + (w >> 8)) & 0x00FF00FF00FF00FFull;
   w = (w * 100 + (w >> 16)) & 0x0000FFFF0000FFFFull;
   return (w * 10000 + (w >> 32)) & 0xFFFFFFFFull;
 }
+
+// The number the word's first n (1 to 8) digit bytes spell: they are moved to the top so the
+// bytes below read as leading zeros, then pairs, fours and eights are combined.
+std::uint64_t digits_value(std::uint64_t w, int n) { return eight_digits_value((w & every_byte(0x0F)) << (8 * (8 - n))); }
 
 // The word without its byte k (0 to 7): the bytes after it move down one, a zero comes in on top.
 std::uint64_t without_byte(std::uint64_t w, int k) {
@@ -200,6 +207,91 @@ constexpr std::size_t enough_text = 24;
   return static_cast<std::size_t>(stop - begin);
 }
 
+std::size_t terminator_length(const char* stop) { return stop[0] == '\r' && stop[1] == '\n' ? 2 : 1; }
+
+// Lines printed alike: the same number of time digits, the same separator, the value as "d.dd"
+// and the same terminator, e.g. "5234\t0.00\r\n". The sketch prints them by the thousand; one is
+// checked against the shape with a few 16-byte SSE2 operations instead of a scan of its fields.
+// XOR with the pattern turns a digit into its value (0 to 9) and a matching separator or
+// terminator into 0, so the whole line is one comparison with the most each byte may be.
+class PrintedShape {
+ public:
+  // No shape: fits nothing.
+  PrintedShape() = default;
+
+  // The shape of a line printed_line took (length bytes before its terminator), if it has one.
+  static PrintedShape of(const char* line, std::size_t length) {
+    PrintedShape shape;
+#if defined(__x86_64__)
+    const int time_digits = leading_digits(load_word(line));
+    const char* const value = line + time_digits + 1;
+    if (length != static_cast<std::size_t>(time_digits) + 5 || !is_digit(value[0]) || value[1] != '.' ||
+        !is_digit(value[2]) || !is_digit(value[3]))
+      return shape;  // a value printed some other way ("-1.5", "-.25", "12.5")
+    const char* const stop = line + length;
+    const bool crlf = stop[0] == '\r' && stop[1] == '\n';
+    if (!crlf && stop[0] != '\n') return shape;  // a lone CR: the next line's end could differ
+    const std::size_t bytes = length + (crlf ? 2 : 1);
+    alignas(16) unsigned char pattern[16] = {}, most[16];
+    std::memset(most, 0xFF, sizeof most);  // bytes after the line: anything
+    for (std::size_t i = 0; i < bytes; ++i) {
+      const bool digit = is_digit(line[i]);
+      pattern[i] = digit ? '0' : static_cast<unsigned char>(line[i]);
+      most[i] = digit ? 9 : 0;
+    }
+    shape.pattern_ = _mm_load_si128(reinterpret_cast<const __m128i*>(pattern));
+    shape.most_ = _mm_load_si128(reinterpret_cast<const __m128i*>(most));
+    shape.time_digits_ = time_digits;
+    shape.bytes_ = bytes;
+#else
+    (void)line;
+    (void)length;
+#endif
+    return shape;
+  }
+
+  // Takes the lines printed this way from p on, at most room, while a line starts at or before
+  // last (so 16 bytes are readable): writes their numbers, as printed_line gives them, to
+  // millis and values and returns how many. A tight loop: the shape stays in registers.
+  std::size_t take_alike(const char* p, const char* last, std::size_t room, double* millis, double* values) const {
+    std::size_t n = 0;
+#if defined(__x86_64__)
+    if (bytes_ == 0) return 0;
+    const __m128i pattern = pattern_, most = most_;
+    const int time_shift = 8 * (8 - time_digits_);
+    for (; n < room && p <= last; ++n, p += bytes_) {
+      const __m128i x = _mm_xor_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)), pattern);
+      if (_mm_movemask_epi8(_mm_cmpeq_epi8(_mm_min_epu8(x, most), x)) != 0xFFFF) break;  // a byte over its most
+      // x's first bytes are the time's digit values; the shift drops the bytes after them.
+      millis[n] = static_cast<double>(eight_digits_value(static_cast<std::uint64_t>(_mm_cvtsi128_si64(x)) << time_shift));
+      const char* const v = p + time_digits_ + 1;  // "d.dd"
+      const unsigned mantissa = (static_cast<unsigned char>(v[0]) - unsigned{'0'}) * 100 +
+                                (static_cast<unsigned char>(v[2]) - unsigned{'0'}) * 10 +
+                                (static_cast<unsigned char>(v[3]) - unsigned{'0'});
+      values[n] = plain_decimal_value(mantissa, 2, false);
+    }
+#else
+    (void)p;
+    (void)last;
+    (void)room;
+    (void)millis;
+    (void)values;
+#endif
+    return n;
+  }
+
+  // The line's bytes, its terminator included.
+  std::size_t bytes() const { return bytes_; }
+
+ private:
+#if defined(__x86_64__)
+  __m128i pattern_ = _mm_setzero_si128();
+  __m128i most_ = _mm_setzero_si128();
+#endif
+  int time_digits_ = 0;
+  std::size_t bytes_ = 0;  // 0: no shape
+};
+
 }  // namespace
 
 std::size_t parse_printed_sample(std::string_view text, LabLine& sample) {
@@ -231,13 +323,19 @@ PrintedLines parse_printed_lines(std::string_view text, std::size_t max_lines, s
   values.resize(base + room);
   double* const millis_out = millis.data() + base;
   double* const values_out = values.data() + base;
+  const char* const last = end - enough_text;  // the last line start the fast path may read from
   while (true) {
     millis_out[taken.lines] = static_cast<double>(ticks);
     values_out[taken.lines] = value;
-    const char* const stop = p + length;  // CR or LF, with enough_text bytes after p
-    p = stop + (stop[0] == '\r' && stop[1] == '\n' ? 2 : 1);
     ++taken.lines;
-    if (taken.lines == room || static_cast<std::size_t>(end - p) < enough_text) break;
+    // The sketch's next lines are usually printed like this one: taken by its shape, in a run.
+    const PrintedShape shape = PrintedShape::of(p, length);
+    p += length + terminator_length(p + length);
+    const std::size_t alike =
+        shape.take_alike(p, last, room - taken.lines, millis_out + taken.lines, values_out + taken.lines);
+    taken.lines += alike;
+    p += alike * shape.bytes();
+    if (taken.lines == room || p > last) break;
     length = printed_line(p, ticks, value);
     if (length == 0) break;
   }
