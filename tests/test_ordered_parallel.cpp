@@ -79,3 +79,37 @@ TEST(OrderedParallel, NothingToDo) {
   for_each_ordered(0, 4, [&](std::size_t) { return ++calls; }, [&](std::size_t, int) { ++calls; });
   EXPECT_EQ(calls, 0);
 }
+
+// The consumer sleeps until a batch of results in a row is ready: every count of inputs, batch
+// boundary or not, and the last, partial batch, still comes out whole and in order, with uneven
+// work and a slow consumer; an exception near the end still reaches the caller.
+TEST(OrderedParallel, BatchedHandoffsLoseNothing) {
+  for (unsigned jobs : {2u, 3u, 5u}) {
+    for (std::size_t n = 2; n <= 41; n += 3) {
+      std::vector<std::size_t> order;
+      for_each_ordered(
+          n, jobs,
+          [](std::size_t i) {
+            if (i % 5 == 1) std::this_thread::sleep_for(std::chrono::microseconds(100));
+            return i + 1;
+          },
+          [&](std::size_t i, std::size_t r) {
+            EXPECT_EQ(r, i + 1);
+            if (i % 11 == 3) std::this_thread::sleep_for(std::chrono::microseconds(300));
+            order.push_back(i);
+          });
+      ASSERT_EQ(order.size(), n) << jobs << " jobs";
+      for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(order[i], i);
+    }
+    std::vector<std::size_t> seen;
+    EXPECT_THROW(for_each_ordered(
+                     30, jobs,
+                     [](std::size_t i) {
+                       if (i == 29) throw std::runtime_error("the last input is bad");
+                       return i;
+                     },
+                     [&](std::size_t i, std::size_t) { seen.push_back(i); }),
+                 std::runtime_error);
+    for (std::size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], i);
+  }
+}
