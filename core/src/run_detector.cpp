@@ -76,7 +76,7 @@ void RunDetector::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
 // Per sample for every live window, so inlined into its callers; the usual step (sample i
 // follows the window's last, exactly one old sample expires) is one slide(). s is sample i,
 // passed in so that it is not reloaded from the ring after the stores to the sums.
-inline void RunDetector::advance(WindowFit& w, std::size_t i, Sample s) {
+[[gnu::always_inline]] inline void RunDetector::advance(WindowFit& w, std::size_t i, Sample s) {
   const Sample* ring = ring_.get();
   const std::size_t mask = mask_;
   // w.n always equals w.end - w.first: an empty window contiguous with i has first == i.
@@ -106,7 +106,7 @@ inline void RunDetector::advance(WindowFit& w, std::size_t i, Sample s) {
   if (w.updates > refresh_every) [[unlikely]] rebuild(w, w.first, w.end);
 }
 
-inline void RunDetector::coast_step(std::size_t i, Sample s) {
+[[gnu::always_inline]] inline void RunDetector::coast_step(std::size_t i, Sample s) {
   advance(hold_, i, s);
   if (hold_long_live_) [[unlikely]] advance(hold_long_, i, s);
   coast_checks(i, s);
@@ -114,7 +114,7 @@ inline void RunDetector::coast_step(std::size_t i, Sample s) {
 
 // Per coasting sample; kept small (the rare outcomes are calls) since it runs for every sample.
 // s is sample i, and hold_ ends at i (it was advanced to it, or rebuilt up to it).
-inline void RunDetector::coast_checks(std::size_t i, Sample s, bool at_end) {
+[[gnu::always_inline]] inline void RunDetector::coast_checks(std::size_t i, Sample s, bool at_end) {
   const double t_i = s.t;
   if (buffered() > opt_.max_buffer || t_i - run_.t_cut_s > opt_.max_coast_s) [[unlikely]] {
     coast_too_long(i);
@@ -350,6 +350,9 @@ void RunDetector::trim_idle() {
 bool RunDetector::confirms_decline(const WindowFit& w) const {
   // Cheapest tests first: an idle lead-in (zeros, a steady supply) fails one of them.
   if (w.n < 6 || w.first < lo_) return false;
+  // The slope's sign is Sxy's (Sxx > 0, else the slope is 0): a level or rising window, half of
+  // an idle lead-in, is out before the divisions.
+  if (!(w.stv - w.st * w.sv / w.n < 0)) return false;
   const double mu = w.mean();
   if (!(mu > 0)) return false;
   const double dur = duration(w);
@@ -680,7 +683,7 @@ bool RunDetector::flat(const WindowFit& w) const {
   return level(w, d, w.mean(), sxx, e);
 }
 
-bool RunDetector::level(const WindowFit& w, double d, double m, double& sxx, double& e) const {
+[[gnu::always_inline]] inline bool RunDetector::level(const WindowFit& w, double d, double m, double& sxx, double& e) const {
   const bool low = v0_ > 0 ? m <= standstill_max_fraction * v0_ : true;
   if (!low) return false;
   // w.slope() and w.resid_sd() (n >= 3), sharing Sxx and Sxy: the same operations, done once.
