@@ -256,10 +256,11 @@ class PrintedShape {
   std::size_t take_alike(const char* p, const char* last, std::size_t room, double* millis, double* values) const {
     std::size_t n = 0;
 #if defined(__x86_64__)
-    if (bytes_ == 0) return 0;
+    if (bytes_ == 0 || p > last) return 0;
+    const std::size_t most_lines = std::min(room, static_cast<std::size_t>(last - p) / bytes_ + 1);
     const __m128i pattern = pattern_, most = most_;
     const int time_shift = 8 * (8 - time_digits_);
-    for (; n < room && p <= last; ++n, p += bytes_) {
+    for (; n < most_lines; ++n, p += bytes_) {
       const __m128i x = _mm_xor_si128(_mm_loadu_si128(reinterpret_cast<const __m128i*>(p)), pattern);
       if (_mm_movemask_epi8(_mm_cmpeq_epi8(_mm_min_epu8(x, most), x)) != 0xFFFF) break;  // a byte over its most
       // x's first bytes are the time's digit values; the shift drops the bytes after them.
