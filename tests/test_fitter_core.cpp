@@ -329,5 +329,47 @@ TEST(FitterCore, SamplesViewAndDecodedMessageGiveTheSameResults) {
   EXPECT_EQ(run(true, 2), run(false, 2));  // three benches, two held: evictions all along
 }
 
+// Benches found by the reader's channel number (refit) give what finding them by name gives,
+// with benches interleaved, evicted and filtered, and ids that are negative or out of range.
+TEST(FitterCore, ChannelIdsGiveTheSameResultsAsBenchNames) {
+  const Stream a = make_stream(2, 12), b = make_stream(1, 22), c = make_stream(1, 32);
+  auto run = [&](bool by_id, std::size_t max_benches) {
+    CollectingSink sink;
+    FitterOptions o;
+    o.max_benches = max_benches;
+    o.bench_regex = "[abc]";
+    FitterCore core(o, sink);
+    const std::pair<const char*, const Stream*> benches[] = {{"a", &a}, {"b", &b}, {"c", &c}, {"z", &c}};
+    const std::int32_t ids[] = {3, 0, FitterCore::max_channel_ids + 5, 7};  // "z" is filtered
+    std::int64_t utime = 0;
+    for (std::size_t i = 0; i < a.t_us.size(); ++i)
+      for (std::size_t k = 0; k < 4; ++k) {
+        const auto& [id, s] = benches[k];
+        if (i >= s->t_us.size()) continue;
+        const auto bytes = encode(batch(id, *s, i, 1, static_cast<std::int64_t>(i)));
+        SamplesView v;
+        EXPECT_TRUE(view_samples_message(v, bytes.data(), static_cast<std::int64_t>(bytes.size())));
+        utime += 5000;
+        if (by_id)
+          core.on_samples(i % 97 == 5 ? -1 : ids[k], id, v, utime);
+        else
+          core.on_samples(id, v, utime);
+      }
+    core.finish(utime);
+    std::vector<std::string> out;
+    for (const auto& f : sink.fits)
+      out.push_back(fmt::format("{} {} {} {} {}", f.bench, f.fit.run.number, f.first_seq, f.last_seq,
+                                f.fit.best.empty() ? 0.0 : f.fit.models.front().rmse));
+    const FitterCounters& n = core.counters();
+    out.push_back(fmt::format("{} {} {} {} {}", n.samples, n.sample_messages, n.dropped_benches, n.filtered,
+                              sink.runs.size()));
+    return out;
+  };
+  const auto by_name = run(false, 256);
+  EXPECT_GE(by_name.size(), 5u);
+  EXPECT_EQ(run(true, 256), by_name);
+  EXPECT_EQ(run(true, 2), run(false, 2));  // evictions all along: a channel's bench is found anew
+}
+
 }  // namespace
 }  // namespace spindown

@@ -214,7 +214,7 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
     switch (ev.kind) {
       // Decoded (and checked) once, by the reader: the core takes the message as it is.
       case LcmLogEvent::Kind::samples:
-        core.on_samples(ev.bench, ev.samples_view, ev.log_utime);
+        core.on_samples(ev.channel_id, ev.bench, ev.samples_view, ev.log_utime);
         break;
       case LcmLogEvent::Kind::config:
         core.on_config(ev.bench, ev.config, ev.log_utime);

@@ -195,6 +195,7 @@ FitterCore::Bench* FitterCore::find_bench(std::string_view id, std::int64_t recv
                       id, kind, id, benches_.size(), v.id),
           recv_utime);
     bench_cache_.forget(&v);
+    std::replace(bench_by_channel_.begin(), bench_by_channel_.end(), &v, static_cast<Bench*>(nullptr));
     benches_.erase(victim);
   }
   auto b = std::make_unique<Bench>(std::string(id), opt_.runs);
@@ -288,14 +289,43 @@ void FitterCore::on_samples(std::string_view bench, const samples_t& m, std::int
 }
 
 void FitterCore::on_samples(std::string_view bench, const SamplesView& m, std::int64_t recv_utime) {
+  on_samples(-1, bench, m, recv_utime);
+}
+
+// One flat function per message at one sample per message (refit): the bench by its channel's
+// number, the checks and the push inlined, so only the detector is a call.
+void FitterCore::on_samples(std::int32_t channel_id, std::string_view bench, const SamplesView& m,
+                            std::int64_t recv_utime) {
   ++counters_.sample_messages;
-  Bench* bp = bench_for(bench, recv_utime, "SAMPLE");
-  if (!bp) return;
+  // A negative id wraps to a huge index: one comparison covers both ends.
+  Bench* bp = static_cast<std::uint32_t>(channel_id) < bench_by_channel_.size()
+                  ? bench_by_channel_[static_cast<std::uint32_t>(channel_id)]
+                  : nullptr;
+  if (bp) {  // bench_for()'s bookkeeping for a bench it would find in its cache
+    bp->last_active = ++activity_;
+  } else {
+    bp = bench_for_channel(channel_id, bench, recv_utime);
+    if (!bp) return;
+  }
   take_samples(*bp, m, static_cast<std::size_t>(m.n), recv_utime);  // n checked against the bytes
 }
 
+FitterCore::Bench* FitterCore::bench_for_channel(std::int32_t channel_id, std::string_view bench,
+                                                 std::int64_t recv_utime) {
+  Bench* b = bench_for(bench, recv_utime, "SAMPLE");
+  if (b && channel_id >= 0 && channel_id < max_channel_ids) {
+    const auto slot = static_cast<std::size_t>(channel_id);
+    if (slot >= bench_by_channel_.size()) bench_by_channel_.resize(slot + 1, nullptr);
+    bench_by_channel_[slot] = b;
+  }
+  return b;
+}
+
+// Inlined into each on_samples(): at one sample per message a call's register saves and
+// argument moves cost as much as the checks.
 template <class Message>
-void FitterCore::take_samples(Bench& b, const Message& m, std::size_t n, std::int64_t recv_utime) {
+[[gnu::always_inline]] inline void FitterCore::take_samples(Bench& b, const Message& m, std::size_t n,
+                                                             std::int64_t recv_utime) {
   const std::string& ch = b.channel;
 
   // Rate cap first: a flood costs one comparison per message.
@@ -406,8 +436,10 @@ void FitterCore::restart_clock(Bench& b, std::int64_t recv_utime) {
   trim_mirror(b);
 }
 
-// Small enough to inline into the per-sample loop: everything rare is a call.
-inline void FitterCore::push_sample(Bench& b, std::int64_t seq, double t_s, double value, std::int64_t recv_utime) {
+// Inlined into the per-sample loop (not left to the compiler, which kept it a call): everything
+// rare is a call.
+[[gnu::always_inline]] inline void FitterCore::push_sample(Bench& b, std::int64_t seq, double t_s, double value,
+                                                           std::int64_t recv_utime) {
   if (b.pending_restart) restart_clock(b, recv_utime);
   ++counters_.samples;
   b.mirror.push_back({t_s, value, seq});

@@ -167,7 +167,7 @@ std::int64_t LcmLogReader::find_marker(std::int64_t from) {
   }
 }
 
-inline const LcmLogReader::ChannelInfo& LcmLogReader::channel_info(std::string_view channel) {
+[[gnu::always_inline]] inline const LcmLogReader::ChannelInfo& LcmLogReader::channel_info(std::string_view channel) {
   const ChannelInfo* cached = channel_cache_.slot(channel);
   if (cached && short_string_equal(cached->channel, channel)) return *cached;  // nearly always
   return find_channel(channel);
@@ -243,9 +243,10 @@ bool LcmLogReader::next(LcmLogEvent& event) {
 }
 
 // A sound event whose bytes (header at p) are all in the buffer: kept, whatever follows it
-// (another event, the end, or garbage that the next call skips and reports).
-inline void LcmLogReader::accept(LcmLogEvent& event, const unsigned char* p, std::int32_t channel_len,
-                          std::int32_t data_len) {
+// (another event, the end, or garbage that the next call skips and reports). Inlined into next()
+// with the channel lookup and the decode: one flat function per event.
+[[gnu::always_inline]] inline void LcmLogReader::accept(LcmLogEvent& event, const unsigned char* p,
+                                                      std::int32_t channel_len, std::int32_t data_len) {
   event.file_offset = pos_;
   pos_ += event_header_bytes + channel_len + data_len;
   ++events_;
@@ -333,7 +334,8 @@ bool LcmLogReader::next_checked(LcmLogEvent& event) {
   return true;
 }
 
-inline void LcmLogReader::decode(LcmLogEvent& event, const ChannelInfo& info, const void* data, std::int32_t size) {
+[[gnu::always_inline]] inline void LcmLogReader::decode(LcmLogEvent& event, const ChannelInfo& info, const void* data,
+                                                      std::int32_t size) {
   event.data = data;
   event.data_size = size;
   event.channel_id = info.id;

@@ -128,6 +128,11 @@ class FitterCore {
   // Already decoded messages (tests, tools; a log reader's view); bench is the channel's bench id.
   void on_samples(std::string_view bench, const samples_t& msg, std::int64_t recv_utime);
   void on_samples(std::string_view bench, const SamplesView& msg, std::int64_t recv_utime);
+  // The same from a reader that numbers its channels (LcmLogEvent::channel_id; one numbering per
+  // core): after a channel's first message its bench is found by that number instead of by
+  // hashing and comparing the name again. A negative id (or one past max_channel_ids) goes by name.
+  void on_samples(std::int32_t channel_id, std::string_view bench, const SamplesView& msg, std::int64_t recv_utime);
+  static constexpr std::int32_t max_channel_ids = 1024;
   void on_config(std::string_view bench, const config_t& msg, std::int64_t recv_utime);
   // End of the stream (refit, shutdown): open coasts are closed and fitted as `spindown fit`
   // does at the end of a file.
@@ -149,6 +154,8 @@ class FitterCore {
   struct Bench;
   Bench* bench_for(std::string_view id, std::int64_t recv_utime, std::string_view kind);
   Bench* find_bench(std::string_view id, std::int64_t recv_utime, std::string_view kind);  // past the cache
+  // bench_for() for a SAMPLE channel whose id is not yet in bench_by_channel_; remembers the answer.
+  Bench* bench_for_channel(std::int32_t channel_id, std::string_view bench, std::int64_t recv_utime);
   void error(std::string text, std::int64_t utime);
   // The per-bench checks and the detector, for n samples of either form of message.
   template <class Message>
@@ -167,6 +174,7 @@ class FitterCore {
   std::regex bench_filter_;
   std::map<std::string, std::unique_ptr<Bench>, std::less<>> benches_;
   ShortNameCache<Bench> bench_cache_;  // bench id -> bench, before the map
+  std::vector<Bench*> bench_by_channel_;  // by a reader's channel id; nullptr: not known (or evicted)
   std::uint64_t activity_ = 0;   // increases per message: least recently active = smallest
   std::uint64_t arrivals_ = 0;   // order of first appearance
   FitterCounters counters_;

@@ -74,8 +74,9 @@ struct SamplesView {
 // and points view at it. False and *why otherwise, with the words the log reader and the fitter
 // report ("sample count 57 does not fit in 1445 bytes (truncated or damaged)"); a wrong
 // fingerprint or a message shorter than one is worded as decode_message words it.
-// Inline, as a reader makes it once per message: a sound message passes the checks here; any
-// other is handed to view_samples_message_worded, which checks again and says what is wrong.
+// Always inlined, as a reader makes it once per message (a call costs as much as the checks): a
+// sound message passes the checks here; any other is handed to view_samples_message_worded,
+// which checks again and says what is wrong.
 inline bool view_samples_message(SamplesView& view, const void* data, std::int64_t size, std::string* why = nullptr);
 
 // view_samples_message step by step, each failed check in words (out of line: the rare path).
@@ -85,7 +86,8 @@ bool view_samples_message_worded(SamplesView& view, const void* data, std::int64
 // keep their capacity.
 void samples_from_view(const SamplesView& view, samples_t& m);
 
-inline bool view_samples_message(SamplesView& view, const void* data, std::int64_t size, std::string* why) {
+[[gnu::always_inline]] inline bool view_samples_message(SamplesView& view, const void* data, std::int64_t size,
+                                                      std::string* why) {
   // Fingerprint, utime and the bench string's length take the first 20 bytes; after the bench
   // come seq, clock_epoch, quantity (13 bytes) and n, then n samples of 8 + 8 + 8 + 4 bytes.
   constexpr std::int64_t bytes_per_sample = 8 + 8 + 8 + 4;
