@@ -304,9 +304,10 @@ class Evaluator {
     double omega[6] = {};  // the lower triangle, row by row: 00, 10, 11, 20, 21, 22
     if (m > 0) {
       double *c0 = score(0), *c1 = score(1), *c2 = score(2);
-      for (std::size_t i = 1; i < m; ++i) {
-        c0[i] += c0[i - 1], c1[i] += c1[i - 1];
-        if constexpr (P == 3) c2[i] += c2[i - 1];
+      double total0 = 0, total1 = 0, total2 = 0;  // in registers: the columns are one array
+      for (std::size_t i = 0; i < m; ++i) {
+        c0[i] = total0 += c0[i], c1[i] = total1 += c1[i];
+        if constexpr (P == 3) c2[i] = total2 += c2[i];
       }
       const std::size_t end = m + span - 1;
       add_window_products<P, false, false>(0, std::min(m, span), m, span, omega);
