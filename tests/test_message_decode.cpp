@@ -356,5 +356,10 @@ TEST(MessageDecode, SamplesViewInlineChecksAgreeWithTheWordedOnes) {
   EXPECT_LT(accepted, cases.size() - 100);  // and plenty that do
 }
 
+// The fingerprint view_samples_message compares against is read once; it is the generated one.
+TEST(MessageDecode, SamplesFingerprintIsTheGeneratedHash) {
+  EXPECT_EQ(samples_fingerprint, static_cast<std::uint64_t>(samples_t::getHash()));
+}
+
 }  // namespace
 }  // namespace spindown

@@ -6,6 +6,7 @@
 #include <exception>
 #include <fmt/format.h>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <memory>
 #include <regex>
@@ -193,10 +194,15 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
   std::int64_t last_utime = 0;
   std::size_t file_problems = 0;
   LcmLogEvent ev;
-  std::size_t events_seen = 0;
+  // Progress every 256 events, counted down (one test per event, none for a caller without one).
+  constexpr std::size_t progress_every = 256;
+  std::size_t until_progress = progress ? progress_every : std::numeric_limits<std::size_t>::max();
   while (reader.next(ev)) {
     if (each_event) each_event(ev);
-    if (progress && ++events_seen % 256 == 0) progress(ev.file_offset, reader.file_size(), out.runs_fitted);
+    if (--until_progress == 0) {
+      until_progress = progress_every;
+      progress(ev.file_offset, reader.file_size(), out.runs_fitted);
+    }
     if (ev.number > 0) last_utime = ev.log_utime;
     // A bench's first SAMPLE/CONFIG fixes its place; checked once per channel, not per event.
     const auto id = static_cast<std::size_t>(ev.channel_id);

@@ -22,10 +22,9 @@ namespace {
 constexpr std::int64_t event_header_bytes = 28;  // magic, event number, timestamp, 2 lengths
 constexpr std::int32_t max_channel_bytes = 1000; // lcm_eventlog's own limit
 
-std::uint32_t be32(const unsigned char* p) {
-  return (std::uint32_t(p[0]) << 24) | (std::uint32_t(p[1]) << 16) | (std::uint32_t(p[2]) << 8) | p[3];
-}
-std::uint64_t be64(const unsigned char* p) { return (std::uint64_t(be32(p)) << 32) | be32(p + 4); }
+// One load and a byte swap each (the byte-by-byte form was not always turned into one).
+std::uint32_t be32(const unsigned char* p) { return static_cast<std::uint32_t>(SamplesView::load_be32(p)); }
+std::uint64_t be64(const unsigned char* p) { return SamplesView::load_be64(p); }
 
 bool is_bench_char(char c) {
   return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-';

@@ -82,6 +82,9 @@ inline bool view_samples_message(SamplesView& view, const void* data, std::int64
 // view_samples_message step by step, each failed check in words (out of line: the rare path).
 bool view_samples_message_worded(SamplesView& view, const void* data, std::int64_t size, std::string* why);
 
+// samples_t::getHash() read once: the generated function guards a local static on every call.
+inline const std::uint64_t samples_fingerprint = static_cast<std::uint64_t>(samples_t::getHash());
+
 // The whole samples_t from a view (for readers that hand on the generated type); m's vectors
 // keep their capacity.
 void samples_from_view(const SamplesView& view, samples_t& m);
@@ -93,7 +96,7 @@ void samples_from_view(const SamplesView& view, samples_t& m);
   constexpr std::int64_t bytes_per_sample = 8 + 8 + 8 + 4;
   const auto* d = static_cast<const unsigned char*>(data);
   if (d == nullptr || size < 20 || size > std::numeric_limits<int>::max() ||
-      SamplesView::load_be64(d) != static_cast<std::uint64_t>(samples_t::getHash()))
+      SamplesView::load_be64(d) != samples_fingerprint)
     return view_samples_message_worded(view, data, size, why);
   const std::int64_t bench_len = SamplesView::load_be32(d + 16);
   if (bench_len < 1 || bench_len > size - 20) return view_samples_message_worded(view, data, size, why);
