@@ -2,7 +2,9 @@
 // announces cut and stop as they happen, and keeps its memory bounded.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -252,4 +254,31 @@ TEST(RunDetector, TimeGoingBackIsAClockRestartAndNonFiniteSamplesAreCounted) {
   };
   EXPECT_TRUE(has("clock restart"));
   EXPECT_TRUE(has("1 non-finite"));
+}
+
+// The run's period is the median of all its coast's sample periods, however they are counted
+// (two at a time, across the ring's wrap, odd or even counts, a clock with jitter or a steady one).
+TEST(RunDetector, PeriodIsTheMedianOfAllCoastPeriods) {
+  for (int jitter_ms = 0; jitter_ms <= 3; ++jitter_ms) {
+    const Recording steady = multi_run_recording(nullptr);
+    Recording rec;
+    rec.source = "jittered";
+    std::uint32_t state = 12345u + jitter_ms;
+    double shift = 0;
+    for (std::size_t i = 0; i < steady.size(); ++i) {
+      state = state * 1664525u + 1013904223u;
+      if (jitter_ms > 0) shift += 1e-3 * double(int(state >> 28) % (jitter_ms + 1));
+      rec.push(steady.t_s[i] + shift, steady.value[i]);
+    }
+    const Segmentation seg = find_runs(rec, {});
+    ASSERT_GE(seg.runs.size(), 4u) << jitter_ms;
+    for (const spindown::Run& r : seg.runs) {
+      const std::size_t coast_end = r.stopped ? r.stop_index : r.end_index;
+      std::vector<double> dt;
+      for (std::size_t k = r.cut_index + 1; k < coast_end; ++k) dt.push_back(rec.t_s[k] - rec.t_s[k - 1]);
+      ASSERT_FALSE(dt.empty());
+      std::nth_element(dt.begin(), dt.begin() + dt.size() / 2, dt.end());
+      EXPECT_EQ(r.period_s, dt[dt.size() / 2]) << "jitter " << jitter_ms << " run " << r.number;
+    }
+  }
 }

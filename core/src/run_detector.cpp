@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <emmintrin.h>
 #include <fmt/format.h>
 #include <utility>
 
@@ -218,13 +220,7 @@ double RunDetector::median_period(std::size_t from, std::size_t to) {
     // Over the ring in stretches that do not wrap, so the loop needs no index masking.
     for (std::size_t k = from + 1; k < to;) {
       const std::size_t stretch_end = std::min(to, (k | mask_) + 1);
-      const Sample* p = ring_.get() + (k & mask_);
-      for (std::size_t j = 0; j < stretch_end - k; ++j) {
-        const double d = p[j].t - prev;
-        below += d < guess;
-        at_or_below += d <= guess;
-        prev = p[j].t;
-      }
+      count_periods(ring_.get() + (k & mask_), stretch_end - k, guess, prev, below, at_or_below);
       k = stretch_end;
     }
     if (below <= h && h < at_or_below) return guess;
@@ -233,6 +229,36 @@ double RunDetector::median_period(std::size_t from, std::size_t to) {
   for (std::size_t k = 0; k < n; ++k) dt[k] = t(from + 1 + k) - t(from + k);
   std::nth_element(dt, dt + h, dt + n);
   return dt[h];
+}
+
+void RunDetector::count_periods(const Sample* p, std::size_t m, double guess, double& prev, std::size_t& below,
+                                std::size_t& at_or_below) {
+  // Two periods per step in SSE2 lanes (t(j) - t(j-1) and t(j+1) - t(j), the same subtractions
+  // and comparisons as one at a time); a true comparison is an all-ones lane, -1 when counted.
+  const __m128d g = _mm_set1_pd(guess);
+  __m128d last = _mm_set1_pd(prev);  // high lane: the time before p[j]
+  __m128i n_below = _mm_setzero_si128(), n_at_or_below = _mm_setzero_si128();
+  std::size_t j = 0;
+  for (; j + 2 <= m; j += 2) {
+    const __m128d now = _mm_loadh_pd(_mm_load_sd(&p[j].t), &p[j + 1].t);  // t(j), t(j+1)
+    const __m128d before = _mm_shuffle_pd(last, now, 1);                  // t(j-1), t(j)
+    const __m128d d = _mm_sub_pd(now, before);
+    n_below = _mm_sub_epi64(n_below, _mm_castpd_si128(_mm_cmplt_pd(d, g)));
+    n_at_or_below = _mm_sub_epi64(n_at_or_below, _mm_castpd_si128(_mm_cmple_pd(d, g)));
+    last = now;
+  }
+  alignas(16) std::uint64_t lanes[2];
+  _mm_store_si128(reinterpret_cast<__m128i*>(lanes), n_below);
+  below += lanes[0] + lanes[1];
+  _mm_store_si128(reinterpret_cast<__m128i*>(lanes), n_at_or_below);
+  at_or_below += lanes[0] + lanes[1];
+  if (j > 0) prev = p[j - 1].t;
+  for (; j < m; ++j) {
+    const double d = p[j].t - prev;
+    below += d < guess;
+    at_or_below += d <= guess;
+    prev = p[j].t;
+  }
 }
 
 void RunDetector::push(double t_s, double value) {
@@ -247,10 +273,13 @@ void RunDetector::push(double t_s, double value) {
   const Sample s{t_s, value};
   ring_[i & mask_] = s;
   // Track readings pinned at one positive value (a clipped converter) so the lead-in before
-  // a long clip is still buffered when the coast leaves it. (last_v_ is v(i - 1) when i > base_.)
-  if (i == base_ || value != last_v_) same_start_ = i;
-  last_v_ = value;
-  if (value > 0 && i + 1 - same_start_ >= 5) {
+  // a long clip is still buffered when the coast leaves it. last_v_ is v(i - 1) when i > base_,
+  // NaN when i == base_ (so a new reading there starts a run of its own). A changed reading is
+  // a run of one: only a repeated one can make a plateau.
+  if (value != last_v_) {
+    same_start_ = i;
+    last_v_ = value;
+  } else if (value > 0 && i + 1 - same_start_ >= 5) {
     plateau_start_ = same_start_;
     plateau_end_ = i;
     have_plateau_ = true;
@@ -279,6 +308,7 @@ void RunDetector::clock_restart() {
   need_rise_ = false;
   stream_start_ = next_index_;
   last_t_ = -std::numeric_limits<double>::infinity();
+  last_v_ = std::numeric_limits<double>::quiet_NaN();
   state_ = State::idle;
   lo_ = next_index_;
   need_quiet_ = false;

@@ -182,6 +182,10 @@ class RunDetector {
   double median_of(std::size_t from, std::size_t to);
   // The median of the sample periods in [from, to) (at least two samples), as nth_element picks it.
   double median_period(std::size_t from, std::size_t to);
+  // For the m periods ending at p[0..m) (the first one starting at prev, which becomes the time of
+  // p[m-1]), adds how many are below guess and how many at or below it.
+  static void count_periods(const Sample* p, std::size_t m, double guess, double& prev, std::size_t& below,
+                            std::size_t& at_or_below);
 
   RunOptions opt_;
   std::string source_;
@@ -197,7 +201,7 @@ class RunDetector {
   bool need_rise_ = false;      // after a stop: a new coast must start above rise_level_
   double rise_level_ = 0;
   double last_t_ = -std::numeric_limits<double>::infinity();  // -inf: no sample since the (re)start
-  double last_v_ = 0;  // the last sample's value
+  double last_v_ = std::numeric_limits<double>::quiet_NaN();  // the last sample's value; NaN: none since (re)start
   std::size_t non_finite_ = 0;
   std::size_t same_start_ = 0;  // first of the current run of identical readings
   std::size_t plateau_start_ = 0, plateau_end_ = 0;  // last long positive plateau (clipping?)
