@@ -127,7 +127,7 @@ void RunDetector::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
   const double mu = hold_.sv / hold_.n;     // hold_.mean(), n being at least 3
 
   // Power back before standstill: the reading climbs well above the coast's lowest level.
-  if (dur >= 0.5 * hold_.span_s) level_min_ = std::min(level_min_, mu);
+  if (dur >= hold_half_s_) level_min_ = std::min(level_min_, mu);
   if (s.v > level_min_ + rise_jump_) [[unlikely]] {
     if (rising_++ == 0) rise_start_ = i;
     if (rising_ >= 3) {
@@ -139,8 +139,8 @@ void RunDetector::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
   }
 
   // Standstill: the hold window is flat and low.
-  if (dur < 0.9 * hold_.span_s) return;
-  if (v0_ > 0 && mu > standstill_max_fraction * v0_) return;  // still high: the usual case, cheap
+  if (dur < hold_full_s_) return;
+  if (mu > standstill_ceiling_) return;  // still high: the usual case, cheap
   // Low: while the coast still falls the hold window is not level, and nothing else is to do.
   double sxx = 0, e = 0;
   if (!level(hold_, dur, mu, sxx, e)) return;
@@ -152,6 +152,8 @@ void RunDetector::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
 RunDetector::RunDetector(RunOptions opt, std::string source) : opt_(std::move(opt)), source_(std::move(source)) {
   hold_.span_s = opt_.stop_hold_s;
   hold_long_.span_s = 3.0 * opt_.stop_hold_s;
+  hold_half_s_ = 0.5 * hold_.span_s;
+  hold_full_s_ = 0.9 * hold_.span_s;
   ring_ = std::make_unique_for_overwrite<Sample[]>(initial_ring_size);
   mask_ = initial_ring_size - 1;
 }
@@ -238,14 +240,20 @@ void RunDetector::count_periods(const Sample* p, std::size_t m, double guess, do
   const __m128d g = _mm_set1_pd(guess);
   __m128d last = _mm_set1_pd(prev);  // high lane: the time before p[j]
   __m128i n_below = _mm_setzero_si128(), n_at_or_below = _mm_setzero_si128();
-  std::size_t j = 0;
-  for (; j + 2 <= m; j += 2) {
-    const __m128d now = _mm_loadh_pd(_mm_load_sd(&p[j].t), &p[j + 1].t);  // t(j), t(j+1)
-    const __m128d before = _mm_shuffle_pd(last, now, 1);                  // t(j-1), t(j)
-    const __m128d d = _mm_sub_pd(now, before);
+  const auto count = [&](__m128d now) {  // now: t(j), t(j+1)
+    const __m128d d = _mm_sub_pd(now, _mm_shuffle_pd(last, now, 1));  // minus t(j-1), t(j)
     n_below = _mm_sub_epi64(n_below, _mm_castpd_si128(_mm_cmplt_pd(d, g)));
     n_at_or_below = _mm_sub_epi64(n_at_or_below, _mm_castpd_si128(_mm_cmple_pd(d, g)));
     last = now;
+  };
+  std::size_t j = 0;
+  for (; j + 4 <= m; j += 4) {  // two pairs per step: half the loop overhead
+    count(_mm_loadh_pd(_mm_load_sd(&p[j].t), &p[j + 1].t));
+    count(_mm_loadh_pd(_mm_load_sd(&p[j + 2].t), &p[j + 3].t));
+  }
+  if (j + 2 <= m) {
+    count(_mm_loadh_pd(_mm_load_sd(&p[j].t), &p[j + 1].t));
+    j += 2;
   }
   alignas(16) std::uint64_t lanes[2];
   _mm_store_si128(reinterpret_cast<__m128i*>(lanes), n_below);
@@ -643,6 +651,7 @@ bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
                           sp.pin_last - sp.pin_first + 1));
   }
   v0_ = sp.v0;
+  standstill_ceiling_ = v0_ > 0 ? standstill_max_fraction * v0_ : std::numeric_limits<double>::infinity();
   coast_sd_ = sp.sd_post;
   rise_jump_ = std::max(0.1 * std::abs(v0_), 8.0 * coast_sd_);
   level_min_ = std::numeric_limits<double>::infinity();

@@ -210,6 +210,7 @@ class RunDetector {
 
   WindowFit short_{0.25}, long_{1.0}, vlong_{4.0};  // confirm a decline
   WindowFit hold_{1.0}, hold_long_{3.0};            // confirm a standstill
+  double hold_half_s_ = 0.5, hold_full_s_ = 0.9;     // hold_ durations: 0.5 and 0.9 of its span
   bool hold_long_live_ = false;
   bool creeping_ = false;  // the coast was seen approaching standstill asymptotically
   double quiet_until_s_ = -std::numeric_limits<double>::infinity();  // after a rejected cut
@@ -217,6 +218,7 @@ class RunDetector {
   // The open run.
   Run run_;
   double v0_ = 0;          // reading at the cut (start of the coast line)
+  double standstill_ceiling_ = 0;  // a hold-window mean above it is not low yet (0.3 v0_, or inf if v0_ <= 0)
   double coast_sd_ = 0;    // coast noise near the cut
   double rise_jump_ = 0;   // a reading this far above level_min_ is power coming back
   double level_min_ = 0;   // lowest hold-window mean seen in this coast
