@@ -44,19 +44,6 @@ Segmentation find_runs(const Recording& rec, const RunOptions& opt) {
     return seg;
   }
 
-  // The detector numbers only finite samples; map its indices back when some are not.
-  std::vector<std::size_t> index_of;
-  const bool all_finite = std::all_of(rec.t_s.begin(), rec.t_s.end(), [](double x) { return std::isfinite(x); }) &&
-                          std::all_of(rec.value.begin(), rec.value.end(), [](double x) { return std::isfinite(x); });
-  if (!all_finite) {
-    for (std::size_t i = 0; i < rec.size(); ++i)
-      if (std::isfinite(rec.t_s[i]) && std::isfinite(rec.value[i])) index_of.push_back(i);
-  }
-  auto map = [&](std::size_t k) {
-    if (all_finite) return k;
-    return k < index_of.size() ? index_of[k] : rec.size();
-  };
-
   std::vector<std::size_t> restarts = rec.clock_restarts;
   std::sort(restarts.begin(), restarts.end());
   auto next_restart = restarts.begin();
@@ -65,13 +52,7 @@ Segmentation find_runs(const Recording& rec, const RunOptions& opt) {
   auto collect = [&] {
     for (RunEvent& e : det.take_events()) {
       if (e.has_diagnostic) seg.diagnostics.push_back(e.diagnostic);
-      if (e.kind == RunEvent::Kind::complete) {
-        Run r = e.run;
-        r.cut_index = map(r.cut_index);
-        r.stop_index = map(r.stop_index);
-        r.end_index = map(r.end_index);
-        seg.runs.push_back(std::move(r));
-      }
+      if (e.kind == RunEvent::Kind::complete) seg.runs.push_back(std::move(e.run));  // indices mapped below
     }
   };
   for (std::size_t i = 0; i < rec.size(); ++i) {
@@ -84,6 +65,19 @@ Segmentation find_runs(const Recording& rec, const RunOptions& opt) {
   }
   det.finish();
   collect();
+  // The detector numbers only finite samples (it skips the others): when it saw fewer than all,
+  // map its indices back to the recording's. Known only now, so the runs wait for it.
+  if (det.samples_seen() != rec.size()) {
+    std::vector<std::size_t> index_of;
+    for (std::size_t i = 0; i < rec.size(); ++i)
+      if (std::isfinite(rec.t_s[i]) && std::isfinite(rec.value[i])) index_of.push_back(i);
+    const auto map = [&](std::size_t k) { return k < index_of.size() ? index_of[k] : rec.size(); };
+    for (Run& r : seg.runs) {
+      r.cut_index = map(r.cut_index);
+      r.stop_index = map(r.stop_index);
+      r.end_index = map(r.end_index);
+    }
+  }
   if (seg.runs.empty())
     diag(Diagnostic::Severity::warning,
          fmt::format("no spin-down found in {} samples (no smooth decline after a cut)", rec.size()));
