@@ -219,11 +219,18 @@ double RunDetector::median_period(std::size_t from, std::size_t to) {
     const double guess = probe[probes / 2];
     std::size_t below = 0, at_or_below = 0;
     double prev = t(from);
-    // Over the ring in stretches that do not wrap, so the loop needs no index masking.
+    // Over the ring in stretches that do not wrap, so the loop needs no index masking, and of at
+    // most `chunk` periods: the counts only grow, so the answer is often known before the end -
+    // guess is the median once h + 1 periods are at or below it and n - h at or above it, and is
+    // not once h + 1 are below it.
+    constexpr std::size_t chunk = 256;
     for (std::size_t k = from + 1; k < to;) {
-      const std::size_t stretch_end = std::min(to, (k | mask_) + 1);
+      const std::size_t stretch_end = std::min({to, (k | mask_) + 1, k + chunk});
       count_periods(ring_.get() + (k & mask_), stretch_end - k, guess, prev, below, at_or_below);
       k = stretch_end;
+      const std::size_t counted = k - from - 1, at_or_above = counted - below;
+      if (h < below) break;
+      if (h < at_or_below && at_or_above >= n - h) return guess;
     }
     if (below <= h && h < at_or_below) return guess;
   }
@@ -385,7 +392,7 @@ void RunDetector::trim_idle() {
   if (vlong_.first < base_) reset_window(vlong_, base_, next_index_);
 }
 
-bool RunDetector::confirms_decline(const WindowFit& w) const {
+[[gnu::always_inline]] inline bool RunDetector::confirms_decline(const WindowFit& w) const {
   // Cheapest tests first: an idle lead-in (zeros, a steady supply) fails one of them.
   if (w.n < 6 || w.first < lo_) return false;
   // The slope's sign is Sxy's (Sxx > 0, else the slope is 0): a level or rising window, half of
