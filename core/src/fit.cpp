@@ -186,15 +186,15 @@ class Evaluator {
   SPINDOWN_VECTOR_CLONES DecaySums decay_sums(double alpha) {
     const std::size_t n = tau_.size();
     decay(alpha, n);
-    double ee = 0, ye = 0, t_ee = 0, t_ye = 0, tt_ee = 0, tt_ye = 0;
+    enum { ee, ye, t_ee, t_ye, tt_ee, tt_ye, quantities };
+    Lanes<quantities> acc;
     const double *tau = tau_.data(), *ex = e_.get(), *w = w_.data(), *wy = wy_.get();
-#pragma omp simd reduction(+ : ee, ye, t_ee, t_ye, tt_ee, tt_ye)
-    for (std::size_t i = 0; i < n; ++i) {
+    for_each_in_lanes(0, n, [&](std::size_t i, std::size_t l) SPINDOWN_LANE_BODY {
       const double e = ex[i], t = tau[i], wee = w[i] * e * e, wye = wy[i] * e;
-      ee += wee, t_ee += t * wee, tt_ee += t * t * wee;
-      ye += wye, t_ye += t * wye, tt_ye += t * t * wye;
-    }
-    return {ee, ye, t_ee, t_ye, tt_ee, tt_ye};
+      acc.sum[ee][l] += wee, acc.sum[t_ee][l] += t * wee, acc.sum[tt_ee][l] += t * t * wee;
+      acc.sum[ye][l] += wye, acc.sum[t_ye][l] += t * wye, acc.sum[tt_ye][l] += t * t * wye;
+    });
+    return {acc.total(ee), acc.total(ye), acc.total(t_ee), acc.total(t_ye), acc.total(tt_ee), acc.total(tt_ye)};
   }
 
   // The run as the direct solutions see it: times (sorted or not), weights, weighted readings.
@@ -269,27 +269,30 @@ class Evaluator {
   template <int P, class Row>
   SPINDOWN_VECTOR_CLONES void accumulate(const Row& row) {
     static_assert(P == 2 || P == 3);
-    double sse = 0, plain = 0, r0 = 0, r1 = 0, r2 = 0, j00 = 0, j10 = 0, j11 = 0, j20 = 0, j21 = 0, j22 = 0;
+    enum { sse, plain, r0, r1, r2, j00, j10, j11, j20, j21, j22, quantities };
+    Lanes<quantities> acc;
     const double *tau = tau_.data(), *e = e_.get(), *w = w_.data(), *y = y_.data();
     double *score0 = score(0), *score1 = score(1), *score2 = score(2);
     const std::size_t m = m_;
-#pragma omp simd reduction(+ : sse, plain, r0, r1, r2, j00, j10, j11, j20, j21, j22)
-    for (std::size_t i = 0; i < m; ++i) {
+    for_each_in_lanes(0, m, [&](std::size_t i, std::size_t l) SPINDOWN_LANE_BODY {
       const auto [model, g0, g1, g2] = row.template operator()<P>(tau[i], e[i]);
       const double moving = model > 0 ? 1.0 : 0.0;
       const double d = y[i] - std::max(model, 0.0), wd = w[i] * d;
       const double gw = moving * w[i], gwd = moving * wd;  // the gradient's weights
-      sse += wd * d, plain += d * d;
-      r0 += g0 * gwd, r1 += g1 * gwd;
-      j00 += gw * g0 * g0, j10 += gw * g1 * g0, j11 += gw * g1 * g1;
-      if constexpr (P == 3) r2 += g2 * gwd, j20 += gw * g2 * g0, j21 += gw * g2 * g1, j22 += gw * g2 * g2;
+      auto& a = acc.sum;
+      a[sse][l] += wd * d, a[plain][l] += d * d;
+      a[r0][l] += g0 * gwd, a[r1][l] += g1 * gwd;
+      a[j00][l] += gw * g0 * g0, a[j10][l] += gw * g1 * g0, a[j11][l] += gw * g1 * g1;
+      if constexpr (P == 3)
+        a[r2][l] += g2 * gwd, a[j20][l] += gw * g2 * g0, a[j21][l] += gw * g2 * g1, a[j22][l] += gw * g2 * g2;
       score0[i] = g0 * gwd, score1[i] = g1 * gwd;
       if constexpr (P == 3) score2[i] = g2 * gwd;
-    }
-    last_sse_ = sse + tail_sq_[m];
-    last_plain_sse_ = plain + plain_tail_sq_[m];
-    last_jtj_ << j00, j10, j20, j10, j11, j21, j20, j21, j22;
-    last_jtr_ << r0, r1, r2;
+    });
+    last_sse_ = acc.total(sse) + tail_sq_[m];
+    last_plain_sse_ = acc.total(plain) + plain_tail_sq_[m];
+    last_jtj_ << acc.total(j00), acc.total(j10), acc.total(j20), acc.total(j10), acc.total(j11), acc.total(j21),
+        acc.total(j20), acc.total(j21), acc.total(j22);
+    last_jtr_ << acc.total(r0), acc.total(r1), acc.total(r2);
     if constexpr (P == 2) last_jtj_(2, 2) = 1;
   }
 
@@ -327,19 +330,19 @@ class Evaluator {
   SPINDOWN_VECTOR_CLONES void add_window_products(std::size_t lo, std::size_t hi, std::size_t m, std::size_t span,
                                                   double* omega) const {
     const double *c0 = score(0), *c1 = score(1), *c2 = score(2);
-    double o00 = 0, o10 = 0, o11 = 0, o20 = 0, o21 = 0, o22 = 0;
-#pragma omp simd reduction(+ : o00, o10, o11, o20, o21, o22)
-    for (std::size_t t = lo; t < hi; ++t) {
+    Lanes<6> acc;  // the lower triangle, as omega
+    for_each_in_lanes(lo, hi, [&](std::size_t t, std::size_t l) SPINDOWN_LANE_BODY {
       const std::size_t in = Stopped ? m - 1 : t;
       double s0 = c0[in], s1 = c1[in], s2 = P == 3 ? c2[in] : 0.0;
       if constexpr (Leaves) {
         s0 -= c0[t - span], s1 -= c1[t - span];
         if constexpr (P == 3) s2 -= c2[t - span];
       }
-      o00 += s0 * s0, o10 += s1 * s0, o11 += s1 * s1;
-      if constexpr (P == 3) o20 += s2 * s0, o21 += s2 * s1, o22 += s2 * s2;
-    }
-    omega[0] += o00, omega[1] += o10, omega[2] += o11, omega[3] += o20, omega[4] += o21, omega[5] += o22;
+      auto& a = acc.sum;
+      a[0][l] += s0 * s0, a[1][l] += s1 * s0, a[2][l] += s1 * s1;
+      if constexpr (P == 3) a[3][l] += s2 * s0, a[4][l] += s2 * s1, a[5][l] += s2 * s2;
+    });
+    for (std::size_t k = 0; k < 6; ++k) omega[k] += acc.total(k);
   }
 
   // e_i = exp(−α·τ_i) for the first m samples. A device clock ticks in whole units, so the
@@ -353,8 +356,11 @@ class Evaluator {
     if (alpha == decay_alpha_ && m <= decay_m_) return;
     decay_alpha_ = alpha, decay_m_ = m;
     if (step_code_.empty() || tau_.size() < 2 * anchor_every) {
-      const auto k = static_cast<Eigen::Index>(m);
+      // Over the whole run, whatever m: Eigen's vector and scalar exp may differ in the last bit,
+      // and which one a sample gets must not depend on the m asked for first.
+      const auto k = static_cast<Eigen::Index>(tau_.size());
       Eigen::Map<Eigen::ArrayXd>(e_.get(), k) = (-alpha * Eigen::Map<const Eigen::ArrayXd>(tau_.data(), k)).exp();
+      decay_m_ = tau_.size();
       return;
     }
     for (std::size_t d = 0; d < steps_.size(); ++d) step_factor_[d] = std::exp(-alpha * steps_[d]);
@@ -664,18 +670,19 @@ struct LineSums {
   }
 };
 
-// LineSums over samples [lo, hi) in one vectorised pass (the order of the additions differs from
-// adding them one by one only in rounding).
+// LineSums over samples [lo, hi) in one vectorised pass (four lanes: the order of the additions
+// differs from adding them one by one only in rounding).
 SPINDOWN_VECTOR_CLONES LineSums line_sums(std::span<const double> tau, std::span<const double> w,
                                           std::span<const double> wy, std::size_t lo, std::size_t hi) {
-  double sw = 0, st = 0, stt = 0, sy = 0, sty = 0;
+  enum { sw, st, stt, sy, sty, quantities };
+  Lanes<quantities> acc;
   const double *t = tau.data(), *ws = w.data(), *wys = wy.data();
-#pragma omp simd reduction(+ : sw, st, stt, sy, sty)
-  for (std::size_t i = lo; i < hi; ++i) {
+  for_each_in_lanes(lo, hi, [&](std::size_t i, std::size_t l) SPINDOWN_LANE_BODY {
     const double wt = ws[i] * t[i];
-    sw += ws[i], st += wt, stt += wt * t[i], sy += wys[i], sty += wys[i] * t[i];
-  }
-  return {sw, st, stt, sy, sty};
+    auto& a = acc.sum;
+    a[sw][l] += ws[i], a[st][l] += wt, a[stt][l] += wt * t[i], a[sy][l] += wys[i], a[sty][l] += wys[i] * t[i];
+  });
+  return {acc.total(sw), acc.total(st), acc.total(stt), acc.total(sy), acc.total(sty)};
 }
 
 // The Coulomb model in closed form. While moving it is the straight line u0 − β·τ, and the
@@ -717,24 +724,35 @@ std::optional<Theta> coulomb_by_line_scan(const Evaluator& eval, std::size_t hin
   };
   // The bound from the candidates at the hint; they are weighed again in the scan.
   std::size_t first = 3;
+  double bound = 0;
   if (hint >= 3 && hint <= n) {
     sums = line_sums(tau, w, wy, 0, hint);
     weigh(hint);
     if (found) {
       // The first count with P(m) ≥ G (P is monotone: a suffix sum of non-negative terms).
-      const double gain = best_q / best_d * (1 - 1e-9), total = eval.weighted_sum_sq();
+      bound = best_q / best_d * (1 - 1e-9);
+      const double total = eval.weighted_sum_sq();
       for (std::size_t hi = hint; first < hi;) {
         const std::size_t mid = first + (hi - first) / 2;
-        if (total - eval.weighted_sum_sq_from(mid) < gain) first = mid + 1;
+        if (total - eval.weighted_sum_sq_from(mid) < bound) first = mid + 1;
         else hi = mid;
       }
     }
     sums = LineSums{}, best = LineSums{}, best_q = 0, best_d = 1, best_edge = nan, found = false;
   }
-  sums = line_sums(tau, w, wy, 0, first - 1);
-  for (std::size_t m = first; m <= n; ++m) {
-    sums.add(w[m - 1], wy[m - 1], tau[m - 1]);
-    weigh(m);
+  const auto scan_from = [&](std::size_t from) {
+    sums = line_sums(tau, w, wy, 0, from - 1);
+    for (std::size_t m = from; m <= n; ++m) {
+      sums.add(w[m - 1], wy[m - 1], tau[m - 1]);
+      weigh(m);
+    }
+  };
+  scan_from(first);
+  // The bound holds if the scan's own best reaches G; a boundary test that the hint's sums and
+  // the scan's round differently could deny it that candidate: then every count is weighed.
+  if (first > 3 && !(found && best_q / best_d >= bound)) {
+    sums = LineSums{}, best = LineSums{}, best_q = 0, best_d = 1, best_edge = nan, found = false;
+    scan_from(3);
   }
   if (!found) return std::nullopt;
   return std::isnan(best_edge) ? best.plain() : best.edge(best_edge);

@@ -43,13 +43,16 @@ SPINDOWN_VECTOR_CLONES ReadingNoise estimate(std::span<const double> y, std::spa
                                              double max_ratio) {
   ReadingNoise out;
   const std::size_t n = y.size();
-  double sx = 0, sv = 0, sxx = 0, sxv = 0, x_max = 0;
-#pragma omp simd reduction(+ : sx, sv, sxx, sxv)
-  for (std::size_t i = 1; i < n - 1; ++i) {  // n ≥ 32 here
+  enum { x_sum, v_sum, xx_sum, xv_sum, quantities };
+  Lanes<quantities> acc;
+  for_each_in_lanes(1, n - 1, [&](std::size_t i, std::size_t l) SPINDOWN_LANE_BODY {  // n ≥ 32 here
     const double d = y[i + 1] - 2 * y[i] + y[i - 1];
     const double v = d * d / 6, x = mean[i] * mean[i];
-    sx += x, sv += v, sxx += x * x, sxv += x * v;
-  }
+    auto& a = acc.sum;
+    a[x_sum][l] += x, a[v_sum][l] += v, a[xx_sum][l] += x * x, a[xv_sum][l] += x * v;
+  });
+  const double sx = acc.total(x_sum), sv = acc.total(v_sum), sxx = acc.total(xx_sum), sxv = acc.total(xv_sum);
+  double x_max = 0;
 #pragma omp simd reduction(max : x_max)
   for (std::size_t i = 0; i < n; ++i) x_max = std::max(x_max, mean[i] * mean[i]);  // every sample gets a weight
   const double m = static_cast<double>(n - 2);
@@ -71,12 +74,11 @@ SPINDOWN_VECTOR_CLONES ReadingNoise estimate(std::span<const double> y, std::spa
 
 // The local means ū_i become the weights 1/σ²(ū_i) in place, scaled to average 1.
 SPINDOWN_VECTOR_CLONES void means_to_weights(std::span<double> w, const ReadingNoise& noise) {
-  double total = 0;
+  Lanes<1> total;
   double* x = w.data();
   const std::size_t n = w.size();
-#pragma omp simd reduction(+ : total)
-  for (std::size_t i = 0; i < n; ++i) total += x[i] = 1.0 / noise.variance(x[i]);
-  const double scale = static_cast<double>(n) / total;
+  for_each_in_lanes(0, n, [&](std::size_t i, std::size_t l) SPINDOWN_LANE_BODY { total.sum[0][l] += x[i] = 1.0 / noise.variance(x[i]); });
+  const double scale = static_cast<double>(n) / total.total(0);
 #pragma omp simd
   for (std::size_t i = 0; i < n; ++i) x[i] *= scale;
 }
