@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#if defined(__SSE2__)
 #include <emmintrin.h>
+#endif
 #include <fmt/format.h>
 #include <utility>
 
@@ -242,6 +244,8 @@ double RunDetector::median_period(std::size_t from, std::size_t to) {
 
 void RunDetector::count_periods(const Sample* p, std::size_t m, double guess, double& prev, std::size_t& below,
                                 std::size_t& at_or_below) {
+  std::size_t j = 0;
+#if defined(__SSE2__)  // elsewhere (arm64 benches) the plain loop below counts them all
   // Two periods per step in SSE2 lanes (t(j) - t(j-1) and t(j+1) - t(j), the same subtractions
   // and comparisons as one at a time); a true comparison is an all-ones lane, -1 when counted.
   const __m128d g = _mm_set1_pd(guess);
@@ -253,7 +257,6 @@ void RunDetector::count_periods(const Sample* p, std::size_t m, double guess, do
     n_at_or_below = _mm_sub_epi64(n_at_or_below, _mm_castpd_si128(_mm_cmple_pd(d, g)));
     last = now;
   };
-  std::size_t j = 0;
   for (; j + 4 <= m; j += 4) {  // two pairs per step: half the loop overhead
     count(_mm_loadh_pd(_mm_load_sd(&p[j].t), &p[j + 1].t));
     count(_mm_loadh_pd(_mm_load_sd(&p[j + 2].t), &p[j + 3].t));
@@ -268,6 +271,7 @@ void RunDetector::count_periods(const Sample* p, std::size_t m, double guess, do
   _mm_store_si128(reinterpret_cast<__m128i*>(lanes), n_at_or_below);
   at_or_below += lanes[0] + lanes[1];
   if (j > 0) prev = p[j - 1].t;
+#endif
   for (; j < m; ++j) {
     const double d = p[j].t - prev;
     below += d < guess;
