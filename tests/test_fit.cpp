@@ -156,6 +156,27 @@ TEST(Fit, CoulombOnlyRunIsFitExactlyByCoulomb) {
   }
 }
 
+// The combined model nests viscous and Coulomb, so its weighted SSE (from the AIC, n·log(SSE/n) +
+// 2p) is never above theirs: where LM from the integral start rests on a bound short of a nested
+// fit, the fit starts again from that fit.
+TEST(Fit, CombinedIsNeverWorseThanTheModelsItNests) {
+  for (std::uint64_t seed = 1; seed <= 40; ++seed) {
+    SyntheticRunSpec spec;
+    spec.friction = {seed % 2 ? 0.0 : 2e-7, 1.2e-4};
+    spec.noise_v = 0.004 * static_cast<double>(1 + seed % 5);
+    spec.seed = seed;
+    const Case c = make_case(spec);
+    const RunFit f = fit_case(c);
+    const ModelFit& cb = *f.model(ModelKind::combined);
+    ASSERT_TRUE(cb.converged) << cb.message;
+    for (ModelKind nested : {ModelKind::viscous, ModelKind::coulomb}) {
+      const ModelFit& m = *f.model(nested);
+      if (!m.converged) continue;
+      EXPECT_LE(cb.aic - 6, m.aic - 4 + 1e-9 * std::abs(m.aic)) << "seed " << seed << " " << model_name(nested);
+    }
+  }
+}
+
 // Pure Coulomb friction with noise puts the combined model's α on its bound 0 in some runs: there
 // the curve constants A and B are infinite and carry no standard error (not ±1e299 ± 0).
 TEST(Fit, CombinedAtZeroViscousFrictionGivesNoCurveConstants) {

@@ -347,7 +347,7 @@ bool LcmLogReader::next_checked(LcmLogEvent& event) {
       event.kind = LcmLogEvent::Kind::samples;
       return;
     }
-    reject_samples(event, data, size);
+    recheck_samples(event, data, size);
   } else if (info.kind == 2) {
     std::string why;
     if (decode_message(event.config, data, size, &why)) {
@@ -359,10 +359,16 @@ bool LcmLogReader::next_checked(LcmLogEvent& event) {
   }
 }
 
-// A SAMPLE message that view_samples_message rejects: the problem in its words.
-void LcmLogReader::reject_samples(LcmLogEvent& event, const void* data, std::int32_t size) {
+// A SAMPLE message that view_samples_message turned down, checked again by the worded check, which
+// is the reference: the problem in its words, or the message taken should the two ever disagree
+// (never a good message skipped with an empty reason).
+void LcmLogReader::recheck_samples(LcmLogEvent& event, const void* data, std::int32_t size) {
   std::string why;
-  view_samples_message_worded(event.samples_view, data, size, &why);
+  if (view_samples_message_worded(event.samples_view, data, size, &why)) {
+    if (samples_ == LcmSamples::view_and_message) samples_from_view(event.samples_view, event.samples);
+    event.kind = LcmLogEvent::Kind::samples;
+    return;
+  }
   event.kind = LcmLogEvent::Kind::problem;
   event.problem = fmt::format("event {} on {}: {}; skipped", event.number, event.channel, why);
 }

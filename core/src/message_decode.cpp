@@ -285,18 +285,7 @@ bool view_samples_message_worded(SamplesView& view, const void* data, std::int64
   constexpr std::int64_t bytes_per_sample = 8 + 8 + 8 + 4;
   if (n < 0 || n * bytes_per_sample > size - n_at - 4)
     return fail(why, fmt::format("sample count {} does not fit in {} bytes (truncated or damaged)", n, size));
-
-  view.utime = static_cast<std::int64_t>(be64u(d + 8));
-  view.bench = std::string_view(reinterpret_cast<const char*>(d + 20), static_cast<std::size_t>(bench_len - 1));
-  const unsigned char* p = d + 20 + bench_len;
-  view.seq = static_cast<std::int64_t>(be64u(p));
-  view.clock_epoch = be32(p + 8);
-  view.quantity = static_cast<std::int8_t>(p[12]);
-  view.n = static_cast<std::int32_t>(n);
-  view.device_time_bytes = d + n_at + 4;
-  view.host_time_bytes = view.device_time_bytes + 8 * n;
-  view.value_bytes = view.host_time_bytes + 8 * n;
-  view.raw_adc_bytes = view.value_bytes + 8 * n;
+  fill_samples_view(view, d, bench_len, n_at, n);
   return true;
 }
 

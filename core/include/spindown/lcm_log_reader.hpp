@@ -122,7 +122,7 @@ class LcmLogReader {
   std::int64_t find_marker(std::int64_t from);
   bool find_event_start(LcmLogEvent& event);
   void decode(LcmLogEvent& event, const ChannelInfo& info, const void* data, std::int32_t size);
-  void reject_samples(LcmLogEvent& event, const void* data, std::int32_t size);  // decode()'s rare path
+  void recheck_samples(LcmLogEvent& event, const void* data, std::int32_t size);  // decode()'s rare path
 
   std::string path_;
   LcmSamples samples_;

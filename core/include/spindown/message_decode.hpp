@@ -89,6 +89,23 @@ inline const std::uint64_t samples_fingerprint = static_cast<std::uint64_t>(samp
 // keep their capacity.
 void samples_from_view(const SamplesView& view, samples_t& m);
 
+// The view's fields from a samples_t encoding d whose layout is checked: a bench string of
+// bench_len bytes (its NUL included) and n samples from byte n_at + 4.
+inline void fill_samples_view(SamplesView& view, const unsigned char* d, std::int64_t bench_len, std::int64_t n_at,
+                              std::int64_t n) {
+  view.utime = static_cast<std::int64_t>(SamplesView::load_be64(d + 8));
+  view.bench = std::string_view(reinterpret_cast<const char*>(d + 20), static_cast<std::size_t>(bench_len - 1));
+  const unsigned char* p = d + 20 + bench_len;
+  view.seq = static_cast<std::int64_t>(SamplesView::load_be64(p));
+  view.clock_epoch = SamplesView::load_be32(p + 8);
+  view.quantity = static_cast<std::int8_t>(p[12]);
+  view.n = static_cast<std::int32_t>(n);
+  view.device_time_bytes = d + n_at + 4;
+  view.host_time_bytes = view.device_time_bytes + 8 * n;
+  view.value_bytes = view.host_time_bytes + 8 * n;
+  view.raw_adc_bytes = view.value_bytes + 8 * n;
+}
+
 [[gnu::always_inline]] inline bool view_samples_message(SamplesView& view, const void* data, std::int64_t size,
                                                       std::string* why) {
   // Fingerprint, utime and the bench string's length take the first 20 bytes; after the bench
@@ -104,18 +121,7 @@ void samples_from_view(const SamplesView& view, samples_t& m);
   if (n_at + 4 > size) return view_samples_message_worded(view, data, size, why);
   const std::int64_t n = SamplesView::load_be32(d + n_at);
   if (n < 0 || n * bytes_per_sample > size - n_at - 4) return view_samples_message_worded(view, data, size, why);
-
-  view.utime = static_cast<std::int64_t>(SamplesView::load_be64(d + 8));
-  view.bench = std::string_view(reinterpret_cast<const char*>(d + 20), static_cast<std::size_t>(bench_len - 1));
-  const unsigned char* p = d + 20 + bench_len;
-  view.seq = static_cast<std::int64_t>(SamplesView::load_be64(p));
-  view.clock_epoch = SamplesView::load_be32(p + 8);
-  view.quantity = static_cast<std::int8_t>(p[12]);
-  view.n = static_cast<std::int32_t>(n);
-  view.device_time_bytes = d + n_at + 4;
-  view.host_time_bytes = view.device_time_bytes + 8 * n;
-  view.value_bytes = view.host_time_bytes + 8 * n;
-  view.raw_adc_bytes = view.value_bytes + 8 * n;
+  fill_samples_view(view, d, bench_len, n_at, n);
   return true;
 }
 
