@@ -290,6 +290,18 @@ TEST(FitterCore, OptionsSayWhatIsWrong) {
   EXPECT_FALSE(o.is_valid(&why));
 }
 
+namespace {
+// One line per fit (bench, run, first and last seq, the first model's RMSE): what two ways of
+// feeding a core must agree on.
+std::vector<std::string> fit_lines(const CollectingSink& sink) {
+  std::vector<std::string> out;
+  for (const auto& f : sink.fits)
+    out.push_back(fmt::format("{} {} {} {} {}", f.bench, f.fit.run.number, f.first_seq, f.last_seq,
+                              f.fit.best.empty() ? 0.0 : f.fit.models.front().rmse));
+  return out;
+}
+}  // namespace
+
 // The log reader's in-place view and the decoded samples_t give the same runs, numbers and
 // counters, with benches interleaved (the bench guess) and evicted (the guess forgets them).
 TEST(FitterCore, SamplesViewAndDecodedMessageGiveTheSameResults) {
@@ -316,10 +328,7 @@ TEST(FitterCore, SamplesViewAndDecodedMessageGiveTheSameResults) {
         }
       }
     core.finish(utime);
-    std::vector<std::string> out;
-    for (const auto& f : sink.fits)
-      out.push_back(fmt::format("{} {} {} {} {}", f.bench, f.fit.run.number, f.first_seq, f.last_seq,
-                                f.fit.best.empty() ? 0.0 : f.fit.models.front().rmse));
+    std::vector<std::string> out = fit_lines(sink);
     out.push_back(fmt::format("{} {} {}", core.counters().samples, core.counters().dropped_benches, sink.runs.size()));
     return out;
   };
@@ -356,10 +365,7 @@ TEST(FitterCore, ChannelIdsGiveTheSameResultsAsBenchNames) {
           core.on_samples(id, v, utime);
       }
     core.finish(utime);
-    std::vector<std::string> out;
-    for (const auto& f : sink.fits)
-      out.push_back(fmt::format("{} {} {} {} {}", f.bench, f.fit.run.number, f.first_seq, f.last_seq,
-                                f.fit.best.empty() ? 0.0 : f.fit.models.front().rmse));
+    std::vector<std::string> out = fit_lines(sink);
     const FitterCounters& n = core.counters();
     out.push_back(fmt::format("{} {} {} {} {}", n.samples, n.sample_messages, n.dropped_benches, n.filtered,
                               sink.runs.size()));

@@ -189,6 +189,42 @@ TEST(LabLineFastPath, AgreesWithTheSlowPathOnRandomLines) {
   }
 }
 
+// The lines parse_printed_lines takes from text are exactly those parse_printed_sample takes one
+// after another (the same numbers, bit for bit), each also what the general parser parse_lab_line
+// gives, and it stops at the first it does not take (or at max_lines).
+namespace {
+
+void expect_many_lines_agree(const std::string& text, std::size_t max_lines) {
+  std::vector<double> millis, values;
+  const PrintedLines taken = parse_printed_lines(text, max_lines, millis, values);
+  ASSERT_EQ(millis.size(), taken.lines);
+  ASSERT_EQ(values.size(), taken.lines);
+  std::string_view rest = text;
+  std::size_t lines = 0;
+  while (lines < max_lines) {
+    LabLine one;
+    const std::size_t length = parse_printed_sample(rest, one);
+    if (length == 0) break;
+    ASSERT_LT(lines, taken.lines) << text;
+    EXPECT_EQ(static_cast<double>(one.millis), millis[lines]);
+    EXPECT_EQ(std::memcmp(&one.value, &values[lines], sizeof(double)), 0);
+    const LabLine general = parse_lab_line(rest.substr(0, length));
+    ASSERT_EQ(general.kind, Kind::sample) << rest.substr(0, length);
+    EXPECT_EQ(static_cast<double>(general.millis), millis[lines]) << rest.substr(0, length);
+    EXPECT_EQ(std::memcmp(&general.value, &values[lines], sizeof(double)), 0)
+        << rest.substr(0, length) << " read as " << values[lines];
+    std::size_t next = length + 1;
+    if (rest[length] == '\r' && next < rest.size() && rest[next] == '\n') ++next;
+    rest.remove_prefix(next);
+    ++lines;
+  }
+  ASSERT_EQ(lines, taken.lines) << text;
+  EXPECT_EQ(taken.bytes, text.size() - rest.size());
+}
+
+}  // namespace
+
+
 // The many-lines fast path takes exactly the lines parse_printed_sample takes, one after another,
 // with the same numbers, and stops at the first it does not (or at max_lines).
 TEST(LabLineFastPath, ManyLinesAgreeWithOneLineAtATime) {
@@ -206,28 +242,8 @@ TEST(LabLineFastPath, ManyLinesAgreeWithOneLineAtATime) {
       text += line;
       text += endings[std::uniform_int_distribution<int>(0, 2)(rng)];
     }
-    const std::size_t max_lines = round % 5 == 0 ? 7 : 64;
-    std::vector<double> millis, values;
-    const PrintedLines taken = parse_printed_lines(text, max_lines, millis, values);
-    ASSERT_EQ(millis.size(), taken.lines);
-    ASSERT_EQ(values.size(), taken.lines);
-    // One at a time, as the reader did before.
-    std::string_view rest = text;
-    std::size_t lines = 0;
-    while (lines < max_lines) {
-      LabLine one;
-      const std::size_t length = parse_printed_sample(rest, one);
-      if (length == 0) break;
-      ASSERT_LT(lines, taken.lines) << text;
-      EXPECT_EQ(static_cast<double>(one.millis), millis[lines]);
-      EXPECT_EQ(std::memcmp(&one.value, &values[lines], sizeof(double)), 0);
-      std::size_t next = length + 1;
-      if (rest[length] == '\r' && next < rest.size() && rest[next] == '\n') ++next;
-      rest.remove_prefix(next);
-      ++lines;
-    }
-    ASSERT_EQ(lines, taken.lines) << text;
-    EXPECT_EQ(taken.bytes, text.size() - rest.size());
+    expect_many_lines_agree(text, round % 5 == 0 ? 7 : 64);
+    if (HasFatalFailure()) return;
   }
 }
 
@@ -235,36 +251,6 @@ TEST(LabLineFastPath, ManyLinesAgreeWithOneLineAtATime) {
 // every line parse_printed_lines takes gives exactly what the general parser parse_lab_line gives
 // (whose value is strtod-exact: PlainDecimalsMatchFromCharsBitForBit), and it takes the same
 // lines and bytes as the one-line-at-a-time fast path. Lines it declines go to the reader's slow path.
-namespace {
-
-void expect_many_lines_agree(const std::string& text, std::size_t max_lines) {
-  std::vector<double> millis, values;
-  const PrintedLines taken = parse_printed_lines(text, max_lines, millis, values);
-  ASSERT_EQ(millis.size(), taken.lines);
-  ASSERT_EQ(values.size(), taken.lines);
-  std::string_view rest = text;
-  std::size_t lines = 0;
-  while (lines < max_lines) {
-    LabLine one;
-    const std::size_t length = parse_printed_sample(rest, one);
-    if (length == 0) break;
-    ASSERT_LT(lines, taken.lines) << text;
-    const LabLine general = parse_lab_line(rest.substr(0, length));
-    ASSERT_EQ(general.kind, Kind::sample) << rest.substr(0, length);
-    EXPECT_EQ(static_cast<double>(general.millis), millis[lines]) << rest.substr(0, length);
-    EXPECT_EQ(std::memcmp(&general.value, &values[lines], sizeof(double)), 0)
-        << rest.substr(0, length) << " read as " << values[lines];
-    std::size_t next = length + 1;
-    if (rest[length] == '\r' && next < rest.size() && rest[next] == '\n') ++next;
-    rest.remove_prefix(next);
-    ++lines;
-  }
-  ASSERT_EQ(lines, taken.lines) << text;
-  EXPECT_EQ(taken.bytes, text.size() - rest.size());
-}
-
-}  // namespace
-
 TEST(LabLineFastPath, RunsOfAlikeLinesWithDamageAgreeWithTheGeneralParser) {
   std::mt19937 rng(23);
   const std::string damage = "0123456789 \t\r\n.-+eE0x\v";
