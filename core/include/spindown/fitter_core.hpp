@@ -152,7 +152,7 @@ class FitterCore {
 
  private:
   struct Bench;
-  Bench* bench_for(std::string_view id, std::int64_t recv_utime, std::string_view kind);
+  inline Bench* bench_for(std::string_view id, std::int64_t recv_utime, std::string_view kind);
   Bench* find_bench(std::string_view id, std::int64_t recv_utime, std::string_view kind);  // past the cache
   // bench_for() for a SAMPLE channel whose id is not yet in bench_by_channel_; remembers the answer.
   Bench* bench_for_channel(std::int32_t channel_id, std::string_view bench, std::int64_t recv_utime);
@@ -169,7 +169,7 @@ class FitterCore {
   void restart_clock(Bench& b, std::int64_t recv_utime);
   void fit_and_publish(Bench& b, const Run& run, std::int64_t recv_utime);
   void publish_run(Bench& b, const Run& run, std::int8_t state, std::string note, std::int64_t utime);
-  void trim_mirror(Bench& b);
+  inline void trim_mirror(Bench& b);
 
   FitterOptions opt_;
   FitterSink& sink_;

@@ -104,10 +104,10 @@ class LcmLogReader {
     int kind = 0;           // 0 other, 1 SAMPLE, 2 CONFIG
     std::int32_t id = -1;
   };
-  const ChannelInfo& channel_info(std::string_view channel);
+  inline const ChannelInfo& channel_info(std::string_view channel);
   const ChannelInfo& find_channel(std::string_view channel);  // channel_info() past the cache
   bool next_checked(LcmLogEvent& event);  // next() for all but a whole, sound, buffered event
-  void accept(LcmLogEvent& event, const unsigned char* p, std::int32_t channel_len, std::int32_t data_len);
+  inline void accept(LcmLogEvent& event, const unsigned char* p, std::int32_t channel_len, std::int32_t data_len);
   // Makes n bytes from pos_ available in the buffer (fewer only at the end of the file or on a
   // read error); returns how many are and points *p at the first.
   std::int64_t fill(std::int64_t n, const unsigned char** p) {
@@ -121,7 +121,7 @@ class LcmLogReader {
   // Offset of the first event marker at or after from, or -1 when none follows.
   std::int64_t find_marker(std::int64_t from);
   bool find_event_start(LcmLogEvent& event);
-  void decode(LcmLogEvent& event, const ChannelInfo& info, const void* data, std::int32_t size);
+  inline void decode(LcmLogEvent& event, const ChannelInfo& info, const void* data, std::int32_t size);
   void recheck_samples(LcmLogEvent& event, const void* data, std::int32_t size);  // decode()'s rare path
 
   std::string path_;

@@ -140,25 +140,25 @@ class RunDetector {
   void grow_ring();
   // The ring's first size: a lab run (30 s at 50 Hz) fits without growing.
   static constexpr std::size_t initial_ring_size = 2048;
-  void advance(WindowFit& w, std::size_t i, Sample s);
+  inline void advance(WindowFit& w, std::size_t i, Sample s);
   void rebuild(WindowFit& w, std::size_t from, std::size_t to);
   void reset_window(WindowFit& w, std::size_t lo, std::size_t end);
   double duration(const WindowFit& w) const;
   void trim_idle();
   void idle_step(std::size_t i, Sample s);
-  void coast_step(std::size_t i, Sample s);
-  void coast_checks(std::size_t i, Sample s, bool at_end = false);
+  inline void coast_step(std::size_t i, Sample s);
+  inline void coast_checks(std::size_t i, Sample s, bool at_end = false);
   void time_went_back(double t_s);     // the note, then clock_restart()
   void coast_too_long(std::size_t i);  // max_buffer or max_coast_s reached
   void power_back();                   // the reading rose again before standstill
   void standstill_checks(std::size_t i, bool at_end, double mu, double sxx, double e);
   void tail_step(std::size_t i, Sample s);
-  bool confirms_decline(const WindowFit& w) const;
+  inline bool confirms_decline(const WindowFit& w) const;
   // Whether w shows a standstill: full, low, and no significant slope or drop.
   bool flat(const WindowFit& w) const;
   // The part of flat() after "full": low, no significant slope or drop, for w of duration d and
   // mean m. Sets sxx and e (w.sxx(), w.resid_sd()) for the caller's resolution test.
-  bool level(const WindowFit& w, double d, double m, double& sxx, double& e) const;
+  inline bool level(const WindowFit& w, double d, double m, double& sxx, double& e) const;
   // Where the cut lies in [a, b] (b = newest sample), and what came before it.
   struct CutSplit {
     std::size_t a = 0, cut_index = 0, pre_end = 0, npre = 0;
