@@ -8,7 +8,8 @@
 // Both builds must give the same bits, or a refit on one machine would not reproduce the live
 // fit of another: the files with such loops are compiled with -ffp-contract=off (no FMA in the
 // AVX2 build; core/CMakeLists.txt), and their sums go through Lanes below, never through an
-// `omp simd reduction`, whose partial sums follow the vector width.
+// `omp simd reduction`, whose partial sums follow the vector width (a max, exact in any order,
+// may stay one).
 // Not for sanitizer builds (their runtime starts after the clone is chosen) or other compilers.
 // -DSPINDOWN_VECTOR_CLONES= builds the baseline alone (to check that both give the same bits).
 #ifndef SPINDOWN_VECTOR_CLONES
