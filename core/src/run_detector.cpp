@@ -116,37 +116,51 @@ void RunDetector::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
   coast_checks(i, s);
 }
 
-// Per coasting sample; kept small (the rare outcomes are calls) since it runs for every sample.
-// s is sample i, and hold_ ends at i (it was advanced to it, or rebuilt up to it).
-[[gnu::always_inline]] inline void RunDetector::coast_checks(std::size_t i, Sample s, bool at_end) {
+// Per coasting sample; kept small (the rare outcomes are the caller's calls) since it runs for
+// every sample. s is sample i, and h (hold_, or push_many's copy of it) ends at i; level_min and
+// rising are the coast's lowest level and rise count, updated here.
+[[gnu::always_inline]] inline RunDetector::CoastVerdict RunDetector::coast_verdict(std::size_t i, Sample s,
+                                                                                 const WindowFit& h, double& level_min,
+                                                                                 int& rising) {
   const double t_i = s.t;
-  if (buffered() > opt_.max_buffer || t_i - run_.t_cut_s > opt_.max_coast_s) [[unlikely]] {
-    coast_too_long(i);
-    return;
-  }
-  if (hold_.n < 3 || hold_.first < run_.cut_index) return;
-  const double dur = t_i - t(hold_.first);  // duration(hold_), its last sample being i
-  const double mu = hold_.sv / hold_.n;     // hold_.mean(), n being at least 3
+  // i + 1 - base_ is buffered() after sample i.
+  if (i + 1 - base_ > opt_.max_buffer || t_i - run_.t_cut_s > opt_.max_coast_s) [[unlikely]]
+    return {CoastVerdict::too_long};
+  if (h.n < 3 || h.first < run_.cut_index) return {};
+  const double dur = t_i - t(h.first);  // duration(h), its last sample being i
+  const double mu = h.sv / h.n;         // h.mean(), n being at least 3
 
   // Power back before standstill: the reading climbs well above the coast's lowest level.
-  if (dur >= hold_half_s_) level_min_ = std::min(level_min_, mu);
-  if (s.v > level_min_ + rise_jump_) [[unlikely]] {
-    if (rising_++ == 0) rise_start_ = i;
-    if (rising_ >= 3) {
-      power_back();
-      return;
-    }
+  if (dur >= hold_half_s_) level_min = std::min(level_min, mu);
+  if (s.v > level_min + rise_jump_) [[unlikely]] {
+    if (rising++ == 0) rise_start_ = i;
+    if (rising >= 3) return {CoastVerdict::power_back};
   } else {
-    rising_ = 0;
+    rising = 0;
   }
 
   // Standstill: the hold window is flat and low.
-  if (dur < hold_full_s_) return;
-  if (mu > standstill_ceiling_) return;  // still high: the usual case, cheap
+  if (dur < hold_full_s_) return {};
+  if (mu > standstill_ceiling_) return {};  // still high: the usual case, cheap
   // Low: while the coast still falls the hold window is not level, and nothing else is to do.
-  double sxx = 0, e = 0;
-  if (!level(hold_, dur, mu, sxx, e)) return;
-  standstill_checks(i, at_end, mu, sxx, e);
+  CoastVerdict v{CoastVerdict::level, mu};
+  if (!level(h, dur, mu, v.sxx, v.e)) return {};
+  return v;
+}
+
+// What a verdict asks for; the state it read must be the detector's own again.
+void RunDetector::act_on(const CoastVerdict& v, std::size_t i, bool at_end) {
+  switch (v.what) {
+    case CoastVerdict::go_on: break;
+    case CoastVerdict::too_long: coast_too_long(i); break;
+    case CoastVerdict::power_back: power_back(); break;
+    case CoastVerdict::level: standstill_checks(i, at_end, v.mu, v.sxx, v.e); break;
+  }
+}
+
+[[gnu::always_inline]] inline void RunDetector::coast_checks(std::size_t i, Sample s, bool at_end) {
+  const CoastVerdict v = coast_verdict(i, s, hold_, level_min_, rising_);
+  if (v.what != CoastVerdict::go_on) [[unlikely]] act_on(v, i, at_end);
 }
 
 // ---- detector ----------------------------------------------------------------------------
@@ -280,6 +294,22 @@ void RunDetector::count_periods(const Sample* p, std::size_t m, double guess, do
   }
 }
 
+// Track readings pinned at one positive value (a clipped converter) so the lead-in before a
+// long clip is still buffered when the coast leaves it. last_v is v(i - 1) when i > base_, NaN
+// when i == base_ (so a new reading there starts a run of its own). A changed reading is a run
+// of one: only a repeated one can make a plateau.
+[[gnu::always_inline]] inline void RunDetector::track_repeats(std::size_t i, double value, std::size_t& same_start,
+                                                              double& last_v) {
+  if (value != last_v) {
+    same_start = i;
+    last_v = value;
+  } else if (value > 0 && i + 1 - same_start >= 5) {
+    plateau_start_ = same_start;
+    plateau_end_ = i;
+    have_plateau_ = true;
+  }
+}
+
 void RunDetector::push(double t_s, double value) {
   if (!std::isfinite(t_s) || !std::isfinite(value)) [[unlikely]] {
     ++non_finite_;  // reported by finish(); not a sample, so it takes no index
@@ -291,23 +321,67 @@ void RunDetector::push(double t_s, double value) {
   if (next_index_ - base_ > ring_size()) [[unlikely]] grow_ring();
   const Sample s{t_s, value};
   ring_[i & mask_] = s;
-  // Track readings pinned at one positive value (a clipped converter) so the lead-in before
-  // a long clip is still buffered when the coast leaves it. last_v_ is v(i - 1) when i > base_,
-  // NaN when i == base_ (so a new reading there starts a run of its own). A changed reading is
-  // a run of one: only a repeated one can make a plateau.
-  if (value != last_v_) {
-    same_start_ = i;
-    last_v_ = value;
-  } else if (value > 0 && i + 1 - same_start_ >= 5) {
-    plateau_start_ = same_start_;
-    plateau_end_ = i;
-    have_plateau_ = true;
-  }
+  track_repeats(i, value, same_start_, last_v_);
   switch (state_) {
     case State::idle: idle_step(i, s); break;
     case State::coasting: coast_step(i, s); break;
     case State::tail: tail_step(i, s); break;
   }
+}
+
+void RunDetector::push_many(const double* t_s, const double* value, std::size_t n) {
+  std::size_t k = 0;
+  while (k < n) {
+    if (state_ == State::coasting) {
+      const std::size_t next = coast_run(t_s, value, k, n);
+      if (next != k) {
+        k = next;
+        continue;
+      }
+    }
+    push(t_s[k], value[k]);
+    ++k;
+  }
+}
+
+// push() and coast_step() for one coasting sample after another, the same calls in the same
+// order, on copies of the state push() would read and write for them: in locals the compiler
+// keeps them in registers instead of storing every sum back. A sample push() would treat
+// otherwise (not finite, time going back, the ring full) is left to push().
+std::size_t RunDetector::coast_run(const double* t_s, const double* value, std::size_t k, const std::size_t n) {
+  const bool long_live = hold_long_live_;
+  std::size_t i = next_index_, same_start = same_start_;
+  double last_t = last_t_, last_v = last_v_, level_min = level_min_;
+  int rising = rising_;
+  WindowFit h = hold_, hl = hold_long_;
+  const auto put_back = [&] {
+    next_index_ = i;
+    same_start_ = same_start;
+    last_t_ = last_t;
+    last_v_ = last_v;
+    level_min_ = level_min;
+    rising_ = rising;
+    hold_ = h;
+    if (long_live) hold_long_ = hl;
+  };
+  for (; k < n; ++k) {
+    const Sample s{t_s[k], value[k]};
+    if (!std::isfinite(s.t) || !std::isfinite(s.v) || s.t < last_t || i + 1 - base_ > ring_size()) break;
+    last_t = s.t;
+    ring_[i & mask_] = s;
+    track_repeats(i, s.v, same_start, last_v);
+    advance(h, i, s);
+    if (long_live) advance(hl, i, s);
+    const std::size_t at = i++;
+    const CoastVerdict v = coast_verdict(at, s, h, level_min, rising);
+    if (v.what != CoastVerdict::go_on) [[unlikely]] {
+      put_back();
+      act_on(v, at, false);
+      return k + 1;
+    }
+  }
+  put_back();
+  return k;
 }
 
 // Out of line and cold: formatting the note inside push() would cost every sample a stack frame.

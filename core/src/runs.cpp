@@ -55,13 +55,16 @@ Segmentation find_runs(const Recording& rec, const RunOptions& opt) {
       if (e.kind == RunEvent::Kind::complete) seg.runs.push_back(std::move(e.run));  // indices mapped below
     }
   };
-  for (std::size_t i = 0; i < rec.size(); ++i) {
+  // The samples between declared restarts in one go; events keep their order in the detector.
+  for (std::size_t i = 0; i < rec.size();) {
     while (next_restart != restarts.end() && *next_restart <= i) {
       if (*next_restart == i && i > 0) det.clock_restart();
       ++next_restart;
     }
-    det.push(rec.t_s[i], rec.value[i]);
-    if (det.has_events()) collect();
+    const std::size_t end = next_restart != restarts.end() ? std::min(*next_restart, rec.size()) : rec.size();
+    det.push_many(rec.t_s.data() + i, rec.value.data() + i, end - i);
+    collect();
+    i = end;
   }
   det.finish();
   collect();

@@ -59,6 +59,10 @@ class RunDetector {
   // counted (reported by finish()) and otherwise ignored; time going backwards is taken as
   // a clock restart.
   void push(double t_s, double value);
+  // n samples, exactly as n calls of push() would take them (same arithmetic, same events).
+  // A whole recording's samples go through here (find_runs): the ordinary coasting sample, most
+  // of a recording, runs in a loop that keeps the detector's state in registers.
+  void push_many(const double* t_s, const double* value, std::size_t n);
   // The device clock restarted before the next sample: an open run is closed there.
   void clock_restart();
   // End of the stream: an open coast is closed (never stopped), a tail is cut short.
@@ -147,7 +151,20 @@ class RunDetector {
   void trim_idle();
   void idle_step(std::size_t i, Sample s);
   inline void coast_step(std::size_t i, Sample s);
+  // push_many's loop over samples [k, n) while coasting: push() for each, on local copies of the
+  // state it touches, up to the first sample that decides something (taken) or that push()
+  // alone handles (not taken). Returns the index of the first sample it did not take.
+  std::size_t coast_run(const double* t_s, const double* value, std::size_t k, std::size_t n);
   inline void coast_checks(std::size_t i, Sample s, bool at_end = false);
+  // What the checks of a coasting sample decided: nothing (the usual case), or one of the rare
+  // outcomes, which act_on() carries out.
+  struct CoastVerdict {
+    enum What { go_on, too_long, power_back, level } what = go_on;
+    double mu = 0, sxx = 0, e = 0;  // level: the hold window's mean, Sxx and residual sd
+  };
+  inline CoastVerdict coast_verdict(std::size_t i, Sample s, const WindowFit& h, double& level_min, int& rising);
+  void act_on(const CoastVerdict& v, std::size_t i, bool at_end);
+  inline void track_repeats(std::size_t i, double value, std::size_t& same_start, double& last_v);
   void time_went_back(double t_s);     // the note, then clock_restart()
   void coast_too_long(std::size_t i);  // max_buffer or max_coast_s reached
   void power_back();                   // the reading rose again before standstill
