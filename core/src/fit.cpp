@@ -9,6 +9,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <exception>
 #include <fmt/format.h>
 #include <limits>
@@ -147,18 +148,17 @@ class Evaluator {
         w_(weight),
         wy_(std::make_unique_for_overwrite<double[]>(tau.size())),
         tail_sq_(std::make_unique_for_overwrite<double[]>(tau.size() + 1)),
-        plain_tail_sq_(std::make_unique_for_overwrite<double[]>(tau.size() + 1)),
         e_(std::make_unique_for_overwrite<double[]>(tau.size())),
         scores_(std::make_unique_for_overwrite<double[]>(3 * tau.size())),
         lags_(newey_west_lags(tau.size())),
         sorted_(std::is_sorted(tau.begin(), tau.end())) {
     const std::size_t n = tau.size();
     double sum_y = 0;
-    tail_sq_[n] = plain_tail_sq_[n] = 0;
+    tail_sq_[n] = 0;
+#pragma GCC unroll 4  // a short sequential body: the loop's own count and test were much of it
     for (std::size_t i = n; i-- > 0;) {
       const double yy = y[i] * y[i];
       tail_sq_[i] = tail_sq_[i + 1] + weight[i] * yy;
-      plain_tail_sq_[i] = plain_tail_sq_[i + 1] + yy;
       wy_[i] = weight[i] * y[i];
       sum_y += y[i];
     }
@@ -225,7 +225,11 @@ class Evaluator {
   // Σ(y − model)² without the weights at θ (for RMSE and R², in the reading's unit).
   double plain_sse(const Family& f, const Theta& th) {
     (*this)(f, th);
-    return last_plain_sse_;
+    // The stopped tail's Σy², summed from the end as the suffix sums are: asked for once per model,
+    // so not kept for every m.
+    double tail = 0;
+    for (std::size_t i = tau_.size(); i-- > m_;) tail += y_[i] * y_[i];
+    return last_plain_moving_ + tail;
   }
 
   // Newey–West's bandwidth for n samples: L = ⌈4·(n/100)^(2/9)⌉.
@@ -271,11 +275,15 @@ class Evaluator {
     static_assert(P == 2 || P == 3);
     enum { sse, plain, r0, r1, r2, j00, j10, j11, j20, j21, j22, quantities };
     Lanes<quantities> acc;
-    const double *tau = tau_.data(), *e = e_.get(), *w = w_.data(), *y = y_.data();
-    double *score0 = score(0), *score1 = score(1), *score2 = score(2);
+    // The scores are the only stores: restrict and a local copy of the row tell the compiler they
+    // change no input, which it would otherwise reload every iteration.
+    const Row local_row = row;
+    const double *__restrict tau = tau_.data(), *__restrict e = e_.get(), *__restrict w = w_.data(),
+                             *__restrict y = y_.data();
+    double *__restrict score0 = score(0), *__restrict score1 = score(1), *__restrict score2 = score(2);
     const std::size_t m = m_;
     for_each_in_lanes(0, m, [&](std::size_t i, std::size_t l) SPINDOWN_LANE_BODY {
-      const auto [model, g0, g1, g2] = row.template operator()<P>(tau[i], e[i]);
+      const auto [model, g0, g1, g2] = local_row.template operator()<P>(tau[i], e[i]);
       const double moving = model > 0 ? 1.0 : 0.0;
       const double d = y[i] - std::max(model, 0.0), wd = w[i] * d;
       const double gw = moving * w[i], gwd = moving * wd;  // the gradient's weights
@@ -289,7 +297,7 @@ class Evaluator {
       if constexpr (P == 3) score2[i] = g2 * gwd;
     });
     last_sse_ = acc.total(sse) + tail_sq_[m];
-    last_plain_sse_ = acc.total(plain) + plain_tail_sq_[m];
+    last_plain_moving_ = acc.total(plain);
     last_jtj_ << acc.total(j00), acc.total(j10), acc.total(j20), acc.total(j10), acc.total(j11), acc.total(j21),
         acc.total(j20), acc.total(j21), acc.total(j22);
     last_jtr_ << acc.total(r0), acc.total(r1), acc.total(r2);
@@ -308,6 +316,7 @@ class Evaluator {
     if (m > 0) {
       double *c0 = score(0), *c1 = score(1), *c2 = score(2);
       double total0 = 0, total1 = 0, total2 = 0;  // in registers: the columns are one array
+#pragma GCC unroll 4  // sequential, a few instructions per sample: unrolled, the loop's own are fewer
       for (std::size_t i = 0; i < m; ++i) {
         c0[i] = total0 += c0[i], c1[i] = total1 += c1[i];
         if constexpr (P == 3) c2[i] = total2 += c2[i];
@@ -355,7 +364,7 @@ class Evaluator {
   void decay(double alpha, std::size_t m) {
     if (alpha == decay_alpha_ && m <= decay_m_) return;
     decay_alpha_ = alpha, decay_m_ = m;
-    if (step_code_.empty() || tau_.size() < 2 * anchor_every) {
+    if (!step_code_ || tau_.size() < 2 * anchor_every) {
       // Over the whole run, whatever m: Eigen's vector and scalar exp may differ in the last bit,
       // and which one a sample gets must not depend on the m asked for first.
       const auto k = static_cast<Eigen::Index>(tau_.size());
@@ -365,7 +374,7 @@ class Evaluator {
     }
     for (std::size_t d = 0; d < steps_.size(); ++d) step_factor_[d] = std::exp(-alpha * steps_[d]);
     const double* factor = step_factor_.data();
-    const std::uint8_t* code = step_code_.data();
+    const std::uint8_t* code = step_code_.get();
     double* out = e_.get();
     constexpr std::size_t group = 4 * anchor_every;
     std::size_t anchor = 0;
@@ -375,6 +384,7 @@ class Evaluator {
       const double* t = tau_.data() + anchor;
       double e0 = o0[0] = std::exp(-alpha * t[0]), e1 = o1[0] = std::exp(-alpha * t[anchor_every]);
       double e2 = o2[0] = std::exp(-alpha * t[2 * anchor_every]), e3 = o3[0] = std::exp(-alpha * t[3 * anchor_every]);
+#pragma GCC unroll 3  // 63 steps of four chains: the loop's own count and test were a fifth of it
       for (std::size_t j = 1; j < anchor_every; ++j) {
         o0[j] = e0 *= factor[c0[j]];
         o1[j] = e1 *= factor[c1[j]];
@@ -390,37 +400,45 @@ class Evaluator {
 
   // Codes each sample's step τ_i − τ_(i−1) by its distinct value, bit for bit. The steps of a
   // run are a few clock periods, each in a few rounding variants (~15 in a PuTTY log), so they are
-  // found through a small open-addressed table instead of a search along the list.
-  void index_time_steps() {
+  // found through a small open-addressed table instead of a search along the list. A step already
+  // in its home slot (nearly all of them) takes the short way: one probe, no further tests.
+  // Out of line: inlined into fit_run, its loop kept its pointers and the step on the stack.
+  [[gnu::noinline]] void index_time_steps() {
     constexpr std::size_t max_steps = 32, slots = 64;  // at most half full: probes stay short
     const std::size_t n = tau_.size();
     if (!sorted_ || n < 2) return;
     std::array<std::uint64_t, slots> key{};
     std::array<std::uint8_t, slots> code_plus_one{};  // 0: the slot is free
-    std::vector<std::uint8_t> code(n);
-    std::uint64_t last_bits = 0;
+    auto code = std::make_unique_for_overwrite<std::uint8_t[]>(n);  // code[0] is never read
+    // No "last" step before the first: bits that differ from the first step's in every place.
+    std::uint64_t last_bits = ~std::bit_cast<std::uint64_t>(tau_[1] - tau_[0]);
     std::uint8_t last_code = 0;
-    bool have_last = false;
+    const double* tau = tau_.data();  // a local: the byte stores below could alias a member
+    double before = tau[0];
     for (std::size_t i = 1; i < n; ++i) {
-      const double step = tau_[i] - tau_[i - 1];
-      const auto bits = std::bit_cast<std::uint64_t>(step);
-      if (!have_last || bits != last_bits) {
-        if (!std::isfinite(step)) {  // no product chain through a step that is not a number
-          steps_.clear();
-          return;
-        }
+      const double now = tau[i];
+      const auto bits = std::bit_cast<std::uint64_t>(now - before);
+      before = now;
+      if (bits != last_bits) {
         std::size_t slot = static_cast<std::size_t>((bits * 0x9E3779B97F4A7C15ull) >> 58);
-        while (code_plus_one[slot] != 0 && key[slot] != bits) slot = (slot + 1) % slots;
-        if (code_plus_one[slot] == 0) {
-          if (steps_.size() == max_steps) {  // jittered clock: one exponential per sample
+        if (key[slot] != bits || code_plus_one[slot] == 0) {  // only finite steps are entered
+          const double step = std::bit_cast<double>(bits);  // from the bits: nothing kept for this rare path
+          if (!std::isfinite(step)) {  // no product chain through a step that is not a number
             steps_.clear();
             return;
           }
-          steps_.push_back(step);
-          key[slot] = bits;
-          code_plus_one[slot] = static_cast<std::uint8_t>(steps_.size());
+          while (code_plus_one[slot] != 0 && key[slot] != bits) slot = (slot + 1) % slots;
+          if (code_plus_one[slot] == 0) {
+            if (steps_.size() == max_steps) {  // jittered clock: one exponential per sample
+              steps_.clear();
+              return;
+            }
+            steps_.push_back(step);
+            key[slot] = bits;
+            code_plus_one[slot] = static_cast<std::uint8_t>(steps_.size());
+          }
         }
-        last_bits = bits, last_code = static_cast<std::uint8_t>(code_plus_one[slot] - 1), have_last = true;
+        last_bits = bits, last_code = static_cast<std::uint8_t>(code_plus_one[slot] - 1);
       }
       code[i] = last_code;
     }
@@ -429,13 +447,13 @@ class Evaluator {
   }
   static constexpr std::size_t anchor_every = 64;
   std::vector<double> steps_, step_factor_;
-  std::vector<std::uint8_t> step_code_;
+  std::unique_ptr<std::uint8_t[]> step_code_;  // null: no product chains (see decay)
   double decay_alpha_ = nan;  // e_ holds e^(−α·τ) for this α over the first decay_m_ samples
   std::size_t decay_m_ = 0;
 
   std::span<const double> tau_, y_, w_;
-  // Weighted readings, and the suffix sums Σ_(j≥i) w·y² and Σ_(j≥i) y² (n + 1 each).
-  std::unique_ptr<double[]> wy_, tail_sq_, plain_tail_sq_;
+  // Weighted readings, and the suffix sums Σ_(j≥i) w·y² (n + 1).
+  std::unique_ptr<double[]> wy_, tail_sq_;
   // Scratch the passes overwrite before reading: e^(−ατ), and each column's scores g_j·w·r.
   std::unique_ptr<double[]> e_, scores_;
   double* score(int j) const { return scores_.get() + static_cast<std::size_t>(j) * tau_.size(); }
@@ -451,7 +469,7 @@ class Evaluator {
   bool last_valid_ = false, last_has_omega_ = false;
   Family last_f_{false, false};
   Theta last_th_;
-  double last_sse_ = 0, last_plain_sse_ = 0;
+  double last_sse_ = 0, last_plain_moving_ = 0;  // plain: Σ(y − model)² before the stop
   Eigen::Matrix3d last_jtj_, last_omega_;
   Eigen::Vector3d last_jtr_;
 };
@@ -495,15 +513,43 @@ struct IntegralForm {
   Eigen::Vector3d atb = Eigen::Vector3d::Zero();
 };
 
-IntegralForm integral_form(std::span<const double> tau, std::span<const double> y, std::size_t moving) {
-  // Scalar sums: a 3×3 outer product per sample costs several times more.
-  double integral = 0, s_i = 0, s_t = 0, s_ii = 0, s_it = 0, s_tt = 0, s_y = 0, s_iy = 0, s_ty = 0;
-  for (std::size_t i = 0; i < moving; ++i) {
-    if (i > 0) integral += 0.5 * (y[i] + y[i - 1]) * (tau[i] - tau[i - 1]);
-    const double t = tau[i], v = y[i];
-    s_i += integral, s_t += t, s_ii += integral * integral, s_it += integral * t, s_tt += t * t;
-    s_y += v, s_iy += integral * v, s_ty += t * v;
+// The eight sums are eight independent chains in sample order, kept side by side in vectors of
+// four (GCC's vector extension: each lane is the scalar operation, so every build, of any vector
+// width, gives the scalar loop's bits): Σ(∫, τ, y), Σ∫·(∫, τ, y) and Στ·(·, τ, y). Four samples
+// at a time: their trapezoids in one vector operation, the running integral through them in
+// order, then a 4×4 transpose turns the columns (∫, τ, y) into each sample's row.
+SPINDOWN_VECTOR_CLONES IntegralForm integral_form(std::span<const double> tau, std::span<const double> y,
+                                                  std::size_t moving) {
+  using Four = double __attribute__((vector_size(4 * sizeof(double))));
+  using Pick = std::int64_t __attribute__((vector_size(4 * sizeof(std::int64_t))));
+  const auto load = [](Four& v, const double* p) { std::memcpy(&v, p, sizeof v); };  // no vector return: ABI
+  Four plain = {}, by_integral = {}, by_time = {};
+  const auto add = [&](double integral, double t, const Four& row) {  // row: (∫, τ, y, 0)
+    plain += row, by_integral += integral * row, by_time += t * row;
+  };
+  double integral = 0;
+  if (moving > 0) add(integral, tau[0], Four{integral, tau[0], y[0], 0.0});
+  std::size_t i = 1;
+  for (; i + 4 <= moving; i += 4) {
+    Four t, v, t_before, y_before;
+    load(t, &tau[i]), load(v, &y[i]), load(t_before, &tau[i - 1]), load(y_before, &y[i - 1]);
+    const Four step = 0.5 * (v + y_before) * (t - t_before);
+    const double i0 = integral + step[0], i1 = i0 + step[1], i2 = i1 + step[2], i3 = i2 + step[3];
+    integral = i3;
+    const Four in = {i0, i1, i2, i3}, zero = {};
+    const Four even = __builtin_shuffle(in, t, Pick{0, 4, 2, 6}), odd = __builtin_shuffle(in, t, Pick{1, 5, 3, 7});
+    const Four even_y = __builtin_shuffle(v, zero, Pick{0, 4, 2, 6}), odd_y = __builtin_shuffle(v, zero, Pick{1, 5, 3, 7});
+    add(i0, t[0], __builtin_shuffle(even, even_y, Pick{0, 1, 4, 5}));
+    add(i1, t[1], __builtin_shuffle(odd, odd_y, Pick{0, 1, 4, 5}));
+    add(i2, t[2], __builtin_shuffle(even, even_y, Pick{2, 3, 6, 7}));
+    add(i3, t[3], __builtin_shuffle(odd, odd_y, Pick{2, 3, 6, 7}));
   }
+  for (; i < moving; ++i) {
+    integral += 0.5 * (y[i] + y[i - 1]) * (tau[i] - tau[i - 1]);
+    add(integral, tau[i], Four{integral, tau[i], y[i], 0.0});
+  }
+  const double s_i = plain[0], s_t = plain[1], s_y = plain[2], s_ii = by_integral[0], s_it = by_integral[1],
+               s_iy = by_integral[2], s_tt = by_time[1], s_ty = by_time[2];
   IntegralForm out;  // columns (1, −∫r, −τ)
   out.ata << static_cast<double>(moving), -s_i, -s_t, -s_i, s_ii, s_it, -s_t, s_it, s_tt;
   out.atb << s_y, -s_iy, -s_ty;
@@ -672,17 +718,49 @@ struct LineSums {
 
 // LineSums over samples [lo, hi) in one vectorised pass (four lanes: the order of the additions
 // differs from adding them one by one only in rounding).
-SPINDOWN_VECTOR_CLONES LineSums line_sums(std::span<const double> tau, std::span<const double> w,
-                                          std::span<const double> wy, std::size_t lo, std::size_t hi) {
-  enum { sw, st, stt, sy, sty, quantities };
-  Lanes<quantities> acc;
-  const double *t = tau.data(), *ws = w.data(), *wys = wy.data();
+using LineLanes = Lanes<5>;  // Σw, Σw·τ, Σw·τ², Σw·y, Σw·τ·y
+SPINDOWN_LANE_BODY inline void add_line_lanes(LineLanes& acc, const double* t, const double* ws, const double* wys,
+                                              std::size_t lo, std::size_t hi) {
   for_each_in_lanes(lo, hi, [&](std::size_t i, std::size_t l) SPINDOWN_LANE_BODY {
     const double wt = ws[i] * t[i];
     auto& a = acc.sum;
-    a[sw][l] += ws[i], a[st][l] += wt, a[stt][l] += wt * t[i], a[sy][l] += wys[i], a[sty][l] += wys[i] * t[i];
+    a[0][l] += ws[i], a[1][l] += wt, a[2][l] += wt * t[i], a[3][l] += wys[i], a[4][l] += wys[i] * t[i];
   });
-  return {acc.total(sw), acc.total(st), acc.total(stt), acc.total(sy), acc.total(sty)};
+}
+LineSums line_total(const LineLanes& acc) { return {acc.total(0), acc.total(1), acc.total(2), acc.total(3), acc.total(4)}; }
+
+SPINDOWN_VECTOR_CLONES LineSums line_sums(std::span<const double> tau, std::span<const double> w,
+                                          std::span<const double> wy, std::size_t lo, std::size_t hi) {
+  LineLanes acc;
+  add_line_lanes(acc, tau.data(), w.data(), wy.data(), lo, hi);
+  return line_total(acc);
+}
+
+// Counted from sample 0, sample i adds to lane i mod 4 in order, so the lanes over [0, m) are
+// those over [0, c), c any multiple of 4 up to m, plus the samples [c, m). The Coulomb scan needs
+// the sums up to the hint and then up to an earlier count: line_sums(0, hi) keeps its lanes
+// every checkpoint_every samples (checkpoint k holds [0, k·checkpoint_every)), and the shorter
+// prefix continues from one, bit for bit what line_sums(0, m) gives, instead of starting again.
+constexpr std::size_t checkpoint_every = 64;  // a multiple of the four lanes
+constexpr std::size_t checkpoint_size = sizeof(LineLanes::sum) / sizeof(double);  // doubles per checkpoint
+SPINDOWN_VECTOR_CLONES LineSums line_sums_with_checkpoints(std::span<const double> tau, std::span<const double> w,
+                                                           std::span<const double> wy, std::size_t hi,
+                                                           double* checkpoints) {
+  LineLanes acc;
+  for (std::size_t lo = 0, k = 0; lo < hi; lo += checkpoint_every, ++k) {
+    std::memcpy(checkpoints + k * checkpoint_size, acc.sum, sizeof acc.sum);
+    add_line_lanes(acc, tau.data(), w.data(), wy.data(), lo, std::min(lo + checkpoint_every, hi));
+  }
+  return line_total(acc);
+}
+SPINDOWN_VECTOR_CLONES LineSums line_sums_from_checkpoint(std::span<const double> tau, std::span<const double> w,
+                                                          std::span<const double> wy, std::size_t m,
+                                                          const double* checkpoints) {
+  const std::size_t k = m / checkpoint_every;
+  LineLanes acc;
+  std::memcpy(acc.sum, checkpoints + k * checkpoint_size, sizeof acc.sum);
+  add_line_lanes(acc, tau.data(), w.data(), wy.data(), k * checkpoint_every, m);
+  return line_total(acc);
 }
 
 // The Coulomb model in closed form. While moving it is the straight line u0 − β·τ, and the
@@ -707,11 +785,12 @@ std::optional<Theta> coulomb_by_line_scan(const Evaluator& eval, std::size_t hin
   LineSums sums, best;
   double best_q = 0, best_d = 1, best_edge = nan;  // best_edge: the stop te if the winner is an edge
   bool found = false;
-  const auto take = [&](double q, double d, double edge) {
+  const auto take = [&](double q, double d, double edge) SPINDOWN_LANE_BODY {
     if (q * best_d > best_q * d) best_q = q, best_d = d, best = sums, best_edge = edge, found = true;
   };
-  // The candidates with m moving samples, given their sums.
-  const auto weigh = [&](std::size_t m) {
+  // The candidates with m moving samples, given their sums. Inlined (as take) into the scan, so
+  // that the running sums stay in registers.
+  const auto weigh = [&](std::size_t m) SPINDOWN_LANE_BODY {
     const double t = tau[m - 1];
     // The plain line over the first m counts if it falls (U, B > 0) and stops in (τ[m−1], τ[m]].
     const double det = sums.det(), U = sums.u(), B = sums.b();
@@ -725,8 +804,11 @@ std::optional<Theta> coulomb_by_line_scan(const Evaluator& eval, std::size_t hin
   // The bound from the candidates at the hint; they are weighed again in the scan.
   std::size_t first = 3;
   double bound = 0;
+  // The hint's lanes, for the scan's start (never past the hint); written before read, not zeroed.
+  std::unique_ptr<double[]> checkpoints;
   if (hint >= 3 && hint <= n) {
-    sums = line_sums(tau, w, wy, 0, hint);
+    checkpoints = std::make_unique_for_overwrite<double[]>((hint + checkpoint_every - 1) / checkpoint_every * checkpoint_size);
+    sums = line_sums_with_checkpoints(tau, w, wy, hint, checkpoints.get());
     weigh(hint);
     if (found) {
       // The first count with P(m) ≥ G (P is monotone: a suffix sum of non-negative terms).
@@ -741,7 +823,8 @@ std::optional<Theta> coulomb_by_line_scan(const Evaluator& eval, std::size_t hin
     sums = LineSums{}, best = LineSums{}, best_q = 0, best_d = 1, best_edge = nan, found = false;
   }
   const auto scan_from = [&](std::size_t from) {
-    sums = line_sums(tau, w, wy, 0, from - 1);
+    sums = checkpoints ? line_sums_from_checkpoint(tau, w, wy, from - 1, checkpoints.get())
+                       : line_sums(tau, w, wy, 0, from - 1);
     for (std::size_t m = from; m <= n; ++m) {
       sums.add(w[m - 1], wy[m - 1], tau[m - 1]);
       weigh(m);
@@ -1012,17 +1095,22 @@ RunFit fit_run(std::span<const double> t_s, std::span<const double> value, Quant
   const double k = value_per_rad_per_s(q, opt.bench.kb_v_s_per_rad);
 
   const std::size_t n = end - begin;
-  const auto tau_buffer = std::make_unique_for_overwrite<double[]>(n);
-  const auto y_buffer = std::make_unique_for_overwrite<double[]>(n);
-  const std::span<double> tau(tau_buffer.get(), n), y(y_buffer.get(), n);
-  for (std::size_t i = begin; i < end; ++i) {
-    tau[i - begin] = t_s[i] - run.t_cut_s;
-    y[i - begin] = value[i] - run.zero_level;
+  // τ, y and the weights in one buffer, written before they are read: no zeroing.
+  const auto buffer = std::make_unique_for_overwrite<double[]>(3 * n);
+  const std::span<double> tau(buffer.get(), n), y(buffer.get() + n, n), weight(buffer.get() + 2 * n, n);
+  {
+    // Restrict: the buffer is our own, so the loop vectorises without a test for overlap.
+    const double *__restrict t_in = t_s.data() + begin, *__restrict v_in = value.data() + begin;
+    double *__restrict t_out = tau.data(), *__restrict y_out = y.data();
+    const double t_cut = run.t_cut_s, zero = run.zero_level;
+#pragma omp simd
+    for (std::size_t i = 0; i < n; ++i) t_out[i] = t_in[i] - t_cut, y_out[i] = v_in[i] - zero;
   }
   const std::size_t moving = (run.stopped ? stop : end) - begin;
   const std::string_view runit = quantity_unit(q);
   // Weights from the run's own noise (σ² growing with the reading), shared by every model.
-  const std::vector<double> weight = opt.weighted ? weigh_by_noise(y).weight : std::vector<double>(y.size(), 1.0);
+  if (opt.weighted) weigh_by_noise_into(y, weight);
+  else std::fill(weight.begin(), weight.end(), 1.0);
   Evaluator eval(tau, y, weight);  // one workspace for every model of the run
   const IntegralForm form = integral_form(tau, y, moving);
   for (ModelKind kind : opt.models)

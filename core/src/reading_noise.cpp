@@ -14,10 +14,10 @@ constexpr std::size_t half_window = 8;
 
 // ū_i: mean of y over [i − h, i + h] clipped to the run, as a sliding window sum. Each step
 // adds y_(i+h) while there is one, then takes out y_(i−h−1) once there is one; the loops below
-// are those steps with the two tests decided per range of i (same sums, same order).
-std::vector<double> local_means(std::span<const double> y) {
+// are those steps with the two tests decided per range of i (same sums, same order). Into mean
+// (n values, written not read: the caller's buffer need not be zeroed first).
+void local_means(std::span<const double> y, double* mean) {
   const std::size_t n = y.size(), h = half_window;  // n ≥ 2h + 2 here
-  std::vector<double> mean(n);
   double sum = 0;
   for (std::size_t j = 0; j < h; ++j) sum += y[j];
   std::size_t i = 0;
@@ -26,6 +26,7 @@ std::vector<double> local_means(std::span<const double> y) {
     mean[i] = sum / static_cast<double>(i + h + 1);
   }
   constexpr double full = 2 * half_window + 1;
+#pragma GCC unroll 4  // a sequential sum of a few instructions per sample: fewer loop tests
   for (; i + h < n; ++i) {  // full width
     sum += y[i + h];
     sum -= y[i - h - 1];
@@ -35,7 +36,6 @@ std::vector<double> local_means(std::span<const double> y) {
     sum -= y[i - h - 1];
     mean[i] = sum / static_cast<double>(n - i + h);
   }
-  return mean;
 }
 
 // Least squares of v_i = d_i²/6 on x_i = ū_i², d the second difference.
@@ -45,16 +45,18 @@ SPINDOWN_VECTOR_CLONES ReadingNoise estimate(std::span<const double> y, std::spa
   const std::size_t n = y.size();
   enum { x_sum, v_sum, xx_sum, xv_sum, quantities };
   Lanes<quantities> acc;
+  double lane_max[Lanes<quantities>::count] = {};  // the largest x, per lane (a max is exact in any order)
   for_each_in_lanes(1, n - 1, [&](std::size_t i, std::size_t l) SPINDOWN_LANE_BODY {  // n ≥ 32 here
     const double d = y[i + 1] - 2 * y[i] + y[i - 1];
     const double v = d * d / 6, x = mean[i] * mean[i];
     auto& a = acc.sum;
     a[x_sum][l] += x, a[v_sum][l] += v, a[xx_sum][l] += x * x, a[xv_sum][l] += x * v;
+    lane_max[l] = std::max(lane_max[l], x);
   });
   const double sx = acc.total(x_sum), sv = acc.total(v_sum), sxx = acc.total(xx_sum), sxv = acc.total(xv_sum);
-  double x_max = 0;
-#pragma omp simd reduction(max : x_max)
-  for (std::size_t i = 0; i < n; ++i) x_max = std::max(x_max, mean[i] * mean[i]);  // every sample gets a weight
+  // Every sample gets a weight: the two ends, outside the sums' range, count too.
+  double x_max = std::max({lane_max[0], lane_max[1], lane_max[2], lane_max[3], mean[0] * mean[0],
+                           mean[n - 1] * mean[n - 1]});
   const double m = static_cast<double>(n - 2);
   const double det = m * sxx - sx * sx;
   double a = sv / m, b = 0;  // constant variance unless the reading explains it
@@ -73,7 +75,8 @@ SPINDOWN_VECTOR_CLONES ReadingNoise estimate(std::span<const double> y, std::spa
 }
 
 // The local means ū_i become the weights 1/σ²(ū_i) in place, scaled to average 1.
-SPINDOWN_VECTOR_CLONES void means_to_weights(std::span<double> w, const ReadingNoise& noise) {
+SPINDOWN_VECTOR_CLONES void means_to_weights(std::span<double> w, const ReadingNoise& noise_in) {
+  const ReadingNoise noise = noise_in;  // a copy: the stores to w cannot change it, so no reloads
   Lanes<1> total;
   double* x = w.data();
   const std::size_t n = w.size();
@@ -85,20 +88,24 @@ SPINDOWN_VECTOR_CLONES void means_to_weights(std::span<double> w, const ReadingN
 
 }  // namespace
 
+ReadingNoise weigh_by_noise_into(std::span<const double> y, std::span<double> weight, double max_ratio) {
+  ReadingNoise noise;
+  if (y.size() >= 32) {
+    local_means(y, weight.data());
+    noise = estimate(y, weight, max_ratio);
+    if (noise.known) {
+      means_to_weights(weight, noise);  // one buffer, no second allocation
+      return noise;
+    }
+  }
+  std::fill(weight.begin(), weight.end(), 1.0);
+  return noise;
+}
+
 NoiseWeights weigh_by_noise(std::span<const double> y, double max_ratio) {
   NoiseWeights out;
-  if (y.size() < 32) {
-    out.weight.assign(y.size(), 1.0);
-    return out;
-  }
-  std::vector<double> mean = local_means(y);
-  out.noise = estimate(y, mean, max_ratio);
-  if (!out.noise.known) {
-    out.weight.assign(y.size(), 1.0);
-    return out;
-  }
-  means_to_weights(mean, out.noise);  // one buffer, no second allocation
-  out.weight = std::move(mean);
+  out.weight.resize(y.size());
+  out.noise = weigh_by_noise_into(y, out.weight, max_ratio);
   return out;
 }
 

@@ -38,5 +38,8 @@ struct NoiseWeights {
   std::vector<double> weight;  // one per reading
 };
 NoiseWeights weigh_by_noise(std::span<const double> y, double max_ratio = 4.0);
+// The same into weight (y.size() values, overwritten): the fit's own buffer, which then needs no
+// zeroing or allocation of its own.
+ReadingNoise weigh_by_noise_into(std::span<const double> y, std::span<double> weight, double max_ratio = 4.0);
 
 }  // namespace spindown
