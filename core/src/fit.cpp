@@ -514,14 +514,13 @@ struct IntegralForm {
 };
 
 // The eight sums are eight independent chains in sample order, kept side by side in vectors of
-// four (GCC's vector extension: each lane is the scalar operation, so every build, of any vector
+// four (the GCC/Clang vector extension: each lane is the scalar operation, so every build, of any vector
 // width, gives the scalar loop's bits): Σ(∫, τ, y), Σ∫·(∫, τ, y) and Στ·(·, τ, y). Four samples
 // at a time: their trapezoids in one vector operation, the running integral through them in
 // order, then a 4×4 transpose turns the columns (∫, τ, y) into each sample's row.
 SPINDOWN_VECTOR_CLONES IntegralForm integral_form(std::span<const double> tau, std::span<const double> y,
                                                   std::size_t moving) {
   using Four = double __attribute__((vector_size(4 * sizeof(double))));
-  using Pick = std::int64_t __attribute__((vector_size(4 * sizeof(std::int64_t))));
   const auto load = [](Four& v, const double* p) { std::memcpy(&v, p, sizeof v); };  // no vector return: ABI
   Four plain = {}, by_integral = {}, by_time = {};
   const auto add = [&](double integral, double t, const Four& row) {  // row: (∫, τ, y, 0)
@@ -537,12 +536,12 @@ SPINDOWN_VECTOR_CLONES IntegralForm integral_form(std::span<const double> tau, s
     const double i0 = integral + step[0], i1 = i0 + step[1], i2 = i1 + step[2], i3 = i2 + step[3];
     integral = i3;
     const Four in = {i0, i1, i2, i3}, zero = {};
-    const Four even = __builtin_shuffle(in, t, Pick{0, 4, 2, 6}), odd = __builtin_shuffle(in, t, Pick{1, 5, 3, 7});
-    const Four even_y = __builtin_shuffle(v, zero, Pick{0, 4, 2, 6}), odd_y = __builtin_shuffle(v, zero, Pick{1, 5, 3, 7});
-    add(i0, t[0], __builtin_shuffle(even, even_y, Pick{0, 1, 4, 5}));
-    add(i1, t[1], __builtin_shuffle(odd, odd_y, Pick{0, 1, 4, 5}));
-    add(i2, t[2], __builtin_shuffle(even, even_y, Pick{2, 3, 6, 7}));
-    add(i3, t[3], __builtin_shuffle(odd, odd_y, Pick{2, 3, 6, 7}));
+    const Four even = __builtin_shufflevector(in, t, 0, 4, 2, 6), odd = __builtin_shufflevector(in, t, 1, 5, 3, 7);
+    const Four even_y = __builtin_shufflevector(v, zero, 0, 4, 2, 6), odd_y = __builtin_shufflevector(v, zero, 1, 5, 3, 7);
+    add(i0, t[0], __builtin_shufflevector(even, even_y, 0, 1, 4, 5));
+    add(i1, t[1], __builtin_shufflevector(odd, odd_y, 0, 1, 4, 5));
+    add(i2, t[2], __builtin_shufflevector(even, even_y, 2, 3, 6, 7));
+    add(i3, t[3], __builtin_shufflevector(odd, odd_y, 2, 3, 6, 7));
   }
   for (; i < moving; ++i) {
     integral += 0.5 * (y[i] + y[i - 1]) * (tau[i] - tau[i - 1]);
