@@ -514,10 +514,10 @@ struct IntegralForm {
 };
 
 // The eight sums are eight independent chains in sample order, kept side by side in vectors of
-// four (the GCC/Clang vector extension: each lane is the scalar operation, so every build, of any vector
-// width, gives the scalar loop's bits): Σ(∫, τ, y), Σ∫·(∫, τ, y) and Στ·(·, τ, y). Four samples
-// at a time: their trapezoids in one vector operation, the running integral through them in
-// order, then a 4×4 transpose turns the columns (∫, τ, y) into each sample's row.
+// four (the GCC/Clang vector extension: each lane is the scalar operation, so every build, of
+// any vector width, gives the scalar loop's bits): Σ(∫, τ, y), Σ∫·(∫, τ, y) and Στ·(·, τ, y).
+// Four samples at a time: their trapezoids in one vector operation, the running integral through
+// them in order, then a 4×4 transpose turns the columns (∫, τ, y) into each sample's row.
 SPINDOWN_VECTOR_CLONES IntegralForm integral_form(std::span<const double> tau, std::span<const double> y,
                                                   std::size_t moving) {
   using Four = double __attribute__((vector_size(4 * sizeof(double))));

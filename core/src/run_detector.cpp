@@ -345,8 +345,8 @@ void RunDetector::push_many(const double* t_s, const double* value, std::size_t 
 }
 
 // push() and coast_step() for one coasting sample after another, the same calls in the same
-// order, on copies of the state push() would read and write for them: in locals the compiler
-// keeps them in registers instead of storing every sum back. A sample push() would treat
+// order, on local copies of the state push() would read and write for them, put back into the
+// detector once instead of through its members per sample. A sample push() would treat
 // otherwise (not finite, time going back, the ring full) is left to push().
 std::size_t RunDetector::coast_run(const double* t_s, const double* value, std::size_t k, const std::size_t n) {
   const bool long_live = hold_long_live_;

@@ -61,7 +61,7 @@ class RunDetector {
   void push(double t_s, double value);
   // n samples, exactly as n calls of push() would take them (same arithmetic, same events).
   // A whole recording's samples go through here (find_runs): the ordinary coasting sample, most
-  // of a recording, runs in a loop that keeps the detector's state in registers.
+  // of a recording, runs in a loop on local copies of the state it changes, written back once.
   void push_many(const double* t_s, const double* value, std::size_t n);
   // The device clock restarted before the next sample: an open run is closed there.
   void clock_restart();
