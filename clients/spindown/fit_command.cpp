@@ -11,6 +11,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <unistd.h>
 
 #include "exit_codes.hpp"
 #include "spindown/bench.hpp"
@@ -193,10 +194,15 @@ void setup_fit(CLI::App& app) {
 int run_fit(const FitCommandOptions& options) {
   const FitPlan plan = plan_from(options);
   bool all_usable = true;
-  // --json: one document, written once every file is done (so stderr's problems never land
-  // inside it), assembled from each file's text as it comes.
+  // --json: one document, assembled from each file's text as it comes. On a terminal it is
+  // printed once every file is done, so that stderr's problems never land inside it; into a
+  // file or a pipe it goes out in pieces as the workers finish them, so that writing it overlaps
+  // the fitting instead of following it (5 MB for 1000 runs: milliseconds, and a 5 MB buffer
+  // grown by doubling).
   std::string json;
   FitReportJsonText json_files;
+  const bool json_in_pieces = options.json && !isatty(STDOUT_FILENO);
+  constexpr std::size_t json_piece_bytes = 256 * 1024;
   struct Done {
     FileFit file;
     std::string text;  // the file's tables or JSON entry, formatted by the worker too
@@ -215,6 +221,10 @@ int run_fit(const FitCommandOptions& options) {
         all_usable = all_usable && d.file.usable();
         if (options.json) {
           json_files.add(d.text, json);
+          if (json_in_pieces && json.size() >= json_piece_bytes) {
+            std::cout << json;
+            json.clear();
+          }
         } else {
           std::cout << d.text << '\n';
           std::cout.flush();

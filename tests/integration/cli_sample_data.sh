@@ -105,4 +105,20 @@ for fmt in "" "--json"; do
 done
 python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); sys.exit(0 if len(d["files"]) == 2 * int(sys.argv[2]) else 1)' \
   "$tmp/parallel" "${#files[@]}" || { echo "FAIL fit --json -j 3: not one entry per file given"; fail=1; }
+
+# Into a file --json goes out in pieces as the files are done; on a terminal it is printed once
+# at the end. Both are the same document: the files listed often enough that the JSON is several
+# pieces long (more than 256 kB), the terminal a real pty (script), its CR LF made LF again.
+many=()
+for ((k = 0; k < 20; ++k)); do many+=("${files[@]}"); done
+rc=0
+timeout 120 "$bin" fit --json "${many[@]}" >"$tmp/many.file" 2>/dev/null || rc=$?
+printf -v cmd '%q ' "$bin" fit --json "${many[@]}"
+timeout 120 script -qec "$cmd 2>/dev/null" /dev/null </dev/null | tr -d '\r' >"$tmp/many.tty" || true
+size=$(stat -c %s "$tmp/many.file")
+if ((rc != 0 || size <= 256 * 1024)); then
+  echo "FAIL fit --json into a file: exit $rc, $size bytes (more than 256 kB wanted)"; fail=1
+elif ! cmp -s "$tmp/many.file" "$tmp/many.tty"; then
+  echo "FAIL fit --json: a file and a terminal get different documents"; fail=1
+fi
 exit $fail
