@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
 #include <fcntl.h>
 #include <fmt/format.h>
@@ -50,6 +51,9 @@ bool ReadOptions::is_valid(std::string* why) const {
 }
 
 namespace {
+
+// Regular files up to this size are read whole before their format is known.
+constexpr std::uintmax_t whole_read_bytes = 1 << 20;
 
 // Opens path for reading without blocking on a FIFO that has no writer yet (which would hang
 // forever). Call reads_blocking once fstat has said what it is.
@@ -104,6 +108,9 @@ std::optional<FileBytes> read_fd_bytes(int fd, const struct stat& st, const std:
     }
     if (n == 0) break;
     bytes.size += static_cast<std::size_t>(n);
+    // A regular file read to the size fstat gave, with room left in the buffer: that is its end,
+    // and the read that would return 0 is saved. A file that grew meanwhile filled the buffer.
+    if (S_ISREG(st.st_mode) && bytes.size < capacity && bytes.size == static_cast<std::size_t>(st.st_size)) break;
   }
   return bytes;
 }
@@ -220,6 +227,18 @@ std::vector<Recording> read_recordings(const std::string& path, const ReadOption
             {});
         return out;
       }
+    } else if (options.format != FileFormat::lcm_log && static_cast<std::uintmax_t>(st.st_size) <= whole_read_bytes) {
+      // A small file (a lab's text file is ~20 kB) is read whole at once and its first word
+      // looked at in its bytes: one system call fewer than reading the word first. Should it be
+      // an LCM log after all, its bytes are dropped and it is streamed as any log is.
+      text_bytes = read_fd_bytes(fd, st, path, &why, std::size_t{1} << 30);
+      if (!text_bytes) {
+        add(failed(path, why), {});
+        return out;
+      }
+      head_len = std::min(sizeof head, text_bytes->size);
+      std::memcpy(head, text_bytes->data.get(), head_len);
+      if (detect_format(std::string_view(head, head_len), options) == FileFormat::lcm_log) text_bytes.reset();
     } else {
       const ssize_t n = ::pread(fd, head, sizeof head, 0);
       head_len = n > 0 ? static_cast<std::size_t>(n) : 0;
