@@ -59,11 +59,19 @@ double RunDetector::duration(const WindowFit& w) const {
   return w.end > w.first ? t(w.end - 1) - t(w.first) : 0.0;
 }
 
-void RunDetector::rebuild(WindowFit& w, std::size_t from, std::size_t to) {
-  w.clear(from, from < to ? t(from) : 0.0);
-  for (std::size_t k = from; k < to; ++k) w.add(t(k), v(k));
+RunDetector::WindowFit RunDetector::window_over(const Sample* ring, std::size_t mask, double span, std::size_t from,
+                                                std::size_t to) {
+  WindowFit w;
+  w.span_s = span;
+  w.clear(from, from < to ? ring[from & mask].t : 0.0);
+  for (std::size_t k = from; k < to; ++k) w.add(ring[k & mask].t, ring[k & mask].v);
   w.end = to;
   w.updates = 0;
+  return w;
+}
+
+void RunDetector::rebuild(WindowFit& w, std::size_t from, std::size_t to) {
+  w = window_over(ring_.get(), mask_, w.span_s, from, to);
 }
 
 void RunDetector::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
@@ -80,9 +88,8 @@ void RunDetector::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
 // Per sample for every live window, so inlined into its callers; the usual step (sample i
 // follows the window's last, exactly one old sample expires) is one slide(). s is sample i,
 // passed in so that it is not reloaded from the ring after the stores to the sums.
-[[gnu::always_inline]] inline void RunDetector::advance(WindowFit& w, std::size_t i, Sample s) {
-  const Sample* ring = ring_.get();
-  const std::size_t mask = mask_;
+[[gnu::always_inline]] inline void RunDetector::advance(WindowFit& w, const Sample* ring, const std::size_t mask,
+                                                       std::size_t i, Sample s) {
   // w.n always equals w.end - w.first: an empty window contiguous with i has first == i.
   if (w.end != i || w.first == i) [[unlikely]] {
     if (w.end != i) w.clear(i, s.t);  // not contiguous (after a reset): start again from i
@@ -107,7 +114,11 @@ void RunDetector::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
   }
   w.first = first;
   w.end = i + 1;
-  if (w.updates > refresh_every) [[unlikely]] rebuild(w, w.first, w.end);
+  if (w.updates > refresh_every) [[unlikely]] w = window_over(ring, mask, span, w.first, w.end);
+}
+
+[[gnu::always_inline]] inline void RunDetector::advance(WindowFit& w, std::size_t i, Sample s) {
+  advance(w, ring_.get(), mask_, i, s);
 }
 
 [[gnu::always_inline]] inline void RunDetector::coast_step(std::size_t i, Sample s) {
@@ -121,18 +132,18 @@ void RunDetector::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
 // rising are the coast's lowest level and rise count, updated here.
 [[gnu::always_inline]] inline RunDetector::CoastVerdict RunDetector::coast_verdict(std::size_t i, Sample s,
                                                                                  const WindowFit& h, double& level_min,
-                                                                                 int& rising) {
+                                                                                 int& rising, const CoastLimits& c) {
   const double t_i = s.t;
-  // i + 1 - base_ is buffered() after sample i.
-  if (i + 1 - base_ > opt_.max_buffer || t_i - run_.t_cut_s > opt_.max_coast_s) [[unlikely]]
+  // i + 1 - base is buffered() after sample i.
+  if (i + 1 - c.base > c.max_buffer || t_i - c.t_cut_s > c.max_coast_s) [[unlikely]]
     return {CoastVerdict::too_long};
-  if (h.n < 3 || h.first < run_.cut_index) return {};
-  const double dur = t_i - t(h.first);  // duration(h), its last sample being i
-  const double mu = h.sv / h.n;         // h.mean(), n being at least 3
+  if (h.n < 3 || h.first < c.cut_index) return {};
+  const double dur = t_i - c.ring[h.first & c.mask].t;  // duration(h), its last sample being i
+  const double mu = h.sv / h.n;                          // h.mean(), n being at least 3
 
   // Power back before standstill: the reading climbs well above the coast's lowest level.
-  if (dur >= hold_half_s_) level_min = std::min(level_min, mu);
-  if (s.v > level_min + rise_jump_) [[unlikely]] {
+  if (dur >= c.hold_half_s) level_min = std::min(level_min, mu);
+  if (s.v > level_min + c.rise_jump) [[unlikely]] {
     if (rising++ == 0) rise_start_ = i;
     if (rising >= 3) return {CoastVerdict::power_back};
   } else {
@@ -140,11 +151,12 @@ void RunDetector::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
   }
 
   // Standstill: the hold window is flat and low.
-  if (dur < hold_full_s_) return {};
-  if (mu > standstill_ceiling_) return {};  // still high: the usual case, cheap
+  if (dur < c.hold_full_s) return {};
+  if (mu > c.standstill_ceiling) return {};  // still high: the usual case, cheap
   // Low: while the coast still falls the hold window is not level, and nothing else is to do.
+  if (clearly_sloped(h, c.v0, mu)) return {};  // most low samples: no division, no square root
   CoastVerdict v{CoastVerdict::level, mu};
-  if (!level(h, dur, mu, v.sxx, v.e)) return {};
+  if (!level(h, dur, mu, c.v0, v.sxx, v.e)) return {};
   return v;
 }
 
@@ -159,7 +171,7 @@ void RunDetector::act_on(const CoastVerdict& v, std::size_t i, bool at_end) {
 }
 
 [[gnu::always_inline]] inline void RunDetector::coast_checks(std::size_t i, Sample s, bool at_end) {
-  const CoastVerdict v = coast_verdict(i, s, hold_, level_min_, rising_);
+  const CoastVerdict v = coast_verdict(i, s, hold_, level_min_, rising_, coast_limits());
   if (v.what != CoastVerdict::go_on) [[unlikely]] act_on(v, i, at_end);
 }
 
@@ -349,11 +361,22 @@ void RunDetector::push_many(const double* t_s, const double* value, std::size_t 
 // detector once instead of through its members per sample. A sample push() would treat
 // otherwise (not finite, time going back, the ring full) is left to push().
 std::size_t RunDetector::coast_run(const double* t_s, const double* value, std::size_t k, const std::size_t n) {
-  const bool long_live = hold_long_live_;
+  return hold_long_live_ ? coast_loop<true>(t_s, value, k, n) : coast_loop<false>(t_s, value, k, n);
+}
+
+// The loop for a coast with (LongLive) or without the long hold window: without it, the loop
+// has no trace of that window, and fewer values compete for registers.
+template <bool LongLive>
+std::size_t RunDetector::coast_loop(const double* t_s, const double* value, std::size_t k, const std::size_t n) {
+  const CoastLimits c = coast_limits();
+  Sample* const ring = ring_.get();
+  const std::size_t mask = mask_, capacity = ring_size();
   std::size_t i = next_index_, same_start = same_start_;
   double last_t = last_t_, last_v = last_v_, level_min = level_min_;
   int rising = rising_;
-  WindowFit h = hold_, hl = hold_long_;
+  WindowFit h = hold_;
+  WindowFit hl;
+  if constexpr (LongLive) hl = hold_long_;
   const auto put_back = [&] {
     next_index_ = i;
     same_start_ = same_start;
@@ -362,18 +385,18 @@ std::size_t RunDetector::coast_run(const double* t_s, const double* value, std::
     level_min_ = level_min;
     rising_ = rising;
     hold_ = h;
-    if (long_live) hold_long_ = hl;
+    if constexpr (LongLive) hold_long_ = hl;
   };
   for (; k < n; ++k) {
     const Sample s{t_s[k], value[k]};
-    if (!std::isfinite(s.t) || !std::isfinite(s.v) || s.t < last_t || i + 1 - base_ > ring_size()) break;
+    if (!std::isfinite(s.t) || !std::isfinite(s.v) || s.t < last_t || i + 1 - c.base > capacity) break;
     last_t = s.t;
-    ring_[i & mask_] = s;
+    ring[i & mask] = s;
     track_repeats(i, s.v, same_start, last_v);
-    advance(h, i, s);
-    if (long_live) advance(hl, i, s);
+    advance(h, ring, mask, i, s);
+    if constexpr (LongLive) advance(hl, ring, mask, i, s);
     const std::size_t at = i++;
-    const CoastVerdict v = coast_verdict(at, s, h, level_min, rising);
+    const CoastVerdict v = coast_verdict(at, s, h, level_min, rising, c);
     if (v.what != CoastVerdict::go_on) [[unlikely]] {
       put_back();
       act_on(v, at, false);
@@ -804,11 +827,45 @@ bool RunDetector::flat(const WindowFit& w) const {
   const double d = duration(w);
   if (d < 0.9 * w.span_s) return false;
   double sxx = 0, e = 0;
-  return level(w, d, w.mean(), sxx, e);
+  return level(w, d, w.mean(), v0_, sxx, e);
 }
 
-[[gnu::always_inline]] inline bool RunDetector::level(const WindowFit& w, double d, double m, double& sxx, double& e) const {
-  const bool low = v0_ > 0 ? m <= standstill_max_fraction * v0_ : true;
+namespace {
+// level()'s allowance for rounding, in the reading's unit.
+inline double level_tiny(double v0, double m) {
+  const double scale = std::max(std::abs(v0), std::abs(m));
+  return 1e-12 * (scale > 0 ? scale : 1.0);
+}
+}  // namespace
+
+// With T = flat_t_stat: level() needs |s|·√Sxx ≤ T·e + tiny, so R = Sxy²/Sxx ≤ (T·e + tiny)² ≤
+// 2T²·e² + 2·tiny², e² = (Syy − R)/(n − 2). Multiplied through by n·Sxx·(n − 2), with n·Sxx = n·Σt²
+// − (Σt)² and so on, that bound needs no division: a window above it is certainly not level.
+// Each of n·Sxx, n·Sxy, n·Syy is taken at the end of its rounding band least favourable to that
+// (10⁻⁹ of the terms it is the difference of, and of the coast's scale: a constant reading's n·Syy
+// rounds to ±10⁻¹², not 0), and a further 10⁻⁴ is asked for, so it never turns away a window
+// level() would accept. A coast still falling (t ≫ 4) it turns away: most of the low samples.
+[[gnu::always_inline]] inline bool RunDetector::clearly_sloped(const WindowFit& w, double v0, double m) {
+  constexpr double band = 1e-9;
+  const double n = w.n;
+  const double nsxx = n * w.stt - w.st * w.st, nsxy = n * w.stv - w.st * w.sv, nsyy = n * w.svv - w.sv * w.sv;
+  if (!(nsxx > 0)) return false;  // level() takes the slope as 0 then
+  // Sliding sums keep the rounding of readings long gone: a window of zeros after a coast from
+  // v0 can hold Σv² = −10⁻¹³. So the bands also count readings of the coast's scale.
+  const double scale = std::max(std::abs(v0), std::abs(m));
+  const double nsxx_hi = nsxx + band * (n * w.stt + w.st * w.st);
+  const double nsyy_hi = std::max(0.0, nsyy + band * (n * std::abs(w.svv) + w.sv * w.sv + n * n * scale * scale));
+  const double nsxy_lo =
+      std::max(0.0, std::abs(nsxy) - band * (n * std::abs(w.stv) + std::abs(w.st * w.sv) + n * std::abs(w.st) * scale));
+  const double two_t2 = 2 * flat_t_stat * flat_t_stat, tiny = level_tiny(v0, m);
+  const double lhs = (n - 2 + two_t2) * nsxy_lo * nsxy_lo;
+  const double rhs = (two_t2 * nsyy_hi + 2 * tiny * tiny * n * (n - 2)) * nsxx_hi;
+  return lhs > rhs * (1 + 1e-4);
+}
+
+[[gnu::always_inline]] inline bool RunDetector::level(const WindowFit& w, double d, double m, const double v0, double& sxx,
+                                                      double& e) {
+  const bool low = v0 > 0 ? m <= standstill_max_fraction * v0 : true;
   if (!low) return false;
   // w.slope() and w.resid_sd() (n >= 3), sharing Sxx and Sxy: the same operations, done once.
   sxx = w.sxx();
@@ -817,10 +874,9 @@ bool RunDetector::flat(const WindowFit& w) const {
   const double syy = w.svv - w.sv * w.sv / w.n;
   const double sse = sxx > 0 ? syy - sxy * sxy / sxx : syy;
   e = std::sqrt(std::max(sse, 0.0) / (w.n - 2));
-  const double scale = std::max(std::abs(v0_), std::abs(m));
-  const double tiny = 1e-12 * (scale > 0 ? scale : 1.0);
+  const double tiny = level_tiny(v0, m);
   const bool no_slope = std::abs(s) * std::sqrt(sxx) <= flat_t_stat * e + tiny;
-  const bool small_drop = std::abs(s) * d <= std::max(3.0 * e, 0.01 * std::abs(v0_)) + tiny;
+  const bool small_drop = std::abs(s) * d <= std::max(3.0 * e, 0.01 * std::abs(v0)) + tiny;
   return no_slope && small_drop;
 }
 

@@ -144,7 +144,12 @@ class RunDetector {
   void grow_ring();
   // The ring's first size: a lab run (30 s at 50 Hz) fits without growing.
   static constexpr std::size_t initial_ring_size = 2048;
+  // Moves w on to end at sample i (s), reading older samples from ring. Static, with the ring
+  // passed in: a window that is a local of a loop then stays in registers.
+  static inline void advance(WindowFit& w, const Sample* ring, std::size_t mask, std::size_t i, Sample s);
   inline void advance(WindowFit& w, std::size_t i, Sample s);
+  // The window of span span over samples [from, to), its sums added afresh.
+  static WindowFit window_over(const Sample* ring, std::size_t mask, double span, std::size_t from, std::size_t to);
   void rebuild(WindowFit& w, std::size_t from, std::size_t to);
   void reset_window(WindowFit& w, std::size_t lo, std::size_t end);
   double duration(const WindowFit& w) const;
@@ -155,14 +160,29 @@ class RunDetector {
   // state it touches, up to the first sample that decides something (taken) or that push()
   // alone handles (not taken). Returns the index of the first sample it did not take.
   std::size_t coast_run(const double* t_s, const double* value, std::size_t k, std::size_t n);
+  template <bool LongLive>
+  std::size_t coast_loop(const double* t_s, const double* value, std::size_t k, std::size_t n);
   inline void coast_checks(std::size_t i, Sample s, bool at_end = false);
+  // What the coast checks read and a coast does not change, as one value: coast_loop keeps it
+  // in locals, since a store into the ring (doubles) could alias any double member and the
+  // compiler would reload each of them for every sample.
+  struct CoastLimits {
+    const Sample* ring;
+    std::size_t mask, base, max_buffer, cut_index;
+    double max_coast_s, t_cut_s, hold_half_s, hold_full_s, rise_jump, standstill_ceiling, v0;
+  };
+  CoastLimits coast_limits() const {
+    return {ring_.get(), mask_, base_, opt_.max_buffer, run_.cut_index, opt_.max_coast_s, run_.t_cut_s, hold_half_s_,
+            hold_full_s_, rise_jump_, standstill_ceiling_, v0_};
+  }
   // What the checks of a coasting sample decided: nothing (the usual case), or one of the rare
   // outcomes, which act_on() carries out.
   struct CoastVerdict {
     enum What { go_on, too_long, power_back, level } what = go_on;
     double mu = 0, sxx = 0, e = 0;  // level: the hold window's mean, Sxx and residual sd
   };
-  inline CoastVerdict coast_verdict(std::size_t i, Sample s, const WindowFit& h, double& level_min, int& rising);
+  inline CoastVerdict coast_verdict(std::size_t i, Sample s, const WindowFit& h, double& level_min, int& rising,
+                                    const CoastLimits& c);
   void act_on(const CoastVerdict& v, std::size_t i, bool at_end);
   inline void track_repeats(std::size_t i, double value, std::size_t& same_start, double& last_v);
   void time_went_back(double t_s);     // the note, then clock_restart()
@@ -174,8 +194,12 @@ class RunDetector {
   // Whether w shows a standstill: full, low, and no significant slope or drop.
   bool flat(const WindowFit& w) const;
   // The part of flat() after "full": low, no significant slope or drop, for w of duration d and
-  // mean m. Sets sxx and e (w.sxx(), w.resid_sd()) for the caller's resolution test.
-  inline bool level(const WindowFit& w, double d, double m, double& sxx, double& e) const;
+  // mean m, in a coast cut at reading v0. Sets sxx and e (w.sxx(), w.resid_sd()) for the
+  // caller's resolution test.
+  static inline bool level(const WindowFit& w, double d, double m, double v0, double& sxx, double& e);
+  // Whether w's slope is certainly too strong for level() (mean m, coast cut at v0), decided
+  // without its divisions and square roots.
+  static inline bool clearly_sloped(const WindowFit& w, double v0, double m);
   // Where the cut lies in [a, b] (b = newest sample), and what came before it.
   struct CutSplit {
     std::size_t a = 0, cut_index = 0, pre_end = 0, npre = 0;
