@@ -399,48 +399,45 @@ class Evaluator {
   }
 
   // Codes each sample's step τ_i − τ_(i−1) by its distinct value, bit for bit. The steps of a
-  // run are a few clock periods, each in a few rounding variants (~15 in a PuTTY log), so they are
-  // found through a small open-addressed table instead of a search along the list. A step already
-  // in its home slot (nearly all of them) takes the short way: one probe, no further tests.
+  // run are a few clock periods, each in a few rounding variants (~15 in a PuTTY log, in no
+  // order a branch could learn), so they are found through a small open-addressed table. Every
+  // sample looks in its step's home slot first, where nearly all of them are: one test that
+  // nearly always holds, not one on whether the step changed, which a PuTTY log's rounding
+  // makes a coin toss.
   // Out of line: inlined into fit_run, its loop kept its pointers and the step on the stack.
   [[gnu::noinline]] void index_time_steps() {
-    constexpr std::size_t max_steps = 32, slots = 64;  // at most half full: probes stay short
+    // At most an eighth full: a step seldom finds its home slot taken by another.
+    constexpr std::size_t max_steps = 32, slots = 256;
     const std::size_t n = tau_.size();
     if (!sorted_ || n < 2) return;
     std::array<std::uint64_t, slots> key{};
     std::array<std::uint8_t, slots> code_plus_one{};  // 0: the slot is free
     auto code = std::make_unique_for_overwrite<std::uint8_t[]>(n);  // code[0] is never read
-    // No "last" step before the first: bits that differ from the first step's in every place.
-    std::uint64_t last_bits = ~std::bit_cast<std::uint64_t>(tau_[1] - tau_[0]);
-    std::uint8_t last_code = 0;
     const double* tau = tau_.data();  // a local: the byte stores below could alias a member
     double before = tau[0];
     for (std::size_t i = 1; i < n; ++i) {
       const double now = tau[i];
       const auto bits = std::bit_cast<std::uint64_t>(now - before);
       before = now;
-      if (bits != last_bits) {
-        std::size_t slot = static_cast<std::size_t>((bits * 0x9E3779B97F4A7C15ull) >> 58);
-        if (key[slot] != bits || code_plus_one[slot] == 0) {  // only finite steps are entered
-          const double step = std::bit_cast<double>(bits);  // from the bits: nothing kept for this rare path
-          if (!std::isfinite(step)) {  // no product chain through a step that is not a number
+      std::size_t slot = static_cast<std::size_t>((bits * 0x9E3779B97F4A7C15ull) >> 56);
+      if (key[slot] != bits || code_plus_one[slot] == 0) [[unlikely]] {  // only finite steps are entered
+        const double step = std::bit_cast<double>(bits);  // from the bits: nothing kept for this rare path
+        if (!std::isfinite(step)) {  // no product chain through a step that is not a number
+          steps_.clear();
+          return;
+        }
+        while (code_plus_one[slot] != 0 && key[slot] != bits) slot = (slot + 1) % slots;
+        if (code_plus_one[slot] == 0) {
+          if (steps_.size() == max_steps) {  // jittered clock: one exponential per sample
             steps_.clear();
             return;
           }
-          while (code_plus_one[slot] != 0 && key[slot] != bits) slot = (slot + 1) % slots;
-          if (code_plus_one[slot] == 0) {
-            if (steps_.size() == max_steps) {  // jittered clock: one exponential per sample
-              steps_.clear();
-              return;
-            }
-            steps_.push_back(step);
-            key[slot] = bits;
-            code_plus_one[slot] = static_cast<std::uint8_t>(steps_.size());
-          }
+          steps_.push_back(step);
+          key[slot] = bits;
+          code_plus_one[slot] = static_cast<std::uint8_t>(steps_.size());
         }
-        last_bits = bits, last_code = static_cast<std::uint8_t>(code_plus_one[slot] - 1);
       }
-      code[i] = last_code;
+      code[i] = static_cast<std::uint8_t>(code_plus_one[slot] - 1);
     }
     step_code_ = std::move(code);
     step_factor_.resize(steps_.size());
