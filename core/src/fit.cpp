@@ -153,14 +153,18 @@ class Evaluator {
         lags_(newey_west_lags(tau.size())),
         sorted_(std::is_sorted(tau.begin(), tau.end())) {
     const std::size_t n = tau.size();
-    double sum_y = 0;
-    tail_sq_[n] = 0;
+    double sum_y = 0, tail = 0;
+    // The suffix sum runs in a register and the inputs are restrict: read back from the array it
+    // had just stored (the store to wy_ might have changed it), each sample waited on a store.
+    const double *__restrict w_in = weight.data(), *__restrict y_in = y.data();
+    double *__restrict tail_out = tail_sq_.get(), *__restrict wy_out = wy_.get();
+    tail_out[n] = 0;
 #pragma GCC unroll 4  // a short sequential body: the loop's own count and test were much of it
     for (std::size_t i = n; i-- > 0;) {
-      const double yy = y[i] * y[i];
-      tail_sq_[i] = tail_sq_[i + 1] + weight[i] * yy;
-      wy_[i] = weight[i] * y[i];
-      sum_y += y[i];
+      const double yy = y_in[i] * y_in[i];
+      tail_out[i] = tail = tail + w_in[i] * yy;
+      wy_out[i] = w_in[i] * y_in[i];
+      sum_y += y_in[i];
     }
     if (n > 0) {
       const double mean = sum_y / static_cast<double>(n);
