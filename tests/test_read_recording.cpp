@@ -278,3 +278,46 @@ TEST(ReadRecordings, APipeIsReadToItsEndAndDevNullIsEmpty) {
   EXPECT_TRUE(null[0].empty());
   EXPECT_TRUE(null[0].has_errors());
 }
+
+// A log up to 1 MiB is read whole before its first word is looked at, a larger one has that word
+// read alone: both are recognised and streamed, with every sample.
+TEST(ReadRecordings, LcmLogsBelowAndAboveTheWholeReadSizeGiveEverySample) {
+  for (const int batches : {10, 4000}) {  // ~2 kB and ~4 MB of SAMPLE messages, 50 samples each
+    TempFile f("size" + std::to_string(batches) + ".lcm", "");
+    {
+      lcm::LogFile log(f.path, "w");
+      ASSERT_TRUE(log.good());
+      for (int k = 0; k < batches; ++k)
+        write_event(log, "SPINDOWN.a.SAMPLE", batch("a", 50 * k, 50, samples_t::QUANTITY_BACK_EMF_V), k + 1);
+    }
+    const auto size = std::filesystem::file_size(f.path);
+    EXPECT_EQ(size > (1u << 20), batches == 4000) << size << " bytes";
+    std::vector<RecordingInfo> info;
+    const auto recs = read_recordings(f.path, {}, &info);
+    ASSERT_EQ(recs.size(), 1u) << all_diagnostics(recs[0]);
+    EXPECT_EQ(info[0].format, FileFormat::lcm_log);
+    EXPECT_EQ(recs[0].size(), 50u * static_cast<std::size_t>(batches));
+  }
+}
+
+// lcm::LogFile seeks, so an LCM log through a pipe is refused, by name, not read as text.
+TEST(ReadRecordings, AnLcmLogThroughAPipeIsRefusedByName) {
+  TempFile f("piped.lcm", "");
+  {
+    lcm::LogFile log(f.path, "w");
+    ASSERT_TRUE(log.good());
+    write_event(log, "SPINDOWN.a.SAMPLE", batch("a", 0, 10, samples_t::QUANTITY_BACK_EMF_V), 1);
+  }
+  std::ifstream in(f.path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_LT(bytes.size(), 4096u);  // fits the pipe's buffer: no writer thread needed
+  int fds[2];
+  ASSERT_EQ(::pipe(fds), 0);
+  ASSERT_EQ(::write(fds[1], bytes.data(), bytes.size()), static_cast<ssize_t>(bytes.size()));
+  ::close(fds[1]);
+  const auto recs = read_recordings("/proc/self/fd/" + std::to_string(fds[0]));
+  ::close(fds[0]);
+  ASSERT_EQ(recs.size(), 1u);
+  EXPECT_TRUE(recs[0].has_errors());
+  EXPECT_TRUE(mentions(recs[0], "it is a pipe or device")) << all_diagnostics(recs[0]);
+}

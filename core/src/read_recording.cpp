@@ -191,12 +191,10 @@ std::vector<Recording> read_recordings(const std::string& path, const ReadOption
     return out;
   }
 
-  // An LCM log is streamed, never loaded whole: look at its first word only. Text is read
-  // whole through the same descriptor (one open per file). A pipe, FIFO or device can be read
-  // only once, so it is read whole first (an LCM log cannot come that way: lcm::LogFile seeks).
-  char head[4] = {};
-  std::size_t head_len = 0;
+  // An LCM log is streamed by lcm::LogFile, which seeks (so it cannot come through a pipe); its
+  // first word says what it is. Text is read whole through the same descriptor (one open per file).
   std::optional<FileBytes> text_bytes;
+  bool lcm_log = false;
   {
     const int fd = open_for_reading(path);
     if (fd < 0) {
@@ -214,48 +212,40 @@ std::vector<Recording> read_recordings(const std::string& path, const ReadOption
       add(failed(path, fmt::format("cannot read {}: it is a directory", path)), {});
       return out;
     }
-    if (!S_ISREG(st.st_mode)) {
+    const auto read_whole = [&] {
       text_bytes = read_fd_bytes(fd, st, path, &why, std::size_t{1} << 30);
-      if (!text_bytes) {
-        add(failed(path, why), {});
-        return out;
-      }
-      if (detect_format(text_bytes->view(), options) == FileFormat::lcm_log || options.format == FileFormat::lcm_log) {
-        add(failed(path, fmt::format("cannot read {} as an LCM log: it is a pipe or device, and lcm::LogFile needs a "
-                                     "regular file",
-                                     path)),
-            {});
-        return out;
-      }
-    } else if (options.format != FileFormat::lcm_log && static_cast<std::uintmax_t>(st.st_size) <= whole_read_bytes) {
-      // A small file (a lab's text file is ~20 kB) is read whole at once and its first word
-      // looked at in its bytes: one system call fewer than reading the word first. Should it be
-      // an LCM log after all, its bytes are dropped and it is streamed as any log is.
-      text_bytes = read_fd_bytes(fd, st, path, &why, std::size_t{1} << 30);
-      if (!text_bytes) {
-        add(failed(path, why), {});
-        return out;
-      }
+      if (!text_bytes) add(failed(path, why), {});
+      return text_bytes.has_value();
+    };
+    // Read whole first: a pipe, FIFO or device (it can be read only once), or a small regular
+    // file (a lab's text file is ~20 kB: its first word is then looked at in its bytes, one
+    // system call fewer than reading the word first). Otherwise the first word is read alone.
+    const bool regular = S_ISREG(st.st_mode);
+    char head[4] = {};
+    std::size_t head_len = 0;
+    if (!regular ||
+        (options.format != FileFormat::lcm_log && static_cast<std::uintmax_t>(st.st_size) <= whole_read_bytes)) {
+      if (!read_whole()) return out;
       head_len = std::min(sizeof head, text_bytes->size);
       std::memcpy(head, text_bytes->data.get(), head_len);
-      if (detect_format(std::string_view(head, head_len), options) == FileFormat::lcm_log) text_bytes.reset();
     } else {
       const ssize_t n = ::pread(fd, head, sizeof head, 0);
       head_len = n > 0 ? static_cast<std::size_t>(n) : 0;
-      const bool lcm = detect_format(std::string_view(head, head_len), options) == FileFormat::lcm_log ||
-                       options.format == FileFormat::lcm_log;
-      if (!lcm) {
-        text_bytes = read_fd_bytes(fd, st, path, &why, std::size_t{1} << 30);
-        if (!text_bytes) {
-          add(failed(path, why), {});
-          return out;
-        }
-      }
     }
+    lcm_log = detect_format(std::string_view(head, head_len), options) == FileFormat::lcm_log ||
+              options.format == FileFormat::lcm_log;
+    if (lcm_log && !regular) {
+      add(failed(path, fmt::format("cannot read {} as an LCM log: it is a pipe or device, and lcm::LogFile needs a "
+                                   "regular file",
+                                   path)),
+          {});
+      return out;
+    }
+    if (lcm_log) text_bytes.reset();  // a small log read whole: streamed as any log is
+    else if (!text_bytes && !read_whole()) return out;
   }
 
-  if (detect_format(std::string_view(head, head_len), options) == FileFormat::lcm_log ||
-      options.format == FileFormat::lcm_log) {
+  if (lcm_log) {
     LcmLogContents log = read_lcm_log(path, options.lcm);
     for (BenchLog& b : log.benches) {
       if (b.sample_messages == 0) continue;
