@@ -4,6 +4,9 @@
 # byte-identity of their stdout and stderr.
 # Usage: bench/fit_ab.sh OLD_BIN_DIR NEW_BIN_DIR   (env ROUNDS=20 RUNS=1000 KEEP=DIR)
 set -euo pipefail
+ROOT=$(cd "$(dirname "$0")/.." && pwd)
+# shellcheck source=bench/bench_common.bash
+source "$ROOT/bench/bench_common.bash"
 OLD=${1:?usage: fit_ab.sh OLD_BIN_DIR NEW_BIN_DIR}
 NEW=${2:?usage: fit_ab.sh OLD_BIN_DIR NEW_BIN_DIR}
 ROUNDS=${ROUNDS:-20}
@@ -11,13 +14,8 @@ RUNS=${RUNS:-1000}
 ((ROUNDS >= 1 && ROUNDS <= 1000)) || { echo "ROUNDS must be 1..1000" >&2; exit 2; }
 for b in "$OLD" "$NEW"; do [[ -x $b/spindown ]] || { echo "missing $b/spindown" >&2; exit 2; }; done
 [[ -x $NEW/make_runs ]] || { echo "missing $NEW/make_runs (build it first)" >&2; exit 2; }
-if [[ -n ${KEEP:-} ]]; then WORK=$KEEP; mkdir -p "$WORK"; else
-  WORK=$(mktemp -d /tmp/spindown-fit-ab.XXXXXX)
-  trap 'rm -rf "$WORK"' EXIT
-fi
-[[ -f $WORK/runs/index.tsv ]] || "$NEW/make_runs" "$WORK/runs" "$RUNS" 1 >/dev/null
-mapfile -t FILES < <(tail -n +2 "$WORK/runs/index.tsv" | cut -f1 | sed "s|^|$WORK/runs/|")
-cat "${FILES[@]}" >/dev/null  # page cache warm for both
+bench_work_dir fit-ab
+generated_runs "$NEW" "$RUNS" >/dev/null
 
 run() {  # run BIN TAG: wall in microseconds; stdout and stderr kept per tag
   local t0 t1

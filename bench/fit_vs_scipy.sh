@@ -10,6 +10,8 @@
 # Usage: bench/fit_vs_scipy.sh [BIN_DIR]   (default build/bin; env RUNS=1000 REPEAT=3 KEEP=DIR)
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
+# shellcheck source=bench/bench_common.bash
+source "$ROOT/bench/bench_common.bash"
 BIN=${1:-${SPINDOWN_BIN_DIR:-$ROOT/build/bin}}
 RUNS=${RUNS:-1000}
 REPEAT=${REPEAT:-3}
@@ -18,14 +20,9 @@ for p in spindown make_runs; do
   [[ -x $BIN/$p ]] || { echo "missing $BIN/$p (build it first)" >&2; exit 2; }
 done
 $PY -c 'import scipy, numpy' 2>/dev/null || { echo "python3-scipy not installed" >&2; exit 2; }
-if [[ -n ${KEEP:-} ]]; then WORK=$KEEP; mkdir -p "$WORK"; else
-  WORK=$(mktemp -d /tmp/spindown-vs-scipy.XXXXXX)
-  trap 'rm -rf "$WORK"' EXIT
-fi
+bench_work_dir vs-scipy
 
-"$BIN/make_runs" "$WORK/runs" "$RUNS" 1
-mapfile -t FILES < <(tail -n +2 "$WORK/runs/index.tsv" | cut -f1 | sed "s|^|$WORK/runs/|")
-cat "${FILES[@]}" >/dev/null  # page cache warm for both
+generated_runs "$BIN" "$RUNS"
 
 wall() {  # wall OUT CMD...: seconds of wall time, stdout to OUT
   local t0 t1

@@ -9,6 +9,8 @@
 #        ADC_BITS=10 DECIMALS=2: ADC_BITS=0 DECIMALS=-1 takes the lab's quantization out)
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
+# shellcheck source=bench/bench_common.bash
+source "$ROOT/bench/bench_common.bash"
 BIN=${1:-${SPINDOWN_BIN_DIR:-$ROOT/build/bin}}
 RUNS=${RUNS:-500}
 SEED=${SEED:-1}
@@ -16,10 +18,7 @@ DATA=${SPINDOWN_SHARED_DATA:-$ROOT/../shared/data}
 TRUTH=${TRUTH:-$DATA/seed-3v-run1.tsv.truth.json}
 [[ -x $BIN/monte_carlo ]] || { echo "missing $BIN/monte_carlo (build it first)" >&2; exit 2; }
 [[ -r $TRUTH ]] || { echo "no truth file $TRUTH (set TRUTH=… or SPINDOWN_SHARED_DATA)" >&2; exit 2; }
-if [[ -n ${KEEP:-} ]]; then WORK=$KEEP; mkdir -p "$WORK"; else
-  WORK=$(mktemp -d /tmp/spindown-mc.XXXXXX)
-  trap 'rm -rf "$WORK"' EXIT
-fi
+bench_work_dir mc
 "$BIN/monte_carlo" "$WORK" "$RUNS" "$SEED" "$TRUTH" "${ADC_BITS:-10}" "${DECIMALS:-2}" >/dev/null
 /usr/bin/python3 "$ROOT/bench/scipy_lab_fits.py" fit "$WORK" >"$WORK/scipy.tsv" 2>"$WORK/scipy.err" || true
 /usr/bin/python3 "$ROOT/bench/scipy_lab_fits.py" mc-summary "$WORK"

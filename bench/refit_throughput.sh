@@ -7,6 +7,8 @@
 #        BATCH=1 FORMAT=--json|"" KEEP=DIR)
 set -euo pipefail
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
+# shellcheck source=bench/bench_common.bash
+source "$ROOT/bench/bench_common.bash"
 BIN=${1:-${SPINDOWN_BIN_DIR:-$ROOT/build/bin}}
 SIZES=${SIZES:-1000000 10000000}
 BATCH=${BATCH:-1}
@@ -15,10 +17,7 @@ for p in spindown make_lcm_log; do
   [[ -x $BIN/$p ]] || { echo "missing $BIN/$p (build it first)" >&2; exit 2; }
 done
 [[ -x /usr/bin/time ]] || { echo "/usr/bin/time not installed (Debian package time)" >&2; exit 2; }
-if [[ -n ${KEEP:-} ]]; then WORK=$KEEP; mkdir -p "$WORK"; else
-  WORK=$(mktemp -d /tmp/spindown-refit-bench.XXXXXX)
-  trap 'rm -rf "$WORK"' EXIT
-fi
+bench_work_dir refit-bench
 
 echo "machine: $(lscpu | sed -n 's/^Model name: *//p'), $(nproc) cores; load average $(cut -d' ' -f1-3 /proc/loadavg)"
 printf '%-12s %9s %9s %8s %8s %12s %12s %9s %6s\n' samples "log MB" messages "wall s" "CPU s" "samples/s" "per CPU s" \

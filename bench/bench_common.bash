@@ -1,0 +1,20 @@
+# Sourced by the bench scripts.
+
+# bench_work_dir NAME: WORK is $KEEP (created, kept) or a new /tmp/spindown-NAME.* removed on exit.
+bench_work_dir() {
+  if [[ -n ${KEEP:-} ]]; then
+    WORK=$KEEP
+    mkdir -p "$WORK"
+  else
+    WORK=$(mktemp -d "/tmp/spindown-$1.XXXXXX")
+    trap 'rm -rf "$WORK"' EXIT
+  fi
+}
+
+# generated_runs BIN_DIR COUNT: COUNT lab runs written by BIN_DIR/make_runs into $WORK/runs (seed
+# 1; it prints one line), their paths in FILES, read once so both sides find them in the page cache.
+generated_runs() {
+  "$1/make_runs" "$WORK/runs" "$2" 1
+  mapfile -t FILES < <(tail -n +2 "$WORK/runs/index.tsv" | cut -f1 | sed "s|^|$WORK/runs/|")
+  cat "${FILES[@]}" >/dev/null
+}
