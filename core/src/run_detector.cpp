@@ -369,8 +369,8 @@ std::size_t RunDetector::coast_run(const double* t_s, const double* value, std::
 template <bool LongLive>
 std::size_t RunDetector::coast_loop(const double* t_s, const double* value, std::size_t k, const std::size_t n) {
   const CoastLimits c = coast_limits();
-  Sample* const ring = ring_.get();
-  const std::size_t mask = mask_, capacity = ring_size();
+  Sample* const ring = ring_.get();  // c.ring, writable: the loop stores each sample
+  const std::size_t mask = c.mask, capacity = ring_size();
   std::size_t i = next_index_, same_start = same_start_;
   double last_t = last_t_, last_v = last_v_, level_min = level_min_;
   int rising = rising_;
