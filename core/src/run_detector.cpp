@@ -51,7 +51,8 @@ std::string fmt_s(double t) { return fmt::format("{:.3f} s", t); }
 void RunDetector::WindowFit::clear(std::size_t at, double t_origin) {
   first = end = at;
   t0 = t_origin;
-  n = st = stt = sv = svv = stv = 0;
+  n = stv = 0;
+  s1 = s2 = WindowFit::Pair{};
   updates = 0;
 }
 
@@ -139,7 +140,7 @@ void RunDetector::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
     return {CoastVerdict::too_long};
   if (h.n < 3 || h.first < c.cut_index) return {};
   const double dur = t_i - c.ring[h.first & c.mask].t;  // duration(h), its last sample being i
-  const double mu = h.sv / h.n;                          // h.mean(), n being at least 3
+  const double mu = h.sv() / h.n;                        // h.mean(), n being at least 3
 
   // Power back before standstill: the reading climbs well above the coast's lowest level.
   if (dur >= c.hold_half_s) level_min = std::min(level_min, mu);
@@ -498,7 +499,7 @@ void RunDetector::trim_idle() {
   if (w.n < 6 || w.first < lo_) return false;
   // The slope's sign is Sxy's (Sxx > 0, else the slope is 0): a level or rising window, half of
   // an idle lead-in, is out before the divisions.
-  if (!(w.stv - w.st * w.sv / w.n < 0)) return false;
+  if (!(w.stv - w.st() * w.sv() / w.n < 0)) return false;
   const double mu = w.mean();
   if (!(mu > 0)) return false;
   const double dur = duration(w);
@@ -684,7 +685,7 @@ RunDetector::CutSplit RunDetector::split_at_cut(std::size_t a, std::size_t b, co
       sp.pre_max = std::max(sp.pre_max, v(k));
     }
     sp.pre_mean = f.mean();
-    sp.pre_sd = std::sqrt(std::max(f.svv / f.n - sp.pre_mean * sp.pre_mean, 0.0));
+    sp.pre_sd = std::sqrt(std::max(f.svv() / f.n - sp.pre_mean * sp.pre_mean, 0.0));
     // A lead-in falling at a good part of the coast's own rate is more coast: the cut lies
     // further back.
     const double s = f.slope(), sd = f.resid_sd();
@@ -848,15 +849,16 @@ inline double level_tiny(double v0, double m) {
 [[gnu::always_inline]] inline bool RunDetector::clearly_sloped(const WindowFit& w, double v0, double m) {
   constexpr double band = 1e-9;
   const double n = w.n;
-  const double nsxx = n * w.stt - w.st * w.st, nsxy = n * w.stv - w.st * w.sv, nsyy = n * w.svv - w.sv * w.sv;
+  const double st = w.st(), stt = w.stt(), sv = w.sv(), svv = w.svv(), stv = w.stv;
+  const double nsxx = n * stt - st * st, nsxy = n * stv - st * sv, nsyy = n * svv - sv * sv;
   if (!(nsxx > 0)) return false;  // level() takes the slope as 0 then
   // Sliding sums keep the rounding of readings long gone: a window of zeros after a coast from
   // v0 can hold Σv² = −10⁻¹³. So the bands also count readings of the coast's scale.
   const double scale = std::max(std::abs(v0), std::abs(m));
-  const double nsxx_hi = nsxx + band * (n * w.stt + w.st * w.st);
-  const double nsyy_hi = std::max(0.0, nsyy + band * (n * std::abs(w.svv) + w.sv * w.sv + n * n * scale * scale));
+  const double nsxx_hi = nsxx + band * (n * stt + st * st);
+  const double nsyy_hi = std::max(0.0, nsyy + band * (n * std::abs(svv) + sv * sv + n * n * scale * scale));
   const double nsxy_lo =
-      std::max(0.0, std::abs(nsxy) - band * (n * std::abs(w.stv) + std::abs(w.st * w.sv) + n * std::abs(w.st) * scale));
+      std::max(0.0, std::abs(nsxy) - band * (n * std::abs(stv) + std::abs(st * sv) + n * std::abs(st) * scale));
   const double two_t2 = 2 * flat_t_stat * flat_t_stat, tiny = level_tiny(v0, m);
   const double lhs = (n - 2 + two_t2) * nsxy_lo * nsxy_lo;
   const double rhs = (two_t2 * nsyy_hi + 2 * tiny * tiny * n * (n - 2)) * nsxx_hi;
@@ -869,9 +871,9 @@ inline double level_tiny(double v0, double m) {
   if (!low) return false;
   // w.slope() and w.resid_sd() (n >= 3), sharing Sxx and Sxy: the same operations, done once.
   sxx = w.sxx();
-  const double sxy = w.stv - w.st * w.sv / w.n;
+  const double sxy = w.stv - w.st() * w.sv() / w.n;
   const double s = sxx > 0 ? sxy / sxx : 0.0;
-  const double syy = w.svv - w.sv * w.sv / w.n;
+  const double syy = w.svv() - w.sv() * w.sv() / w.n;
   const double sse = sxx > 0 ? syy - sxy * sxy / sxx : syy;
   e = std::sqrt(std::max(sse, 0.0) / (w.n - 2));
   const double tiny = level_tiny(v0, m);
@@ -924,7 +926,7 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
       for (std::size_t j = from; j < first_in; ++j) f.add(t(j), v(j));
       const double sl = f.slope();
       if (sl < 0) {
-        const double tb = f.st / f.n, vb = f.mean();
+        const double tb = f.st() / f.n, vb = f.mean();
         const double th = f.t0 + tb + (z - vb) / sl;
         if (std::isfinite(th)) t_hit = std::clamp(th, t_quarter, t(i));
       }

@@ -77,57 +77,53 @@ class RunDetector {
   std::size_t buffered() const { return next_index_ - base_; }
 
  private:
-  // Least-squares line over a sliding time window of the buffer, O(1) per sample.
+  // Least-squares line over a sliding time window of the buffer, O(1) per sample. The sums are
+  // kept in pairs of lanes, (Σt, Σv) and (Σt², Σv²), each lane doing the scalar operation (so the
+  // bits of one sum at a time), two sums per instruction.
   struct WindowFit {
+    using Pair = double __attribute__((vector_size(2 * sizeof(double))));
     double span_s = 1.0;
     std::size_t first = 0, end = 0;  // absolute indices [first, end)
     double t0 = 0;                   // time origin for the sums (precision)
-    double n = 0, st = 0, stt = 0, sv = 0, svv = 0, stv = 0;
+    double n = 0;
+    Pair s1{}, s2{};  // (Σt, Σv), (Σt², Σv²), t from t0
+    double stv = 0;   // Σt·v
     unsigned updates = 0;
+    double st() const { return s1[0]; }
+    double sv() const { return s1[1]; }
+    double stt() const { return s2[0]; }
+    double svv() const { return s2[1]; }
     void clear(std::size_t at, double t_origin);
     void add(double t, double v) {
-      t -= t0;
-      n += 1;
-      st += t;
-      stt += t * t;
-      sv += v;
-      svv += v * v;
-      stv += t * v;
+      const Pair d{t - t0, v};
+      n += 1, s1 += d, s2 += d * d, stv += d[0] * d[1];
       ++updates;
     }
     void remove(double t, double v) {
-      t -= t0;
-      n -= 1;
-      st -= t;
-      stt -= t * t;
-      sv -= v;
-      svv -= v * v;
-      stv -= t * v;
+      const Pair d{t - t0, v};
+      n -= 1, s1 -= d, s2 -= d * d, stv -= d[0] * d[1];
       ++updates;
     }
     // add(t_in, v_in) then remove(t_out, v_out), bit for bit, in one pass over the sums.
     void slide(double t_in, double v_in, double t_out, double v_out) {
-      t_in -= t0;
-      t_out -= t0;
-      st = st + t_in - t_out;
-      stt = stt + t_in * t_in - t_out * t_out;
-      sv = sv + v_in - v_out;
-      svv = svv + v_in * v_in - v_out * v_out;
-      stv = stv + t_in * v_in - t_out * v_out;
+      const Pair in{t_in - t0, v_in}, out{t_out - t0, v_out};
+      s1 = s1 + in - out;
+      s2 = s2 + in * in - out * out;
+      stv = stv + in[0] * in[1] - out[0] * out[1];
       updates += 2;
     }
-    double mean() const { return n > 0 ? sv / n : 0.0; }
-    double sxx() const { return stt - st * st / n; }
+    double mean() const { return n > 0 ? sv() / n : 0.0; }
+    double sxx() const { return stt() - st() * st() / n; }
     double slope() const {
       if (n < 2) return 0.0;
       const double sxx_ = sxx();
       if (!(sxx_ > 0)) return 0.0;
-      return (stv - st * sv / n) / sxx_;
+      return (stv - st() * sv() / n) / sxx_;
     }
     double resid_sd() const {
       if (n < 3) return 0.0;
-      const double syy = svv - sv * sv / n;
-      const double sxy = stv - st * sv / n;
+      const double syy = svv() - sv() * sv() / n;
+      const double sxy = stv - st() * sv() / n;
       const double sxx_ = sxx();
       const double sse = sxx_ > 0 ? syy - sxy * sxy / sxx_ : syy;
       return std::sqrt(std::max(sse, 0.0) / (n - 2));
