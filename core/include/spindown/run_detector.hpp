@@ -78,8 +78,8 @@ class RunDetector {
 
  private:
   // Least-squares line over a sliding time window of the buffer, O(1) per sample. The sums are
-  // kept in pairs of lanes, (Σt, Σv) and (Σt², Σv²), each lane doing the scalar operation (so the
-  // bits of one sum at a time), two sums per instruction.
+  // kept in pairs of lanes, (Σt, Σv) and (Σt², Σv²): each lane does the scalar operation, so
+  // every sum has the bits it would have alone, and two sums take one instruction.
   struct WindowFit {
     using Pair = double __attribute__((vector_size(2 * sizeof(double))));
     double span_s = 1.0;
