@@ -4,6 +4,7 @@
 // text, JSON and exit code; and the LCM self-test over memq://.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <unistd.h>
@@ -186,6 +187,24 @@ TEST(LcmUrl, EnvFileAndResolutionOrder) {
   EXPECT_EQ(resolve_lcm_url("", std::nullopt, std::nullopt).url, "udpm://239.255.76.67:7667?ttl=0");
 }
 
+// The services' receive buffer goes into a udpm URL that does not set one, and nowhere else.
+TEST(LcmUrl, ReceiveBufferIsAddedOnlyWhereItBelongs) {
+  EXPECT_EQ(with_receive_buffer("udpm://239.255.76.67:7667?ttl=1", services_recv_buf_bytes),
+            "udpm://239.255.76.67:7667?ttl=1&recv_buf_size=16777216");
+  EXPECT_EQ(with_receive_buffer("udpm://239.255.76.67:7667", 1000), "udpm://239.255.76.67:7667?recv_buf_size=1000");
+  EXPECT_EQ(with_receive_buffer("udpm://239.255.76.67:7667?recv_buf_size=5", 1000),
+            "udpm://239.255.76.67:7667?recv_buf_size=5");  // the URL's own wins
+  EXPECT_EQ(with_receive_buffer("memq://", 1000), "memq://");
+  EXPECT_EQ(with_receive_buffer("udpm://239.255.76.67:7667?ttl=1", 0), "udpm://239.255.76.67:7667?ttl=1");
+  const char* before = std::getenv("LCM_DEFAULT_URL");
+  const std::string saved = before ? before : "";
+  ::setenv("LCM_DEFAULT_URL", "udpm://239.255.76.70:7700?ttl=0", 1);
+  EXPECT_EQ(with_receive_buffer("", 1000), "udpm://239.255.76.70:7700?ttl=0&recv_buf_size=1000");
+  ::unsetenv("LCM_DEFAULT_URL");
+  EXPECT_EQ(with_receive_buffer("", 1000), "udpm://239.255.76.67:7667?ttl=0&recv_buf_size=1000");
+  if (before) ::setenv("LCM_DEFAULT_URL", saved.c_str(), 1);
+}
+
 TEST(LcmTtl, ZeroWarnsUnlessSingleHostOneIsOkMoreWarns) {
   const auto zero = check_lcm_ttl(url_of("udpm://239.255.76.67:7667?ttl=0"), "LCM's default", false, std::nullopt);
   EXPECT_EQ(zero.level, CheckLevel::warn);
@@ -212,10 +231,15 @@ TEST(LcmTtl, ShellAndServicesOnDifferentGroupsWarn) {
 TEST(ReceiveBuffer, BelowTwoMegabytesWarnsWithTheSysctl) {
   const auto small = check_receive_buffer(212992, 17);
   EXPECT_EQ(small.level, CheckLevel::warn);
-  EXPECT_TRUE(contains(small.fix, "sysctl -w net.core.rmem_max=4194304")) << small.fix;
+  EXPECT_TRUE(contains(small.fix, "sysctl -w net.core.rmem_max=16777216")) << small.fix;
   EXPECT_TRUE(contains(small.detail, "17 UDP datagrams dropped")) << small.detail;
   EXPECT_EQ(check_receive_buffer(2097152, 0).level, CheckLevel::ok);
-  EXPECT_EQ(check_receive_buffer(8388608, std::nullopt).level, CheckLevel::ok);
+  // Enough for LCM, less than the services ask for: ok, and the detail says how to give them all.
+  const auto between = check_receive_buffer(8388608, std::nullopt);
+  EXPECT_EQ(between.level, CheckLevel::ok);
+  EXPECT_TRUE(contains(between.detail, "ask for 16 MB and get this")) << between.detail;
+  EXPECT_TRUE(contains(between.detail, "sysctl -w net.core.rmem_max=16777216")) << between.detail;
+  EXPECT_FALSE(contains(check_receive_buffer(16777216, 0).detail, "ask for")) << "enough: nothing to add";
   EXPECT_EQ(check_receive_buffer(std::nullopt, std::nullopt).level, CheckLevel::skip);
 }
 

@@ -1,6 +1,7 @@
 #include "spindown/lcm_url.hpp"
 
 #include <charconv>
+#include <cstdlib>
 #include <fmt/format.h>
 
 namespace spindown {
@@ -99,6 +100,15 @@ ResolvedLcmUrl resolve_lcm_url(const std::string& cli, const std::optional<std::
   if (env && !env->empty()) return {*env, "LCM_DEFAULT_URL"};
   if (env_file && !env_file->empty()) return {*env_file, std::string(env_file_path)};
   return {std::string(lcm_builtin_default_url), "LCM's default"};
+}
+
+std::string with_receive_buffer(std::string url, long bytes) {
+  if (url.empty()) {
+    const char* env = std::getenv("LCM_DEFAULT_URL");
+    url = env && *env ? env : std::string(lcm_builtin_default_url);
+  }
+  if (bytes <= 0 || url.rfind("udpm://", 0) != 0 || url.find("recv_buf_size") != std::string::npos) return url;
+  return url + (url.find('?') == std::string::npos ? "?" : "&") + fmt::format("recv_buf_size={}", bytes);
 }
 
 }  // namespace spindown

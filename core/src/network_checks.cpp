@@ -268,7 +268,11 @@ DoctorCheck check_receive_buffer(std::optional<long> rmem_max, std::optional<lon
     return c;
   }
   c.detail = fmt::format("net.core.rmem_max = {} ({:.3g} MB) ≥ LCM's recommended 2 MB{}{}", *rmem_max, mb,
-                         *rmem_max < spindown_requested_rmem_bytes ? " (the services ask for 4 MB and get this)" : "",
+                         *rmem_max < spindown_requested_rmem_bytes
+                             ? fmt::format(" (the services ask for {} MB and get this: a full-speed burst can "
+                                           "overflow it; `sysctl -w net.core.rmem_max={}` gives them all of it)",
+                                           spindown_requested_rmem_bytes >> 20, spindown_requested_rmem_bytes)
+                             : "",
                          errors);
   return c;
 }

@@ -13,21 +13,11 @@
 #include "spindown/effects.hpp"
 #include "spindown/fit.hpp"
 #include "spindown/lcm_channels.hpp"
+#include "spindown/lcm_url.hpp"
 
 namespace {
 std::atomic<bool> g_stop{false};
 extern "C" void on_signal(int) { g_stop = true; }
-
-// A larger kernel receive buffer so a burst (100 benches, a busy host) is not dropped by the
-// socket before LCM reads it; LCM's own default URL when none is given.
-std::string with_receive_buffer(std::string url, long bytes) {
-  if (url.empty()) {
-    const char* env = std::getenv("LCM_DEFAULT_URL");
-    url = env && *env ? env : "udpm://239.255.76.67:7667?ttl=0";
-  }
-  if (bytes <= 0 || url.rfind("udpm://", 0) != 0 || url.find("recv_buf_size") != std::string::npos) return url;
-  return url + (url.find('?') == std::string::npos ? "?" : "&") + fmt::format("recv_buf_size={}", bytes);
-}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -35,7 +25,7 @@ int main(int argc, char** argv) {
   spindown::FitterServiceOptions o;
   std::vector<std::string> models;
   double kv = 0;
-  long recv_buf = 4 << 20;
+  long recv_buf = spindown::services_recv_buf_bytes;
   std::vector<std::string> bench_configs;
   app.add_option("--lcm-url", o.lcm_url, "LCM URL (default: LCM_DEFAULT_URL or LCM's default)");
   app.add_option("--recv-buf", recv_buf, "udpm receive buffer bytes added to the URL (0 = leave the URL alone)");
@@ -111,7 +101,7 @@ int main(int argc, char** argv) {
     return 2;
   }
 
-  o.lcm_url = with_receive_buffer(o.lcm_url, recv_buf);
+  o.lcm_url = spindown::with_receive_buffer(o.lcm_url, recv_buf);
   spindown::FitterService service(o);
   if (!service.good()) {
     fmt::print(stderr, "spindown-fitter: cannot start LCM{}{}\n", o.lcm_url.empty() ? "" : " at ", o.lcm_url);

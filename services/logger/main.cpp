@@ -16,6 +16,7 @@
 
 #include "spindown/event_log_writer.hpp"
 #include "spindown/lcm_status.hpp"
+#include "spindown/lcm_url.hpp"
 #include "spindown/log_recorder.hpp"
 
 namespace {
@@ -28,16 +29,6 @@ std::int64_t wall_us() {
       .count();
 }
 
-// LCM's udpm receive buffer (SO_RCVBUF) is what absorbs a burst before LCM's own thread reads
-// it; raise it unless the URL already says.
-std::string with_receive_buffer(std::string url, long bytes) {
-  if (url.empty()) {
-    const char* env = std::getenv("LCM_DEFAULT_URL");
-    url = env && *env ? env : "udpm://239.255.76.67:7667?ttl=0";
-  }
-  if (bytes <= 0 || url.rfind("udpm://", 0) != 0 || url.find("recv_buf_size") != std::string::npos) return url;
-  return url + (url.find('?') == std::string::npos ? "?" : "&") + fmt::format("recv_buf_size={}", bytes);
-}
 
 // Datagrams the kernel dropped because a UDP receive buffer was full, in this network
 // namespace (all sockets, not only ours): the part of LCM's loss that can be seen at all.
@@ -73,7 +64,7 @@ int main(int argc, char** argv) {
   std::string lcm_url, channels;
   spindown::EventLogWriterOptions w;
   spindown::LogRecorderOptions r;
-  long recv_buf = 4 << 20;
+  long recv_buf = spindown::services_recv_buf_bytes;
   bool quiet = false;
   app.add_option("--lcm-url", lcm_url, "LCM URL (default: LCM_DEFAULT_URL or LCM's default)");
   app.add_option("--channels", channels,
@@ -126,7 +117,7 @@ int main(int argc, char** argv) {
   sigaction(SIGTERM, &sa, nullptr);
   std::signal(SIGPIPE, SIG_IGN);
 
-  const std::string url = with_receive_buffer(lcm_url, recv_buf);
+  const std::string url = spindown::with_receive_buffer(lcm_url, recv_buf);
   lcm::LCM lcm(url);
   if (!lcm.good()) {
     fmt::print(stderr, "spindown-logger: cannot start LCM at {}\n", url);

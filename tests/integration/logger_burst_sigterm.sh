@@ -3,8 +3,9 @@
 # three benches as fast as the publisher can send is recorded completely, and SIGTERM right
 # after the last message loses nothing (the logger drains LCM and its queue before exiting).
 #
-# A full-speed burst can overflow the logger's socket receive buffer (4 MiB) while its LCM
-# thread is descheduled (rarely: once in ~15 CI runs). The kernel then drops datagrams that no
+# A full-speed burst can overflow the logger's socket receive buffer (16 MiB asked, capped at
+# net.core.rmem_max) while its LCM thread is descheduled (rarely: once in ~15 CI runs at 4 MiB).
+# The kernel then drops datagrams that no
 # process ever sees, and counts them (RcvbufErrors). So every burst is held to "the log lacks
 # no message beyond what the kernel dropped" (the logger's own loss, counted or not, fails the
 # test), and bursts are repeated (at most 3) until one arrives whole: that one must be logged

@@ -28,7 +28,7 @@ for round in 1 2 3 4 5; do
   wait "$logger" 2>/dev/null || true
   kill -TERM "$pub"
   wait "$pub" || fail "publisher failed"
-  # At 500 Hz the 4 MiB receive buffer holds seconds of traffic: the kernel should drop none
+  # At 500 Hz the receive buffer (16 MiB asked, capped at rmem_max) holds seconds of traffic: the kernel should drop none
   # (a gap with kernel drops here would mean the logger was starved for seconds, not lost data).
   kernel_drops=$(( $(udp_rcvbuf_errors) - kernel_before ))
 
