@@ -23,7 +23,8 @@ for step in "install -m 0755 $bin/spindown-bridge /usr/local/bin/spindown-bridge
             "/etc/sysusers.d/spindown.conf" "systemd-sysusers" \
             "/etc/systemd/system/spindown-bridge@.service" "/etc/systemd/system/spindown-fitter.service" \
             "/etc/systemd/system/spindown-logger.service" "/etc/udev/rules.d/99-spindown.rules" \
-            "/etc/spindown/lcm.env" "dry run: nothing was changed"; do
+            "/etc/spindown/lcm.env" "/etc/sysctl.d/60-spindown.conf" "sysctl -q -p /etc/sysctl.d/60-spindown.conf" \
+            "dry run: nothing was changed"; do
   check "dry run mentions $step" "grep -qF -- '$step' '$tmp/dry.out'"
 done
 # The dry run with the build: says it would run setup and a Release build, runs neither.
@@ -51,7 +52,7 @@ for p in spindown spindown-bridge spindown-fitter spindown-logger; do
 done
 for f in etc/systemd/system/spindown-bridge@.service etc/systemd/system/spindown-fitter.service \
          etc/systemd/system/spindown-logger.service etc/sysusers.d/spindown.conf etc/udev/rules.d/99-spindown.rules \
-         etc/spindown/lcm.env usr/local/share/doc/spindown/README.md; do
+         etc/spindown/lcm.env etc/sysctl.d/60-spindown.conf usr/local/share/doc/spindown/README.md; do
   check "$f installed" "[[ -s '$root/$f' ]]"
 done
 check "user spindown created (offline sysusers)" "grep -q '^spindown:' '$root/etc/passwd'"
