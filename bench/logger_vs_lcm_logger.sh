@@ -23,8 +23,9 @@ command -v lcm-logger >/dev/null || { echo "lcm-logger not installed" >&2; exit 
 if [[ -z "${SPINDOWN_IN_NETNS:-}" ]]; then exec env SPINDOWN_IN_NETNS=1 unshare -n bash "$0" "$BIN"; fi
 ip link set lo up
 ip route add 224.0.0.0/4 dev lo
-# What the loggers' receive buffers can be: spindown-logger asks for 16 MB, the kernel caps it here.
-echo "net.core.rmem_max = $(cat /proc/sys/net/core/rmem_max) (spindown-logger asks for 16777216)"
+# What the loggers' receive buffers can be: the kernel caps what each asks for (spindown-logger: its
+# --recv-buf) at this.
+echo "net.core.rmem_max = $(cat /proc/sys/net/core/rmem_max)"
 URL='udpm://239.255.76.67:7667?ttl=0'
 WORK=$(mktemp -d /tmp/spindown-logger-bench.XXXXXX)
 PIDS=()

@@ -103,10 +103,8 @@ ResolvedLcmUrl resolve_lcm_url(const std::string& cli, const std::optional<std::
 }
 
 std::string with_receive_buffer(std::string url, long bytes) {
-  if (url.empty()) {
-    const char* env = std::getenv("LCM_DEFAULT_URL");
-    url = env && *env ? env : std::string(lcm_builtin_default_url);
-  }
+  const char* env = std::getenv("LCM_DEFAULT_URL");
+  url = resolve_lcm_url(url, env ? std::optional<std::string>(env) : std::nullopt, std::nullopt).url;
   if (bytes <= 0 || url.rfind("udpm://", 0) != 0 || url.find("recv_buf_size") != std::string::npos) return url;
   return url + (url.find('?') == std::string::npos ? "?" : "&") + fmt::format("recv_buf_size={}", bytes);
 }

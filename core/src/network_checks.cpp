@@ -264,14 +264,14 @@ DoctorCheck check_receive_buffer(std::optional<long> rmem_max, std::optional<lon
                            "is dropped by the kernel before LCM reads it{}",
                            *rmem_max, mb, errors);
     c.fix = fmt::format("sysctl -w net.core.rmem_max={0}\necho 'net.core.rmem_max = {0}' > /etc/sysctl.d/60-spindown.conf   # at every boot",
-                        spindown_requested_rmem_bytes);
+                        services_recv_buf_bytes);
     return c;
   }
   c.detail = fmt::format("net.core.rmem_max = {} ({:.3g} MB) ≥ LCM's recommended 2 MB{}{}", *rmem_max, mb,
-                         *rmem_max < spindown_requested_rmem_bytes
+                         *rmem_max < services_recv_buf_bytes
                              ? fmt::format(" (the services ask for {} MB and get this: a full-speed burst can "
                                            "overflow it; `sysctl -w net.core.rmem_max={}` gives them all of it)",
-                                           spindown_requested_rmem_bytes >> 20, spindown_requested_rmem_bytes)
+                                           services_recv_buf_bytes >> 20, services_recv_buf_bytes)
                              : "",
                          errors);
   return c;

@@ -222,18 +222,16 @@ std::vector<Recording> read_recordings(const std::string& path, const ReadOption
     // system call fewer than reading the word first). Otherwise the first word is read alone.
     const bool regular = S_ISREG(st.st_mode);
     char head[4] = {};
-    std::size_t head_len = 0;
+    std::string_view first_word;
     if (!regular ||
         (options.format != FileFormat::lcm_log && static_cast<std::uintmax_t>(st.st_size) <= whole_read_bytes)) {
       if (!read_whole()) return out;
-      head_len = std::min(sizeof head, text_bytes->size);
-      std::memcpy(head, text_bytes->data.get(), head_len);
+      first_word = text_bytes->view().substr(0, sizeof head);
     } else {
       const ssize_t n = ::pread(fd, head, sizeof head, 0);
-      head_len = n > 0 ? static_cast<std::size_t>(n) : 0;
+      first_word = std::string_view(head, n > 0 ? static_cast<std::size_t>(n) : 0);
     }
-    lcm_log = detect_format(std::string_view(head, head_len), options) == FileFormat::lcm_log ||
-              options.format == FileFormat::lcm_log;
+    lcm_log = detect_format(first_word, options) == FileFormat::lcm_log || options.format == FileFormat::lcm_log;
     if (lcm_log && !regular) {
       add(failed(path, fmt::format("cannot read {} as an LCM log: it is a pipe or device, and lcm::LogFile needs a "
                                    "regular file",

@@ -62,7 +62,6 @@ DoctorCheck check_lcm_ttl(const LcmUrl& url, const std::string& source, bool sin
 // LCM recommends ≥ 2 MB of socket receive buffer; the services ask for 16 MB (--recv-buf) and the
 // kernel caps it at net.core.rmem_max. rcvbuf_errors: Udp RcvbufErrors from /proc/net/snmp.
 inline constexpr long lcm_recommended_rmem_bytes = 2L << 20;
-inline constexpr long spindown_requested_rmem_bytes = services_recv_buf_bytes;
 DoctorCheck check_receive_buffer(std::optional<long> rmem_max, std::optional<long> rcvbuf_errors);
 // Udp RcvbufErrors from the text of /proc/net/snmp.
 std::optional<long> parse_udp_rcvbuf_errors(std::string_view proc_net_snmp);
