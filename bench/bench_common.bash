@@ -18,3 +18,14 @@ generated_runs() {
   mapfile -t FILES < <(tail -n +2 "$WORK/runs/index.tsv" | cut -f1 | sed "s|^|$WORK/runs/|")
   cat "${FILES[@]}" >/dev/null
 }
+
+# wall_us OUT ERR CMD...: CMD's wall time in microseconds, its stdout to OUT and stderr appended
+# to ERR. The clock is bash's own EPOCHREALTIME: a `date` process on each side of CMD would add
+# its own start-up (~1.2 ms here) to every figure, most of all to the fastest.
+wall_us() {
+  local t0 t1
+  t0=${EPOCHREALTIME/[.,]/}
+  "${@:3}" >"$1" 2>>"$2" || true
+  t1=${EPOCHREALTIME/[.,]/}
+  echo $((t1 - t0))
+}

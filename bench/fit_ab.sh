@@ -18,11 +18,8 @@ bench_work_dir fit-ab
 generated_runs "$NEW" "$RUNS" >/dev/null
 
 run() {  # run BIN TAG: wall in microseconds; stdout and stderr kept per tag
-  local t0 t1
-  t0=$(date +%s%N)
-  "$1/spindown" fit --json "${FILES[@]}" >"$WORK/$2.json" 2>"$WORK/$2.err" || true
-  t1=$(date +%s%N)
-  echo $(((t1 - t0) / 1000))
+  : >"$WORK/$2.err"
+  wall_us "$WORK/$2.json" "$WORK/$2.err" "$1/spindown" fit --json "${FILES[@]}"
 }
 old=() new=()
 for ((r = 0; r < ROUNDS; r++)); do

@@ -25,11 +25,7 @@ bench_work_dir vs-scipy
 generated_runs "$BIN" "$RUNS"
 
 wall() {  # wall OUT CMD...: seconds of wall time, stdout to OUT
-  local t0 t1
-  t0=$(date +%s%N)
-  "${@:2}" >"$1" 2>>"$WORK/stderr.txt" || true
-  t1=$(date +%s%N)
-  awk "BEGIN{printf \"%.3f\", ($t1 - $t0) / 1e9}"
+  awk "BEGIN{printf \"%.4f\", $(wall_us "$1" "$WORK/stderr.txt" "${@:2}") / 1e6}"
 }
 best() { printf '%s\n' "$@" | sort -g | head -1; }
 
