@@ -256,10 +256,12 @@ void setup_doctor(CLI::App& app) {
   sub->add_option("--lcm-url", opt->lcm_url, "LCM URL to check (default: LCM_DEFAULT_URL, else /etc/spindown/lcm.env)");
   sub->add_option("--env-file", opt->env_file, "The services' LCM env file")->capture_default_str();
   sub->add_option("--bench-config", opt->bench_config,
-                  "Bench files or directories (default /etc/spindown/benches when it exists)");
+                  "Bench files or directories (default /etc/spindown/benches when it exists); repeat the flag for more")
+      ->allow_extra_args(false);
   sub->add_option("--service-user", opt->service_user, "User the services run as")->capture_default_str();
   sub->add_option("--checks", opt->checks, "Only these checks: ttl,route,firewall,buffer,selftest,serial,clock")
       ->delimiter(',')
+      ->allow_extra_args(false)
       ->check(CLI::IsMember(all_checks));
   sub->add_option("--timeout", opt->timeout_s, "Seconds the LCM self-test waits for its message")
       ->capture_default_str()

@@ -172,13 +172,15 @@ void setup_fit(CLI::App& app) {
   sub->add_option("FILE", opt->files, "Arduino/PuTTY log, delimited text (CSV/TSV) or LCM log")->required();
   sub->add_flag("--json", opt->json, "Print one JSON object {\"files\":[{\"runs\":[{\"models\":…}]}]} instead of tables");
   sub->add_option("--models", opt->models, "Models to fit, comma-separated: viscous,coulomb,combined (default all)")
-      ->delimiter(',');
+      ->delimiter(',')
+      ->allow_extra_args(false);  // one value per flag: `--models combined a.tsv b.tsv` leaves the files alone
   sub->add_flag("--lab-units", opt->lab_units, "Also give the lab's units (g·cm², g·cm²·s⁻¹, g·cm²·rad·s⁻²)");
   sub->add_flag("-v,--verbose", opt->verbose, "Show every diagnostic, notes included");
 
   sub->add_option("--bench-config", opt->bench_configs,
                   "Per-bench TOML file(s): [bench] J/K_b (flags win) and [motor]/[baseline]/[health] for the "
-                  "motor health verdict; a directory means every *.toml in it")
+                  "motor health verdict; a directory means every *.toml in it; repeat the flag for more")
+      ->allow_extra_args(false)
       ->check(CLI::ExistingPath);
   sub->add_option("-j,--jobs", opt->jobs, "Files fitted at once (default 0: one per core); output keeps the order given")
       ->check(CLI::Range(0u, 1024u));

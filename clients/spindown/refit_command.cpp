@@ -314,7 +314,9 @@ void setup_refit(CLI::App& app) {
   sub->add_option("LOG", opt->logs, "LCM event log(s) (spindown-logger, lcm-logger)")->required();
   sub->add_flag("--json", opt->json, "Print one JSON object {\"files\":[{\"runs\":[…]}]} instead of tables");
   sub->add_option("--bench", opt->bench_regex, "Only benches whose id matches this regex (default all)");
-  sub->add_option("--models", opt->models, "Models to fit: viscous,coulomb,combined (default all)")->delimiter(',');
+  sub->add_option("--models", opt->models, "Models to fit: viscous,coulomb,combined (default all)")
+      ->delimiter(',')
+      ->allow_extra_args(false);
   sub->add_flag("--lab-units", opt->lab_units, "Also give the lab's units");
   sub->add_flag("-v,--verbose", opt->verbose, "Show every diagnostic, notes included");
   sub->add_flag("--no-progress", opt->no_progress, "No progress line on a terminal (there is none when stderr is not one)");

@@ -66,10 +66,14 @@ void setup_report(CLI::App& app) {
   sub->add_option("-o,--output", opt->output, "The HTML page to write")->required();
   sub->add_option("--bench", opt->text_bench, "Bench id for the text files (default: each file's name)");
   sub->add_option("--bench-config", opt->bench_configs,
-                  "Per-bench TOML file(s) with [motor]/[baseline]/[health]; a directory means every *.toml in it")
+                  "Per-bench TOML file(s) with [motor]/[baseline]/[health]; a directory means every *.toml in it; "
+                  "repeat the flag for more")
+      ->allow_extra_args(false)
       ->check(CLI::ExistingPath);
   sub->add_option("--base", opt->base, "The explain workflow's starting model (default viscous)");
-  sub->add_option("--models", opt->models, "Models to fit: viscous,coulomb,combined (default all)")->delimiter(',');
+  sub->add_option("--models", opt->models, "Models to fit: viscous,coulomb,combined (default all)")
+      ->delimiter(',')
+      ->allow_extra_args(false);
   sub->add_flag("--no-explain", opt->no_explain, "Leave out the explain story (faster)");
   sub->add_option("--title", opt->title, "Page title");
   sub->add_flag("--no-progress", opt->no_progress, "No progress line on a terminal");

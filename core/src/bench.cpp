@@ -12,9 +12,9 @@ bool BenchParams::is_valid(std::string* why) const {
     return false;
   };
   // Bounds wide enough for any bench motor, tight enough to catch unit mistakes (g·cm² as kg·m²).
-  if (!std::isfinite(inertia_kg_m2) || inertia_kg_m2 <= 0 || inertia_kg_m2 > 10)
+  if (!std::isfinite(inertia_kg_m2) || inertia_kg_m2 <= 0 || inertia_kg_m2 >= 10)
     return fail(fmt::format("inertia {} kg·m² is not a positive value below 10 kg·m²", inertia_kg_m2));
-  if (!std::isfinite(kb_v_s_per_rad) || kb_v_s_per_rad <= 0 || kb_v_s_per_rad > 10)
+  if (!std::isfinite(kb_v_s_per_rad) || kb_v_s_per_rad <= 0 || kb_v_s_per_rad >= 10)
     return fail(fmt::format("K_b {} V·s/rad is not a positive value below 10 V·s/rad", kb_v_s_per_rad));
   return true;
 }

@@ -89,6 +89,22 @@ print(",".join(m["name"] for m in run["models"]))')
 [[ "$models" == "coulomb,combined" ]] || { echo "FAIL --models coulomb,combined gave '$models'"; fail=1; }
 timeout 60 "$bin" fit --lab-units "$seed" | grep -qF "g·cm²·s⁻¹" || { echo "FAIL --lab-units text"; fail=1; }
 
+# A list option takes one value per flag: the files after `--models combined` are files, and
+# `--bench-config` before them leaves them alone too.
+files_fitted=$(timeout 60 "$bin" fit --json --models combined "$seed" "$seed" | python3 -c '
+import json, sys
+d = json.load(sys.stdin)
+print(len(d["files"]), ",".join(m["name"] for f in d["files"] for r in f["runs"] for m in r["models"]))' 2>/dev/null || true)
+[[ "$files_fitted" == "2 combined,combined" ]] || { echo "FAIL --models before two files gave '$files_fitted'"; fail=1; }
+printf 'bench_id = "b"\n' >"$tmp/b.toml"
+n_files=$(timeout 60 "$bin" fit --json --bench-config "$tmp/b.toml" "$seed" "$seed" 2>"$tmp/bc.err" |
+  python3 -c 'import json, sys; print(len(json.load(sys.stdin)["files"]))' 2>/dev/null || true)
+[[ "$n_files" == 2 ]] || { echo "FAIL --bench-config before two files fitted '$n_files': $(head -c 300 "$tmp/bc.err")"; fail=1; }
+# J must be below 10 kg·m², as the message says: 10 itself is bad usage.
+rc=0
+timeout 60 "$bin" fit --inertia 10 "$seed" >/dev/null 2>"$tmp/j10.err" || rc=$?
+[[ $rc -eq 2 ]] && grep -q "below 10" "$tmp/j10.err" || { echo "FAIL --inertia 10 gave rc $rc: $(head -c 300 "$tmp/j10.err")"; fail=1; }
+
 # The same run as CSV in seconds and rpm, columns named by the user.
 python3 - "$seed" "$tmp/seed.csv" <<'PY'
 import math, sys
