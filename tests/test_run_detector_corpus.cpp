@@ -22,7 +22,10 @@
 namespace spindown {
 namespace {
 
-constexpr std::uint64_t recorded_hash = 0xc123cf6558ddcf94ull;
+// Recorded on 2026-11-25, when an asymptotic coast's floor within a reading step of its "zeros"
+// lead-in became the lead-in's zero: of the 407 recordings only viscous-only.tsv changed (zero
+// level 0.01 → 0 and its note). Before: 0xc123cf6558ddcf94.
+constexpr std::uint64_t recorded_hash = 0x5f410526924038caull;
 constexpr int generated_recordings = 400;
 
 TEST(RunDetectorCorpus, FindsTheRecordedRunsBitForBit) {

@@ -28,7 +28,9 @@
 namespace spindown {
 namespace {
 
-constexpr std::uint64_t recorded_hash = 0xdfb42f4014578905ull;
+// Recorded on 2026-11-25, when an asymptotic coast's floor within a reading step of its "zeros"
+// lead-in became the lead-in's zero (viscous-only.tsv's runs). Before: 0xdfb42f4014578905.
+constexpr std::uint64_t recorded_hash = 0x7171de5f64b33361ull;
 
 // Each recording of the shared data as read, then damaged in each of the corpus's ways.
 std::vector<corpus::Case> plain_and_damaged() {

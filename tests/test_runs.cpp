@@ -214,6 +214,59 @@ TEST(FindRuns, OtherBenchesRippleOffsetAndUnits) {
   }
 }
 
+// A purely viscous coast never stops: on the 2-decimal print its floor is 0.01 V long before the
+// motor stops. That is where the decay sank below the print, not the zero, so within a step of
+// the lead-in's zero the lead-in's zero is the run's. A real offset on the coasting reading
+// (0.06 V, six steps above the lead-in) is kept.
+TEST(FindRuns, AsymptoticCoastTakesTheLeadInsZeroUnlessItsFloorIsClearlyAbove) {
+  for (const double offset : {0.0, 0.06}) {
+    SyntheticRunSpec spec;
+    spec.friction = {1.2e-6, 0.0};
+    spec.max_coast_s = 60;
+    spec.offset_v = offset;
+    spec.seed = 11;
+    const SyntheticRun s = make_synthetic_run(spec);
+    const auto seg = find_runs(to_recording(s));
+    ASSERT_EQ(seg.runs.size(), 1u) << "offset " << offset;
+    const spindown::Run& r = seg.runs[0];
+    EXPECT_FALSE(r.stopped) << "offset " << offset;
+    EXPECT_EQ(r.lead_in, "zeros");
+    if (offset == 0.0) {
+      EXPECT_EQ(r.zero_level, 0.0);
+      const bool said = std::any_of(seg.diagnostics.begin(), seg.diagnostics.end(), [](const Diagnostic& d) {
+        return d.message.find("within one reading step of the lead-in's zero, so zero level 0") != std::string::npos;
+      });
+      EXPECT_TRUE(said) << "the note says which zero was taken";
+    } else {
+      EXPECT_GE(r.zero_level, offset) << "the floor, offset included, is kept";
+      EXPECT_LT(r.zero_level, offset + 0.05) << "the floor, offset included, is kept";
+    }
+  }
+}
+
+// A gap of a day in the middle of a coast (logging paused, the clock jumped): the coast is cut
+// short at the gap, the sample after it is not fitted as part of it, and the user is warned.
+TEST(FindRuns, GapMidCoastCutsTheCoastThereWithAWarning) {
+  SyntheticRunSpec spec;
+  spec.seed = 5;
+  const SyntheticRun s = make_synthetic_run(spec);
+  Recording rec = to_recording(s);
+  const std::size_t gap_at = 1000;  // ~17 s after the cut, mid-coast
+  ASSERT_LT(gap_at, rec.size());
+  ASSERT_GT(rec.t_s[gap_at], s.t_cut_ms / 1000.0 + 5);
+  for (std::size_t i = gap_at; i < rec.size(); ++i) rec.t_s[i] += 86400;
+  const auto seg = find_runs(rec);
+  ASSERT_GE(seg.runs.size(), 1u);
+  const spindown::Run& r = seg.runs[0];
+  EXPECT_FALSE(r.stopped);
+  EXPECT_EQ(r.end_index, gap_at) << "the sample after the gap is not this coast's";
+  const auto warned = std::find_if(seg.diagnostics.begin(), seg.diagnostics.end(), [](const Diagnostic& d) {
+    return d.severity == Diagnostic::Severity::warning && d.message.find("mid-coast") != std::string::npos;
+  });
+  ASSERT_NE(warned, seg.diagnostics.end()) << "a coast cut short by a gap is a warning, not a note";
+  EXPECT_NE(warned->message.find("no samples for 8.64e+04 s"), std::string::npos) << warned->message;
+}
+
 TEST(FindRuns, SeveralRunsInOneRecordingAreFoundSeparately) {
   Recording rec;
   rec.source = "multi";

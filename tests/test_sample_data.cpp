@@ -100,14 +100,20 @@ TEST(SampleData, ViscousOnlyRunNeedsNoCoulombTerm) {
   EXPECT_LT(std::abs(f.run.t_cut_s - truth.t_cut_s), period_of(f.rec, f.run.cut_index));
   const ModelFit* v = f.fit.model(ModelKind::viscous);
   ASSERT_TRUE(v && v->converged);
+  // The coast never stops: its floor on the 2-decimal print (0.01 V) is where the decay sank below
+  // the print, not the zero. Subtracting it made c1 1.4 % (19 standard errors) too high and
+  // invented Coulomb friction; the lead-in's zero is the zero.
+  EXPECT_FALSE(f.run.stopped);
+  EXPECT_EQ(f.run.zero_level, 0.0);
   const Parameter& c1 = *v->param("c1");
-  EXPECT_LT(std::abs(c1.value - truth.c_v), 0.05 * truth.c_v) << c1.value << "±" << c1.std_error;
+  EXPECT_LT(std::abs(c1.value - truth.c_v), 3 * c1.std_error) << c1.value << "±" << c1.std_error;
   const ModelFit* m = f.fit.model(ModelKind::combined);
   ASSERT_TRUE(m && m->converged);
   const Parameter& c3 = *m->param("c3");
-  EXPECT_LT(std::abs(c3.value - truth.c_v), 0.05 * truth.c_v) << c3.value << "±" << c3.std_error;
-  // Truth c_c = 0: whatever Coulomb torque the fit finds is under 1 % of the viscous torque at the cut.
-  EXPECT_LT(m->param("c4")->value, 0.01 * c3.value * m->param("omega0")->value);
+  EXPECT_LT(std::abs(c3.value - truth.c_v), 0.01 * truth.c_v) << c3.value << "±" << c3.std_error;
+  // Truth c_c = 0: whatever Coulomb torque the fit finds is under 0.2 % of the viscous torque at
+  // the cut (0.06 % now; 0.41 % with the floor subtracted).
+  EXPECT_LT(m->param("c4")->value, 0.002 * c3.value * m->param("omega0")->value);
 }
 
 class HiddenEffectFile : public ::testing::TestWithParam<const char*> {};

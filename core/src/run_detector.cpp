@@ -752,6 +752,7 @@ bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
   run_.t_cut_s = sp.t_cut_s;
   run_.lead_in = lead;
   run_note_.clear();
+  run_note_severity_ = Diagnostic::Severity::note;
   if (sp.clipped) {
     emit_diag(Diagnostic::Severity::warning,
               fmt::format("run {}: reading pinned at {:g} (converter's top?) from {} to {} ({} samples): "
@@ -762,6 +763,7 @@ bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
   v0_ = sp.v0;
   standstill_ceiling_ = v0_ > 0 ? standstill_max_fraction * v0_ : std::numeric_limits<double>::infinity();
   coast_sd_ = sp.sd_post;
+  lead_in_zero_ = lead == "zeros" ? sp.pre_mean : std::numeric_limits<double>::quiet_NaN();
   rise_jump_ = std::max(0.1 * std::abs(v0_), 8.0 * coast_sd_);
   level_min_ = std::numeric_limits<double>::infinity();
   rising_ = 0;
@@ -790,6 +792,19 @@ void RunDetector::coast_too_long(std::size_t i) {
                                 fmt_s(run_.t_cut_s), opt_.max_buffer)};
     events_.push_back(std::move(e));
     to_idle(i + 1, true);
+    return;
+  }
+  // The coast was within max_coast_s until one step jumped past it: a gap in the recording
+  // (logging paused, the device clock jumped), not a coast that went on too long. The sample
+  // after the gap is not this coast's, and the user must hear that the coast was cut short.
+  const double step = i > run_.cut_index ? t(i) - t(i - 1) : 0.0;
+  if (i > run_.cut_index + 1 && t(i - 1) - run_.t_cut_s <= opt_.max_coast_s &&
+      step > std::max(2.0, 0.01 * opt_.max_coast_s)) {  // 2 s: a hundred lost samples at the lab's 20 ms
+    run_note_severity_ = Diagnostic::Severity::warning;
+    close_unstopped(i, fmt::format("no samples for {:.3g} s mid-coast (from {} to {}): the coast is cut short there "
+                                   "and fitted as never stopped; the samples after the gap are not in this run",
+                                   step, fmt_s(t(i - 1)), fmt_s(t(i))));
+    to_idle(i, true);
     return;
   }
   close_unstopped(i + 1, fmt::format("no standstill within max_coast_s ({:g} s): closed as never stopped",
@@ -880,6 +895,15 @@ inline double level_tiny(double v0, double m) {
   const bool no_slope = std::abs(s) * std::sqrt(sxx) <= flat_t_stat * e + tiny;
   const bool small_drop = std::abs(s) * d <= std::max(3.0 * e, 0.01 * std::abs(v0)) + tiny;
   return no_slope && small_drop;
+}
+
+double RunDetector::reading_step(std::size_t from, std::size_t to) const {
+  double step = std::numeric_limits<double>::infinity();
+  for (std::size_t k = from + 1; k < to; ++k) {
+    const double d = std::abs(v(k) - v(k - 1));
+    if (d > 0) step = std::min(step, d);
+  }
+  return std::isfinite(step) ? step : 0.0;
 }
 
 void RunDetector::found_standstill(std::size_t i, bool at_end) {
@@ -979,10 +1003,22 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
     // exponential's tail still carries information for the fit.
     creeping_ = true;
   } else {
+    // The floor an asymptotic coast shows is where its decay sank below the reading's
+    // resolution, not where it is heading (an exponential heads for the true zero): on a
+    // 2-decimal print it is 0.01 V long before the motor stops, and subtracting that from every
+    // reading bends the viscous curve into Coulomb friction that is not there. Within a step
+    // of the lead-in's zero (the motor at rest, read before the run), that zero is the better
+    // measured. A floor clearly above it (an offset only the coasting reading has) is kept.
+    std::string floor_said;
+    const double band = std::max(3.0 * sd_z, reading_step(hold_.first, i + 1));
+    if (std::isfinite(lead_in_zero_) && std::abs(z - lead_in_zero_) <= band * (1 + 1e-9) && z != lead_in_zero_) {
+      run_.zero_level = lead_in_zero_;
+      floor_said = fmt::format(", within one reading step of the lead-in's zero, so zero level {:g}", lead_in_zero_);
+    }
     run_note_ = fmt::format(
-        "run cut at {}: the coast approaches its floor ({:g}) asymptotically (last quarter {:.2f}x slower than "
+        "run cut at {}: the coast approaches its floor ({:g}{}) asymptotically (last quarter {:.2f}x slower than "
         "the mean rate), as pure viscous friction does: treated as never stopped, coast closed at {}",
-        fmt_s(run_.t_cut_s), z, end_rate > 0 ? 1.0 / end_rate : 0.0, fmt_s(t(i)));
+        fmt_s(run_.t_cut_s), z, floor_said, end_rate > 0 ? 1.0 / end_rate : 0.0, fmt_s(t(i)));
     run_.stopped = false;
     complete_run(i + 1);
     to_idle(i + 1, true);
@@ -1088,11 +1124,12 @@ void RunDetector::complete_run(std::size_t end) {
     e.run.number = ++accepted_;
     if (!run_note_.empty()) {
       e.has_diagnostic = true;
-      e.diagnostic = {Diagnostic::Severity::note, source_, 0, fmt::format("run {}: {}", e.run.number, run_note_)};
+      e.diagnostic = {run_note_severity_, source_, 0, fmt::format("run {}: {}", e.run.number, run_note_)};
     }
   }
   events_.push_back(std::move(e));
   run_note_.clear();
+  run_note_severity_ = Diagnostic::Severity::note;
 }
 
 }  // namespace spindown

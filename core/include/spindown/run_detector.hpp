@@ -217,6 +217,9 @@ class RunDetector {
   void to_idle(std::size_t lo, bool need_quiet);
   void emit_diag(Diagnostic::Severity sev, std::string msg);
   double median_of(std::size_t from, std::size_t to);
+  // The smallest positive change between consecutive readings in [from, to): the converter's or
+  // the printing's step on quantized readings; 0 when none changes.
+  double reading_step(std::size_t from, std::size_t to) const;
   // The median of the sample periods in [from, to) (at least two samples), as nth_element picks it.
   double median_period(std::size_t from, std::size_t to);
   // For the m periods ending at p[0..m) (the first one starting at prev, which becomes the time of
@@ -254,9 +257,12 @@ class RunDetector {
 
   // The open run.
   Run run_;
+  std::string run_note_;  // said with the run when it completes, at run_note_severity_
+  Diagnostic::Severity run_note_severity_ = Diagnostic::Severity::note;
   double v0_ = 0;          // reading at the cut (start of the coast line)
   double standstill_ceiling_ = 0;  // a hold-window mean above it is not low yet (0.3 v0_, or inf if v0_ <= 0)
   double coast_sd_ = 0;    // coast noise near the cut
+  double lead_in_zero_ = 0;  // mean reading of a "zeros" lead-in (the motor at rest); NaN for other lead-ins
   double rise_jump_ = 0;   // a reading this far above level_min_ is power coming back
   double level_min_ = 0;   // lowest hold-window mean seen in this coast
   int rising_ = 0;         // consecutive samples far above level_min_ (power back?)
@@ -264,7 +270,6 @@ class RunDetector {
   double depart_band_ = 0; // tail: how far from zero_level counts as leaving standstill
   int departing_ = 0;
   std::size_t depart_start_ = 0;
-  std::string run_note_;   // note attached to the completed run
 
   std::vector<RunEvent> events_;
   // Work space for medians and the cut search, grown (never shrunk, never zeroed) as needed.
