@@ -108,6 +108,15 @@ TEST(Fit, CurveConstantsFollowTheLabDefinitions) {
     }
 }
 
+// With one model asked for (--models combined) there is nothing to compare: the reason says so,
+// not that the others failed.
+TEST(Fit, OneModelAskedForIsBestBecauseItIsTheOnlyOne) {
+  const Case c = make_case(SyntheticRunSpec{});
+  const RunFit f = fit_case(c, {ModelKind::combined});
+  EXPECT_EQ(f.best, "combined");
+  EXPECT_EQ(f.best_reason, "the only model asked for");
+}
+
 TEST(Fit, CombinedIsBestOnCombinedFrictionAndSaysWhy) {
   const Case c = make_case(SyntheticRunSpec{});
   const RunFit f = fit_case(c);

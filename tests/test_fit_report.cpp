@@ -219,6 +219,9 @@ TEST(FitReportText, BestReasonFromTheFitWins) {
   f.best_reason.clear();
   f.models.resize(1);
   f.best = "viscous";
+  EXPECT_EQ(explain_best(f), "viscous is the only model asked for");
+  f.models.resize(2);
+  f.models[1].converged = false;
   EXPECT_EQ(explain_best(f), "viscous is the only model that converged");
   f.best.clear();
   EXPECT_EQ(explain_best(f), "no model converged");

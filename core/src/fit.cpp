@@ -1154,7 +1154,7 @@ RunFit fit_run(std::span<const double> t_s, std::span<const double> value, Quant
       out.best_reason = fmt::format("lowest BIC, {:.1f} below {} ({} evidence); RMSE {:.4g} {} vs {:.4g} {}", dbic,
                                     model_name(second->kind), strength, best->rmse, runit, second->rmse, runit);
     } else {
-      out.best_reason = "the only model that converged";
+      out.best_reason = out.models.size() == 1 ? "the only model asked for" : "the only model that converged";
     }
   }
   return out;

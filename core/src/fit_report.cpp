@@ -176,7 +176,8 @@ std::string explain_best(const RunFit& fit) {
   const ModelFit* best = best_model(fit);
   if (!best) return "no model converged";
   const ModelFit* second = runner_up(fit, best);
-  if (!second) return fmt::format("{} is the only model that converged", fit.best);
+  if (!second)
+    return fmt::format("{} is the only model {}", fit.best, fit.models.size() == 1 ? "asked for" : "that converged");
   const double delta = second->bic - best->bic;
   return fmt::format("lowest BIC: ΔBIC = {:.1f} below {} ({} evidence); RMSE {:.4g} vs {:.4g}", delta,
                      model_name(second->kind), evidence(delta), best->rmse, second->rmse);
