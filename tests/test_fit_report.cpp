@@ -319,7 +319,13 @@ TEST(FitReportJsonText, MatchesTheDocumentsDumpByteForByte) {
   FileFit repeated = one_file(lab_like_fit());  // a repeated key: the document keeps one member
   repeated.runs[0].models[0].params.push_back(param("c1", 9.0, 1.0, "N*m*s/rad"));
 
-  const std::vector<FileFit> all = {usual, two_runs, empty, health_only, repeated};
+  FileFit benches = one_file(lab_like_fit());  // an LCM log of two benches: each run names its own
+  benches.runs.push_back(odd);
+  benches.run_bench = {"bench000", "b\"1"};
+  benches.health = {a_verdict(), std::nullopt};
+  benches.lcm_log = true;
+
+  const std::vector<FileFit> all = {usual, two_runs, empty, health_only, repeated, benches};
   for (const bool lab_units : {false, true}) {
     ReportOptions opt;
     opt.lab_units = lab_units;
@@ -327,6 +333,28 @@ TEST(FitReportJsonText, MatchesTheDocumentsDumpByteForByte) {
     for (const auto& f : all) EXPECT_EQ(streamed({&f, 1}, opt), document({&f, 1}, opt)) << f.file;
   }
   EXPECT_EQ(streamed({}, {}), document({}, {}));
+}
+
+// `spindown fit` on an LCM log of several benches: a "-- bench" line before each bench's runs,
+// "bench" -> "id" in JSON (no sequence numbers: those are the refit's), messages not lines.
+TEST(FitReportText, RunsOfSeveralBenchesSayWhoseTheyAre) {
+  FileFit f = one_file(lab_like_fit());
+  f.runs.push_back(lab_like_fit());
+  f.runs.push_back(lab_like_fit());
+  f.run_bench = {"bench000", "bench000", "bench001"};
+  f.lcm_log = true;
+  const std::string text = format_file_fit(f);
+  EXPECT_NE(text.find("messages ("), std::string::npos) << text;
+  EXPECT_EQ(text.find("lines ("), std::string::npos) << text;
+  const auto first = text.find("-- bench bench000"), second = text.find("-- bench bench001");
+  ASSERT_NE(first, std::string::npos) << text;
+  ASSERT_NE(second, std::string::npos) << text;
+  EXPECT_EQ(text.find("-- bench bench000", first + 1), std::string::npos) << "one line per bench, not per run";
+  const Json j = file_fit_json(f, {});
+  EXPECT_EQ(j["runs"][2]["bench"]["id"], "bench001");
+  EXPECT_FALSE(j["runs"][0].contains("first_seq"));
+  EXPECT_FALSE(one_file(lab_like_fit()).lcm_log);
+  EXPECT_FALSE(file_fit_json(one_file(lab_like_fit()), {})["runs"][0]["bench"].contains("id"));
 }
 
 // The refit's run text (tagged, nested eight spaces deep in {"files":[{"runs":[…]}]}) must be the

@@ -76,6 +76,7 @@ FileFit fit_file(const std::string& path, const FitPlan& plan) {
   try {
     std::vector<RecordingInfo> info;
     const auto recordings = read_recordings(path, plan.read, &info);
+    out.lcm_log = !info.empty() && info.front().format == FileFormat::lcm_log;
     for (std::size_t k = 0; k < recordings.size(); ++k) {
       const Recording& rec = recordings[k];
       // An LCM log names several benches: say which one a failure is about.
@@ -127,6 +128,11 @@ FileFit fit_file(const std::string& path, const FitPlan& plan) {
       }
       for (const Run& run : seg.runs) {
         RunFit fit = fit_run(rec, run, fit_opt);
+        // An LCM log of several benches: each run says whose it is (run numbers restart per bench).
+        if (recordings.size() > 1) {
+          out.run_bench.resize(out.runs.size());
+          out.run_bench.push_back(k < info.size() && !info[k].bench.empty() ? info[k].bench : rec.source);
+        }
         if (fit.best.empty()) {
           std::string why;
           for (const auto& m : fit.models)

@@ -260,6 +260,7 @@ Json file_fit_json(const FileFit& file, const ReportOptions& opt) {
   Json runs = Json::array();
   for (std::size_t i = 0; i < file.runs.size(); ++i) {
     runs.push_back(run_fit_json(file.runs[i], opt));
+    if (i < file.run_bench.size()) tag_run_json(runs.back(), {file.run_bench[i], 0, 0, false});
     if (i < file.health.size() && file.health[i]) runs.back()["health"] = health_json(*file.health[i]);
   }
   Json diagnostics = Json::array();
@@ -555,7 +556,7 @@ void write_run_fit(PrettyJsonWriter& w, const RunFit& fit, const ReportOptions& 
   }
   if (tags) w.member("id", tags->bench_id);
   w.end_object();
-  if (tags) {
+  if (tags && tags->has_seq) {
     w.key("first_seq"); w.integer(tags->first_seq);
     w.key("last_seq"); w.integer(tags->last_seq);
   }
@@ -598,7 +599,8 @@ void write_file_fit(std::string& out, std::size_t indent, const FileFit& file, c
   w.begin_array();
   for (std::size_t i = 0; i < file.runs.size(); ++i) {
     w.element();
-    write_run_fit(w, file.runs[i], opt);
+    const RunTags tags{i < file.run_bench.size() ? std::string_view(file.run_bench[i]) : std::string_view(), 0, 0, false};
+    write_run_fit(w, file.runs[i], opt, i < file.run_bench.size() ? &tags : nullptr);
     if (i < file.health.size() && file.health[i]) {
       w.key("health");
       write_health(w, *file.health[i]);
@@ -650,6 +652,7 @@ std::string file_fit_json_text(const FileFit& file, const ReportOptions& opt) {
 
 void tag_run_json(Json& run, const RunTags& tags) {
   run["bench"]["id"] = tags.bench_id;
+  if (!tags.has_seq) return;
   run["first_seq"] = tags.first_seq;
   run["last_seq"] = tags.last_seq;
 }
@@ -748,9 +751,9 @@ std::string format_file_fit(const FileFit& file, const ReportOptions& opt) {
     if (d.severity == Diagnostic::Severity::error) ++errors;
     if (d.severity == Diagnostic::Severity::warning) ++warnings;
   }
-  std::string out = fmt::format("== {}: {} samples from {} lines ({} skipped), {} run{} fitted", file.file,
-                                file.samples, file.lines_read, file.lines_skipped, file.runs.size(),
-                                file.runs.size() == 1 ? "" : "s");
+  std::string out = fmt::format("== {}: {} samples from {} {} ({} skipped), {} run{} fitted", file.file,
+                                file.samples, file.lines_read, file.lcm_log ? "messages" : "lines",
+                                file.lines_skipped, file.runs.size(), file.runs.size() == 1 ? "" : "s");
   auto count = [](std::size_t n, std::string_view what) { return fmt::format("{} {}{}", n, what, n == 1 ? "" : "s"); };
   if (errors + warnings > 0) out += ", " + count(errors, "error") + ", " + count(warnings, "warning");
   out += '\n';
@@ -759,6 +762,8 @@ std::string format_file_fit(const FileFit& file, const ReportOptions& opt) {
     for (const auto& why : file.failures) out += fmt::format("  not used: {}\n", why);
   }
   for (std::size_t i = 0; i < file.runs.size(); ++i) {
+    if (i < file.run_bench.size() && (i == 0 || file.run_bench[i] != file.run_bench[i - 1]))
+      out += fmt::format("\n-- bench {}\n", file.run_bench[i]);
     out += '\n' + format_run_fit(file.runs[i], opt);
     if (i < file.health.size() && file.health[i]) out += format_health_verdict(*file.health[i]);
   }

@@ -25,6 +25,10 @@ struct FileFit {
   std::size_t lines_read = 0, lines_skipped = 0;
   std::vector<Diagnostic> diagnostics;  // reading, segmentation and fitting problems
   std::vector<RunFit> runs;
+  // The bench each run is from (same order as runs) when the file is an LCM log of several
+  // benches; empty for a file of one bench. JSON: "bench" -> "id"; text: a "-- bench" line.
+  std::vector<std::string> run_bench;
+  bool lcm_log = false;  // what was read were LCM messages, not text lines
   // Motor health verdict per run (same order as runs) when a bench file was given; empty or
   // nullopt entries: not assessed (no "health" in JSON).
   std::vector<std::optional<HealthVerdict>> health;
@@ -59,6 +63,7 @@ Json fit_report_json(std::span<const FileFit> files, const ReportOptions& opt = 
 struct RunTags {
   std::string_view bench_id;
   std::int64_t first_seq = 0, last_seq = 0;
+  bool has_seq = true;  // false: the bench id only (`spindown fit` on an LCM log of several benches)
 };
 void tag_run_json(Json& run, const RunTags& tags);  // adds the tags to run_fit_json()'s document
 Json tagged_run_fit_json(const RunFit& fit, const RunTags& tags, const ReportOptions& opt = {});
