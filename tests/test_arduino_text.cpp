@@ -9,6 +9,8 @@
 #include <tuple>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "spindown/arduino_text.hpp"
 #include "spindown/synthetic_run.hpp"
 
@@ -142,6 +144,24 @@ TEST(ArduinoText, BinaryJunkIsAClearErrorWithoutAFloodOfWarnings) {
   const Recording nuls = read_arduino_text(std::string(4096, '\0'), "zeros.bin");
   ASSERT_TRUE(nuls.has_errors());
   EXPECT_NE(nuls.diagnostics.front().message.find("binary"), std::string::npos);
+}
+
+// More problem lines than are listed one by one: the summary gives the lowest and highest line
+// not listed, whichever order they were found in (the cut first line's note comes after the
+// parser's warnings), and how many of each kind.
+TEST(ArduinoText, UnlistedProblemLinesAreSummarisedWithTheirRangeAndKinds) {
+  std::string text = "3\t0.00\r\n";  // line 1: cut short (logging started mid-line)
+  for (int i = 0; i < 200; ++i) {
+    if (i >= 50 && i < 80) text += "garbled\r\n";  // lines 52 … 81
+    else text += fmt::format("{}\t{:.2f}\r\n", 5234 + 20 * i, 1.0);
+  }
+  const Recording r = read_arduino_text(text, "many.tsv");
+  const auto summary = std::find_if(r.diagnostics.begin(), r.diagnostics.end(), [](const Diagnostic& d) {
+    return d.message.find("not listed one by one") != std::string::npos;
+  });
+  ASSERT_NE(summary, r.diagnostics.end());
+  EXPECT_EQ(summary->message,
+            "12 more problem lines not listed one by one (10 warnings, 2 notes; between lines 1 and 82); 32 in all");
 }
 
 TEST(ArduinoText, TextWithoutSamplesSaysWhy) {
@@ -333,7 +353,7 @@ TEST(ArduinoText, ManyBadLinesAreSummarised) {
   EXPECT_EQ(warnings[0]->line, 6);
   EXPECT_EQ(warnings[20]->line, 0);
   EXPECT_NE(warnings[20]->message.find("480 more problem lines"), std::string::npos) << warnings[20]->message;
-  EXPECT_NE(warnings[20]->message.find("lines 26 to 505"), std::string::npos) << warnings[20]->message;
+  EXPECT_NE(warnings[20]->message.find("(480 warnings; between lines 26 and 505)"), std::string::npos) << warnings[20]->message;
 }
 
 TEST(ArduinoText, TenMegabyteLineWithoutNewline) {

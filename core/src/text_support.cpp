@@ -112,14 +112,24 @@ void LineReporter::report(Diagnostic::Severity severity, std::int64_t line, std:
     rec_.diagnostics.push_back({severity, rec_.source, line, std::move(message)});
     return;
   }
-  if (first_unlisted_ == 0) first_unlisted_ = line;
-  last_unlisted_ = line;
+  // Reports do not come in line order (the timeline's follow the parser's), so the range is the
+  // lowest and highest line, and each severity is counted.
+  if (first_unlisted_ == 0 || line < first_unlisted_) first_unlisted_ = line;
+  last_unlisted_ = std::max(last_unlisted_, line);
+  ++unlisted_[static_cast<int>(severity)];
 }
 
 void LineReporter::finish() {
   if (count_ <= max_) return;
-  rec_.warn(0, fmt::format("{} more problem lines not listed one by one (lines {} to {}); {} in all",
-                           count_ - max_, first_unlisted_, last_unlisted_, count_));
+  std::string kinds;
+  constexpr std::pair<Diagnostic::Severity, const char*> names[] = {
+      {Diagnostic::Severity::error, "error"}, {Diagnostic::Severity::warning, "warning"},
+      {Diagnostic::Severity::note, "note"}};
+  for (const auto& [severity, name] : names)
+    if (const std::size_t n = unlisted_[static_cast<int>(severity)])
+      kinds += fmt::format("{}{} {}{}", kinds.empty() ? "" : ", ", n, name, n == 1 ? "" : "s");
+  rec_.warn(0, fmt::format("{} more problem lines not listed one by one ({}; between lines {} and {}); {} in all",
+                           count_ - max_, kinds, first_unlisted_, last_unlisted_, count_));
 }
 
 void sort_by_line(Recording& rec) {

@@ -136,7 +136,8 @@ class LineReporter {
   Recording& rec_;
   std::size_t max_;
   std::size_t count_ = 0;
-  std::int64_t first_unlisted_ = 0, last_unlisted_ = 0;
+  std::int64_t first_unlisted_ = 0, last_unlisted_ = 0;  // lowest and highest line not listed
+  std::size_t unlisted_[3] = {};                          // by severity
 };
 
 // Diagnostics in line order, those about the whole file (line 0) last; stable.
