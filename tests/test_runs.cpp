@@ -267,6 +267,37 @@ TEST(FindRuns, GapMidCoastCutsTheCoastThereWithAWarning) {
   EXPECT_NE(warned->message.find("no samples for 8.64e+04 s"), std::string::npos) << warned->message;
 }
 
+// A silence of 3 s inside a coast: when samples were lost the reading fell across it as the
+// coast does (a note); when the device clock jumped with the readings going on, it did not (a
+// warning: the fit's times, and so its friction, are wrong by the jump).
+TEST(FindRuns, GapInsideACoastIsTakenAsSamplesLostOrWarnedAsAClockJump) {
+  SyntheticRunSpec spec;
+  spec.seed = 5;
+  const SyntheticRun s = make_synthetic_run(spec);
+  const Recording whole = to_recording(s);
+  const std::size_t gap_at = 700;  // ~8 s after the cut, mid-coast
+  ASSERT_GT(whole.t_s[gap_at], s.t_cut_ms / 1000.0 + 5);
+  Recording lost, jumped;
+  for (std::size_t i = 0; i < whole.size(); ++i) {
+    if (i < gap_at || whole.t_s[i] >= whole.t_s[gap_at] + 3.0) lost.push(whole.t_s[i], whole.value[i]);
+    jumped.push(whole.t_s[i] + (i >= gap_at ? 3.0 : 0.0), whole.value[i]);
+  }
+  const auto said = [](const Segmentation& seg) {
+    for (const auto& d : seg.diagnostics)
+      if (d.message.find("mid-coast") != std::string::npos) return std::make_pair(d.severity, d.message);
+    return std::make_pair(Diagnostic::Severity::error, std::string("nothing said"));
+  };
+  const Segmentation a = find_runs(lost), b = find_runs(jumped);
+  ASSERT_EQ(a.runs.size(), 1u);
+  ASSERT_EQ(b.runs.size(), 1u);
+  EXPECT_TRUE(a.runs[0].stopped);
+  EXPECT_EQ(said(a).first, Diagnostic::Severity::note) << said(a).second;
+  EXPECT_NE(said(a).second.find("taken as samples lost"), std::string::npos) << said(a).second;
+  EXPECT_EQ(said(b).first, Diagnostic::Severity::warning) << said(b).second;
+  EXPECT_NE(said(b).second.find("device clock jumped?"), std::string::npos) << said(b).second;
+  EXPECT_EQ(said(find_runs(whole)).second, "nothing said") << "a coast without a gap says nothing";
+}
+
 TEST(FindRuns, SeveralRunsInOneRecordingAreFoundSeparately) {
   Recording rec;
   rec.source = "multi";

@@ -1090,6 +1090,38 @@ void RunDetector::close_unstopped(std::size_t end, const std::string& why) {
   complete_run(end);
 }
 
+// A long silence inside a fitted coast. Samples lost while the motor coasted on leave the
+// reading lower after the gap by about the coast's slope times the gap, and the fit is right to
+// take the times as given (a note). A device clock that jumped while the readings went on
+// leaves the reading where it was: the fit's times are then wrong by the jump, and so is its
+// friction (a warning). Said once per run, for the longest gap.
+void RunDetector::warn_of_gap_in_coast(int number, std::size_t from, std::size_t to, double period_s) {
+  std::size_t at = 0;
+  double longest = 0;
+  for (std::size_t k = from + 1; k < to; ++k)
+    if (t(k) - t(k - 1) > longest) longest = t(k) - t(k - 1), at = k;
+  if (at == 0 || !(longest > std::max(1.0, 25.0 * period_s))) return;
+  // The coast's slope over up to a second before the gap.
+  std::size_t a = at - 1;
+  while (a > from && t(at - 1) - t(a - 1) <= 1.0) --a;
+  WindowFit before;
+  before.clear(a, t(a));
+  for (std::size_t k = a; k < at; ++k) before.add(t(k), v(k));
+  const double expected = before.n >= 5 ? -before.slope() * longest : 0.0;
+  const double fell = v(at - 1) - v(at);
+  const std::string gap = fmt::format("run {}: no samples for {:.3g} s mid-coast (from {} to {})", number, longest,
+                                      fmt_s(t(at - 1)), fmt_s(t(at)));
+  if (expected > 6.0 * before.resid_sd() && expected > 0 && fell < 0.5 * expected)
+    emit_diag(Diagnostic::Severity::warning,
+              fmt::format("{}: the reading fell {:.3g} across it where the coast would have fallen {:.3g}: the "
+                          "device clock jumped? The fit takes the times as given, so its friction is wrong by "
+                          "the jump",
+                          gap, fell, expected));
+  else
+    emit_diag(Diagnostic::Severity::note,
+              fmt::format("{}: the reading fell across it as the coast would, taken as samples lost", gap));
+}
+
 void RunDetector::complete_run(std::size_t end) {
   Run r = run_;
   end = std::max(end, r.cut_index);
@@ -1122,6 +1154,7 @@ void RunDetector::complete_run(std::size_t end) {
   } else {
     e.kind = RunEvent::Kind::complete;
     e.run.number = ++accepted_;
+    warn_of_gap_in_coast(e.run.number, r.cut_index, coast_end, r.period_s);
     if (!run_note_.empty()) {
       e.has_diagnostic = true;
       e.diagnostic = {run_note_severity_, source_, 0, fmt::format("run {}: {}", e.run.number, run_note_)};
