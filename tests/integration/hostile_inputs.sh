@@ -59,6 +59,9 @@ for k, (t, v) in enumerate(rows):
     dup.append((t, v))
     if 400 <= k < 410: dup.append((t, v))
 write("duplicates.tsv", dup)
+# 9 s into the coast the device clock jumps 3 s while the readings go on; or logging stops for a day.
+write("clock_jump.tsv", [(t + (3000 if k >= 600 else 0), v) for k, (t, v) in enumerate(rows)])
+write("day_gap.tsv", [(t + (86400000 if k >= 600 else 0), v) for k, (t, v) in enumerate(rows)])
 with open("latin1.tsv", "wb") as f:
     f.write(b"=~=~=~=~=~=~=~=~=~=~=~= PuTTY log 2023.09.14 10:21:33 =~=~=~=~=~=~=~=~=~=~=~=\r\n")
     f.write("Messung Motor Nr. 3 \xb5C gestartet \xe4\xf6\xfc\r\n".encode("latin-1"))
@@ -118,6 +121,8 @@ cases=(
   "a 1 MiB line|fit|long_line.tsv|0|line too long"
   "millis() wrapping at 2^32 mid-coast|fit -v|millis_wrap.tsv|0|wrapped"
   "duplicate timestamps (10 lines twice)|fit|duplicates.tsv|0|duplicate line"
+  "device clock jumping 3 s mid-coast, readings going on|fit|clock_jump.tsv|0|device clock jumped"
+  "a day without samples mid-coast|fit|day_gap.tsv|0|not in this run"
   "non-UTF-8 bytes (Latin-1 line, invalid sequences)|fit|latin1.tsv|0|not a number"
   "a directory|fit|a_directory|1|it is a directory"
   "a missing file|fit|missing.tsv|1|No such file"
