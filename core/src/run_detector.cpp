@@ -1113,9 +1113,8 @@ void RunDetector::warn_of_gap_in_coast(int number, std::size_t from, std::size_t
                                       fmt_s(t(at - 1)), fmt_s(t(at)));
   if (expected > 6.0 * before.resid_sd() && expected > 0 && fell < 0.5 * expected)
     emit_diag(Diagnostic::Severity::warning,
-              fmt::format("{}: the reading fell {:.3g} across it where the coast would have fallen {:.3g}: the "
-                          "device clock jumped? The fit takes the times as given, so its friction is wrong by "
-                          "the jump",
+              fmt::format("{}: the device clock jumped? The reading fell {:.3g} across it where the coast would "
+                          "have fallen {:.3g}; the fit takes the times as given, so its friction is wrong by the jump",
                           gap, fell, expected));
   else
     emit_diag(Diagnostic::Severity::note,

@@ -122,7 +122,7 @@ cases=(
   "millis() wrapping at 2^32 mid-coast|fit -v|millis_wrap.tsv|0|wrapped"
   "duplicate timestamps (10 lines twice)|fit|duplicates.tsv|0|duplicate line"
   "device clock jumping 3 s mid-coast, readings going on|fit|clock_jump.tsv|0|device clock jumped"
-  "a day without samples mid-coast|fit|day_gap.tsv|0|not in this run"
+  "a day without samples mid-coast|fit|day_gap.tsv|0|cut short there"
   "non-UTF-8 bytes (Latin-1 line, invalid sequences)|fit|latin1.tsv|0|not a number"
   "a directory|fit|a_directory|1|it is a directory"
   "a missing file|fit|missing.tsv|1|No such file"
