@@ -1,7 +1,9 @@
 #include "explain_command.hpp"
 
 #include <CLI/CLI.hpp>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <exception>
 #include <fmt/format.h>
 #include <fstream>
@@ -10,6 +12,7 @@
 #include <string>
 
 #include "exit_codes.hpp"
+#include "file_problems.hpp"
 #include "spindown/bench.hpp"
 #include "spindown/explain.hpp"
 #include "spindown/explain_report.hpp"
@@ -89,15 +92,6 @@ FileExplain explain_file(const std::string& path, const ExplainPlan& plan) {
   return out;
 }
 
-void report_problems(const FileExplain& file, bool verbose) {
-  std::vector<Diagnostic> shown;
-  for (const auto& d : file.diagnostics)
-    if (verbose || d.severity != Diagnostic::Severity::note) shown.push_back(d);
-  for (const auto& line : summarize_diagnostics(shown, verbose ? 0 : 8)) std::cerr << line << '\n';
-  for (const auto& why : file.failures) std::cerr << file.file << ": error: not used: " << why << '\n';
-  std::cerr.flush();
-}
-
 }  // namespace
 
 void setup_explain(CLI::App& app) {
@@ -128,7 +122,8 @@ int run_explain(const ExplainCommandOptions& options) {
   bool all_usable = true;
   for (const auto& path : options.files) {
     FileExplain file = explain_file(path, plan);
-    report_problems(file, options.verbose);
+    report_file_problems(std::cerr, file.file, file.diagnostics, file.failures, options.verbose,
+                         options.verbose ? 0 : 8);
     all_usable = all_usable && file.usable();
     if (!options.json) {
       std::cout << format_file_explain(file) << std::flush;
@@ -142,7 +137,7 @@ int run_explain(const ExplainCommandOptions& options) {
     std::ofstream svg(options.svg, std::ios::binary | std::ios::trunc);
     if (svg) svg << explain_svg(files);
     if (!svg || !svg.flush()) {
-      std::cerr << options.svg << ": error: cannot write the figure\n";
+      std::cerr << fmt::format("{}: error: cannot write the figure: {}\n", options.svg, std::strerror(errno));
       return exit_unusable;
     }
   }

@@ -14,6 +14,7 @@
 #include <unistd.h>
 
 #include "exit_codes.hpp"
+#include "file_problems.hpp"
 #include "spindown/bench.hpp"
 #include "spindown/bench_file.hpp"
 #include "spindown/fit.hpp"
@@ -152,23 +153,6 @@ FileFit fit_file(const std::string& path, const FitPlan& plan) {
   return out;
 }
 
-// Problems go to stderr, naming the file (and line): warnings and errors always, notes with -v.
-void report_problems(const FileFit& file, const FitPlan& plan, bool verbose) {
-  // An error that made the file unusable is said once, by its "not used" line.
-  auto is_a_failure = [&](const Diagnostic& d) {
-    return d.severity == Diagnostic::Severity::error &&
-           std::any_of(file.failures.begin(), file.failures.end(), [&](const std::string& why) {
-             return why.size() >= d.message.size() && why.ends_with(d.message);
-           });
-  };
-  std::vector<Diagnostic> shown;
-  for (const auto& d : file.diagnostics)
-    if ((verbose || d.severity != Diagnostic::Severity::note) && !is_a_failure(d)) shown.push_back(d);
-  for (const auto& line : summarize_diagnostics(shown, plan.report.max_diagnostics)) std::cerr << line << '\n';
-  for (const auto& why : file.failures) std::cerr << file.file << ": error: not used: " << why << '\n';
-  std::cerr.flush();
-}
-
 }  // namespace
 
 void setup_fit(CLI::App& app) {
@@ -225,7 +209,8 @@ int run_fit(const FitCommandOptions& options) {
         return d;
       },
       [&](std::size_t, Done d) {
-        report_problems(d.file, plan, options.verbose);
+        report_file_problems(std::cerr, d.file.file, d.file.diagnostics, d.file.failures, options.verbose,
+                             plan.report.max_diagnostics);
         all_usable = all_usable && d.file.usable();
         if (options.json) {
           json_files.add(d.text, json);

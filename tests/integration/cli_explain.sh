@@ -52,4 +52,15 @@ set -e
 [ $code -eq 1 ] || fail "missing file gave exit $code"
 grep -q "missing.tsv" "$work/mixed.err" || fail "missing file not named"
 grep -q "missing effect: coulomb" "$work/mixed.txt" || fail "the good file was not explained"
+# An empty file's error is said once (by its "not used" line), as spindown fit says it.
+: > "$work/empty.tsv"
+code=0
+timeout 60 "$bin" explain "$work/empty.tsv" > /dev/null 2> "$work/empty.err" || code=$?
+[ $code -eq 1 ] || fail "empty file gave exit $code"
+[ "$(grep -c "the file is empty" "$work/empty.err")" -eq 1 ] || fail "empty file's error said $(grep -c "the file is empty" "$work/empty.err") times"
+# A figure that cannot be written says why.
+code=0
+timeout 60 "$bin" explain "$data/seed-3v-run1.tsv" --svg "$work/no/such/dir/fig.svg" > /dev/null 2> "$work/svg.err" || code=$?
+[ $code -eq 1 ] || fail "unwritable --svg gave exit $code"
+grep -q "cannot write the figure: No such file or directory" "$work/svg.err" || fail "unwritable --svg: $(cat "$work/svg.err")"
 echo "cli_explain: ok"
