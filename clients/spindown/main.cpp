@@ -13,6 +13,7 @@
 #include "watch_command.hpp"
 #include "report_command.hpp"
 #include "doctor_command.hpp"
+#include "simulate_command.hpp"
 
 int main(int argc, char** argv) {
   CLI::App app{"spindown: fit friction models to DC-motor spin-down recordings"};
@@ -25,6 +26,7 @@ int main(int argc, char** argv) {
   spindown::cli::setup_baseline(app);
   spindown::cli::setup_report(app);
   spindown::cli::setup_doctor(app);
+  spindown::cli::setup_simulate(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {  // a subcommand finished with a non-zero exit code

@@ -12,6 +12,7 @@
 
 #include "spindown/pseudo_terminal.hpp"
 #include "spindown/virtual_bench.hpp"
+#include "spindown/virtual_bench_cli.hpp"
 
 namespace {
 
@@ -41,48 +42,14 @@ void relink(const std::string& link, const std::string& target) {
 int main(int argc, char** argv) {
   CLI::App app{"spindown-virtual-bench: a simulated spin-down bench on a pseudo-terminal"};
   spindown::VirtualBenchOptions o;
-  auto& sp = o.spec;
-  std::string protocol = "lab", lead_in = "zeros", link, truth_file, sent_file;
-  double speed = 1.0, wait_reader_s = 30, linger_s = 1.0, period_ms = 20, jitter_ms = 0.5;
+  spindown::VirtualBenchCli cli;
+  std::string link, truth_file, sent_file;
+  double speed = 1.0, wait_reader_s = 30, linger_s = 1.0;
   app.set_config("--config", "", "TOML file with any of these options (key = long option name)");
-  app.add_option("--protocol", protocol, "lab (millis<TAB>volts) or spindown-v1")
-      ->check(CLI::IsMember({"lab", "spindown-v1"}));
+  spindown::add_virtual_bench_options(app, o, cli);
   app.add_option("--baud", o.baud, "baud rate (default 9600 lab, 115200 spindown-v1)");
   app.add_option("--speed", speed, "times faster than real time; 0 = as fast as possible")
       ->check(CLI::Range(0.0, 1e6));
-  app.add_option("--runs", o.runs, "runs: spin up, steady, cut, coast, stop, tail");
-  app.add_option("--idle", o.idle_s, "seconds at rest between runs");
-  app.add_option("--period-ms", period_ms, "loop period (ms)");
-  app.add_option("--jitter-ms", jitter_ms, "uniform ± jitter of the period (ms)");
-  app.add_option("--e0", sp.e0_v, "back-EMF at the cut (V)");
-  app.add_option("--e0-step", o.e0_step_v, "added to e0 at each further run (V)");
-  app.add_option("--supply", sp.supply_v, "pin reading before the cut with --lead-in supply (V)");
-  app.add_option("--lead-in", lead_in, "what the pin reads before the cut")
-      ->check(CLI::IsMember({"zeros", "floating", "supply"}));
-  app.add_option("--lead-in-s", sp.lead_in_s, "seconds recorded before the cut");
-  app.add_option("--tail-s", sp.tail_s, "seconds recorded after the stop");
-  app.add_option("--max-coast-s", sp.max_coast_s, "longest coast simulated");
-  app.add_option("--inertia", sp.bench.inertia_kg_m2, "J (kg*m^2)");
-  app.add_option("--kb", sp.bench.kb_v_s_per_rad, "K_b (V*s/rad)");
-  app.add_option("--viscous", sp.friction.viscous, "c_v (N*m*s/rad)");
-  app.add_option("--coulomb", sp.friction.coulomb, "c_c (N*m)");
-  app.add_option("--stribeck-static", sp.friction.stribeck_static, "c_s (N*m)");
-  app.add_option("--stribeck-speed", sp.friction.stribeck_speed, "w_s (rad/s)");
-  app.add_option("--windage", sp.friction.windage, "c_w (N*m*s^2/rad^2)");
-  app.add_option("--offset", sp.offset_v, "sensor offset after the cut (V)");
-  app.add_option("--noise", sp.noise_v, "white noise (V)");
-  app.add_option("--ripple", sp.ripple, "relative commutator ripple");
-  app.add_option("--adc-bits", sp.adc_bits, "ADC bits (0 = no quantization)");
-  app.add_option("--decimals", sp.decimals, "decimals the lab sketch prints");
-  app.add_option("--seed", sp.seed, "random seed");
-  app.add_option("--firmware", o.firmware, "firmware name in the spindown-v1 banner");
-  app.add_option("--reset-at", o.reset_at_s, "bench seconds at which the Arduino resets (repeatable)");
-  app.add_option("--unplug-at", o.unplug_at_s, "bench seconds at which the cable is pulled");
-  app.add_option("--unplug-for", o.unplug_for_s, "seconds the cable stays out");
-  app.add_option("--garbage-every", o.garbage_every, "a garbage line after every N-th sample line");
-  app.add_option("--partial-every", o.partial_every, "every N-th sample line cut short");
-  app.add_option("--long-line-at", o.long_line_at_s, "bench seconds at which an over-long line is sent");
-  app.add_option("--long-line-bytes", o.long_line_bytes, "bytes of that line (no newline until its end)");
   app.add_option("--link", link, "symlink to the pty's path (like /dev/ttyACM0)");
   app.add_option("--truth", truth_file, "write parameters, cut/stop times and faults as JSON");
   app.add_option("--sent", sent_file, "write every sample line sent (TSV: epoch device_time_us value raw_adc device_seq)");
@@ -90,13 +57,7 @@ int main(int argc, char** argv) {
   app.add_option("--linger", linger_s, "seconds to keep the pty open after the last line");
   CLI11_PARSE(app, argc, argv);
 
-  o.protocol = protocol == "lab" ? spindown::BenchProtocol::lab : spindown::BenchProtocol::spindown_v1;
-  sp.lead_in = lead_in == "zeros" ? spindown::LeadIn::zeros
-               : lead_in == "supply" ? spindown::LeadIn::supply
-                                     : spindown::LeadIn::floating;
-  sp.period_s = period_ms / 1000.0;
-  sp.jitter_s = jitter_ms / 1000.0;
-  o.seed = sp.seed;
+  spindown::apply_virtual_bench_cli(cli, o);
 
   std::unique_ptr<spindown::VirtualBench> bench;
   try {

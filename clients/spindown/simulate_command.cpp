@@ -1,0 +1,69 @@
+#include "simulate_command.hpp"
+
+#include <CLI/CLI.hpp>
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fmt/format.h>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <stdexcept>
+
+#include "exit_codes.hpp"
+
+namespace spindown::cli {
+
+void setup_simulate(CLI::App& app) {
+  auto opt = std::make_shared<SimulateCommandOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "simulate", "Write what the lab's Arduino would print for simulated spin-down runs (known-answer recordings)");
+  sub->footer("Exit codes: 0 ok, 1 a file could not be written, 2 bad usage (an existing -o file is refused).");
+  sub->add_option("-o,--output", opt->out, "The recording to write (default: stdout)");
+  sub->add_option("--truth", opt->truth, "Also write the parameters, each run's cut and stop, and the faults (JSON)");
+  sub->add_flag("--putty-header", opt->putty_header, "Start with a PuTTY log's header line, as the lab's logs do");
+  add_virtual_bench_options(*sub, opt->bench, opt->bench_cli);
+  sub->callback([opt]() {
+    const int code = run_simulate(*opt);
+    if (code != exit_ok) throw CLI::RuntimeError(code);
+  });
+}
+
+int run_simulate(SimulateCommandOptions o) {
+  apply_virtual_bench_cli(o.bench_cli, o.bench);
+  const bool to_stdout = o.out.empty() || o.out == "-";
+  for (const std::string& path : {to_stdout ? std::string() : o.out, o.truth})
+    if (!path.empty() && std::filesystem::exists(path)) {
+      std::cerr << fmt::format("spindown simulate: {}: the file exists (refused: choose a new name)\n", path);
+      return exit_bad_usage;
+    }
+  std::unique_ptr<VirtualBench> bench;
+  try {
+    bench = std::make_unique<VirtualBench>(o.bench);
+  } catch (const std::exception& e) {
+    std::cerr << fmt::format("spindown simulate: {}\n", e.what());
+    return exit_bad_usage;
+  }
+  std::string text;
+  if (o.putty_header) text += "=~=~=~=~=~=~=~=~=~=~=~= PuTTY log 2023.09.14 10:21:33 =~=~=~=~=~=~=~=~=~=~=~=\r\n";
+  for (const BenchEmission& e : bench->emissions()) text += e.bytes;
+  // Written whole or not at all: a half-written recording would read as a damaged one.
+  const auto write = [](const std::string& path, const std::string& bytes) {
+    std::ofstream f(path, std::ios::binary | std::ios::trunc);
+    if (f) f << bytes;
+    if (!f || !f.flush()) {
+      std::cerr << fmt::format("spindown simulate: {}: cannot write: {}\n", path, std::strerror(errno));
+      return false;
+    }
+    return true;
+  };
+  if (to_stdout) {
+    std::cout << text << std::flush;
+  } else if (!write(o.out, text)) {
+    return exit_unusable;
+  }
+  if (!o.truth.empty() && !write(o.truth, bench->truth().dump(2) + "\n")) return exit_unusable;
+  return exit_ok;
+}
+
+}  // namespace spindown::cli

@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# `spindown simulate`: a known-answer recording. fit finds the friction it was made with (within
+# its standard errors), explain names an effect it was given, the truth file says what was
+# simulated, the same seed gives the same bytes on stdout and in a file, faults show up as
+# fit's warnings, and an existing file is never overwritten.
+set -euo pipefail
+bin="${SPINDOWN_BIN_DIR:?}/spindown"
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+
+timeout 60 "$bin" simulate -o "$work/run.tsv" --truth "$work/run.json" --putty-header \
+  --viscous 2.5e-7 --coulomb 9e-5 --seed 4
+head -1 "$work/run.tsv" | grep -q "PuTTY log" || fail "no PuTTY header"
+timeout 60 "$bin" fit --json "$work/run.tsv" > "$work/fit.json"
+python3 - "$work/fit.json" "$work/run.json" <<'PY' || fail "fit does not find the simulated friction"
+import json, sys
+fit, truth = (json.load(open(p)) for p in sys.argv[1:3])
+assert truth["c_v"] == 2.5e-7 and truth["c_c"] == 9e-5, truth
+runs = fit["files"][0]["runs"]
+assert len(runs) == 1 and runs[0]["best"] == "combined", runs
+p = {m["name"]: m for m in runs[0]["models"]}["combined"]["params"]
+for name, true in (("c3", 2.5e-7), ("c4", 9e-5)):
+    z = (p[name]["value"] - true) / p[name]["stderr"]
+    assert abs(z) < 4, (name, p[name], true, z)
+    print(f"{name} = {p[name]['value']:.5g} ± {p[name]['stderr']:.2g} (truth {true:g}, {z:+.1f} se)")
+PY
+
+# An effect given to the simulator is the effect explain names.
+timeout 60 "$bin" simulate -o "$work/offset.tsv" --offset 0.06 --seed 5
+timeout 120 "$bin" explain "$work/offset.tsv" --base viscous,coulomb > "$work/offset.txt"
+grep -q "missing effect: sensor_offset" "$work/offset.txt" || fail "explain did not name the simulated offset"
+
+# Same seed, same bytes, to stdout or a file.
+timeout 60 "$bin" simulate --seed 4 --viscous 2.5e-7 --coulomb 9e-5 --putty-header > "$work/stdout.tsv"
+cmp -s "$work/stdout.tsv" "$work/run.tsv" || fail "stdout and -o differ for the same seed"
+
+# Faults the lab meets come out as fit's warnings, the rest still fitted.
+timeout 60 "$bin" simulate -o "$work/garbage.tsv" --garbage-every 100 --seed 6
+timeout 60 "$bin" fit "$work/garbage.tsv" > "$work/garbage.out" 2> "$work/garbage.err"
+grep -q "warning" "$work/garbage.err" || fail "garbage lines gave no warning"
+grep -q "best: combined" "$work/garbage.out" || fail "the run with garbage lines was not fitted"
+
+# An existing file is refused (exit 2), and left as it was; bad physics is bad usage.
+code=0
+timeout 60 "$bin" simulate -o "$work/run.tsv" --seed 9 2> "$work/exists.err" || code=$?
+[ $code -eq 2 ] || fail "existing -o gave exit $code"
+grep -q "the file exists" "$work/exists.err" || fail "existing -o not explained"
+cmp -s "$work/stdout.tsv" "$work/run.tsv" || fail "an existing file was changed"
+code=0
+timeout 60 "$bin" simulate --inertia -1 > /dev/null 2> "$work/bad.err" || code=$?
+[ $code -eq 2 ] || fail "negative J gave exit $code: $(cat "$work/bad.err")"
+echo "cli_simulate: ok"
