@@ -212,6 +212,15 @@ TEST(FitReportText, FileHeaderAndFailures) {
   EXPECT_FALSE(file.usable());
 }
 
+// The run's noise is the standstill's spread when it stopped, the coast's when it did not.
+TEST(FitReportText, NoiseSaysWhereItWasMeasured) {
+  RunFit f = lab_like_fit();
+  f.run.stopped = true;
+  EXPECT_NE(format_run_fit(f).find("standstill noise"), std::string::npos) << format_run_fit(f);
+  f.run.stopped = false;
+  EXPECT_NE(format_run_fit(f).find("coast noise"), std::string::npos) << format_run_fit(f);
+}
+
 TEST(FitReportText, BestReasonFromTheFitWins) {
   RunFit f = lab_like_fit();
   f.best_reason = "because the fitter said so";

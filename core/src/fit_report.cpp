@@ -722,8 +722,10 @@ std::string format_run_fit(const RunFit& fit, const ReportOptions& opt) {
     out += ", did not stop";
   out += fmt::format(", {} samples", samples_in(run));
   if (!run.lead_in.empty()) out += fmt::format(", lead-in: {}", run.lead_in);
-  out += fmt::format("\n  zero level {:.3g} {}, noise {:.2g} {}, period {:.1f} ms\n", run.zero_level, unit,
-                     run.noise_level, unit, run.period_s * 1e3);
+  // noise_level is the spread at standstill for a run that stopped (0 when every reading there is
+  // the same printed value), the coast's near the cut for one that did not: the label says which.
+  out += fmt::format("\n  zero level {:.3g} {}, {} noise {:.2g} {}, period {:.1f} ms\n", run.zero_level, unit,
+                     run.stopped ? "standstill" : "coast", run.noise_level, unit, run.period_s * 1e3);
   out += fmt::format("  bench: J = {:.6g} kg·m² ({}), K_b = {:.6g} V·s/rad ({})", fit.bench.inertia_kg_m2,
                      fit.bench.inertia_source, fit.bench.kb_v_s_per_rad, fit.bench.kb_source);
   if (opt.lab_units) out += fmt::format("; J = {:.6g} g·cm²", inertia_to_g_cm2(fit.bench.inertia_kg_m2));
