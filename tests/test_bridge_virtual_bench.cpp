@@ -70,6 +70,27 @@ TEST(VirtualBench, LabRunsReplayExactly) {
     ASSERT_GE(em[i].wire_s - em[i - 1].wire_s, em[i].bytes.size() * 10.0 / 9600 - 1e-12);
 }
 
+// decimals < 0 is "full precision" (SyntheticRunSpec): every digit of the reading is printed,
+// and the bridge reads back the very double; it printed whole volts ("3") before.
+TEST(VirtualBench, FullPrecisionPrintsEveryDigit) {
+  EXPECT_EQ(printed_value(2.75390625, 2), "2.75");
+  EXPECT_EQ(printed_value(2.75390625, -1), "2.75390625");
+  EXPECT_EQ(printed_value(0.1, -1), "0.1");
+  VirtualBenchOptions o;
+  o.spec.decimals = -1;
+  VirtualBench bench(o);
+  std::size_t fractional = 0;
+  for (const auto& s : bench.sent()) fractional += s.value != std::round(s.value);
+  EXPECT_GT(fractional, bench.sent().size() / 2) << "readings printed as whole volts";
+  CaptureSink sink;
+  BridgeSettings s;
+  s.bench = "vb";
+  s.device = "/dev/vb";
+  SerialBridge bridge(s, sink);
+  replay(bench, bridge);
+  expect_same(bench, sink);
+}
+
 TEST(VirtualBench, FaultsAreCountedAndSamplesStillMatch) {
   VirtualBenchOptions o;
   o.protocol = BenchProtocol::spindown_v1;

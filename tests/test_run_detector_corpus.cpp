@@ -23,12 +23,13 @@ namespace spindown {
 namespace {
 
 // Recorded on 2026-11-25, after two behaviour changes, each compared recording by recording:
-// - an asymptotic coast's floor within a reading step of its "zeros" lead-in became the lead-in's
-//   zero: of the 407 recordings only viscous-only.tsv changed (zero level 0.01 → 0, its note);
+// - an asymptotic coast's floor that the flatness test cannot tell from its "zeros" lead-in's zero
+//   (3 sd, 1 % of the cut's reading, a step) became that zero: of the 407 recordings only
+//   viscous-only.tsv changed (zero level 0.01 → 0, its note);
 // - a silence of over 1 s (and 25 periods) inside a fitted coast is said: 19 generated recordings
 //   with lost samples gained a note ("taken as samples lost"), nothing else changed.
 // Before: 0xc123cf6558ddcf94.
-constexpr std::uint64_t recorded_hash = 0x0f11e92f792fbe66ull;
+constexpr std::uint64_t recorded_hash = 0x0df837417b92c5e0ull;
 constexpr int generated_recordings = 400;
 
 TEST(RunDetectorCorpus, FindsTheRecordedRunsBitForBit) {

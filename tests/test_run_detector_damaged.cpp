@@ -28,9 +28,10 @@
 namespace spindown {
 namespace {
 
-// Recorded on 2026-11-25, when an asymptotic coast's floor within a reading step of its "zeros"
-// lead-in became the lead-in's zero (viscous-only.tsv's runs). Before: 0xdfb42f4014578905.
-constexpr std::uint64_t recorded_hash = 0x7171de5f64b33361ull;
+// Recorded on 2026-11-25, when an asymptotic coast's floor that the flatness test cannot tell
+// from its "zeros" lead-in's zero became that zero (viscous-only.tsv's runs). Before:
+// 0xdfb42f4014578905.
+constexpr std::uint64_t recorded_hash = 0xba8bc83497a25bedull;
 
 // Each recording of the shared data as read, then damaged in each of the corpus's ways.
 std::vector<corpus::Case> plain_and_damaged() {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fmt/format.h>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -219,11 +220,19 @@ TEST(FindRuns, OtherBenchesRippleOffsetAndUnits) {
 // the lead-in's zero the lead-in's zero is the run's. A real offset on the coasting reading
 // (0.06 V, six steps above the lead-in) is kept.
 TEST(FindRuns, AsymptoticCoastTakesTheLeadInsZeroUnlessItsFloorIsClearlyAbove) {
-  for (const double offset : {0.0, 0.06}) {
+  // The lab's print, and a finer one (no converter, 4 decimals) where the floor, 0.0106 V, is
+  // noise and not a print step: it is still the decay lost in the noise, not an offset.
+  struct Case {
+    double offset;
+    int decimals, adc_bits;
+  };
+  for (const auto [offset, decimals, adc_bits] : {Case{0.0, 2, 10}, Case{0.0, 4, 0}, Case{0.06, 2, 10}}) {
     SyntheticRunSpec spec;
     spec.friction = {1.2e-6, 0.0};
     spec.max_coast_s = 60;
     spec.offset_v = offset;
+    spec.decimals = decimals;
+    spec.adc_bits = adc_bits;
     spec.seed = 11;
     const SyntheticRun s = make_synthetic_run(spec);
     const auto seg = find_runs(to_recording(s));
@@ -231,12 +240,13 @@ TEST(FindRuns, AsymptoticCoastTakesTheLeadInsZeroUnlessItsFloorIsClearlyAbove) {
     const spindown::Run& r = seg.runs[0];
     EXPECT_FALSE(r.stopped) << "offset " << offset;
     EXPECT_EQ(r.lead_in, "zeros");
+    const std::string what = fmt::format("offset {} decimals {}", offset, decimals);
     if (offset == 0.0) {
-      EXPECT_EQ(r.zero_level, 0.0);
+      EXPECT_NEAR(r.zero_level, 0.0, 1e-3) << what;
       const bool said = std::any_of(seg.diagnostics.begin(), seg.diagnostics.end(), [](const Diagnostic& d) {
-        return d.message.find("within one reading step of the lead-in's zero, so zero level 0") != std::string::npos;
+        return d.message.find("not to be told from the lead-in's zero, so zero level") != std::string::npos;
       });
-      EXPECT_TRUE(said) << "the note says which zero was taken";
+      EXPECT_TRUE(said) << "the note says which zero was taken; " << what;
     } else {
       EXPECT_GE(r.zero_level, offset) << "the floor, offset included, is kept";
       EXPECT_LT(r.zero_level, offset + 0.05) << "the floor, offset included, is kept";

@@ -45,7 +45,7 @@ int run_simulate(SimulateCommandOptions o) {
     return exit_bad_usage;
   }
   std::string text;
-  if (o.putty_header) text += "=~=~=~=~=~=~=~=~=~=~=~= PuTTY log 2023.09.14 10:21:33 =~=~=~=~=~=~=~=~=~=~=~=\r\n";
+  if (o.putty_header) text += putty_log_header;
   for (const BenchEmission& e : bench->emissions()) text += e.bytes;
   // Written whole or not at all: a half-written recording would read as a damaged one.
   const auto write = [](const std::string& path, const std::string& bytes) {

@@ -1003,17 +1003,19 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
     // exponential's tail still carries information for the fit.
     creeping_ = true;
   } else {
-    // The floor an asymptotic coast shows is where its decay sank below the reading's
-    // resolution, not where it is heading (an exponential heads for the true zero): on a
-    // 2-decimal print it is 0.01 V long before the motor stops, and subtracting that from every
-    // reading bends the viscous curve into Coulomb friction that is not there. Within a step
-    // of the lead-in's zero (the motor at rest, read before the run), that zero is the better
-    // measured. A floor clearly above it (an offset only the coasting reading has) is kept.
+    // The floor an asymptotic coast shows is where its decay was lost in the noise or the print,
+    // not where it is heading (an exponential heads for the true zero): 0.01 V on the lab's
+    // 2-decimal print long before the motor stops, and subtracting that from every reading
+    // bends the viscous curve into Coulomb friction that is not there. A floor the detector's
+    // own flatness test cannot tell from the lead-in's zero (the motor at rest, read before the
+    // run) gives way to that zero: within 3 noise sd, 1 % of the cut's reading (level()'s
+    // allowance for a flat window's drop) or one reading step. A floor clearly above it (an
+    // offset only the coasting reading has) is kept.
     std::string floor_said;
-    const double band = std::max(3.0 * sd_z, reading_step(hold_.first, i + 1));
+    const double band = std::max({3.0 * sd_z, 0.01 * std::abs(v0_), reading_step(hold_.first, i + 1)});
     if (std::isfinite(lead_in_zero_) && std::abs(z - lead_in_zero_) <= band * (1 + 1e-9) && z != lead_in_zero_) {
       run_.zero_level = lead_in_zero_;
-      floor_said = fmt::format(", within one reading step of the lead-in's zero, so zero level {:g}", lead_in_zero_);
+      floor_said = fmt::format(", not to be told from the lead-in's zero, so zero level {:g}", lead_in_zero_);
     }
     run_note_ = fmt::format(
         "run cut at {}: the coast approaches its floor ({:g}{}) asymptotically (last quarter {:.2f}x slower than "

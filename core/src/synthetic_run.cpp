@@ -66,12 +66,14 @@ SyntheticRun make_synthetic_run(const SyntheticRunSpec& s) {
 std::string to_arduino_text(const SyntheticRun& run, int decimals, bool putty_header) {
   std::string text;
   text.reserve(run.t_ms.size() * 14 + 100);
-  if (putty_header)
-    text += "=~=~=~=~=~=~=~=~=~=~=~= PuTTY log 2023.09.14 10:21:33 =~=~=~=~=~=~=~=~=~=~=~=\r\n";
-  for (std::size_t i = 0; i < run.t_ms.size(); ++i) {
-    text += fmt::format("{:.0f}\t{:.{}f}\r\n", run.t_ms[i], run.volts[i], decimals);
-  }
+  if (putty_header) text += putty_log_header;
+  for (std::size_t i = 0; i < run.t_ms.size(); ++i)
+    text += fmt::format("{:.0f}\t{}\r\n", run.t_ms[i], printed_value(run.volts[i], decimals));
   return text;
+}
+
+std::string printed_value(double v, int decimals) {
+  return decimals >= 0 ? fmt::format("{:.{}f}", v, decimals) : fmt::format("{}", v);
 }
 
 }  // namespace spindown

@@ -154,7 +154,7 @@ VirtualBench::VirtualBench(VirtualBenchOptions options) : o_(std::move(options))
         s.raw_adc = adc;
         s.device_seq = seq;
       } else {
-        line = fmt::format("{}\t{:.{}f}\r\n", millis, run.volts[i], std::max(spec.decimals, 0));
+        line = fmt::format("{}\t{}\r\n", millis, printed_value(run.volts[i], spec.decimals));
         s.device_time_us = std::int64_t(millis) * 1000;
         s.value = std::stod(line.substr(line.find('\t') + 1));
       }

@@ -5,6 +5,7 @@
 // jitter. Used by the virtual bench, by tests and by benchmarks.
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "spindown/bench.hpp"
@@ -52,5 +53,13 @@ SyntheticRun make_synthetic_run(const SyntheticRunSpec& spec);
 
 // The Arduino sketch's text: "millis\tvolts\r\n" per sample, optionally after a PuTTY header.
 std::string to_arduino_text(const SyntheticRun& run, int decimals = 2, bool putty_header = false);
+
+// The header line a PuTTY log starts with (as the lab's logs do), CR LF included.
+inline constexpr std::string_view putty_log_header =
+    "=~=~=~=~=~=~=~=~=~=~=~= PuTTY log 2023.09.14 10:21:33 =~=~=~=~=~=~=~=~=~=~=~=\r\n";
+
+// A reading as printed: `decimals` places, or with a negative count every digit needed to read
+// the same double back (SyntheticRunSpec::decimals: "negative = full precision").
+std::string printed_value(double v, int decimals);
 
 }  // namespace spindown
