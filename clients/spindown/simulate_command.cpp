@@ -9,6 +9,8 @@
 #include <iostream>
 #include <memory>
 #include <stdexcept>
+#include <utility>
+#include <vector>
 
 #include "exit_codes.hpp"
 
@@ -47,22 +49,35 @@ int run_simulate(SimulateCommandOptions o) {
   std::string text;
   if (o.putty_header) text += putty_log_header;
   for (const BenchEmission& e : bench->emissions()) text += e.bytes;
-  // Written whole or not at all: a half-written recording would read as a damaged one.
-  const auto write = [](const std::string& path, const std::string& bytes) {
-    std::ofstream f(path, std::ios::binary | std::ios::trunc);
+  if (to_stdout) std::cout << text << std::flush;
+  // The recording and its truth, both or neither: each is written beside its name and renamed
+  // into place once both are complete (a half-written recording would read as a damaged one,
+  // and a recording without its truth would block the retry, since -o never overwrites).
+  std::vector<std::pair<std::string, std::string>> files;  // name, bytes
+  if (!to_stdout) files.emplace_back(o.out, std::move(text));
+  if (!o.truth.empty()) files.emplace_back(o.truth, bench->truth().dump(2) + "\n");
+  const auto remove_parts = [&] {
+    std::error_code ec;
+    for (const auto& [path, bytes] : files) std::filesystem::remove(path + ".part", ec);
+  };
+  for (const auto& [path, bytes] : files) {
+    std::ofstream f(path + ".part", std::ios::binary | std::ios::trunc);
     if (f) f << bytes;
     if (!f || !f.flush()) {
       std::cerr << fmt::format("spindown simulate: {}: cannot write: {}\n", path, std::strerror(errno));
-      return false;
+      remove_parts();
+      return exit_unusable;
     }
-    return true;
-  };
-  if (to_stdout) {
-    std::cout << text << std::flush;
-  } else if (!write(o.out, text)) {
-    return exit_unusable;
   }
-  if (!o.truth.empty() && !write(o.truth, bench->truth().dump(2) + "\n")) return exit_unusable;
+  for (const auto& [path, bytes] : files) {
+    std::error_code ec;
+    std::filesystem::rename(path + ".part", path, ec);
+    if (ec) {
+      std::cerr << fmt::format("spindown simulate: {}: cannot write: {}\n", path, ec.message());
+      remove_parts();
+      return exit_unusable;
+    }
+  }
   return exit_ok;
 }
 

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <random>
 #include <stdexcept>
+#include <utility>
 
 #include "spindown/spindown_protocol.hpp"
 
@@ -27,6 +28,34 @@ bool VirtualBenchOptions::is_valid(std::string* why) const {
   if (long_line_bytes > (256u << 20)) return fail("long_line_bytes above 256 MiB");
   if (garbage_every < 0 || partial_every < 0) return fail("garbage/partial every N must be ≥ 0");
   if (protocol == BenchProtocol::spindown_v1 && spec.adc_bits <= 0) return fail("spindown-v1 needs an ADC (adc_bits > 0)");
+  // The physics: a NaN or infinity never reaches the simulator (it would integrate forever),
+  // and friction, noise and times cannot be negative.
+  const auto& f = spec.friction;
+  const std::pair<const char*, double> at_least_zero[] = {
+      {"viscous", f.viscous},   {"coulomb", f.coulomb},       {"stribeck-static", f.stribeck_static},
+      {"stribeck-speed", f.stribeck_speed}, {"windage", f.windage}, {"noise", spec.noise_v},
+      {"ripple", spec.ripple},  {"lead-in-s", spec.lead_in_s}, {"tail-s", spec.tail_s}};
+  for (const auto& [name, v] : at_least_zero)
+    if (!(std::isfinite(v) && v >= 0)) return fail(fmt::format("--{} {} must be a finite number ≥ 0", name, v));
+  const std::pair<const char*, double> above_zero[] = {{"e0", spec.e0_v},
+                                                       {"inertia", spec.bench.inertia_kg_m2},
+                                                       {"kb", spec.bench.kb_v_s_per_rad},
+                                                       {"max-coast-s", spec.max_coast_s},
+                                                       {"adc reference", spec.adc_ref_v}};
+  for (const auto& [name, v] : above_zero)
+    if (!(std::isfinite(v) && v > 0)) return fail(fmt::format("--{} {} must be a finite number > 0", name, v));
+  const std::pair<const char*, double> finite[] = {{"supply", spec.supply_v}, {"offset", spec.offset_v},
+                                                   {"e0-step", e0_step_v}, {"unplug-at", unplug_at_s},
+                                                   {"long-line-at", long_line_at_s}};
+  for (const auto& [name, v] : finite)
+    if (!std::isfinite(v)) return fail(fmt::format("--{} {} must be a finite number", name, v));
+  for (const double r : reset_at_s)
+    if (!(std::isfinite(r) && r >= 0)) return fail(fmt::format("--reset-at {} must be a finite time ≥ 0", r));
+  if (f.stribeck_static > 0 && !(f.stribeck_speed > 0))
+    return fail("--stribeck-static needs --stribeck-speed > 0 (the speed scale of the Stribeck dip)");
+  if (spec.max_coast_s > 3600) return fail(fmt::format("--max-coast-s {} above an hour", spec.max_coast_s));
+  if (spec.adc_bits < 0 || spec.adc_bits > 24) return fail(fmt::format("--adc-bits {} not in 0-24", spec.adc_bits));
+  if (spec.decimals > 15) return fail(fmt::format("--decimals {} above 15", spec.decimals));
   return true;
 }
 

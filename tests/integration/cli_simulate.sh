@@ -50,4 +50,20 @@ cmp -s "$work/stdout.tsv" "$work/run.tsv" || fail "an existing file was changed"
 code=0
 timeout 60 "$bin" simulate --inertia -1 > /dev/null 2> "$work/bad.err" || code=$?
 [ $code -eq 2 ] || fail "negative J gave exit $code: $(cat "$work/bad.err")"
+# Impossible physics is bad usage, said at once: a NaN used to make the simulator run forever.
+for bad in "--viscous nan" "--coulomb inf" "--coulomb -1e-4" "--noise -1" "--lead-in-s -1" "--reset-at -3" \
+           "--stribeck-static 2e-4"; do
+  code=0
+  # shellcheck disable=SC2086  # the option and its value are two words
+  timeout 20 "$bin" simulate $bad > /dev/null 2> "$work/bad.err" || code=$?
+  [ $code -eq 2 ] || fail "simulate $bad gave exit $code: $(head -c 200 "$work/bad.err")"
+  grep -qF -- "${bad%% *}" "$work/bad.err" || fail "simulate $bad: $(cat "$work/bad.err")"
+done
+# The recording and its truth, both or neither: a truth that cannot be written leaves no
+# recording behind (which -o would then refuse to overwrite).
+code=0
+timeout 60 "$bin" simulate -o "$work/alone.tsv" --truth "$work/no/such/dir/t.json" 2> "$work/truth.err" || code=$?
+[ $code -eq 1 ] || fail "unwritable --truth gave exit $code"
+[ ! -e "$work/alone.tsv" ] || fail "the recording was written without its truth"
+ls "$work" | grep -q '\.part$' && fail "a .part file was left behind"
 echo "cli_simulate: ok"
