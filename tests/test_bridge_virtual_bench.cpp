@@ -17,6 +17,15 @@ struct CaptureSink : BridgeSink {
   void publish(const status_t&) override {}
 };
 
+// The bridge's settings for the virtual bench "vb".
+BridgeSettings vb_settings(int baud = 0) {
+  BridgeSettings s;
+  s.bench = "vb";
+  s.device = "/dev/vb";
+  if (baud) s.baud = baud;
+  return s;
+}
+
 void replay(const VirtualBench& bench, SerialBridge& bridge) {
   std::int64_t t = 0;
   bridge.start(t);
@@ -57,10 +66,7 @@ TEST(VirtualBench, LabRunsReplayExactly) {
   EXPECT_EQ(bench.truth()["runs"].size(), 2u);
   EXPECT_TRUE(bench.truth()["runs"][0]["stopped"].get<bool>());
   CaptureSink sink;
-  BridgeSettings s;
-  s.bench = "vb";
-  s.device = "/dev/vb";
-  SerialBridge bridge(s, sink);
+  SerialBridge bridge(vb_settings(), sink);
   replay(bench, bridge);
   expect_same(bench, sink);
   EXPECT_EQ(bridge.counters().lines_bad, 0);
@@ -83,10 +89,7 @@ TEST(VirtualBench, FullPrecisionPrintsEveryDigit) {
   for (const auto& s : bench.sent()) fractional += s.value != std::round(s.value);
   EXPECT_GT(fractional, bench.sent().size() / 2) << "readings printed as whole volts";
   CaptureSink sink;
-  BridgeSettings s;
-  s.bench = "vb";
-  s.device = "/dev/vb";
-  SerialBridge bridge(s, sink);
+  SerialBridge bridge(vb_settings(), sink);
   replay(bench, bridge);
   expect_same(bench, sink);
 }
@@ -104,11 +107,7 @@ TEST(VirtualBench, FaultsAreCountedAndSamplesStillMatch) {
   o.long_line_bytes = 100'000;
   VirtualBench bench(o);
   CaptureSink sink;
-  BridgeSettings s;
-  s.bench = "vb";
-  s.device = "/dev/vb";
-  s.baud = 115200;
-  SerialBridge bridge(s, sink);
+  SerialBridge bridge(vb_settings(115200), sink);
   replay(bench, bridge);
   expect_same(bench, sink);
   const auto& f = bench.truth()["faults"];
@@ -125,10 +124,7 @@ TEST(VirtualBench, WrongBaudGarbageNeverBecomesSamples) {
   o.protocol = BenchProtocol::spindown_v1;
   VirtualBench bench(o);
   CaptureSink sink;
-  BridgeSettings s;
-  s.bench = "vb";
-  s.device = "/dev/vb";
-  SerialBridge bridge(s, sink);
+  SerialBridge bridge(vb_settings(), sink);
   bridge.start(0);
   std::uint64_t state = 1;
   for (int reader : {9600, 57600, 230400, 1000000})
