@@ -130,10 +130,8 @@ FileFit fit_file(const std::string& path, const FitPlan& plan) {
       for (const Run& run : seg.runs) {
         RunFit fit = fit_run(rec, run, fit_opt);
         // An LCM log of several benches: each run says whose it is (run numbers restart per bench).
-        if (recordings.size() > 1) {
-          out.run_bench.resize(out.runs.size());
+        if (recordings.size() > 1)
           out.run_bench.push_back(k < info.size() && !info[k].bench.empty() ? info[k].bench : rec.source);
-        }
         if (fit.best.empty()) {
           std::string why;
           for (const auto& m : fit.models)

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "exit_codes.hpp"
+#include "file_problems.hpp"
 #include "spindown/bench.hpp"
 #include "spindown/fit_message.hpp"
 #include "spindown/progress.hpp"
@@ -389,11 +390,11 @@ int run_refit(const RefitCommandOptions& o) {
         },
         stream ? RefitRunFn(each_run) : RefitRunFn());
     progress.finish();
-    // Problems on stderr, as `spindown fit` does.
-    std::vector<Diagnostic> shown;
-    for (const auto& d : r.file.diagnostics)
-      if (o.verbose || d.severity != Diagnostic::Severity::note) shown.push_back(d);
-    for (const auto& line : summarize_diagnostics(shown, report.max_diagnostics)) std::cerr << line << '\n';
+    // Problems on stderr, as `spindown fit` says them; with --live or --compare the file's failures
+    // are not the point (the comparison's counts are).
+    report_file_problems(std::cerr, path, r.file.diagnostics,
+                         o.live || o.compare ? std::vector<std::string>{} : r.file.failures, o.verbose,
+                         report.max_diagnostics);
 
     if (o.live || o.compare) {
       // Recorded results, keyed by bench and run; the refit's likewise.
@@ -462,7 +463,6 @@ int run_refit(const RefitCommandOptions& o) {
       continue;
     }
 
-    for (const auto& why : r.file.failures) std::cerr << path << ": error: not used: " << why << '\n';
     ok = ok && r.file.usable();
     // Spools by bench in order of first appearance (a bench never seen on SAMPLE/CONFIG last).
     std::vector<RunSpool*> ordered;

@@ -599,8 +599,12 @@ void write_file_fit(std::string& out, std::size_t indent, const FileFit& file, c
   w.begin_array();
   for (std::size_t i = 0; i < file.runs.size(); ++i) {
     w.element();
-    const RunTags tags{i < file.run_bench.size() ? std::string_view(file.run_bench[i]) : std::string_view(), 0, 0, false};
-    write_run_fit(w, file.runs[i], opt, i < file.run_bench.size() ? &tags : nullptr);
+    if (i < file.run_bench.size()) {
+      const RunTags bench{file.run_bench[i], 0, 0, false};
+      write_run_fit(w, file.runs[i], opt, &bench);
+    } else {
+      write_run_fit(w, file.runs[i], opt);
+    }
     if (i < file.health.size() && file.health[i]) {
       w.key("health");
       write_health(w, *file.health[i]);

@@ -797,13 +797,12 @@ void RunDetector::coast_too_long(std::size_t i) {
   // The coast was within max_coast_s until one step jumped past it: a gap in the recording
   // (logging paused, the device clock jumped), not a coast that went on too long. The sample
   // after the gap is not this coast's, and the user must hear that the coast was cut short.
-  const double step = i > run_.cut_index ? t(i) - t(i - 1) : 0.0;
   if (i > run_.cut_index + 1 && t(i - 1) - run_.t_cut_s <= opt_.max_coast_s &&
-      step > std::max(2.0, 0.01 * opt_.max_coast_s)) {  // 2 s: a hundred lost samples at the lab's 20 ms
+      t(i) - t(i - 1) > std::max(2.0, 0.01 * opt_.max_coast_s)) {  // 2 s: a hundred lost samples at the lab's 20 ms
     run_note_severity_ = Diagnostic::Severity::warning;
-    close_unstopped(i, fmt::format("no samples for {:.3g} s mid-coast (from {} to {}): the coast is cut short there "
-                                   "and fitted as never stopped; the samples after the gap are not in this run",
-                                   step, fmt_s(t(i - 1)), fmt_s(t(i))));
+    close_unstopped(i, fmt::format("{}: the coast is cut short there and fitted as never stopped; the samples "
+                                   "after the gap are not in this run",
+                                   gap_before(i)));
     to_idle(i, true);
     return;
   }
@@ -1103,16 +1102,11 @@ void RunDetector::warn_of_gap_in_coast(int number, std::size_t from, std::size_t
   for (std::size_t k = from + 1; k < to; ++k)
     if (t(k) - t(k - 1) > longest) longest = t(k) - t(k - 1), at = k;
   if (at == 0 || !(longest > std::max(1.0, 25.0 * period_s))) return;
-  // The coast's slope over up to a second before the gap.
-  std::size_t a = at - 1;
-  while (a > from && t(at - 1) - t(a - 1) <= 1.0) --a;
-  WindowFit before;
-  before.clear(a, t(a));
-  for (std::size_t k = a; k < at; ++k) before.add(t(k), v(k));
+  WindowFit before{1.0};  // the coast's slope over the second before the gap
+  reset_window(before, from, at);
   const double expected = before.n >= 5 ? -before.slope() * longest : 0.0;
   const double fell = v(at - 1) - v(at);
-  const std::string gap = fmt::format("run {}: no samples for {:.3g} s mid-coast (from {} to {})", number, longest,
-                                      fmt_s(t(at - 1)), fmt_s(t(at)));
+  const std::string gap = fmt::format("run {}: {}", number, gap_before(at));
   if (expected > 6.0 * before.resid_sd() && expected > 0 && fell < 0.5 * expected)
     emit_diag(Diagnostic::Severity::warning,
               fmt::format("{}: the device clock jumped? The reading fell {:.3g} across it where the coast would "
@@ -1121,6 +1115,11 @@ void RunDetector::warn_of_gap_in_coast(int number, std::size_t from, std::size_t
   else
     emit_diag(Diagnostic::Severity::note,
               fmt::format("{}: the reading fell across it as the coast would, taken as samples lost", gap));
+}
+
+std::string RunDetector::gap_before(std::size_t i) const {
+  return fmt::format("no samples for {:.3g} s mid-coast (from {} to {})", t(i) - t(i - 1), fmt_s(t(i - 1)),
+                     fmt_s(t(i)));
 }
 
 void RunDetector::complete_run(std::size_t end) {

@@ -215,6 +215,7 @@ class RunDetector {
   void close_unstopped(std::size_t end, const std::string& why);
   void complete_run(std::size_t end);
   void warn_of_gap_in_coast(int number, std::size_t from, std::size_t to, double period_s);
+  std::string gap_before(std::size_t i) const;  // "no samples for … s mid-coast (from … to …)", before sample i
   void to_idle(std::size_t lo, bool need_quiet);
   void emit_diag(Diagnostic::Severity sev, std::string msg);
   double median_of(std::size_t from, std::size_t to);
