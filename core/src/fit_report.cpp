@@ -219,6 +219,8 @@ Json run_fit_json(const RunFit& fit, const ReportOptions& opt) {
             {"best", fit.best.empty() ? Json(nullptr) : Json(fit.best)},
             {"best_reason", explain_best(fit)},
             {"stopped", run.stopped},
+            {"end", end_name(run.end)},
+            {"t_end_s", number(run.t_end_s)},
             {"lead_in", run.lead_in},
             {"zero_level", number(run.zero_level)},
             {"noise_level", number(run.noise_level)},
@@ -534,6 +536,8 @@ void write_run_fit(PrettyJsonWriter& w, const RunFit& fit, const ReportOptions& 
   else w.string(fit.best);
   w.member("best_reason", explain_best(fit));
   w.member("stopped", run.stopped);
+  w.member("end", end_name(run.end));
+  w.member_number("t_end_s", run.t_end_s);
   w.member("lead_in", run.lead_in);
   w.member_number("zero_level", run.zero_level);
   w.member_number("noise_level", run.noise_level);
@@ -721,9 +725,10 @@ std::string format_run_fit(const RunFit& fit, const ReportOptions& opt) {
   std::string out;
   out += fmt::format("run {}: cut at t = {:.3f} s", run.number, run.t_cut_s);
   if (run.stopped && std::isfinite(run.t_stop_s))
-    out += fmt::format(", stopped at t = {:.3f} s ({:.2f} s after the cut)", run.t_stop_s, run.t_stop_s - run.t_cut_s);
+    out += fmt::format(", stopped at t = {:.3f} s ({:.2f} s after the cut), fitted to t = {:.3f} s", run.t_stop_s,
+                       run.t_stop_s - run.t_cut_s, run.t_end_s);
   else
-    out += ", did not stop";
+    out += fmt::format(", did not stop: fitted to t = {:.3f} s ({})", run.t_end_s, end_name(run.end));
   out += fmt::format(", {} samples", samples_in(run));
   if (!run.lead_in.empty()) out += fmt::format(", lead-in: {}", run.lead_in);
   // noise_level is the spread at standstill for a run that stopped (0 when every reading there is

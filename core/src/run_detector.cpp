@@ -39,12 +39,21 @@ constexpr double slope_resolution = 0.05;
 // In the tail, a hold-window mean this fraction of the amplitude below the zero level retracts
 // the stop.
 constexpr double retract_fraction = 0.01;
+// The long hold window spans at least this fraction of the coast before it.
+constexpr double long_hold_fraction = 0.03;
 // Recompute sliding sums from scratch this often (rounding drift).
 constexpr unsigned refresh_every = 4096;
 
 std::string fmt_s(double t) { return fmt::format("{:.3f} s", t); }
 
 }  // namespace
+
+// A silence inside a coast (from the sample at prev to the one at t, the coast cut at t_cut) that
+// ends it: longer than 2 s (a hundred lost samples at the lab's 20 ms) and than the coast seen
+// before it, so the samples after it would be a coast the fit barely knew the way to.
+[[gnu::always_inline]] inline bool long_silence(double prev, double t, double t_cut) {
+  return t - prev > 2.0 && t - prev > prev - t_cut;
+}
 
 // ---- sliding least-squares line ----------------------------------------------------------
 
@@ -132,11 +141,13 @@ void RunDetector::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
 // every sample. s is sample i, and h (hold_, or push_many's copy of it) ends at i; level_min and
 // rising are the coast's lowest level and rise count, updated here.
 [[gnu::always_inline]] inline RunDetector::CoastVerdict RunDetector::coast_verdict(std::size_t i, Sample s,
-                                                                                 const WindowFit& h, double& level_min,
+                                                                                 double prev_t, const WindowFit& h,
+                                                                                 double& level_min,
                                                                                  int& rising, const CoastLimits& c) {
   const double t_i = s.t;
   // i + 1 - base is buffered() after sample i.
-  if (i + 1 - c.base > c.max_buffer || t_i - c.t_cut_s > c.max_coast_s) [[unlikely]]
+  if (i + 1 - c.base > c.max_buffer || t_i - c.t_cut_s > c.max_coast_s || long_silence(prev_t, t_i, c.t_cut_s))
+      [[unlikely]]
     return {CoastVerdict::too_long};
   if (h.n < 3 || h.first < c.cut_index) return {};
   const double dur = t_i - c.ring[h.first & c.mask].t;  // duration(h), its last sample being i
@@ -172,7 +183,8 @@ void RunDetector::act_on(const CoastVerdict& v, std::size_t i, bool at_end) {
 }
 
 [[gnu::always_inline]] inline void RunDetector::coast_checks(std::size_t i, Sample s, bool at_end) {
-  const CoastVerdict v = coast_verdict(i, s, hold_, level_min_, rising_, coast_limits());
+  const double prev_t = i > base_ ? t(i - 1) : s.t;
+  const CoastVerdict v = coast_verdict(i, s, prev_t, hold_, level_min_, rising_, coast_limits());
   if (v.what != CoastVerdict::go_on) [[unlikely]] act_on(v, i, at_end);
 }
 
@@ -391,13 +403,14 @@ std::size_t RunDetector::coast_loop(const double* t_s, const double* value, std:
   for (; k < n; ++k) {
     const Sample s{t_s[k], value[k]};
     if (!std::isfinite(s.t) || !std::isfinite(s.v) || s.t < last_t || i + 1 - c.base > capacity) break;
+    const double prev_t = last_t;
     last_t = s.t;
     ring[i & mask] = s;
     track_repeats(i, s.v, same_start, last_v);
     advance(h, ring, mask, i, s);
     if constexpr (LongLive) advance(hl, ring, mask, i, s);
     const std::size_t at = i++;
-    const CoastVerdict v = coast_verdict(at, s, h, level_min, rising, c);
+    const CoastVerdict v = coast_verdict(at, s, prev_t, h, level_min, rising, c);
     if (v.what != CoastVerdict::go_on) [[unlikely]] {
       put_back();
       act_on(v, at, false);
@@ -417,7 +430,7 @@ std::size_t RunDetector::coast_loop(const double* t_s, const double* value, std:
 }
 
 void RunDetector::clock_restart() {
-  if (state_ == State::coasting) close_unstopped(next_index_, "the device clock restarted mid-coast");
+  if (state_ == State::coasting) close_unstopped(next_index_, "the device clock restarted mid-coast", Run::End::clock_restart);
   else if (state_ == State::tail) complete_run(next_index_);
   base_ = next_index_;
   time_cursor_ = next_index_;
@@ -441,7 +454,7 @@ void RunDetector::finish() {
   // A recording that ends soon after the stop: the hold window alone decides.
   if (state_ == State::coasting && next_index_ > base_)
     coast_checks(next_index_ - 1, ring_[(next_index_ - 1) & mask_], true);
-  if (state_ == State::coasting) close_unstopped(next_index_, "the recording ends mid-coast (never reached standstill)");
+  if (state_ == State::coasting) close_unstopped(next_index_, "the recording ends mid-coast (never reached standstill)", Run::End::end_of_data);
   else if (state_ == State::tail) complete_run(next_index_);
   if (state_ != State::idle) to_idle(next_index_, false);
   if (non_finite_ > 0) {
@@ -698,6 +711,41 @@ RunDetector::CutSplit RunDetector::split_at_cut(std::size_t a, std::size_t b, co
   return sp;
 }
 
+double RunDetector::smoothed(std::size_t k, std::size_t lo, std::size_t hi) const {
+  const std::size_t from = k > lo ? k - 1 : k, to = std::min(k + 2, hi + 1);
+  double sum = 0;
+  for (std::size_t j = from; j < to; ++j) sum += v(j);
+  return sum / double(to - from);
+}
+
+bool RunDetector::at_peak(CutSplit& sp, std::size_t b) {
+  if (sp.clipped || b < sp.cut_index + 3) return false;
+  const double thr = std::max(4.0 * sp.sd_post, 0.02 * std::abs(sp.v0));
+  // The highest reading (a 3-sample mean, so one noisy sample does not make the peak) from the
+  // cut found to the newest sample.
+  std::size_t p = sp.cut_index;
+  double top = smoothed(p, sp.cut_index, b);
+  for (std::size_t k = sp.cut_index + 1; k <= b; ++k) {
+    const double m = smoothed(k, sp.cut_index, b);
+    if (m > top) top = m, p = k;
+  }
+  if (top > smoothed(sp.cut_index, sp.cut_index, b) + thr && p < b) {
+    // A rise after the cut found: the coast starts at its peak, and what came before is the rise.
+    sp.pre_end = p;
+    sp.cut_index = p;
+    sp.t_cut_s = t(p);
+    sp.v0 = top;
+    sp.npre = p - sp.a;
+    sp.pre_declining = false;
+    return true;
+  }
+  // A lead-in that climbs into the cut: its last samples rise to the coast's start.
+  const std::size_t c = sp.cut_index;
+  if (c < sp.a + 6) return false;
+  const double before = smoothed(c - 5, sp.a, b), last = smoothed(c - 2, sp.a, b);
+  return last > before + thr && last >= sp.v0 - thr && before < sp.v0 - 2.0 * thr;
+}
+
 std::string RunDetector::classify_lead_in(const CutSplit& sp) const {
   if (sp.npre < 3) return "none";
   const double scale = std::abs(sp.v0);
@@ -733,12 +781,18 @@ bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
     break;
   }
 
+  // The coast begins at the peak, never before a rise: a motor's ramp or a hand's push straight
+  // into the peak (a speed sensor's reading) is the powered phase, not the coast.
+  const bool spin_up = at_peak(sp, b);
+  if (spin_up) lead = "spin-up";
+
   // Whether this is a cut at all.
   bool plausible = sp.v0 > 0;
   const double scale = std::abs(sp.v0);
   if (lead == "none") plausible = plausible && sp.a <= stream_start_;  // only a stream that starts mid-coast
   if (lead == "powered" && sp.pre_sd > 0.05 * scale) plausible = false;  // a rough "plateau"
   if ((lead == "zeros" || lead == "floating") && sp.v0 < 1.5 * sp.pre_max) plausible = false;
+  if (spin_up && sp.pre_declining) sp.pre_declining = false;  // the rise's own end, not a decline
   if (sp.pre_declining) plausible = false;  // a decline with no cut in reach
   // A cut without a step (a kink, or a stream that starts mid-coast) rests on the slope alone:
   // a quarter-second window of noise can fake it, so it needs a window of a second or more.
@@ -763,6 +817,7 @@ bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
   v0_ = sp.v0;
   standstill_ceiling_ = v0_ > 0 ? standstill_max_fraction * v0_ : std::numeric_limits<double>::infinity();
   coast_sd_ = sp.sd_post;
+  coast_step_ = reading_step(sp.cut_index, i + 1);
   lead_in_zero_ = lead == "zeros" ? sp.pre_mean : std::numeric_limits<double>::quiet_NaN();
   rise_jump_ = std::max(0.1 * std::abs(v0_), 8.0 * coast_sd_);
   level_min_ = std::numeric_limits<double>::infinity();
@@ -797,23 +852,32 @@ void RunDetector::coast_too_long(std::size_t i) {
   // The coast was within max_coast_s until one step jumped past it: a gap in the recording
   // (logging paused, the device clock jumped), not a coast that went on too long. The sample
   // after the gap is not this coast's, and the user must hear that the coast was cut short.
-  if (i > run_.cut_index + 1 && t(i - 1) - run_.t_cut_s <= opt_.max_coast_s &&
-      t(i) - t(i - 1) > std::max(2.0, 0.01 * opt_.max_coast_s)) {  // 2 s: a hundred lost samples at the lab's 20 ms
+  if (i > run_.cut_index && t(i - 1) - run_.t_cut_s <= opt_.max_coast_s && long_silence(t(i - 1), t(i), run_.t_cut_s)) {
     run_note_severity_ = Diagnostic::Severity::warning;
-    close_unstopped(i, fmt::format("{}: the coast is cut short there and fitted as never stopped; the samples "
-                                   "after the gap are not in this run",
-                                   gap_before(i)));
+    close_unstopped(i,
+                    fmt::format("{}: the coast is cut short there and fitted as never stopped; the samples "
+                                "after the gap are not in this run",
+                                gap_before(i)),
+                    Run::End::gap);
     to_idle(i, true);
     return;
   }
-  close_unstopped(i + 1, fmt::format("no standstill within max_coast_s ({:g} s): closed as never stopped",
-                                     opt_.max_coast_s));
+  run_note_severity_ = Diagnostic::Severity::warning;
+  close_unstopped(i + 1,
+                  fmt::format("no standstill within max_coast_s ({:g} s): closed there as never stopped; the rest of "
+                              "this coast is not a run",
+                              opt_.max_coast_s),
+                  Run::End::cap);
   to_idle(i + 1, true);
+  // The coast goes on: no new run until the reading rises above where it was closed.
+  need_rise_ = true;
+  rise_level_ = v(i) + std::max(0.1 * std::abs(v0_), 8.0 * coast_sd_);
 }
 
 void RunDetector::power_back() {
   const std::size_t at = rise_start_;
-  close_unstopped(at, fmt::format("the reading rose again at {} before standstill (power restored?)", fmt_s(t(at))));
+  close_unstopped(at, fmt::format("the reading rose again at {} before standstill (power restored?)", fmt_s(t(at))),
+                  Run::End::power_back);
   to_idle(at, false);
 }
 
@@ -824,11 +888,17 @@ void RunDetector::standstill_checks(std::size_t i, bool at_end, double mu, doubl
   bool resolved = at_end;
   if (!at_end) {
     const double mean_rate = (v0_ - mu) / std::max(t(i) - run_.t_cut_s, 1e-9);
-    resolved = sxx > 0 && e / std::sqrt(sxx) <= slope_resolution * mean_rate;
+    // A quantized reading can sit on one value for the whole window (e = 0) while the motor still
+    // turns: its resolution is at best the step's uniform spread.
+    const double e_eff = std::max(e, coast_step_ * 0.2886751345948129);
+    resolved = sxx > 0 && e_eff / std::sqrt(sxx) <= slope_resolution * mean_rate;
   }
   if (creeping_ && !at_end) resolved = false;  // an asymptotic coast ends when the long window is flat
   if (!resolved) {
     if (!hold_long_live_) {
+      // Three hold windows, or 3 % of the coast so far if longer: a heavy flywheel's coast falls a
+      // few mV a second near its end, which a 3 s window of noisy readings can take for level.
+      hold_long_.span_s = std::max(3.0 * opt_.stop_hold_s, long_hold_fraction * (t(i) - run_.t_cut_s));
       reset_window(hold_long_, run_.cut_index, i + 1);
       hold_long_live_ = true;
     }
@@ -1021,6 +1091,7 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
         "the mean rate), as pure viscous friction does: treated as never stopped, coast closed at {}",
         fmt_s(run_.t_cut_s), z, floor_said, end_rate > 0 ? 1.0 / end_rate : 0.0, fmt_s(t(i)));
     run_.stopped = false;
+    run_.end = Run::End::asymptotic;
     complete_run(i + 1);
     to_idle(i + 1, true);
   }
@@ -1083,8 +1154,9 @@ void RunDetector::tail_step(std::size_t i, Sample s) {
   }
 }
 
-void RunDetector::close_unstopped(std::size_t end, const std::string& why) {
+void RunDetector::close_unstopped(std::size_t end, const std::string& why, Run::End reason) {
   run_.stopped = false;
+  run_.end = reason;
   run_.zero_level = 0;
   run_.noise_level = coast_sd_;
   run_note_ = fmt::format("run cut at {}: {}", fmt_s(run_.t_cut_s), why);
@@ -1126,6 +1198,8 @@ void RunDetector::complete_run(std::size_t end) {
   Run r = run_;
   end = std::max(end, r.cut_index);
   r.end_index = end;
+  if (r.stopped) r.end = Run::End::stopped;
+  r.t_end_s = end > r.cut_index ? t(end - 1) : r.t_cut_s;
   if (r.stopped) {
     r.stop_index = std::min(r.stop_index, end);
     if (end > r.stop_index) {

@@ -17,11 +17,25 @@ bool RunOptions::is_valid(std::string* why) const {
   if (!positive(stop_hold_s)) return fail(fmt::format("stop_hold_s must be > 0 (got {})", stop_hold_s));
   if (!(std::isfinite(min_coast_s) && min_coast_s >= 0))
     return fail(fmt::format("min_coast_s must be >= 0 (got {})", min_coast_s));
-  if (!positive(max_coast_s) || max_coast_s <= min_coast_s)
+  if (!(max_coast_s > 0) || max_coast_s <= min_coast_s)  // +inf: no cap (offline)
     return fail(fmt::format("max_coast_s must be > min_coast_s (got {} and {})", max_coast_s, min_coast_s));
   if (!(std::isfinite(tail_s) && tail_s >= 0)) return fail(fmt::format("tail_s must be >= 0 (got {})", tail_s));
   if (max_buffer < 64) return fail(fmt::format("max_buffer must be at least 64 samples (got {})", max_buffer));
   return true;
+}
+
+const char* end_name(Run::End e) {
+  switch (e) {
+    case Run::End::stopped: return "stopped";
+    case Run::End::signal_lost: return "signal lost";
+    case Run::End::gap: return "gap";
+    case Run::End::end_of_data: return "end of data";
+    case Run::End::cap: return "cap";
+    case Run::End::power_back: return "power back";
+    case Run::End::clock_restart: return "clock restart";
+    case Run::End::asymptotic: return "asymptotic";
+  }
+  return "?";
 }
 
 Segmentation find_runs(const Recording& rec, const RunOptions& opt) {

@@ -9,6 +9,30 @@
 
 namespace spindown {
 
+namespace {
+
+// Single bad samples in the coast's middle 90 %, apart from each other: a dropout (the reading 0)
+// or a glitch (half of it), as a loose connector or a missed pulse gives. Their own random
+// stream, so the rest of the recording is the one without them.
+void add_glitches(SyntheticRun& out, const SyntheticRunSpec& s) {
+  const double from_ms = out.t_cut_ms + 0.05 * 1000.0 * out.t_stop_s, to_ms = out.t_cut_ms + 0.95 * 1000.0 * out.t_stop_s;
+  std::vector<std::size_t> coast;
+  for (std::size_t i = 0; i < out.t_ms.size(); ++i)
+    if (out.t_ms[i] > from_ms && out.t_ms[i] < to_ms && out.volts[i] > 0) coast.push_back(i);
+  if (coast.size() < 10u * std::size_t(s.glitches)) return;
+  std::mt19937_64 rng(s.seed ^ 0x5bd1e995u);
+  const std::size_t stride = coast.size() / std::size_t(s.glitches);
+  for (int g = 0; g < s.glitches; ++g) {
+    const std::size_t i = coast[std::size_t(g) * stride + 1 + rng() % (stride - 2)];
+    const double factor = g % 2 == 0 ? 0.0 : 0.5;
+    out.volts[i] = std::round(out.volts[i] * factor * 1e6) / 1e6;
+    if (out.adc[i] >= 0) out.adc[i] = int(out.adc[i] * factor);
+    out.glitch_index.push_back(i);
+  }
+}
+
+}  // namespace
+
 SyntheticRun make_synthetic_run(const SyntheticRunSpec& s) {
   SyntheticRun out;
   std::mt19937_64 rng(s.seed);
@@ -16,17 +40,35 @@ SyntheticRun make_synthetic_run(const SyntheticRunSpec& s) {
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
 
   out.omega0 = s.e0_v / s.bench.kb_v_s_per_rad;
-  out.t_cut_ms = s.t0_ms + s.lead_in_s * 1000.0;
+  // A recording that starts mid-coast has no lead-in: its first sample is start_s after the cut.
+  const bool mid_coast = s.start_s > 0;
+  out.t_cut_ms = mid_coast ? s.t0_ms - s.start_s * 1000.0 : s.t0_ms + s.lead_in_s * 1000.0;
   CoastSimulator sim(s.friction, s.bench.inertia_kg_m2, out.omega0);
+  const double gap_from_ms = out.t_cut_ms + s.gap_from_s * 1000.0, gap_to_ms = gap_from_ms + s.gap_s * 1000.0;
+  // A per-revolution sensor: the speed measured from the last two pulses, held in between.
+  const double pulse_angle = s.pulses_per_rev > 0 ? 2.0 * M_PI / s.pulses_per_rev : 0.0;
+  double prev_angle = 0, prev_tau = 0, last_pulse = 0, held_omega = out.omega0;
+  bool lost = false;
 
   const int adc_max = s.adc_bits > 0 ? (1 << s.adc_bits) - 1 : 0;
   const double p10 = s.decimals >= 0 ? std::pow(10.0, s.decimals) : 0.0;
   double floating = 0.2;  // a floating pin wanders slowly between rails' noise and ~0.6 V
   double t_real_ms = s.t0_ms;
   for (std::size_t guard = 0; guard < 50'000'000; ++guard) {
+    if (s.gap_s > 0 && t_real_ms >= gap_from_ms && t_real_ms < gap_to_ms) {  // the logger paused
+      t_real_ms += 1000.0 * (s.period_s + s.jitter_s * unit(rng));
+      continue;
+    }
     double v = 0.0;
     if (t_real_ms < out.t_cut_ms) {
       switch (s.lead_in) {
+        case LeadIn::spin_up: {
+          // At rest, then a concave rise (a motor's ramp, a hand's push) that still climbs at the cut.
+          const double u = 1.0 - (out.t_cut_ms - t_real_ms) / (1000.0 * s.spin_up_s);
+          v = u > 0 ? s.e0_v * (1.0 - std::exp(-3.0 * u)) / (1.0 - std::exp(-3.0)) : 0.0;
+          v += s.noise_v * gauss(rng);
+          break;
+        }
         case LeadIn::zeros: v = 0.0; break;
         case LeadIn::supply: v = s.supply_v + s.noise_v * gauss(rng); break;
         case LeadIn::floating:
@@ -37,7 +79,24 @@ SyntheticRun make_synthetic_run(const SyntheticRunSpec& s) {
     } else {
       const double tau = (t_real_ms - out.t_cut_ms) / 1000.0;
       if (tau > sim.time()) sim.advance(tau - sim.time());
-      const double w = sim.omega();
+      double w = sim.omega();
+      if (pulse_angle > 0) {
+        // Pulses where the angle crossed a multiple of pulse_angle since the last sample (the angle
+        // taken as linear in between); the speed is one pulse angle over the last pulse interval.
+        const double a = sim.angle();
+        for (double next = (std::floor(prev_angle / pulse_angle) + 1) * pulse_angle; next <= a; next += pulse_angle) {
+          const double t_pulse = prev_tau + (tau - prev_tau) * (next - prev_angle) / (a - prev_angle);
+          if (t_pulse > last_pulse) held_omega = pulse_angle / (t_pulse - last_pulse);
+          last_pulse = t_pulse;
+        }
+        prev_angle = a, prev_tau = tau;
+        if (s.pulse_timeout_s > 0 && tau - last_pulse > s.pulse_timeout_s) {
+          if (!lost) out.t_signal_lost_ms = out.t_cut_ms + 1000.0 * last_pulse;
+          lost = true;
+          held_omega = 0;
+        }
+        w = held_omega;
+      }
       const double ripple = s.ripple * std::sin(s.ripple_per_rev * sim.angle());
       v = s.bench.kb_v_s_per_rad * w * (1.0 + ripple) + s.offset_v + s.noise_v * gauss(rng);
       const bool done_stopped = sim.stopped() && tau > sim.stop_time() + s.tail_s;
@@ -60,6 +119,7 @@ SyntheticRun make_synthetic_run(const SyntheticRunSpec& s) {
   }
   out.stopped = sim.stopped();
   out.t_stop_s = sim.stopped() ? sim.stop_time() : s.max_coast_s;
+  if (s.glitches > 0) add_glitches(out, s);
   return out;
 }
 

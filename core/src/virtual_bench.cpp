@@ -34,7 +34,8 @@ bool VirtualBenchOptions::is_valid(std::string* why) const {
   const std::pair<const char*, double> at_least_zero[] = {
       {"viscous", f.viscous},   {"coulomb", f.coulomb},       {"stribeck-static", f.stribeck_static},
       {"stribeck-speed", f.stribeck_speed}, {"windage", f.windage}, {"noise", spec.noise_v},
-      {"ripple", spec.ripple},  {"lead-in-s", spec.lead_in_s}, {"tail-s", spec.tail_s}};
+      {"ripple", spec.ripple},  {"lead-in-s", spec.lead_in_s}, {"tail-s", spec.tail_s},
+      {"start-s", spec.start_s}, {"gap-s", spec.gap_s}, {"pulse-timeout-s", spec.pulse_timeout_s}};
   for (const auto& [name, v] : at_least_zero)
     if (!(std::isfinite(v) && v >= 0)) return fail(fmt::format("--{} {} must be a finite number ≥ 0", name, v));
   const std::pair<const char*, double> above_zero[] = {{"e0", spec.e0_v},
@@ -53,6 +54,12 @@ bool VirtualBenchOptions::is_valid(std::string* why) const {
     if (!(std::isfinite(r) && r >= 0)) return fail(fmt::format("--reset-at {} must be a finite time ≥ 0", r));
   if (f.stribeck_static > 0 && !(f.stribeck_speed > 0))
     return fail("--stribeck-static needs --stribeck-speed > 0 (the speed scale of the Stribeck dip)");
+  if (!std::isfinite(spec.gap_from_s)) return fail(fmt::format("--gap-from-s {} must be a finite number", spec.gap_from_s));
+  if (spec.lead_in == LeadIn::spin_up && !(std::isfinite(spec.spin_up_s) && spec.spin_up_s > 0 && spec.spin_up_s <= spec.lead_in_s))
+    return fail(fmt::format("--spin-up-s {} must be > 0 and at most --lead-in-s ({})", spec.spin_up_s, spec.lead_in_s));
+  if (spec.glitches < 0 || spec.glitches > 1000) return fail(fmt::format("--glitches {} not in 0-1000", spec.glitches));
+  if (spec.pulses_per_rev < 0 || spec.pulses_per_rev > 10000)
+    return fail(fmt::format("--pulses-per-rev {} not in 0-10000", spec.pulses_per_rev));
   if (spec.max_coast_s > 3600) return fail(fmt::format("--max-coast-s {} above an hour", spec.max_coast_s));
   if (spec.adc_bits < 0 || spec.adc_bits > 24) return fail(fmt::format("--adc-bits {} not in 0-24", spec.adc_bits));
   if (spec.decimals > 15) return fail(fmt::format("--decimals {} above 15", spec.decimals));
@@ -144,6 +151,13 @@ VirtualBench::VirtualBench(VirtualBenchOptions options) : o_(std::move(options))
     const SyntheticRun run = make_synthetic_run(spec);
     nlohmann::json rt{{"run", k + 1},        {"e0", spec.e0_v},       {"w0", run.omega0},
                       {"t_stop_s", run.t_stop_s}, {"stopped", run.stopped}, {"cut_bench_s", run_start_s + run.t_cut_ms / 1000.0}};
+    if (spec.start_s > 0) rt["starts_mid_coast_s"] = spec.start_s;
+    if (spec.gap_s > 0) rt["gap_bench_s"] = {run_start_s + run.t_cut_ms / 1000.0 + spec.gap_from_s, spec.gap_s};
+    if (run.t_signal_lost_ms >= 0) rt["signal_lost_bench_s"] = run_start_s + run.t_signal_lost_ms / 1000.0;
+    if (!run.glitch_index.empty()) {
+      auto& g = rt["glitch_bench_s"] = nlohmann::json::array();
+      for (std::size_t i : run.glitch_index) g.push_back(run_start_s + run.t_ms[i] / 1000.0);
+    }
     std::int64_t first_sent = -1;
     for (std::size_t i = 0; i < run.t_ms.size(); ++i) {
       const double t = run_start_s + run.t_ms[i] / 1000.0;  // bench time of this sample

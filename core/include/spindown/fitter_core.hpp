@@ -41,7 +41,8 @@
 namespace spindown {
 
 struct FitterOptions {
-  RunOptions runs;                       // the same defaults as `spindown fit`
+  // `spindown fit`'s defaults, but for a cap on a coast that never stops: live, a bound on memory.
+  RunOptions runs{.max_coast_s = 600.0};
   std::vector<ModelKind> models{all_models[0], all_models[1], all_models[2]};
   BenchParams default_bench;             // J, K_b for a bench without (usable) CONFIG
   bool ignore_config = false;            // always use default_bench (like `spindown fit --inertia`)

@@ -177,7 +177,8 @@ class RunDetector {
     enum What { go_on, too_long, power_back, level } what = go_on;
     double mu = 0, sxx = 0, e = 0;  // level: the hold window's mean, Sxx and residual sd
   };
-  inline CoastVerdict coast_verdict(std::size_t i, Sample s, const WindowFit& h, double& level_min, int& rising,
+  inline CoastVerdict coast_verdict(std::size_t i, Sample s, double prev_t, const WindowFit& h, double& level_min,
+                                    int& rising,
                                     const CoastLimits& c);
   void act_on(const CoastVerdict& v, std::size_t i, bool at_end);
   inline void track_repeats(std::size_t i, double value, std::size_t& same_start, double& last_v);
@@ -209,10 +210,15 @@ class RunDetector {
   };
   CutSplit split_at_cut(std::size_t a, std::size_t b, const WindowFit& w);
   std::string classify_lead_in(const CutSplit& sp) const;
+  // The mean of samples k-1..k+1 within [lo, hi].
+  double smoothed(std::size_t k, std::size_t lo, std::size_t hi) const;
+  // Whether the coast found in sp follows a rise straight into its peak (a spin-up): a rise after
+  // the cut moves the cut to the peak.
+  bool at_peak(CutSplit& sp, std::size_t b);
   bool try_start_coast(std::size_t i, const WindowFit& w);
   void found_standstill(std::size_t i, bool at_end);
   void tail_ends_by_time(std::size_t upto);
-  void close_unstopped(std::size_t end, const std::string& why);
+  void close_unstopped(std::size_t end, const std::string& why, Run::End reason);
   void complete_run(std::size_t end);
   void warn_of_gap_in_coast(int number, std::size_t from, std::size_t to, double period_s);
   std::string gap_before(std::size_t i) const;  // "no samples for … s mid-coast (from … to …)", before sample i
@@ -264,6 +270,7 @@ class RunDetector {
   double v0_ = 0;          // reading at the cut (start of the coast line)
   double standstill_ceiling_ = 0;  // a hold-window mean above it is not low yet (0.3 v0_, or inf if v0_ <= 0)
   double coast_sd_ = 0;    // coast noise near the cut
+  double coast_step_ = 0;  // the reading's smallest step near the cut (its quantization; 0 if none seen)
   double lead_in_zero_ = 0;  // mean reading of a "zeros" lead-in (the motor at rest); NaN for other lead-ins
   double rise_jump_ = 0;   // a reading this far above level_min_ is power coming back
   double level_min_ = 0;   // lowest hold-window mean seen in this coast

@@ -18,7 +18,8 @@ struct RunOptions {
   double stop_hold_s = 1.0;        // reading must stay at the zero level this long to call a stop
   double min_coast_s = 0.5;        // shorter coasts are reported and ignored
   std::size_t min_samples = 8;     // fewer coasting samples: reported and ignored
-  double max_coast_s = 600.0;      // a coast that does not stop by then is closed as "never stopped"
+  double max_coast_s = std::numeric_limits<double>::infinity();  // live: a memory bound (the fitter sets 600 s);
+                                   // a coast that has not stopped by then is closed as "never stopped"
   double tail_s = 2.0;             // standstill kept after the stop for the fit (pins the stop)
   std::size_t max_buffer = 200000; // samples buffered per stream (bounded memory)
   bool is_valid(std::string* why) const;
@@ -37,9 +38,29 @@ struct Run {
   double zero_level = 0;           // reading at standstill (median of the stopped tail; for an
                                    // asymptotic coast its floor; 0 when the coast was cut short)
   double noise_level = 0;          // standard deviation of the reading at standstill
-  std::string lead_in;             // "zeros", "floating", "supply", "powered", "none"
+  std::string lead_in;             // "zeros", "floating", "supply", "powered", "spin-up" (a rise straight into
+                                   // the peak), "none" (the cut was not recorded: the coast is partial)
   double period_s = 0;             // median sample period within the coast
+  // Why the fitted window ends where it does, and the device time of its last sample.
+  enum class End {
+    stopped,        // standstill reached (the tail after it is in the window)
+    signal_lost,    // the reading collapsed or froze faster than friction allows: the sensor gave up
+    gap,            // a pause in the recording mid-coast
+    end_of_data,    // the recording ends (or the stream was closed) mid-coast
+    cap,            // max_coast_s reached (a live memory bound)
+    power_back,     // the reading rose again before standstill
+    clock_restart,  // the device clock restarted (reset, reconnect)
+    asymptotic,     // the decay was lost in the noise before a stop (pure viscous)
+  };
+  End end = End::end_of_data;
+  double t_end_s = std::numeric_limits<double>::quiet_NaN();
+  std::vector<std::size_t> outliers;  // single samples in the coast that are not the motor's (dropouts,
+                                      // glitches): left out of every fit, ascending
+  bool partial() const { return lead_in == "none"; }
 };
+
+// The name of why a run's window ends, as text and JSON say it ("stopped", "signal lost", …).
+const char* end_name(Run::End e);
 
 struct Segmentation {
   std::vector<Run> runs;

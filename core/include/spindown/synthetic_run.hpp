@@ -13,7 +13,11 @@
 
 namespace spindown {
 
-enum class LeadIn { zeros, floating, supply };
+// zeros, floating, supply: what the pin reads while the motor is powered, the reading jumping to
+// the back-EMF at the cut (the lab's rig). spin_up: a speed sensor (tachometer, encoder) on a
+// rig spun up by a motor ramp or by hand: at rest, then over the last spin_up_s of the lead-in
+// the reading rises to e0 and the supply is cut at the peak, with no steady plateau.
+enum class LeadIn { zeros, floating, supply, spin_up };
 
 struct SyntheticRunSpec {
   BenchParams bench;
@@ -37,6 +41,15 @@ struct SyntheticRunSpec {
   int decimals = 2;            // printing; negative = full precision
   double t0_ms = 5234;         // device time of the first sample
   std::uint64_t seed = 1;
+  // What other rigs' recordings hold (all off by default; each leaves the random stream of the
+  // others untouched when off).
+  double spin_up_s = 3.0;      // LeadIn::spin_up: seconds of the rise (0.3: by hand; lead_in_s: a ramp)
+  double start_s = 0.0;        // > 0: the recording starts this long after the cut (mid-coast, no lead-in)
+  double gap_from_s = 0.0;     // no samples in [cut + gap_from_s, cut + gap_from_s + gap_s): the logger paused
+  double gap_s = 0.0;
+  int glitches = 0;            // coasting samples replaced by a dropout (0) or a glitch (half the value)
+  int pulses_per_rev = 0;      // > 0: a per-revolution sensor: the speed is measured once per pulse and held
+  double pulse_timeout_s = 0;  // per-revolution sensor: reads 0 after this long without a pulse (0: holds)
 };
 
 struct SyntheticRun {
@@ -47,6 +60,9 @@ struct SyntheticRun {
   double t_stop_s = 0;        // seconds from the cut to the stop (or max_coast_s)
   double omega0 = 0;          // rad/s at the cut
   bool stopped = false;
+  // Truth for run finding, in the recording's own samples.
+  std::vector<std::size_t> glitch_index;  // samples replaced by a dropout or glitch
+  double t_signal_lost_ms = -1;  // per-revolution sensor: device time of its last pulse before it gave up (-1: never)
 };
 
 SyntheticRun make_synthetic_run(const SyntheticRunSpec& spec);

@@ -27,8 +27,16 @@ inline void add_virtual_bench_options(CLI::App& app, VirtualBenchOptions& o, Vir
   app.add_option("--e0", sp.e0_v, "back-EMF at the cut (V)");
   app.add_option("--e0-step", o.e0_step_v, "added to e0 at each further run (V)");
   app.add_option("--supply", sp.supply_v, "pin reading before the cut with --lead-in supply (V)");
-  app.add_option("--lead-in", cli.lead_in, "what the pin reads before the cut")
-      ->check(CLI::IsMember({"zeros", "floating", "supply"}));
+  app.add_option("--lead-in", cli.lead_in,
+                 "what the pin reads before the cut (spin-up: a speed sensor's rise to the peak, cut there)")
+      ->check(CLI::IsMember({"zeros", "floating", "supply", "spin-up"}));
+  app.add_option("--spin-up-s", sp.spin_up_s, "--lead-in spin-up: seconds of the rise (0.3: by hand)");
+  app.add_option("--start-s", sp.start_s, "the recording starts this long after the cut (mid-coast)");
+  app.add_option("--gap-from-s", sp.gap_from_s, "a pause in the recording from this long after the cut (< 0: before)");
+  app.add_option("--gap-s", sp.gap_s, "seconds the recording pauses (no samples)");
+  app.add_option("--glitches", sp.glitches, "single bad coasting samples: dropouts (0) and glitches (half)");
+  app.add_option("--pulses-per-rev", sp.pulses_per_rev, "a per-revolution speed sensor: pulses per turn (0: none)");
+  app.add_option("--pulse-timeout-s", sp.pulse_timeout_s, "per-revolution sensor: reads 0 after this long without a pulse (0: holds)");
   app.add_option("--lead-in-s", sp.lead_in_s, "seconds recorded before the cut");
   app.add_option("--tail-s", sp.tail_s, "seconds recorded after the stop");
   app.add_option("--max-coast-s", sp.max_coast_s, "longest coast simulated");
@@ -58,9 +66,10 @@ inline void add_virtual_bench_options(CLI::App& app, VirtualBenchOptions& o, Vir
 // After parsing: the names and milliseconds into o.
 inline void apply_virtual_bench_cli(const VirtualBenchCli& cli, VirtualBenchOptions& o) {
   o.protocol = cli.protocol == "lab" ? BenchProtocol::lab : BenchProtocol::spindown_v1;
-  o.spec.lead_in = cli.lead_in == "zeros"    ? LeadIn::zeros
-                   : cli.lead_in == "supply" ? LeadIn::supply
-                                             : LeadIn::floating;
+  o.spec.lead_in = cli.lead_in == "zeros"     ? LeadIn::zeros
+                   : cli.lead_in == "supply"  ? LeadIn::supply
+                   : cli.lead_in == "spin-up" ? LeadIn::spin_up
+                                              : LeadIn::floating;
   o.spec.period_s = cli.period_ms / 1000.0;
   o.spec.jitter_s = cli.jitter_ms / 1000.0;
   o.seed = o.spec.seed;
