@@ -103,8 +103,8 @@ inline std::vector<Case> make_cases(int per_pattern) {
     {  // the logger paused for minutes; the coast begins at the first sample after it
       SyntheticRunSpec s = base;
       s.lead_in = k % 2 ? LeadIn::supply : LeadIn::zeros;
-      s.lead_in_s = 5.0;
       s.gap_s = 30.0 + 15.0 * (k % 8);
+      s.lead_in_s = s.gap_s + 5.0;
       s.gap_from_s = -(s.gap_s - 0.2 - 0.3 * (k % 6));
       cases.push_back(single("pause before the coast", s));
     }

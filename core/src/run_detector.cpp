@@ -430,6 +430,7 @@ std::size_t RunDetector::coast_loop(const double* t_s, const double* value, std:
 }
 
 void RunDetector::clock_restart() {
+  restarted_mid_coast_ = state_ == State::coasting;
   if (state_ == State::coasting) close_unstopped(next_index_, "the device clock restarted mid-coast", Run::End::clock_restart);
   else if (state_ == State::tail) complete_run(next_index_);
   base_ = next_index_;
@@ -437,6 +438,7 @@ void RunDetector::clock_restart() {
   have_plateau_ = false;
   need_rise_ = false;
   stream_start_ = next_index_;
+  resume_index_ = 0;
   last_t_ = -std::numeric_limits<double>::infinity();
   last_v_ = std::numeric_limits<double>::quiet_NaN();
   state_ = State::idle;
@@ -526,6 +528,11 @@ void RunDetector::trim_idle() {
 }
 
 void RunDetector::idle_step(std::size_t i, Sample s) {
+  // A pause in the recording (over 2 s): what follows may be a coast whose cut it hid.
+  if (i > base_ && s.t - t(i - 1) > 2.0) [[unlikely]] {
+    resume_index_ = i;
+    resume_pause_s_ = s.t - t(i - 1);
+  }
   advance(short_, i, s);
   advance(long_, i, s);
   advance(vlong_, i, s);
@@ -746,6 +753,36 @@ bool RunDetector::at_peak(CutSplit& sp, std::size_t b) {
   return last > before + thr && last >= sp.v0 - thr && before < sp.v0 - 2.0 * thr;
 }
 
+std::string RunDetector::start_not_seen(CutSplit& sp) {
+  const std::size_t c = sp.cut_index;
+  // The first sample after the stream's start or the last pause, whichever came last.
+  const bool after_pause = resume_index_ > stream_start_;
+  const std::size_t seen_from = after_pause ? resume_index_ : stream_start_;
+  if (c < seen_from || std::max(sp.a, base_) > seen_from) return {};
+  // From there to the cut found, a "lead-in" that lies on the coast's line is more coast.
+  const std::size_t a = seen_from;
+  if (c > a) {
+    const double tol = std::max(4.0 * sp.sd_post, 0.01 * std::abs(sp.v0));
+    double sse = 0;
+    for (std::size_t k = a; k < c; ++k) {
+      const double r = v(k) - (sp.v0 + sp.post_slope * (t(k) - t(c)));
+      sse += r * r;
+    }
+    if (sp.post_slope >= 0 || std::sqrt(sse / double(c - a)) > tol) return {};
+  }
+  sp.cut_index = a;
+  sp.pre_end = a;
+  sp.npre = 0;
+  sp.t_cut_s = t(a);
+  sp.v0 = sp.v0 + sp.post_slope * (t(a) - t(c));
+  if (after_pause)
+    return fmt::format("the recording paused for {:.3g} s (until {}) right before this coast: its cut was not "
+                       "recorded, so the coast is taken from the first sample after the pause",
+                       resume_pause_s_, fmt_s(t(a)));
+  return fmt::format("the recording starts mid-coast at {}: the cut was not recorded, so the coast is partial",
+                     fmt_s(t(a)));
+}
+
 std::string RunDetector::classify_lead_in(const CutSplit& sp) const {
   if (sp.npre < 3) return "none";
   const double scale = std::abs(sp.v0);
@@ -785,11 +822,17 @@ bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
   // into the peak (a speed sensor's reading) is the powered phase, not the coast.
   const bool spin_up = at_peak(sp, b);
   if (spin_up) lead = "spin-up";
+  // A coast whose start was not recorded: the recording (or the stream after a clock restart)
+  // begins on it, or resumes on it after a pause. Its cut is not known: the coast is partial and
+  // taken from its first sample, never given an invented cut in the pause or a lead-in.
+  std::string unseen;
+  if (!spin_up && !sp.clipped) unseen = start_not_seen(sp);
+  if (!unseen.empty()) lead = "none";
 
   // Whether this is a cut at all.
   bool plausible = sp.v0 > 0;
   const double scale = std::abs(sp.v0);
-  if (lead == "none") plausible = plausible && sp.a <= stream_start_;  // only a stream that starts mid-coast
+  if (lead == "none") plausible = plausible && !unseen.empty();  // a stream that starts mid-coast, or a pause
   if (lead == "powered" && sp.pre_sd > 0.05 * scale) plausible = false;  // a rough "plateau"
   if ((lead == "zeros" || lead == "floating") && sp.v0 < 1.5 * sp.pre_max) plausible = false;
   if (spin_up && sp.pre_declining) sp.pre_declining = false;  // the rise's own end, not a decline
@@ -807,6 +850,12 @@ bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
   run_.lead_in = lead;
   run_note_.clear();
   run_note_severity_ = Diagnostic::Severity::note;
+  fragment_ = restarted_mid_coast_ && sp.cut_index == stream_start_;
+  restarted_mid_coast_ = false;
+  if (!unseen.empty() && !fragment_) {
+    run_note_ = unseen;
+    run_note_severity_ = Diagnostic::Severity::warning;
+  }
   if (sp.clipped) {
     emit_diag(Diagnostic::Severity::warning,
               fmt::format("run {}: reading pinned at {:g} (converter's top?) from {} to {} ({} samples): "
@@ -1219,7 +1268,15 @@ void RunDetector::complete_run(std::size_t end) {
 
   RunEvent e;
   e.run = r;
-  if (coast_s < opt_.min_coast_s || coast_n < opt_.min_samples) {
+  if (fragment_) {
+    e.kind = RunEvent::Kind::ignored;
+    e.has_diagnostic = true;
+    e.diagnostic = {Diagnostic::Severity::note, source_, 0,
+                    fmt::format("coast from {} to {} ignored: the rest of a coast after the device clock restarted "
+                                "(reset, reconnect); its cut was not seen",
+                                fmt_s(r.t_cut_s), fmt_s(r.t_end_s))};
+    fragment_ = false;
+  } else if (coast_s < opt_.min_coast_s || coast_n < opt_.min_samples) {
     e.kind = RunEvent::Kind::ignored;
     e.has_diagnostic = true;
     e.diagnostic = {Diagnostic::Severity::note, source_, 0,

@@ -210,6 +210,9 @@ class RunDetector {
   };
   CutSplit split_at_cut(std::size_t a, std::size_t b, const WindowFit& w);
   std::string classify_lead_in(const CutSplit& sp) const;
+  // Why the coast in sp has no recorded cut (the stream begins on it, or a pause hides it), with
+  // sp moved to the coast's first sample; empty when its cut is in the data.
+  std::string start_not_seen(CutSplit& sp);
   // The mean of samples k-1..k+1 within [lo, hi].
   double smoothed(std::size_t k, std::size_t lo, std::size_t hi) const;
   // Whether the coast found in sp follows a rise straight into its peak (a spin-up): a rise after
@@ -245,6 +248,8 @@ class RunDetector {
   std::size_t time_cursor_ = 0;  // first buffered sample within the idle keep time
   std::size_t lo_ = 0;          // earliest index the current lead-in search may use
   std::size_t stream_start_ = 0;  // first index after the stream start / last clock restart
+  std::size_t resume_index_ = 0;  // first sample after the last pause (over 2 s) while idle
+  double resume_pause_s_ = 0;     // that pause's length
   bool need_quiet_ = false;     // after a closed coast: no new run until the decline pauses
   bool need_rise_ = false;      // after a stop: a new coast must start above rise_level_
   double rise_level_ = 0;
@@ -260,7 +265,9 @@ class RunDetector {
   WindowFit hold_{1.0}, hold_long_{3.0};            // confirm a standstill
   double hold_half_s_ = 0.5, hold_full_s_ = 0.9;     // hold_ durations: 0.5 and 0.9 of its span
   bool hold_long_live_ = false;
-  bool creeping_ = false;  // the coast was seen approaching standstill asymptotically
+  bool creeping_ = false;
+  bool restarted_mid_coast_ = false;  // the clock restarted while a coast was open: its rest is a fragment
+  bool fragment_ = false;             // the open run is such a rest: ignored when complete  // the coast was seen approaching standstill asymptotically
   double quiet_until_s_ = -std::numeric_limits<double>::infinity();  // after a rejected cut
 
   // The open run.
