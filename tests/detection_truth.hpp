@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <fmt/format.h>
 #include <map>
 #include <string>
@@ -181,6 +183,8 @@ struct PatternScore {
   int recordings = 0, truth_runs = 0, found = 0, missed = 0, invented = 0;
   int false_stops = 0;      // stopped, where the motor never stopped within the recording
   int partial_wrong = 0;    // a coast whose start was not recorded, given a lead-in all the same
+  int false_lost = 0;       // "signal lost" where the motor was seen to stop
+  int bad_samples = 0, rejected = 0, wrongly_rejected = 0;  // dropouts/glitches made, left out; good samples left out
   std::vector<double> cut_err, end_err;  // |detected - truth| in sample periods
   static double quantile(std::vector<double> x, double q) {
     if (x.empty()) return 0.0;
@@ -201,6 +205,19 @@ inline int epoch_of(const Recording& rec, std::size_t index) {
   int e = 0;
   for (std::size_t r : rec.clock_restarts) e += r <= index && r > 0;
   return e;
+}
+
+// One line per truth run and per detected run, for a look at a pattern's failures.
+inline std::string detail(const Case& c, const Segmentation& seg) {
+  std::string out = fmt::format("{}: {} samples\n", c.pattern, c.rec.size());
+  for (const TruthRun& tr : c.runs)
+    out += fmt::format("  truth    cut {:.3f} end {:.3f} ({}){}\n", tr.t_cut_s, tr.t_end_s, int(tr.end),
+                       tr.partial ? " partial" : "");
+  for (const Run& r : seg.runs)
+    out += fmt::format("  detected cut {:.3f} end {:.3f} ({}) lead-in {}\n", r.t_cut_s, detected_end_s(r, c.rec),
+                       end_name(r.end), r.lead_in);
+  for (const Diagnostic& d : seg.diagnostics) out += "  " + d.message + "\n";
+  return out;
 }
 
 inline void score_case(const Case& c, const Segmentation& seg, PatternScore& ps) {
@@ -230,25 +247,39 @@ inline void score_case(const Case& c, const Segmentation& seg, PatternScore& ps)
     else if (r.stopped)
       ++ps.false_stops;
     if (tr.partial && r.lead_in != "none") ++ps.partial_wrong;
+    if (tr.end == TruthRun::End::stopped && r.end == Run::End::signal_lost) ++ps.false_lost;
   }
+  ps.bad_samples += int(c.glitch_t_s.size());
+  for (const Run& r : seg.runs)
+    for (std::size_t k : r.outliers) {
+      const bool bad = std::find(c.glitch_t_s.begin(), c.glitch_t_s.end(), c.rec.t_s[k]) != c.glitch_t_s.end();
+      ++(bad ? ps.rejected : ps.wrongly_rejected);
+    }
   for (bool u : used) ps.invented += !u;
 }
 
+// Scores every case; prints each one of the pattern named by SPINDOWN_TRUTH_DETAIL (if set).
 inline std::map<std::string, PatternScore> score_all(const std::vector<Case>& cases, const RunOptions& opt = {}) {
   std::map<std::string, PatternScore> out;
-  for (const Case& c : cases) score_case(c, find_runs(c.rec, opt), out[c.pattern]);
+  const char* show = std::getenv("SPINDOWN_TRUTH_DETAIL");
+  for (const Case& c : cases) {
+    const Segmentation seg = find_runs(c.rec, opt);
+    if (show && c.pattern == show) std::fputs(detail(c, seg).c_str(), stdout);
+    score_case(c, seg, out[c.pattern]);
+  }
   return out;
 }
 
 inline std::string score_table(const std::map<std::string, PatternScore>& scores) {
-  std::string out = fmt::format("{:<24} {:>4} {:>5} {:>6} {:>8} {:>9} {:>9} {:>9} {:>9} {:>6} {:>7}\n", "pattern",
+  std::string out = fmt::format("{:<24} {:>4} {:>5} {:>6} {:>8} {:>9} {:>9} {:>9} {:>9} {:>6} {:>7} {:>6} {:>8}\n", "pattern",
                                 "recs", "runs", "missed", "invented", "cut p50", "cut p90", "end p50", "end p90",
-                                "f.stop", "partial");
+                                "f.stop", "partial", "f.lost", "outliers");
   for (const auto& [name, s] : scores)
-    out += fmt::format("{:<24} {:>4} {:>5} {:>6} {:>8} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f} {:>6} {:>7}\n", name,
+    out += fmt::format("{:<24} {:>4} {:>5} {:>6} {:>8} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f} {:>6} {:>7} {:>6} {:>8}\n", name,
                        s.recordings, s.truth_runs, s.missed, s.invented, PatternScore::quantile(s.cut_err, 0.5),
                        PatternScore::quantile(s.cut_err, 0.9), PatternScore::quantile(s.end_err, 0.5),
-                       PatternScore::quantile(s.end_err, 0.9), s.false_stops, s.partial_wrong);
+                       PatternScore::quantile(s.end_err, 0.9), s.false_stops, s.partial_wrong, s.false_lost,
+                       fmt::format("{}/{}+{}", s.rejected, s.bad_samples, s.wrongly_rejected));
   return out;
 }
 

@@ -197,16 +197,19 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
   const std::size_t begin = std::min(run.cut_index, t_s.size());
   const std::size_t end = std::clamp(run.end_index, begin, std::min(t_s.size(), value.size()));
   const std::size_t stop = std::clamp(run.stop_index, begin, end);
+  std::size_t moving = 0;  // samples kept before the stop
   for (std::size_t i = begin; i < end; ++i) {
     if (!std::isfinite(t_s[i]) || !std::isfinite(value[i])) continue;
+    if (std::binary_search(run.outliers.begin(), run.outliers.end(), i)) continue;  // a dropout or glitch
     out.tau.push_back(t_s[i] - run.t_cut_s);
     out.y.push_back(value[i]);
+    moving += i < stop || !run.stopped;
   }
   const double k = value_per_rad_per_s(q, opt.bench.kb_v_s_per_rad);
   EffectFitData data;
   data.tau = out.tau;
   data.y = out.y;
-  data.moving = std::min((run.stopped ? stop : end) - begin, out.tau.size());
+  data.moving = moving;
   data.k = k;
   data.inertia_kg_m2 = opt.bench.inertia_kg_m2;
   data.unit = out.unit;

@@ -1094,11 +1094,25 @@ RunFit fit_run(std::span<const double> t_s, std::span<const double> value, Quant
   const std::size_t stop = std::clamp(run.stop_index, begin, end);
   const double k = value_per_rad_per_s(q, opt.bench.kb_v_s_per_rad);
 
-  const std::size_t n = end - begin;
+  // The run's outliers (dropouts, glitches) are left out: the samples kept, and those of them moving.
+  const auto out_lo = std::lower_bound(run.outliers.begin(), run.outliers.end(), begin);
+  const auto out_hi = std::lower_bound(out_lo, run.outliers.end(), end);
+  const std::size_t n = end - begin - std::size_t(out_hi - out_lo);
   // τ, y and the weights in one buffer, written before they are read: no zeroing.
   const auto buffer = std::make_unique_for_overwrite<double[]>(3 * n);
   const std::span<double> tau(buffer.get(), n), y(buffer.get() + n, n), weight(buffer.get() + 2 * n, n);
-  {
+  if (out_lo != out_hi) {
+    std::size_t j = 0;
+    auto next = out_lo;
+    for (std::size_t i = begin; i < end; ++i) {
+      if (next != out_hi && *next == i) {
+        ++next;
+        continue;
+      }
+      tau[j] = t_s[i] - run.t_cut_s, y[j] = value[i] - run.zero_level;
+      ++j;
+    }
+  } else {
     // Restrict: the buffer is our own, so the loop vectorises without a test for overlap.
     const double *__restrict t_in = t_s.data() + begin, *__restrict v_in = value.data() + begin;
     double *__restrict t_out = tau.data(), *__restrict y_out = y.data();
@@ -1106,7 +1120,9 @@ RunFit fit_run(std::span<const double> t_s, std::span<const double> value, Quant
 #pragma omp simd
     for (std::size_t i = 0; i < n; ++i) t_out[i] = t_in[i] - t_cut, y_out[i] = v_in[i] - zero;
   }
-  const std::size_t moving = (run.stopped ? stop : end) - begin;
+  const std::size_t moving_end = run.stopped ? stop : end;
+  const std::size_t moving =
+      moving_end - begin - std::size_t(std::lower_bound(out_lo, out_hi, moving_end) - out_lo);
   const std::string_view runit = quantity_unit(q);
   // Weights from the run's own noise (σ² growing with the reading), shared by every model.
   if (opt.weighted) weigh_by_noise_into(y, weight);

@@ -110,6 +110,9 @@ std::optional<RunFit> from_fit_message(const fit_t& m, std::string* why) {
   fit.run.t_cut_s = m.t_cut_s;
   fit.run.stopped = std::isfinite(m.t_stop_s);
   fit.run.t_stop_s = m.t_stop_s;
+  // FIT carries no window end nor its reason (the LCM type is unchanged): a stop is said, the rest
+  // is not known.
+  if (fit.run.stopped) fit.run.end = Run::End::stopped;
   fit.run.cut_index = 0;
   fit.run.end_index = static_cast<std::size_t>(std::max(m.samples, 0));
   fit.run.stop_index = fit.run.end_index;

@@ -542,6 +542,7 @@ void FitterCore::fit_and_publish(Bench& b, const Run& run, std::int64_t recv_uti
   local.cut_index = 0;
   local.stop_index = run.stop_index - run.cut_index;
   local.end_index = run.end_index - run.cut_index;
+  for (std::size_t& k : local.outliers) k -= run.cut_index;
 
   FitResult r;
   r.bench = b.id;

@@ -744,6 +744,11 @@ bool RunDetector::at_peak(CutSplit& sp, std::size_t b) {
     sp.v0 = top;
     sp.npre = p - sp.a;
     sp.pre_declining = false;
+    WindowFit coast;  // the coast's line and noise from the peak on (the rise is not its noise)
+    coast.clear(p, t(p));
+    for (std::size_t k = p; k <= b; ++k) coast.add(t(k), v(k));
+    sp.post_slope = coast.slope();
+    sp.sd_post = coast.resid_sd();
     return true;
   }
   // A lead-in that climbs into the cut: its last samples rise to the coast's start.
@@ -1046,6 +1051,7 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
     }
   }
   first_in = std::min(first_in, i);
+  if (signal_lost(i, first_in, z, sd_z, amp)) return;
 
   // Where the coast crossed the last quarter of its amplitude.
   const double quarter = z + 0.25 * amp;
@@ -1146,6 +1152,51 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
   }
 }
 
+bool RunDetector::signal_lost(std::size_t i, std::size_t first_in, double z, double sd_z, double amp) {
+  if (first_in < run_.cut_index + 8 || !(amp > 0)) return false;
+  // The coast's last reading before the standstill, and the first sample that held it.
+  const std::size_t last = first_in - 1;
+  std::size_t held = last;
+  while (held > run_.cut_index && v(held - 1) == v(last)) --held;
+  // The most friction lets the reading fall in one sample: the coast's slope over the second
+  // before the held value, per period.
+  WindowFit f{1.0};
+  reset_window(f, run_.cut_index, held);
+  const double period = t(first_in) - t(last);
+  const double fall = f.n >= 5 ? std::max(-f.slope(), 0.0) * period : 0.0;
+  const double drop = v(last) - z;
+  // A collapse: a fall far beyond the coast's, from a reading held longer than the coast allows
+  // (friction would have moved it two steps), or beyond any fall the coast showed. A lab stop's
+  // last printed values (0.02, 0.01 on the 2-decimal print) are neither.
+  const double held_for = double(first_in - held);
+  const bool big_drop = drop > std::max({10.0 * fall, 6.0 * f.resid_sd(), 3.0 * coast_step_, 0.005 * amp});
+  const bool long_hold = held_for * fall > std::max(2.0 * coast_step_, 3.0 * f.resid_sd());
+  const bool collapse = big_drop && (long_hold || drop > 30.0 * fall);
+  // Or the "standstill" is one value, held exactly, well above the motor's zero.
+  std::size_t frozen_from = first_in;
+  while (frozen_from > run_.cut_index && v(frozen_from - 1) == z) --frozen_from;
+  const double zero = std::isfinite(lead_in_zero_) ? lead_in_zero_ : 0.0;
+  const bool frozen = sd_z == 0 && z - zero > 0.05 * amp && frozen_from < first_in;
+  if (!collapse && !frozen) return false;
+  const std::size_t from = collapse ? held : frozen_from;
+  const double level = v(from);
+  run_note_severity_ = Diagnostic::Severity::warning;
+  close_unstopped(from + 1,
+                  fmt::format("signal lost below {:g} at {}: {} where friction lets it fall about {:.2g} a sample; a "
+                              "sensor that gives up at low speed (per-revolution pulses, an encoder, a display)? "
+                              "Fitted up to there, as never stopped",
+                              level, fmt_s(t(from)),
+                              collapse ? fmt::format("the reading fell from {:g} to {:g} in one sample", v(last), z)
+                                       : fmt::format("the reading froze on {:g} from {}", z, fmt_s(t(frozen_from))),
+                              fall),
+                  Run::End::signal_lost);
+  to_idle(i + 1, true);
+  // No new run until the reading rises above what the sensor last showed.
+  need_rise_ = true;
+  rise_level_ = std::max(level, z) + std::max(0.1 * std::abs(v0_), 8.0 * coast_sd_);
+  return true;
+}
+
 void RunDetector::tail_ends_by_time(std::size_t upto) {
   const double t_end = run_.t_stop_s + opt_.tail_s;
   for (std::size_t e = run_.stop_index + 1; e <= upto; ++e) {
@@ -1172,15 +1223,7 @@ void RunDetector::tail_step(std::size_t i, Sample s) {
     // drop <= 0 never exceeds the band (its first term is >= 0): the usual case, without a sqrt.
     if (drop > 0 &&
         drop > std::max(4.0 * run_.noise_level / std::sqrt(hold_.n), retract_fraction * (v0_ - run_.zero_level))) {
-      emit_diag(Diagnostic::Severity::note,
-                fmt::format("run cut at {}: standstill at {} retracted, the reading kept falling", fmt_s(run_.t_cut_s),
-                            fmt_s(run_.t_stop_s)));
-      run_.stopped = false;
-      run_.t_stop_s = std::numeric_limits<double>::quiet_NaN();
-      state_ = State::coasting;
-      level_min_ = std::numeric_limits<double>::infinity();
-      rising_ = 0;
-      coast_checks(i, s);
+      retract_stop(i, s);
       return;
     }
   }
@@ -1197,10 +1240,40 @@ void RunDetector::tail_step(std::size_t i, Sample s) {
     departing_ = 0;
   }
   if (s.t >= run_.t_stop_s + opt_.tail_s) {
+    if (still_falling(i)) {
+      retract_stop(i, s);
+      return;
+    }
     const std::size_t end = departing_ > 0 ? depart_start_ : i;
     complete_run(end);
     to_idle(end, false);
   }
+}
+
+bool RunDetector::still_falling(std::size_t i) const {
+  // Over the whole tail, a slope many standard errors below zero, lower than the quantization
+  // allows a level reading, and at least a third of the approach's: the "standstill" was a slow
+  // exponential's stretch (a viscous coast at a fraction of its start), not a stop.
+  if (i < run_.stop_index + 8) return false;
+  const WindowFit w = window_over(ring_.get(), mask_, 1e300, run_.stop_index, i + 1);
+  const double sxx = w.sxx();
+  if (!(sxx > 0)) return false;
+  const double slope = w.slope();
+  const double e = std::max(w.resid_sd(), coast_step_ * 0.2886751345948129);
+  const double mean_rate = (v0_ - run_.zero_level) / std::max(run_.t_stop_s - run_.t_cut_s, 1e-9);
+  return slope < 0 && -slope * std::sqrt(sxx) > 6.0 * e && -slope > 0.1 * mean_rate;
+}
+
+void RunDetector::retract_stop(std::size_t i, Sample s) {
+  emit_diag(Diagnostic::Severity::note,
+            fmt::format("run cut at {}: standstill at {} retracted, the reading kept falling", fmt_s(run_.t_cut_s),
+                        fmt_s(run_.t_stop_s)));
+  run_.stopped = false;
+  run_.t_stop_s = std::numeric_limits<double>::quiet_NaN();
+  state_ = State::coasting;
+  level_min_ = std::numeric_limits<double>::infinity();
+  rising_ = 0;
+  coast_checks(i, s);
 }
 
 void RunDetector::close_unstopped(std::size_t end, const std::string& why, Run::End reason) {
@@ -1236,6 +1309,28 @@ void RunDetector::warn_of_gap_in_coast(int number, std::size_t from, std::size_t
   else
     emit_diag(Diagnostic::Severity::note,
               fmt::format("{}: the reading fell across it as the coast would, taken as samples lost", gap));
+}
+
+void RunDetector::find_outliers(Run& r, std::size_t coast_end) {
+  // A single sample far off the line through its two neighbours, which agree with each other: a
+  // dropout (a loose wire reads 0) or a glitch (a missed pulse halves a speed), not the motor,
+  // which cannot leave its course for one sample and come back.
+  const double floor = std::max(10.0 * coast_sd_, 5.0 * coast_step_);
+  std::string where;
+  std::size_t shown = 0;
+  for (std::size_t k = r.cut_index + 1; k + 1 < coast_end; ++k) {
+    const double a = v(k - 1), b = v(k + 1), ta = t(k - 1), tb = t(k + 1);
+    const double expected = tb > ta ? a + (b - a) * (t(k) - ta) / (tb - ta) : 0.5 * (a + b);
+    const double off = std::abs(v(k) - expected);
+    if (off > floor && off > 0.1 * std::abs(expected) && std::abs(b - a) < 0.5 * off) [[unlikely]] {
+      r.outliers.push_back(k);
+      if (shown++ < 3) where += fmt::format("{}{} at {} (expected {:.3g})", shown > 1 ? ", " : "", v(k), fmt_s(t(k)), expected);
+    }
+  }
+  if (r.outliers.empty()) return;
+  emit_diag(Diagnostic::Severity::warning,
+            fmt::format("run {}: {} single-sample outlier(s) left out of the fit (dropouts or glitches): {}{}", r.number,
+                        r.outliers.size(), where, r.outliers.size() > 3 ? ", …" : ""));
 }
 
 std::string RunDetector::gap_before(std::size_t i) const {
@@ -1286,6 +1381,7 @@ void RunDetector::complete_run(std::size_t end) {
     e.kind = RunEvent::Kind::complete;
     e.run.number = ++accepted_;
     warn_of_gap_in_coast(e.run.number, r.cut_index, coast_end, r.period_s);
+    find_outliers(e.run, coast_end);
     if (!run_note_.empty()) {
       e.has_diagnostic = true;
       e.diagnostic = {run_note_severity_, source_, 0, fmt::format("run {}: {}", e.run.number, run_note_)};

@@ -93,6 +93,7 @@ Segmentation find_runs(const Recording& rec, const RunOptions& opt) {
       r.cut_index = map(r.cut_index);
       r.stop_index = map(r.stop_index);
       r.end_index = map(r.end_index);
+      for (std::size_t& k : r.outliers) k = map(k);
     }
   }
   if (seg.runs.empty())

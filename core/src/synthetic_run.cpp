@@ -90,15 +90,16 @@ SyntheticRun make_synthetic_run(const SyntheticRunSpec& s) {
           last_pulse = t_pulse;
         }
         prev_angle = a, prev_tau = tau;
-        if (s.pulse_timeout_s > 0 && tau - last_pulse > s.pulse_timeout_s) {
-          if (!lost) out.t_signal_lost_ms = out.t_cut_ms + 1000.0 * last_pulse;
+        // Past the timeout the sensor gives up for good (a display's lowest speed): it reads 0.
+        if (s.pulse_timeout_s > 0 && !lost && tau - last_pulse > s.pulse_timeout_s) {
+          out.t_signal_lost_ms = out.t_cut_ms + 1000.0 * last_pulse;
           lost = true;
-          held_omega = 0;
         }
-        w = held_omega;
+        w = lost ? 0.0 : held_omega;
       }
       const double ripple = s.ripple * std::sin(s.ripple_per_rev * sim.angle());
-      v = s.bench.kb_v_s_per_rad * w * (1.0 + ripple) + s.offset_v + s.noise_v * gauss(rng);
+      // A per-revolution sensor's reading is a count, not an analog voltage: no noise on it.
+      v = s.bench.kb_v_s_per_rad * w * (1.0 + ripple) + s.offset_v + (pulse_angle > 0 ? 0.0 : s.noise_v * gauss(rng));
       const bool done_stopped = sim.stopped() && tau > sim.stop_time() + s.tail_s;
       const bool done_coast = !sim.stopped() && tau > s.max_coast_s;
       if (done_stopped || done_coast) break;

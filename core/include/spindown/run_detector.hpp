@@ -187,6 +187,10 @@ class RunDetector {
   void power_back();                   // the reading rose again before standstill
   void standstill_checks(std::size_t i, bool at_end, double mu, double sxx, double e);
   void tail_step(std::size_t i, Sample s);
+  // Whether the tail up to sample i still falls clearly: the stop was no stop.
+  bool still_falling(std::size_t i) const;
+  // Back to coasting from the tail at sample i (s), with a note.
+  void retract_stop(std::size_t i, Sample s);
   inline bool confirms_decline(const WindowFit& w) const;
   // Whether w shows a standstill: full, low, and no significant slope or drop.
   bool flat(const WindowFit& w) const;
@@ -220,9 +224,15 @@ class RunDetector {
   bool at_peak(CutSplit& sp, std::size_t b);
   bool try_start_coast(std::size_t i, const WindowFit& w);
   void found_standstill(std::size_t i, bool at_end);
+  // At a standstill found at sample i (its first sample first_in, level z, spread sd_z, the coast's
+  // amplitude amp): whether the reading collapsed or froze faster than friction allows, the sensor
+  // giving up; if so the run is closed there, never stopped.
+  bool signal_lost(std::size_t i, std::size_t first_in, double z, double sd_z, double amp);
   void tail_ends_by_time(std::size_t upto);
   void close_unstopped(std::size_t end, const std::string& why, Run::End reason);
   void complete_run(std::size_t end);
+  // Single samples in r's coast [cut, coast_end) that are not the motor's: into r.outliers, with a warning.
+  void find_outliers(Run& r, std::size_t coast_end);
   void warn_of_gap_in_coast(int number, std::size_t from, std::size_t to, double period_s);
   std::string gap_before(std::size_t i) const;  // "no samples for … s mid-coast (from … to …)", before sample i
   void to_idle(std::size_t lo, bool need_quiet);
