@@ -1051,7 +1051,7 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
     }
   }
   first_in = std::min(first_in, i);
-  if (signal_lost(i, first_in, z, sd_z, amp)) return;
+  if (signal_lost(i, first_in, z, amp)) return;
 
   // Where the coast crossed the last quarter of its amplitude.
   const double quarter = z + 0.25 * amp;
@@ -1152,7 +1152,7 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
   }
 }
 
-bool RunDetector::signal_lost(std::size_t i, std::size_t first_in, double z, double sd_z, double amp) {
+bool RunDetector::signal_lost(std::size_t i, std::size_t first_in, double z, double amp) {
   if (first_in < run_.cut_index + 8 || !(amp > 0)) return false;
   // The coast's last reading before the standstill, and the first sample that held it.
   const std::size_t last = first_in - 1;
@@ -1172,13 +1172,8 @@ bool RunDetector::signal_lost(std::size_t i, std::size_t first_in, double z, dou
   const bool big_drop = drop > std::max({10.0 * fall, 6.0 * f.resid_sd(), 3.0 * coast_step_, 0.005 * amp});
   const bool long_hold = held_for * fall > std::max(2.0 * coast_step_, 3.0 * f.resid_sd());
   const bool collapse = big_drop && (long_hold || drop > 30.0 * fall);
-  // Or the "standstill" is one value, held exactly, well above the motor's zero.
-  std::size_t frozen_from = first_in;
-  while (frozen_from > run_.cut_index && v(frozen_from - 1) == z) --frozen_from;
-  const double zero = std::isfinite(lead_in_zero_) ? lead_in_zero_ : 0.0;
-  const bool frozen = sd_z == 0 && z - zero > 0.05 * amp && frozen_from < first_in;
-  if (!collapse && !frozen) return false;
-  const std::size_t from = collapse ? held : frozen_from;
+  if (!collapse) return false;
+  const std::size_t from = held;
   const double level = v(from);
   run_note_severity_ = Diagnostic::Severity::warning;
   close_unstopped(from + 1,
@@ -1186,9 +1181,7 @@ bool RunDetector::signal_lost(std::size_t i, std::size_t first_in, double z, dou
                               "sensor that gives up at low speed (per-revolution pulses, an encoder, a display)? "
                               "Fitted up to there, as never stopped",
                               level, fmt_s(t(from)),
-                              collapse ? fmt::format("the reading fell from {:g} to {:g} in one sample", v(last), z)
-                                       : fmt::format("the reading froze on {:g} from {}", z, fmt_s(t(frozen_from))),
-                              fall),
+                              fmt::format("the reading fell from {:g} to {:g} in one sample", v(last), z), fall),
                   Run::End::signal_lost);
   to_idle(i + 1, true);
   // No new run until the reading rises above what the sensor last showed.

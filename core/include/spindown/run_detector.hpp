@@ -224,10 +224,10 @@ class RunDetector {
   bool at_peak(CutSplit& sp, std::size_t b);
   bool try_start_coast(std::size_t i, const WindowFit& w);
   void found_standstill(std::size_t i, bool at_end);
-  // At a standstill found at sample i (its first sample first_in, level z, spread sd_z, the coast's
-  // amplitude amp): whether the reading collapsed or froze faster than friction allows, the sensor
-  // giving up; if so the run is closed there, never stopped.
-  bool signal_lost(std::size_t i, std::size_t first_in, double z, double sd_z, double amp);
+  // At a standstill found at sample i (its first sample first_in, level z, the coast's amplitude
+  // amp): whether the reading collapsed to it from a held value faster than friction allows, the
+  // sensor giving up; if so the run is closed there, never stopped.
+  bool signal_lost(std::size_t i, std::size_t first_in, double z, double amp);
   void tail_ends_by_time(std::size_t upto);
   void close_unstopped(std::size_t end, const std::string& why, Run::End reason);
   void complete_run(std::size_t end);
