@@ -89,6 +89,8 @@ fit_t to_fit_message(const RunFit& fit, const FitProvenance& about, std::int64_t
   m.noise_level = fit.run.noise_level;
   m.period_s = fit.run.period_s;
   m.first_seq = about.first_seq;
+  m.t_end_s = fit.run.t_end_s;
+  m.end = end_name(fit.run.end);
   m.last_seq = about.last_seq;
   return m;
 }
@@ -110,9 +112,8 @@ std::optional<RunFit> from_fit_message(const fit_t& m, std::string* why) {
   fit.run.t_cut_s = m.t_cut_s;
   fit.run.stopped = std::isfinite(m.t_stop_s);
   fit.run.t_stop_s = m.t_stop_s;
-  // FIT carries no window end nor its reason (the LCM type is unchanged): a stop is said, the rest
-  // is not known.
-  if (fit.run.stopped) fit.run.end = Run::End::stopped;
+  fit.run.t_end_s = m.t_end_s;
+  fit.run.end = end_from_name(m.end);
   fit.run.cut_index = 0;
   fit.run.end_index = static_cast<std::size_t>(std::max(m.samples, 0));
   fit.run.stop_index = fit.run.end_index;

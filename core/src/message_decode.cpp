@@ -202,6 +202,8 @@ constexpr WireField fit_fields[] = {
     {"finding_ratio", Wire::f64, 40},               // 49
     {"finding_ratio_stderr", Wire::f64, 40},        // 50
     {"finding_unit", Wire::string, 40},             // 51
+    {"t_end_s", Wire::f64},                         // 52
+    {"end", Wire::string},                          // 53
 };
 
 constexpr WireField explain_fields[] = {

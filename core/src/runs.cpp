@@ -38,6 +38,13 @@ const char* end_name(Run::End e) {
   return "?";
 }
 
+Run::End end_from_name(std::string_view name) {
+  for (Run::End e : {Run::End::stopped, Run::End::signal_lost, Run::End::gap, Run::End::end_of_data, Run::End::cap,
+                     Run::End::power_back, Run::End::clock_restart, Run::End::asymptotic})
+    if (name == end_name(e)) return e;
+  return Run::End::end_of_data;
+}
+
 Segmentation find_runs(const Recording& rec, const RunOptions& opt) {
   Segmentation seg;
   auto diag = [&](Diagnostic::Severity sev, std::string msg) {

@@ -8,6 +8,7 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "spindown/recording.hpp"
@@ -61,6 +62,8 @@ struct Run {
 
 // The name of why a run's window ends, as text and JSON say it ("stopped", "signal lost", …).
 const char* end_name(Run::End e);
+// The reason named by end_name(), or end_of_data for a name it does not give.
+Run::End end_from_name(std::string_view name);
 
 struct Segmentation {
   std::vector<Run> runs;
