@@ -167,6 +167,23 @@ inline std::vector<Case> make_cases(int per_pattern) {
       s.start_s = 2.0 + 1.5 * (k % 6);
       cases.push_back(single("starts mid-coast", s));
     }
+    {  // three runs back to back, as a lab session records them (each lead-in in turn)
+      Case c;
+      c.pattern = "three runs";
+      double t0_ms = 5234;
+      for (int r = 0; r < 3; ++r) {
+        SyntheticRunSpec s = base;
+        s.seed = base.seed * 3 + std::uint64_t(r);
+        s.lead_in = LeadIn((k + r) % 3);
+        s.e0_v = base.e0_v + 0.3 * r;
+        s.t0_ms = t0_ms;
+        const SyntheticRun sim = make_synthetic_run(s);
+        append(c.rec, sim);
+        c.runs.push_back(truth_of(sim));
+        t0_ms = sim.t_ms.back() + 20;
+      }
+      cases.push_back(std::move(c));
+    }
     {  // an uneven loop: periods from 11 to 29 ms
       SyntheticRunSpec s = base;
       s.lead_in = LeadIn(k % 3);

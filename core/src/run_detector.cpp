@@ -131,9 +131,13 @@ void RunDetector::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
   advance(w, ring_.get(), mask_, i, s);
 }
 
-[[gnu::always_inline]] inline void RunDetector::coast_step(std::size_t i, Sample s) {
+[[gnu::always_inline]] inline void RunDetector::coast_step(std::size_t i, Sample s, double prev_t) {
   advance(hold_, i, s);
   if (hold_long_live_) [[unlikely]] advance(hold_long_, i, s);
+  if (long_silence(prev_t, s.t, run_.t_cut_s)) [[unlikely]] {
+    coast_too_long(i);
+    return;
+  }
   coast_checks(i, s);
 }
 
@@ -141,14 +145,12 @@ void RunDetector::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
 // every sample. s is sample i, and h (hold_, or push_many's copy of it) ends at i; level_min and
 // rising are the coast's lowest level and rise count, updated here.
 [[gnu::always_inline]] inline RunDetector::CoastVerdict RunDetector::coast_verdict(std::size_t i, Sample s,
-                                                                                 double prev_t, const WindowFit& h,
+                                                                                 const WindowFit& h,
                                                                                  double& level_min,
                                                                                  int& rising, const CoastLimits& c) {
   const double t_i = s.t;
   // i + 1 - base is buffered() after sample i.
-  if (i + 1 - c.base > c.max_buffer || t_i - c.t_cut_s > c.max_coast_s || long_silence(prev_t, t_i, c.t_cut_s))
-      [[unlikely]]
-    return {CoastVerdict::too_long};
+  if (i + 1 - c.base > c.max_buffer || t_i - c.t_cut_s > c.max_coast_s) [[unlikely]] return {CoastVerdict::too_long};
   if (h.n < 3 || h.first < c.cut_index) return {};
   const double dur = t_i - c.ring[h.first & c.mask].t;  // duration(h), its last sample being i
   const double mu = h.sv() / h.n;                        // h.mean(), n being at least 3
@@ -183,8 +185,7 @@ void RunDetector::act_on(const CoastVerdict& v, std::size_t i, bool at_end) {
 }
 
 [[gnu::always_inline]] inline void RunDetector::coast_checks(std::size_t i, Sample s, bool at_end) {
-  const double prev_t = i > base_ ? t(i - 1) : s.t;
-  const CoastVerdict v = coast_verdict(i, s, prev_t, hold_, level_min_, rising_, coast_limits());
+  const CoastVerdict v = coast_verdict(i, s, hold_, level_min_, rising_, coast_limits());
   if (v.what != CoastVerdict::go_on) [[unlikely]] act_on(v, i, at_end);
 }
 
@@ -341,6 +342,7 @@ void RunDetector::push(double t_s, double value) {
     return;
   }
   if (t_s < last_t_) [[unlikely]] time_went_back(t_s);  // never for the first sample: last_t_ is -inf
+  const double prev_t = last_t_;  // -inf for a stream's first sample
   last_t_ = t_s;
   const std::size_t i = next_index_++;
   if (next_index_ - base_ > ring_size()) [[unlikely]] grow_ring();
@@ -348,8 +350,8 @@ void RunDetector::push(double t_s, double value) {
   ring_[i & mask_] = s;
   track_repeats(i, value, same_start_, last_v_);
   switch (state_) {
-    case State::idle: idle_step(i, s); break;
-    case State::coasting: coast_step(i, s); break;
+    case State::idle: idle_step(i, s, prev_t); break;
+    case State::coasting: coast_step(i, s, prev_t); break;
     case State::tail: tail_step(i, s); break;
   }
 }
@@ -402,15 +404,16 @@ std::size_t RunDetector::coast_loop(const double* t_s, const double* value, std:
   };
   for (; k < n; ++k) {
     const Sample s{t_s[k], value[k]};
-    if (!std::isfinite(s.t) || !std::isfinite(s.v) || s.t < last_t || i + 1 - c.base > capacity) break;
-    const double prev_t = last_t;
+    // push() takes a sample that is not finite, goes back in time or follows a silence of over 2 s.
+    if (!std::isfinite(s.t) || !std::isfinite(s.v) || s.t < last_t || s.t - last_t > 2.0 || i + 1 - c.base > capacity)
+      break;
     last_t = s.t;
     ring[i & mask] = s;
     track_repeats(i, s.v, same_start, last_v);
     advance(h, ring, mask, i, s);
     if constexpr (LongLive) advance(hl, ring, mask, i, s);
     const std::size_t at = i++;
-    const CoastVerdict v = coast_verdict(at, s, prev_t, h, level_min, rising, c);
+    const CoastVerdict v = coast_verdict(at, s, h, level_min, rising, c);
     if (v.what != CoastVerdict::go_on) [[unlikely]] {
       put_back();
       act_on(v, at, false);
@@ -470,6 +473,7 @@ void RunDetector::to_idle(std::size_t lo, bool need_quiet) {
   // After a stop, a new coast must start above the standstill: a slow coast's last creep
   // after a premature stop is not a new run.
   need_rise_ = state_ == State::tail && run_.stopped;
+  block_band_ = 0;
   rise_level_ = run_.zero_level + depart_band_;
   state_ = State::idle;
   lo_ = lo;
@@ -527,11 +531,15 @@ void RunDetector::trim_idle() {
   return -s * std::sqrt(w.sxx()) >= confirm_t_stat * sd;
 }
 
-void RunDetector::idle_step(std::size_t i, Sample s) {
+void RunDetector::idle_step(std::size_t i, Sample s, double prev_t) {
+  // A coast closed before its stop (cap, signal lost) blocks new runs until the reading rises
+  // well above the lowest it has shown since: a new spin-up does, the rest of that coast never.
+  if (block_band_ > 0) [[unlikely]]
+    rise_level_ = std::min(rise_level_, s.v + block_band_);
   // A pause in the recording (over 2 s): what follows may be a coast whose cut it hid.
-  if (i > base_ && s.t - t(i - 1) > 2.0) [[unlikely]] {
+  if (s.t - prev_t > 2.0) [[unlikely]] {
     resume_index_ = i;
-    resume_pause_s_ = s.t - t(i - 1);
+    resume_pause_s_ = s.t - prev_t;
   }
   advance(short_, i, s);
   advance(long_, i, s);
@@ -731,11 +739,12 @@ bool RunDetector::at_peak(CutSplit& sp, std::size_t b) {
   // The highest reading (a 3-sample mean, so one noisy sample does not make the peak) from the
   // cut found to the newest sample.
   std::size_t p = sp.cut_index;
-  double top = smoothed(p, sp.cut_index, b);
-  for (std::size_t k = sp.cut_index + 1; k <= b; ++k) {
-    const double m = smoothed(k, sp.cut_index, b);
-    if (m > top) top = m, p = k;
+  double top3 = 3.0 * smoothed(p, sp.cut_index, b);  // three times the mean: sums compared, no division
+  for (std::size_t k = sp.cut_index + 1; k < b; ++k) {
+    const double m3 = v(k - 1) + v(k) + v(k + 1);
+    if (m3 > top3) top3 = m3, p = k;
   }
+  const double top = top3 / 3.0;
   if (top > smoothed(sp.cut_index, sp.cut_index, b) + thr && p < b) {
     // A rise after the cut found: the coast starts at its peak, and what came before is the rise.
     sp.pre_end = p;
@@ -774,6 +783,16 @@ std::string RunDetector::start_not_seen(CutSplit& sp) {
       sse += r * r;
     }
     if (sp.post_slope >= 0 || std::sqrt(sse / double(c - a)) > tol) return {};
+    // … and is not clearly flatter than the coast (a noisy plateau within the tolerance is a
+    // lead-in, its step hidden in the noise).
+    if (c - a >= 5) {
+      const WindowFit pre = window_over(ring_.get(), mask_, 1e300, a, c);
+      // A quantized reading can repeat one value over a few samples of a coast: its spread is at
+      // least the step's.
+      const double e = std::max(pre.resid_sd(), reading_step(a, c + 1) * 0.2886751345948129);
+      const double s = pre.slope(), se = pre.sxx() > 0 ? e / std::sqrt(pre.sxx()) : 0.0;
+      if (s - sp.post_slope > 3.0 * se && s > 0.5 * sp.post_slope) return {};
+    }
   }
   sp.cut_index = a;
   sp.pre_end = a;
@@ -923,9 +942,9 @@ void RunDetector::coast_too_long(std::size_t i) {
                               opt_.max_coast_s),
                   Run::End::cap);
   to_idle(i + 1, true);
-  // The coast goes on: no new run until the reading rises above where it was closed.
-  need_rise_ = true;
-  rise_level_ = v(i) + std::max(0.1 * std::abs(v0_), 8.0 * coast_sd_);
+  // The coast goes on: no new run until the reading rises above where it was closed, or has come
+  // down to the motor's zero (stopped) first.
+  block_until_rise(v(i));
 }
 
 void RunDetector::power_back() {
@@ -1152,6 +1171,12 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
   }
 }
 
+void RunDetector::block_until_rise(double level) {
+  need_rise_ = true;
+  block_band_ = std::max(0.1 * std::abs(v0_), 8.0 * coast_sd_);
+  rise_level_ = level + block_band_;
+}
+
 bool RunDetector::signal_lost(std::size_t i, std::size_t first_in, double z, double amp) {
   if (first_in < run_.cut_index + 8 || !(amp > 0)) return false;
   // The coast's last reading before the standstill, and the first sample that held it.
@@ -1160,8 +1185,13 @@ bool RunDetector::signal_lost(std::size_t i, std::size_t first_in, double z, dou
   while (held > run_.cut_index && v(held - 1) == v(last)) --held;
   // The most friction lets the reading fall in one sample: the coast's slope over the second
   // before the held value, per period.
-  WindowFit f{1.0};
-  reset_window(f, run_.cut_index, held);
+  std::size_t from = held;  // the second before the held value, found from its end
+  while (from > run_.cut_index && t(held) - t(from - 1) <= 1.0) --from;
+  WindowFit f = window_over(ring_.get(), mask_, 1.0, from, held);
+  if (f.n < 5) return false;  // too few samples to know how fast friction lets it fall
+  // A sensor that gives up reads zero (the motor's, when the lead-in showed it) after it.
+  const double zero = std::isfinite(lead_in_zero_) ? lead_in_zero_ : 0.0;
+  if (std::abs(z - zero) > 0.05 * amp) return false;
   const double period = t(first_in) - t(last);
   const double fall = f.n >= 5 ? std::max(-f.slope(), 0.0) * period : 0.0;
   const double drop = v(last) - z;
@@ -1173,20 +1203,18 @@ bool RunDetector::signal_lost(std::size_t i, std::size_t first_in, double z, dou
   const bool long_hold = held_for * fall > std::max(2.0 * coast_step_, 3.0 * f.resid_sd());
   const bool collapse = big_drop && (long_hold || drop > 30.0 * fall);
   if (!collapse) return false;
-  const std::size_t from = held;
-  const double level = v(from);
+  const double level = v(held);
   run_note_severity_ = Diagnostic::Severity::warning;
-  close_unstopped(from + 1,
+  close_unstopped(held + 1,
                   fmt::format("signal lost below {:g} at {}: {} where friction lets it fall about {:.2g} a sample; a "
                               "sensor that gives up at low speed (per-revolution pulses, an encoder, a display)? "
                               "Fitted up to there, as never stopped",
-                              level, fmt_s(t(from)),
+                              level, fmt_s(t(held)),
                               fmt::format("the reading fell from {:g} to {:g} in one sample", v(last), z), fall),
                   Run::End::signal_lost);
   to_idle(i + 1, true);
-  // No new run until the reading rises above what the sensor last showed.
-  need_rise_ = true;
-  rise_level_ = std::max(level, z) + std::max(0.1 * std::abs(v0_), 8.0 * coast_sd_);
+  // No new run until the reading rises above what the sensor last showed (or after a standstill).
+  block_until_rise(std::max(level, z));
   return true;
 }
 
@@ -1283,11 +1311,7 @@ void RunDetector::close_unstopped(std::size_t end, const std::string& why, Run::
 // take the times as given (a note). A device clock that jumped while the readings went on
 // leaves the reading where it was: the fit's times are then wrong by the jump, and so is its
 // friction (a warning). Said once per run, for the longest gap.
-void RunDetector::warn_of_gap_in_coast(int number, std::size_t from, std::size_t to, double period_s) {
-  std::size_t at = 0;
-  double longest = 0;
-  for (std::size_t k = from + 1; k < to; ++k)
-    if (t(k) - t(k - 1) > longest) longest = t(k) - t(k - 1), at = k;
+void RunDetector::warn_of_gap_in_coast(int number, std::size_t from, std::size_t at, double longest, double period_s) {
   if (at == 0 || !(longest > std::max(1.0, 25.0 * period_s))) return;
   WindowFit before{1.0};  // the coast's slope over the second before the gap
   reset_window(before, from, at);
@@ -1304,22 +1328,78 @@ void RunDetector::warn_of_gap_in_coast(int number, std::size_t from, std::size_t
               fmt::format("{}: the reading fell across it as the coast would, taken as samples lost", gap));
 }
 
-void RunDetector::find_outliers(Run& r, std::size_t coast_end) {
-  // A single sample far off the line through its two neighbours, which agree with each other: a
-  // dropout (a loose wire reads 0) or a glitch (a missed pulse halves a speed), not the motor,
-  // which cannot leave its course for one sample and come back.
+void RunDetector::scan_coast(Run& r, std::size_t coast_end) {
+  // One pass over the coast for its longest silence and its outliers. An outlier is a single
+  // sample far off its two neighbours' midpoint, which agree with each other (|b - a| well
+  // below the offset, so the time interpolation differs little from the midpoint): a dropout
+  // (a loose wire reads 0) or a glitch (a missed pulse halves a speed), not the motor, which
+  // cannot leave its course for one sample and come back.
+  std::size_t gap_at = 0;
+  double longest = 0;
+  const double said = std::max(1.0, 25.0 * r.period_s);  // a shorter silence is not said: not looked for
   const double floor = std::max(10.0 * coast_sd_, 5.0 * coast_step_);
+  const Sample* ring = ring_.get();
   std::string where;
   std::size_t shown = 0;
-  for (std::size_t k = r.cut_index + 1; k + 1 < coast_end; ++k) {
-    const double a = v(k - 1), b = v(k + 1), ta = t(k - 1), tb = t(k + 1);
-    const double expected = tb > ta ? a + (b - a) * (t(k) - ta) / (tb - ta) : 0.5 * (a + b);
-    const double off = std::abs(v(k) - expected);
-    if (off > floor && off > 0.1 * std::abs(expected) && std::abs(b - a) < 0.5 * off) [[unlikely]] {
+  const auto outlier = [&](std::size_t k, double a, double c, double b, double tk) {
+    const double expected = 0.5 * (a + b), off = std::abs(c - expected);
+    if (off > floor && off > 0.1 * std::abs(expected) && std::abs(b - a) < 0.5 * off) {
       r.outliers.push_back(k);
-      if (shown++ < 3) where += fmt::format("{}{} at {} (expected {:.3g})", shown > 1 ? ", " : "", v(k), fmt_s(t(k)), expected);
+      if (shown++ < 3) where += fmt::format("{}{} at {} (expected {:.3g})", shown > 1 ? ", " : "", c, fmt_s(tk), expected);
     }
+  };
+  // Samples k of [cut + 1, coast_end - 1), over the ring in stretches whose triples (k - 1, k,
+  // k + 1) do not wrap, each scanned first without a branch for any sample off by more than the
+  // floor (the usual answer: none).
+  std::size_t k = r.cut_index + 1;
+  while (k + 1 < coast_end) {
+    const std::size_t at = (k - 1) & mask_;
+    const std::size_t n = std::min(coast_end - 1 - k, ring_size() - 2 - std::min(at, ring_size() - 2));
+    if (n == 0) {  // the triple wraps: one sample the slow way
+      if (t(k) - t(k - 1) > std::max(longest, said)) longest = t(k) - t(k - 1), gap_at = k;
+      outlier(k, v(k - 1), v(k), v(k + 1), t(k));
+      ++k;
+      continue;
+    }
+    const Sample* p = ring + at;
+    double widest = 0;  // the stretch's longest period (its place found only if it matters)
+    bool any = false;
+    std::size_t j = 0;
+#if defined(__SSE2__)  // elsewhere (arm64 benches) the plain loop below does them all
+    // Two samples per step in SSE2 lanes: each Sample is one (t, v) register; the periods
+    // t(k) - t(k-1) and the offsets from the neighbours' midpoint are the plain loop's.
+    {
+      const __m128d half = _mm_set1_pd(0.5), fl = _mm_set1_pd(floor), sign = _mm_set1_pd(-0.0);
+      __m128d wmax = _mm_setzero_pd(), over = _mm_setzero_pd();
+      __m128d x0 = _mm_loadu_pd(&p[0].t), x1 = _mm_loadu_pd(&p[1].t);
+      for (; j + 2 < n; j += 2) {  // reads p[j + 3]: j + 3 <= n + 1, within the stretch
+        const __m128d x2 = _mm_loadu_pd(&p[j + 2].t), x3 = _mm_loadu_pd(&p[j + 3].t);
+        wmax = _mm_max_pd(wmax, _mm_sub_pd(_mm_unpacklo_pd(x1, x2), _mm_unpacklo_pd(x0, x1)));
+        const __m128d a = _mm_unpackhi_pd(x0, x1), c = _mm_unpackhi_pd(x1, x2), b = _mm_unpackhi_pd(x2, x3);
+        const __m128d off = _mm_andnot_pd(sign, _mm_sub_pd(c, _mm_mul_pd(half, _mm_add_pd(a, b))));
+        over = _mm_or_pd(over, _mm_cmpgt_pd(off, fl));
+        x0 = x2, x1 = x3;
+      }
+      alignas(16) double w[2];
+      _mm_store_pd(w, wmax);
+      widest = std::max(w[0], w[1]);
+      any = _mm_movemask_pd(over) != 0;
+    }
+#endif
+    for (; j < n; ++j) {
+      widest = std::max(widest, p[j + 1].t - p[j].t);
+      any |= std::abs(p[j + 1].v - 0.5 * (p[j].v + p[j + 2].v)) > floor;
+    }
+    if (widest > std::max(longest, said)) [[unlikely]]
+      for (std::size_t m = 0; m < n; ++m)
+        if (p[m + 1].t - p[m].t > std::max(longest, said)) longest = p[m + 1].t - p[m].t, gap_at = k + m;
+    if (any) [[unlikely]]
+      for (std::size_t m = 0; m < n; ++m) outlier(k + m, p[m].v, p[m + 1].v, p[m + 2].v, p[m + 1].t);
+    k += n;
   }
+  if (k < coast_end && k > r.cut_index && t(k) - t(k - 1) > std::max(longest, said))
+    longest = t(k) - t(k - 1), gap_at = k;
+  warn_of_gap_in_coast(r.number, r.cut_index, gap_at, longest, r.period_s);
   if (r.outliers.empty()) return;
   emit_diag(Diagnostic::Severity::warning,
             fmt::format("run {}: {} single-sample outlier(s) left out of the fit (dropouts or glitches): {}{}", r.number,
@@ -1373,8 +1453,7 @@ void RunDetector::complete_run(std::size_t end) {
   } else {
     e.kind = RunEvent::Kind::complete;
     e.run.number = ++accepted_;
-    warn_of_gap_in_coast(e.run.number, r.cut_index, coast_end, r.period_s);
-    find_outliers(e.run, coast_end);
+    scan_coast(e.run, coast_end);
     if (!run_note_.empty()) {
       e.has_diagnostic = true;
       e.diagnostic = {run_note_severity_, source_, 0, fmt::format("run {}: {}", e.run.number, run_note_)};

@@ -150,8 +150,9 @@ class RunDetector {
   void reset_window(WindowFit& w, std::size_t lo, std::size_t end);
   double duration(const WindowFit& w) const;
   void trim_idle();
-  void idle_step(std::size_t i, Sample s);
-  inline void coast_step(std::size_t i, Sample s);
+  // prev_t: the time of the sample before s (-inf at a stream's start).
+  void idle_step(std::size_t i, Sample s, double prev_t);
+  inline void coast_step(std::size_t i, Sample s, double prev_t);
   // push_many's loop over samples [k, n) while coasting: push() for each, on local copies of the
   // state it touches, up to the first sample that decides something (taken) or that push()
   // alone handles (not taken). Returns the index of the first sample it did not take.
@@ -177,8 +178,7 @@ class RunDetector {
     enum What { go_on, too_long, power_back, level } what = go_on;
     double mu = 0, sxx = 0, e = 0;  // level: the hold window's mean, Sxx and residual sd
   };
-  inline CoastVerdict coast_verdict(std::size_t i, Sample s, double prev_t, const WindowFit& h, double& level_min,
-                                    int& rising,
+  inline CoastVerdict coast_verdict(std::size_t i, Sample s, const WindowFit& h, double& level_min, int& rising,
                                     const CoastLimits& c);
   void act_on(const CoastVerdict& v, std::size_t i, bool at_end);
   inline void track_repeats(std::size_t i, double value, std::size_t& same_start, double& last_v);
@@ -231,9 +231,11 @@ class RunDetector {
   void tail_ends_by_time(std::size_t upto);
   void close_unstopped(std::size_t end, const std::string& why, Run::End reason);
   void complete_run(std::size_t end);
-  // Single samples in r's coast [cut, coast_end) that are not the motor's: into r.outliers, with a warning.
-  void find_outliers(Run& r, std::size_t coast_end);
-  void warn_of_gap_in_coast(int number, std::size_t from, std::size_t to, double period_s);
+  // r's coast [cut, coast_end) in one pass: its longest silence (said by warn_of_gap_in_coast)
+  // and the single samples that are not the motor's (into r.outliers, with a warning).
+  void scan_coast(Run& r, std::size_t coast_end);
+  // The longest silence in a coast from sample from, before sample at (0: none), longest seconds.
+  void warn_of_gap_in_coast(int number, std::size_t from, std::size_t at, double longest, double period_s);
   std::string gap_before(std::size_t i) const;  // "no samples for … s mid-coast (from … to …)", before sample i
   void to_idle(std::size_t lo, bool need_quiet);
   void emit_diag(Diagnostic::Severity sev, std::string msg);
@@ -263,6 +265,10 @@ class RunDetector {
   bool need_quiet_ = false;     // after a closed coast: no new run until the decline pauses
   bool need_rise_ = false;      // after a stop: a new coast must start above rise_level_
   double rise_level_ = 0;
+  double block_band_ = 0;  // > 0: rise_level_ follows the lowest reading since, plus this
+  // After a coast closed before its stop at reading level: no new run until the reading rises
+  // well above it, or above the lowest it shows since (a new spin-up from rest).
+  void block_until_rise(double level);
   double last_t_ = -std::numeric_limits<double>::infinity();  // -inf: no sample since the (re)start
   double last_v_ = std::numeric_limits<double>::quiet_NaN();  // the last sample's value; NaN: none since (re)start
   std::size_t non_finite_ = 0;
