@@ -132,6 +132,16 @@ inline std::vector<Case> make_cases(int per_pattern) {
       s.spin_up_s = 2.0;
       cases.push_back(single("per-rev sensor", s));
     }
+    {  // a run, then a nudge: a small, short coast that is no run
+      Case c = single("nudge after a run", base);
+      SyntheticRunSpec s = base;
+      s.seed = base.seed + 99;
+      s.e0_v = base.e0_v * (0.04 + 0.01 * (k % 4));  // a 1-2 s nudge beside a 15-30 s coast
+      s.lead_in = LeadIn::zeros;
+      s.t0_ms = c.rec.t_s.back() * 1000.0 + 20;
+      append(c.rec, make_synthetic_run(s));
+      cases.push_back(std::move(c));
+    }
     {  // an Arduino reset mid-coast: the device clock restarts, the coast goes on
       SyntheticRunSpec s = base;
       Case c = single("reset mid-coast", s);
@@ -201,6 +211,7 @@ struct PatternScore {
   int false_stops = 0;      // stopped, where the motor never stopped within the recording
   int partial_wrong = 0;    // a coast whose start was not recorded, given a lead-in all the same
   int false_lost = 0;       // "signal lost" where the motor was seen to stop
+  int missed_lost = 0;      // a stop where the sensor gave up
   int bad_samples = 0, rejected = 0, wrongly_rejected = 0;  // dropouts/glitches made, left out; good samples left out
   std::vector<double> cut_err, end_err;  // |detected - truth| in sample periods
   static double quantile(std::vector<double> x, double q) {
@@ -265,6 +276,7 @@ inline void score_case(const Case& c, const Segmentation& seg, PatternScore& ps)
       ++ps.false_stops;
     if (tr.partial && r.lead_in != "none") ++ps.partial_wrong;
     if (tr.end == TruthRun::End::stopped && r.end == Run::End::signal_lost) ++ps.false_lost;
+    if (tr.end == TruthRun::End::signal_lost && r.end != Run::End::signal_lost) ++ps.missed_lost;
   }
   ps.bad_samples += int(c.glitch_t_s.size());
   for (const Run& r : seg.runs)
@@ -288,14 +300,14 @@ inline std::map<std::string, PatternScore> score_all(const std::vector<Case>& ca
 }
 
 inline std::string score_table(const std::map<std::string, PatternScore>& scores) {
-  std::string out = fmt::format("{:<24} {:>4} {:>5} {:>6} {:>8} {:>9} {:>9} {:>9} {:>9} {:>6} {:>7} {:>6} {:>8}\n", "pattern",
+  std::string out = fmt::format("{:<24} {:>4} {:>5} {:>6} {:>8} {:>9} {:>9} {:>9} {:>9} {:>6} {:>7} {:>6} {:>6} {:>8}\n", "pattern",
                                 "recs", "runs", "missed", "invented", "cut p50", "cut p90", "end p50", "end p90",
-                                "f.stop", "partial", "f.lost", "outliers");
+                                "f.stop", "partial", "f.lost", "m.lost", "outliers");
   for (const auto& [name, s] : scores)
-    out += fmt::format("{:<24} {:>4} {:>5} {:>6} {:>8} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f} {:>6} {:>7} {:>6} {:>8}\n", name,
+    out += fmt::format("{:<24} {:>4} {:>5} {:>6} {:>8} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f} {:>6} {:>7} {:>6} {:>6} {:>8}\n", name,
                        s.recordings, s.truth_runs, s.missed, s.invented, PatternScore::quantile(s.cut_err, 0.5),
                        PatternScore::quantile(s.cut_err, 0.9), PatternScore::quantile(s.end_err, 0.5),
-                       PatternScore::quantile(s.end_err, 0.9), s.false_stops, s.partial_wrong, s.false_lost,
+                       PatternScore::quantile(s.end_err, 0.9), s.false_stops, s.partial_wrong, s.false_lost, s.missed_lost,
                        fmt::format("{}/{}+{}", s.rejected, s.bad_samples, s.wrongly_rejected));
   return out;
 }

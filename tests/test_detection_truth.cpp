@@ -27,6 +27,7 @@ constexpr Limits limits[] = {
     {"per-rev sensor", 3.0, 40.0}, {"reset mid-coast", 1.0, 1.0},
     {"slow viscous", 1.0, 1.0}, {"starts mid-coast", 1.0, 6.0},
     {"uneven sampling", 1.0, 6.0}, {"three runs", 1.0, 6.0},
+    {"nudge after a run", 1.0, 6.0},
 };
 
 TEST(DetectionTruth, ScoresEachPattern) {
@@ -45,6 +46,7 @@ TEST(DetectionTruth, ScoresEachPattern) {
     EXPECT_EQ(s.false_stops, 0);
     EXPECT_EQ(s.partial_wrong, 0);
     EXPECT_EQ(s.false_lost, 0);
+    EXPECT_LE(s.missed_lost, s.truth_runs / 10);
     EXPECT_GE(s.rejected, s.bad_samples * 9 / 10);
     EXPECT_EQ(s.wrongly_rejected, 0);
   }

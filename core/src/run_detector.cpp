@@ -434,7 +434,12 @@ std::size_t RunDetector::coast_loop(const double* t_s, const double* value, std:
 
 void RunDetector::clock_restart() {
   restarted_mid_coast_ = state_ == State::coasting;
-  if (state_ == State::coasting) close_unstopped(next_index_, "the device clock restarted mid-coast", Run::End::clock_restart);
+  if (state_ == State::coasting) {
+    run_note_severity_ = Diagnostic::Severity::warning;  // the run is cut short: it changes the result
+    close_unstopped(next_index_,
+                    "the device clock restarted mid-coast (an Arduino reset?): the coast is cut short there",
+                    Run::End::clock_restart);
+  }
   else if (state_ == State::tail) complete_run(next_index_);
   base_ = next_index_;
   time_cursor_ = next_index_;
@@ -1179,6 +1184,7 @@ void RunDetector::block_until_rise(double level) {
 
 bool RunDetector::signal_lost(std::size_t i, std::size_t first_in, double z, double amp) {
   if (first_in < run_.cut_index + 8 || !(amp > 0)) return false;
+  const double zero = std::isfinite(lead_in_zero_) ? lead_in_zero_ : 0.0;
   // The coast's last reading before the standstill, and the first sample that held it.
   const std::size_t last = first_in - 1;
   std::size_t held = last;
@@ -1190,7 +1196,6 @@ bool RunDetector::signal_lost(std::size_t i, std::size_t first_in, double z, dou
   WindowFit f = window_over(ring_.get(), mask_, 1.0, from, held);
   if (f.n < 5) return false;  // too few samples to know how fast friction lets it fall
   // A sensor that gives up reads zero (the motor's, when the lead-in showed it) after it.
-  const double zero = std::isfinite(lead_in_zero_) ? lead_in_zero_ : 0.0;
   if (std::abs(z - zero) > 0.05 * amp) return false;
   const double period = t(first_in) - t(last);
   const double fall = f.n >= 5 ? std::max(-f.slope(), 0.0) * period : 0.0;
@@ -1411,6 +1416,23 @@ std::string RunDetector::gap_before(std::size_t i) const {
                      fmt_s(t(i)));
 }
 
+std::string RunDetector::fragment_reason(const Run& r, std::size_t coast_end, double coast_s) const {
+  // How far the reading fell in this coast, against what the reading can resolve and against the
+  // runs already found in this stream (a nudge, a few samples at a crawl, a piece of a coast).
+  const double amp = v0_ - (r.stopped ? r.zero_level : v(coast_end - 1));
+  if (amp < 3.0 * coast_step_)
+    return fmt::format("it falls {:.3g}, under 3 of the reading's steps ({:.2g})", amp, coast_step_);
+  // Beside the runs before it, only a coast seen to stop is judged: one cut short (end of data, a
+  // gap) may have fallen little so far for reasons that are no fault of its own.
+  if (accepted_ == 0 || !r.stopped) return {};
+  if (amp < 0.03 * largest_amp_)
+    return fmt::format("it falls {:.3g}, under 3 % of the largest run's {:.3g}", amp, largest_amp_);
+  if (coast_s < 0.25 * longest_coast_s_ && amp < 0.1 * largest_amp_)
+    return fmt::format("{:.3g} s and a fall of {:.3g}, beside runs of up to {:.3g} s and {:.3g}", coast_s, amp,
+                       longest_coast_s_, largest_amp_);
+  return {};
+}
+
 void RunDetector::complete_run(std::size_t end) {
   Run r = run_;
   end = std::max(end, r.cut_index);
@@ -1450,9 +1472,16 @@ void RunDetector::complete_run(std::size_t end) {
     e.diagnostic = {Diagnostic::Severity::note, source_, 0,
                     fmt::format("coast cut at {} ignored: {} and {} samples (need {:g} s and {})", fmt_s(r.t_cut_s),
                                 fmt_s(coast_s), coast_n, opt_.min_coast_s, opt_.min_samples)};
+  } else if (const std::string why = fragment_reason(r, coast_end, coast_s); !why.empty()) {
+    e.kind = RunEvent::Kind::ignored;
+    e.has_diagnostic = true;
+    e.diagnostic = {Diagnostic::Severity::note, source_, 0,
+                    fmt::format("coast cut at {} ignored as a fragment, not a run: {}", fmt_s(r.t_cut_s), why)};
   } else {
     e.kind = RunEvent::Kind::complete;
     e.run.number = ++accepted_;
+    largest_amp_ = std::max(largest_amp_, v0_ - (r.stopped ? r.zero_level : v(coast_end - 1)));
+    longest_coast_s_ = std::max(longest_coast_s_, coast_s);
     scan_coast(e.run, coast_end);
     if (!run_note_.empty()) {
       e.has_diagnostic = true;

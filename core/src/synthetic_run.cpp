@@ -47,7 +47,7 @@ SyntheticRun make_synthetic_run(const SyntheticRunSpec& s) {
   const double gap_from_ms = out.t_cut_ms + s.gap_from_s * 1000.0, gap_to_ms = gap_from_ms + s.gap_s * 1000.0;
   // A per-revolution sensor: the speed measured from the last two pulses, held in between.
   const double pulse_angle = s.pulses_per_rev > 0 ? 2.0 * M_PI / s.pulses_per_rev : 0.0;
-  double prev_angle = 0, prev_tau = 0, last_pulse = 0, held_omega = out.omega0;
+  double prev_angle = 0, prev_tau = 0, last_pulse = 0, held_omega = out.omega0, frozen_omega = 0;
   bool lost = false;
 
   const int adc_max = s.adc_bits > 0 ? (1 << s.adc_bits) - 1 : 0;
@@ -90,12 +90,14 @@ SyntheticRun make_synthetic_run(const SyntheticRunSpec& s) {
           last_pulse = t_pulse;
         }
         prev_angle = a, prev_tau = tau;
-        // Past the timeout the sensor gives up for good (a display's lowest speed): it reads 0.
-        if (s.pulse_timeout_s > 0 && !lost && tau - last_pulse > s.pulse_timeout_s) {
+        // Past the timeout the sensor gives up for good (a display's lowest speed): it reads 0, or
+        // (a negative timeout) freezes on its last value, as some rpm counters do.
+        if (s.pulse_timeout_s != 0 && !lost && tau - last_pulse > std::abs(s.pulse_timeout_s)) {
           out.t_signal_lost_ms = out.t_cut_ms + 1000.0 * last_pulse;
           lost = true;
+          frozen_omega = held_omega;
         }
-        w = lost ? 0.0 : held_omega;
+        w = lost ? (s.pulse_timeout_s < 0 ? frozen_omega : 0.0) : held_omega;
       }
       const double ripple = s.ripple * std::sin(s.ripple_per_rev * sim.angle());
       // A per-revolution sensor's reading is a count, not an analog voltage: no noise on it.

@@ -35,7 +35,7 @@ bool VirtualBenchOptions::is_valid(std::string* why) const {
       {"viscous", f.viscous},   {"coulomb", f.coulomb},       {"stribeck-static", f.stribeck_static},
       {"stribeck-speed", f.stribeck_speed}, {"windage", f.windage}, {"noise", spec.noise_v},
       {"ripple", spec.ripple},  {"lead-in-s", spec.lead_in_s}, {"tail-s", spec.tail_s},
-      {"start-s", spec.start_s}, {"gap-s", spec.gap_s}, {"pulse-timeout-s", spec.pulse_timeout_s}};
+      {"start-s", spec.start_s}, {"gap-s", spec.gap_s}};
   for (const auto& [name, v] : at_least_zero)
     if (!(std::isfinite(v) && v >= 0)) return fail(fmt::format("--{} {} must be a finite number ≥ 0", name, v));
   const std::pair<const char*, double> above_zero[] = {{"e0", spec.e0_v},
@@ -54,6 +54,8 @@ bool VirtualBenchOptions::is_valid(std::string* why) const {
     if (!(std::isfinite(r) && r >= 0)) return fail(fmt::format("--reset-at {} must be a finite time ≥ 0", r));
   if (f.stribeck_static > 0 && !(f.stribeck_speed > 0))
     return fail("--stribeck-static needs --stribeck-speed > 0 (the speed scale of the Stribeck dip)");
+  if (!std::isfinite(spec.pulse_timeout_s))
+    return fail(fmt::format("--pulse-timeout-s {} must be a finite number", spec.pulse_timeout_s));
   if (!std::isfinite(spec.gap_from_s)) return fail(fmt::format("--gap-from-s {} must be a finite number", spec.gap_from_s));
   if (spec.lead_in == LeadIn::spin_up && !(std::isfinite(spec.spin_up_s) && spec.spin_up_s > 0 && spec.spin_up_s <= spec.lead_in_s))
     return fail(fmt::format("--spin-up-s {} must be > 0 and at most --lead-in-s ({})", spec.spin_up_s, spec.lead_in_s));

@@ -231,6 +231,10 @@ class RunDetector {
   void tail_ends_by_time(std::size_t upto);
   void close_unstopped(std::size_t end, const std::string& why, Run::End reason);
   void complete_run(std::size_t end);
+  // Why the finished coast r (its coast up to coast_end, coast_s long) is a fragment and not a
+  // run: too small for the reading's resolution, or small and short beside the runs found
+  // before it in this stream; empty when it is a run.
+  std::string fragment_reason(const Run& r, std::size_t coast_end, double coast_s) const;
   // r's coast [cut, coast_end) in one pass: its longest silence (said by warn_of_gap_in_coast)
   // and the single samples that are not the motor's (into r.outliers, with a warning).
   void scan_coast(Run& r, std::size_t coast_end);
@@ -276,6 +280,7 @@ class RunDetector {
   std::size_t plateau_start_ = 0, plateau_end_ = 0;  // last long positive plateau (clipping?)
   bool have_plateau_ = false;
   int accepted_ = 0;
+  double largest_amp_ = 0, longest_coast_s_ = 0;  // of the runs accepted so far (fragments are judged by them)
 
   WindowFit short_{0.25}, long_{1.0}, vlong_{4.0};  // confirm a decline
   WindowFit hold_{1.0}, hold_long_{3.0};            // confirm a standstill

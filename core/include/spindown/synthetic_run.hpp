@@ -49,7 +49,8 @@ struct SyntheticRunSpec {
   double gap_s = 0.0;
   int glitches = 0;            // coasting samples replaced by a dropout (0) or a glitch (half the value)
   int pulses_per_rev = 0;      // > 0: a per-revolution sensor: the speed is measured once per pulse and held
-  double pulse_timeout_s = 0;  // per-revolution sensor: reads 0 after this long without a pulse (0: holds)
+  double pulse_timeout_s = 0;  // per-revolution sensor: reads 0 after this long without a pulse; negative:
+                               // freezes on its last value after -pulse_timeout_s (0: holds between pulses)
 };
 
 struct SyntheticRun {
@@ -62,7 +63,8 @@ struct SyntheticRun {
   bool stopped = false;
   // Truth for run finding, in the recording's own samples.
   std::vector<std::size_t> glitch_index;  // samples replaced by a dropout or glitch
-  double t_signal_lost_ms = -1;  // per-revolution sensor: device time of its last pulse before it gave up (-1: never)
+  double t_signal_lost_ms = -1;  // per-revolution sensor: device time of its last pulse before it gave up
+                                 // (read 0) or froze on its last value (-1: never)
 };
 
 SyntheticRun make_synthetic_run(const SyntheticRunSpec& spec);

@@ -36,7 +36,7 @@ inline void add_virtual_bench_options(CLI::App& app, VirtualBenchOptions& o, Vir
   app.add_option("--gap-s", sp.gap_s, "seconds the recording pauses (no samples)");
   app.add_option("--glitches", sp.glitches, "single bad coasting samples: dropouts (0) and glitches (half)");
   app.add_option("--pulses-per-rev", sp.pulses_per_rev, "a per-revolution speed sensor: pulses per turn (0: none)");
-  app.add_option("--pulse-timeout-s", sp.pulse_timeout_s, "per-revolution sensor: reads 0 after this long without a pulse (0: holds)");
+  app.add_option("--pulse-timeout-s", sp.pulse_timeout_s, "per-revolution sensor: reads 0 after this long without a pulse (< 0: freezes on its last value)");
   app.add_option("--lead-in-s", sp.lead_in_s, "seconds recorded before the cut");
   app.add_option("--tail-s", sp.tail_s, "seconds recorded after the stop");
   app.add_option("--max-coast-s", sp.max_coast_s, "longest coast simulated");
