@@ -2,7 +2,8 @@
 # `spindown simulate`: a known-answer recording. fit finds the friction it was made with (within
 # its standard errors), explain names an effect it was given, the truth file says what was
 # simulated, the same seed gives the same bytes on stdout and in a file, faults show up as
-# fit's warnings, and an existing file is never overwritten.
+# fit's warnings, other rigs' recordings are found right, and an existing file is never
+# overwritten.
 set -euo pipefail
 bin="${SPINDOWN_BIN_DIR:?}/spindown"
 work=$(mktemp -d)
@@ -40,6 +41,30 @@ timeout 60 "$bin" simulate -o "$work/garbage.tsv" --garbage-every 100 --seed 6
 timeout 60 "$bin" fit "$work/garbage.tsv" > "$work/garbage.out" 2> "$work/garbage.err"
 grep -q "warning" "$work/garbage.err" || fail "garbage lines gave no warning"
 grep -q "best: combined" "$work/garbage.out" || fail "the run with garbage lines was not fitted"
+
+# Other rigs' recordings, as a user meets them: a hand spin's cut is the peak, a recording that
+# starts mid-coast is partial and said so, dropouts are left out with a warning, a sensor that
+# gives up is "signal lost", and every run says where its window ends and why (text and JSON).
+timeout 60 "$bin" simulate -o "$work/hand.tsv" --truth "$work/hand.json" --lead-in spin-up --spin-up-s 0.3 \
+  --glitches 4 --seed 7
+timeout 60 "$bin" fit --json "$work/hand.tsv" > "$work/hand.fit.json" 2> "$work/hand.err"
+grep -q "4 single-sample outlier" "$work/hand.err" || fail "dropouts not said: $(cat "$work/hand.err")"
+python3 - "$work/hand.fit.json" "$work/hand.json" <<'PY' || fail "hand spin: cut not at the peak"
+import json, sys
+fit, truth = (json.load(open(p)) for p in sys.argv[1:3])
+run = fit["files"][0]["runs"][0]
+cut = truth["runs"][0]["cut_device_us"] / 1e6  # the cut on the device's clock, as the file has it
+assert run["lead_in"] == "spin-up" and abs(run["t_cut_s"] - cut) < 0.05, (run["lead_in"], run["t_cut_s"], cut)
+assert run["end"] == "stopped" and run["t_end_s"] > run["t_stop_s"], (run["end"], run["t_end_s"])
+PY
+timeout 60 "$bin" simulate -o "$work/mid.tsv" --start-s 4 --seed 8
+timeout 60 "$bin" fit "$work/mid.tsv" > "$work/mid.out" 2> "$work/mid.err"
+grep -q "lead-in: none" "$work/mid.out" || fail "a recording that starts mid-coast: $(head -3 "$work/mid.out")"
+grep -q "starts mid-coast" "$work/mid.err" || fail "a partial coast without a warning"
+timeout 60 "$bin" simulate -o "$work/lost.tsv" --pulses-per-rev 1 --pulse-timeout-s 0.5 --seed 3
+timeout 60 "$bin" fit "$work/lost.tsv" > "$work/lost.out" 2> "$work/lost.err"
+grep -q "(signal lost)" "$work/lost.out" || fail "a sensor that gave up: $(head -3 "$work/lost.out")"
+grep -q "signal lost below" "$work/lost.err" || fail "signal lost without a warning"
 
 # An existing file is refused (exit 2), and left as it was; bad physics is bad usage.
 code=0
