@@ -142,6 +142,23 @@ inline std::vector<Case> make_cases(int per_pattern) {
       append(c.rec, make_synthetic_run(s));
       cases.push_back(std::move(c));
     }
+    {  // a nudge, then the real spin: the nudge came first, so it stays a run, with a warning
+      SyntheticRunSpec s = base;
+      s.seed = base.seed + 77;
+      s.e0_v = base.e0_v * (0.04 + 0.01 * (k % 4));
+      s.lead_in_s = 1.0;
+      s.tail_s = 1.0;
+      const SyntheticRun nudge = make_synthetic_run(s);
+      Case c;
+      c.pattern = "nudge before a run";
+      append(c.rec, nudge);
+      SyntheticRunSpec real = base;
+      real.t0_ms = nudge.t_ms.back() + 20;
+      const SyntheticRun sim = make_synthetic_run(real);
+      append(c.rec, sim);
+      c.runs.push_back(truth_of(sim));
+      cases.push_back(std::move(c));
+    }
     {  // an Arduino reset mid-coast: the device clock restarts, the coast goes on
       SyntheticRunSpec s = base;
       Case c = single("reset mid-coast", s);
@@ -210,6 +227,7 @@ struct PatternScore {
   int recordings = 0, truth_runs = 0, found = 0, missed = 0, invented = 0;
   int false_stops = 0;      // stopped, where the motor never stopped within the recording
   int partial_wrong = 0;    // a coast whose start was not recorded, given a lead-in all the same
+  int invented_said = 0;    // of the invented runs, those a warning calls a fragment
   int false_lost = 0;       // "signal lost" where the motor was seen to stop
   int missed_lost = 0;      // a stop where the sensor gave up
   int bad_samples = 0, rejected = 0, wrongly_rejected = 0;  // dropouts/glitches made, left out; good samples left out
@@ -284,7 +302,17 @@ inline void score_case(const Case& c, const Segmentation& seg, PatternScore& ps)
       const bool bad = std::find(c.glitch_t_s.begin(), c.glitch_t_s.end(), c.rec.t_s[k]) != c.glitch_t_s.end();
       ++(bad ? ps.rejected : ps.wrongly_rejected);
     }
-  for (bool u : used) ps.invented += !u;
+  for (std::size_t j = 0; j < used.size(); ++j) {
+    if (used[j]) continue;
+    ++ps.invented;
+    const std::string said = fmt::format("run {} (cut at", seg.runs[j].number);
+    for (const Diagnostic& d : seg.diagnostics)
+      if (d.severity == Diagnostic::Severity::warning && d.message.rfind(said, 0) == 0 &&
+          d.message.find("looks like a fragment") != std::string::npos) {
+        ++ps.invented_said;
+        break;
+      }
+  }
 }
 
 // Scores every case; prints each one of the pattern named by SPINDOWN_TRUTH_DETAIL (if set).
@@ -300,12 +328,15 @@ inline std::map<std::string, PatternScore> score_all(const std::vector<Case>& ca
 }
 
 inline std::string score_table(const std::map<std::string, PatternScore>& scores) {
-  std::string out = fmt::format("{:<24} {:>4} {:>5} {:>6} {:>8} {:>9} {:>9} {:>9} {:>9} {:>6} {:>7} {:>6} {:>6} {:>8}\n", "pattern",
+  std::string out = fmt::format("{:<24} {:>4} {:>5} {:>6} {:>11} {:>9} {:>9} {:>9} {:>9} {:>6} {:>7} {:>6} {:>6} {:>8}\n", "pattern",
                                 "recs", "runs", "missed", "invented", "cut p50", "cut p90", "end p50", "end p90",
                                 "f.stop", "partial", "f.lost", "m.lost", "outliers");
   for (const auto& [name, s] : scores)
-    out += fmt::format("{:<24} {:>4} {:>5} {:>6} {:>8} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f} {:>6} {:>7} {:>6} {:>6} {:>8}\n", name,
-                       s.recordings, s.truth_runs, s.missed, s.invented, PatternScore::quantile(s.cut_err, 0.5),
+    out += fmt::format("{:<24} {:>4} {:>5} {:>6} {:>11} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f} {:>6} {:>7} {:>6} {:>6} {:>8}\n", name,
+                       s.recordings, s.truth_runs, s.missed,
+                       s.invented_said ? fmt::format("{} ({} said)", s.invented, s.invented_said)
+                                       : fmt::format("{}", s.invented),
+                       PatternScore::quantile(s.cut_err, 0.5),
                        PatternScore::quantile(s.cut_err, 0.9), PatternScore::quantile(s.end_err, 0.5),
                        PatternScore::quantile(s.end_err, 0.9), s.false_stops, s.partial_wrong, s.false_lost, s.missed_lost,
                        fmt::format("{}/{}+{}", s.rejected, s.bad_samples, s.wrongly_rejected));

@@ -1425,12 +1425,74 @@ std::string RunDetector::fragment_reason(const Run& r, std::size_t coast_end, do
   // Beside the runs before it, only a coast seen to stop is judged: one cut short (end of data, a
   // gap) may have fallen little so far for reasons that are no fault of its own.
   if (accepted_ == 0 || !r.stopped) return {};
-  if (amp < 0.03 * largest_amp_)
-    return fmt::format("it falls {:.3g}, under 3 % of the largest run's {:.3g}", amp, largest_amp_);
-  if (coast_s < 0.25 * longest_coast_s_ && amp < 0.1 * largest_amp_)
+  return small_beside(amp, coast_s, largest_amp_, longest_coast_s_);
+}
+
+std::string RunDetector::small_beside(double amp, double coast_s, double largest_amp, double longest_s) {
+  if (amp < 0.03 * largest_amp)
+    return fmt::format("it falls {:.3g}, under 3 % of the largest run's {:.3g}", amp, largest_amp);
+  if (coast_s < 0.25 * longest_s && amp < 0.1 * largest_amp)
     return fmt::format("{:.3g} s and a fall of {:.3g}, beside runs of up to {:.3g} s and {:.3g}", coast_s, amp,
-                       longest_coast_s_, largest_amp_);
+                       longest_s, largest_amp);
   return {};
+}
+
+void RunDetector::warn_of_held_standstill(const Run& r) {
+  // A standstill that reads one value exactly, well above the motor's zero, held far longer than
+  // any value of the coast before it: what a sensor that keeps its last reading shows (an rpm
+  // counter whose pulses stopped). A real offset is reached a reading step at a time, and a
+  // sensor's freeze cannot be told from a stop for sure: said, not decided.
+  if (r.end_index < r.stop_index + 10 || r.stop_index < r.cut_index + 10) return;
+  // The standstill's last value, and where it began (the stop's first samples may still be the
+  // coast's last values).
+  const double z = v(r.end_index - 1);
+  std::size_t held_from = r.end_index - 1;
+  while (held_from > r.cut_index && v(held_from - 1) == z) --held_from;
+  const std::size_t held = r.end_index - held_from;
+  if (held < 10 || 5 * held < 4 * (r.end_index - r.stop_index)) return;  // most of the standstill
+  const double zero = std::isfinite(lead_in_zero_) ? lead_in_zero_ : 0.0;
+  if (!(z - zero > std::max(0.02 * (v0_ - zero), 3.0 * coast_step_))) return;
+  // Reached by a jump of many reading steps (an rpm counter's last update), not by the one step
+  // a coarse reading takes onto a real offset.
+  if (!(v(held_from - 1) - z > 10.0 * coast_step_)) return;
+  std::size_t from = held_from, longest = 1, cur = 1;
+  while (from > r.cut_index && t(held_from) - t(from - 1) <= 2.0) --from;
+  for (std::size_t k = from + 1; k < held_from; ++k) {
+    cur = v(k) == v(k - 1) ? cur + 1 : 1;
+    longest = std::max(longest, cur);
+  }
+  if (held < 5 * longest || held_from < from + 3) return;
+  // The reading's resolution there (the smallest gap between the values it took): a level of a
+  // step or two above zero is a coarse reading's offset, not a frozen one.
+  double* x = scratch(held_from - from);
+  for (std::size_t k = from; k < held_from; ++k) x[k - from] = v(k);
+  std::sort(x, x + (held_from - from));
+  double resolution = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 1; k < held_from - from; ++k)
+    if (x[k] > x[k - 1]) resolution = std::min(resolution, x[k] - x[k - 1]);
+  if (!(z - zero > 3.0 * resolution)) return;
+  emit_diag(Diagnostic::Severity::warning,
+            fmt::format("run {}: the standstill reads exactly {:g} for its last {} samples, {:.1f} % of the reading at "
+                        "the cut, where no value of the coast before it lasted more than {}: a sensor holding its "
+                        "last value? If the motor went on to 0, the zero level and the fits are wrong",
+                        r.number, z, held, 100.0 * (z - zero) / (v0_ - zero), longest));
+}
+
+void RunDetector::warn_of_earlier_fragments(const Run& r, double amp, double coast_s) {
+  // A nudge before the real spin was a run when it came (nothing larger was known): it stays one,
+  // live and offline alike, but the user hears what it looks like now.
+  for (Earlier& e : earlier_) {
+    if (e.warned || !e.stopped) continue;
+    const std::string why = small_beside(e.amp, e.coast_s, amp, coast_s);
+    if (why.empty()) continue;
+    e.warned = true;
+    emit_diag(Diagnostic::Severity::warning,
+              fmt::format("run {} (cut at {}) looks like a fragment beside run {} ({}): a nudge before the real "
+                          "spin? It stays a run, since it came first; leave it out of your results if so",
+                          e.number, fmt_s(e.t_cut_s), r.number, why));
+  }
+  if (earlier_.size() == max_earlier) earlier_.erase(earlier_.begin());
+  earlier_.push_back({r.number, r.t_cut_s, amp, coast_s, r.stopped, false});
 }
 
 void RunDetector::complete_run(std::size_t end) {
@@ -1480,7 +1542,12 @@ void RunDetector::complete_run(std::size_t end) {
   } else {
     e.kind = RunEvent::Kind::complete;
     e.run.number = ++accepted_;
-    largest_amp_ = std::max(largest_amp_, v0_ - (r.stopped ? r.zero_level : v(coast_end - 1)));
+    const double amp = v0_ - (r.stopped ? r.zero_level : v(coast_end - 1));
+    if (r.stopped) {
+      warn_of_earlier_fragments(e.run, amp, coast_s);
+      warn_of_held_standstill(e.run);
+    }
+    largest_amp_ = std::max(largest_amp_, amp);
     longest_coast_s_ = std::max(longest_coast_s_, coast_s);
     scan_coast(e.run, coast_end);
     if (!run_note_.empty()) {

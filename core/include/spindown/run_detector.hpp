@@ -235,6 +235,20 @@ class RunDetector {
   // run: too small for the reading's resolution, or small and short beside the runs found
   // before it in this stream; empty when it is a run.
   std::string fragment_reason(const Run& r, std::size_t coast_end, double coast_s) const;
+  // Why a stopped coast falling amp in coast_s is small beside runs of up to largest_amp and
+  // longest_s; empty when it is not.
+  static std::string small_beside(double amp, double coast_s, double largest_amp, double longest_s);
+  // Runs accepted before r (falling amp in coast_s) that r shows to be fragments: a warning each.
+  void warn_of_earlier_fragments(const Run& r, double amp, double coast_s);
+  // A stopped run whose standstill is one value held far longer than the coast's values: a warning.
+  void warn_of_held_standstill(const Run& r);
+  struct Earlier {
+    int number;
+    double t_cut_s, amp, coast_s;
+    bool stopped, warned;
+  };
+  static constexpr std::size_t max_earlier = 16;  // the last runs remembered for that
+  std::vector<Earlier> earlier_;
   // r's coast [cut, coast_end) in one pass: its longest silence (said by warn_of_gap_in_coast)
   // and the single samples that are not the motor's (into r.outliers, with a warning).
   void scan_coast(Run& r, std::size_t coast_end);
