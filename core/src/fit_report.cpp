@@ -723,10 +723,13 @@ std::string format_run_fit(const RunFit& fit, const ReportOptions& opt) {
   const Run& run = fit.run;
   const std::string unit(quantity_unit(fit.quantity));
   std::string out;
-  out += fmt::format("run {}: cut at t = {:.3f} s", run.number, run.t_cut_s);
+  // A partial coast's first sample is not its cut: the text says so (JSON keeps "t_cut_s").
+  const char* from = run.partial() ? "its first sample" : "the cut";
+  if (run.partial()) out += fmt::format("run {}: coast from t = {:.3f} s (its cut was not recorded)", run.number, run.t_cut_s);
+  else out += fmt::format("run {}: cut at t = {:.3f} s", run.number, run.t_cut_s);
   if (run.stopped && std::isfinite(run.t_stop_s))
-    out += fmt::format(", stopped at t = {:.3f} s ({:.2f} s after the cut), fitted to t = {:.3f} s", run.t_stop_s,
-                       run.t_stop_s - run.t_cut_s, run.t_end_s);
+    out += fmt::format(", stopped at t = {:.3f} s ({:.2f} s after {}), fitted to t = {:.3f} s", run.t_stop_s,
+                       run.t_stop_s - run.t_cut_s, from, run.t_end_s);
   else
     out += fmt::format(", did not stop: fitted to t = {:.3f} s ({})", run.t_end_s, end_name(run.end));
   out += fmt::format(", {} samples", samples_in(run));

@@ -49,10 +49,11 @@ std::string fmt_s(double t) { return fmt::format("{:.3f} s", t); }
 }  // namespace
 
 // A silence inside a coast (from the sample at prev to the one at t, the coast cut at t_cut) that
-// ends it: longer than 2 s (a hundred lost samples at the lab's 20 ms) and than the coast seen
-// before it, so the samples after it would be a coast the fit barely knew the way to.
+// ends it: longer than half a minute and than the coast seen before it, so the samples after it
+// would be a coast the fit barely knew the way to. A shorter one is samples lost (or a clock
+// that jumped), said by warn_of_gap_in_coast, and the coast goes on.
 [[gnu::always_inline]] inline bool long_silence(double prev, double t, double t_cut) {
-  return t - prev > 2.0 && t - prev > prev - t_cut;
+  return t - prev > 30.0 && t - prev > prev - t_cut;
 }
 
 // ---- sliding least-squares line ----------------------------------------------------------
@@ -601,7 +602,12 @@ RunDetector::CutSplit RunDetector::split_at_cut(std::size_t a, std::size_t b, co
     }
     const std::size_t pinned = p - q + 1;
     const double leave = m - v(p + 1);
-    if (q > lower && pinned >= 5 && pinned >= 3 * longest && leave > 0 &&
+    // … and much longer than one step of the reading lasts at the coast's start: a heavy
+    // flywheel's coast holds its first printed value for a second, unclipped.
+    const double slope = w.slope(), step = std::max(reading_step(p + 1, b + 1), leave);
+    const double period = b > p + 1 ? (t(b) - t(p + 1)) / double(b - p - 1) : 0.0;
+    const double step_lasts = slope < 0 && period > 0 && step > 0 ? step / -slope / period : 0.0;
+    if (q > lower && pinned >= 5 && pinned >= 3 * longest && pinned >= 3.0 * step_lasts && leave > 0 &&
         leave <= 0.02 * std::abs(m) + 3.0 * w.resid_sd()) {
       sp.clipped = true;
       sp.pin_first = q;
@@ -937,7 +943,10 @@ void RunDetector::coast_too_long(std::size_t i) {
                                 "after the gap are not in this run",
                                 gap_before(i)),
                     Run::End::gap);
-    to_idle(i, true);
+    to_idle(i, false);
+    // What follows is found afresh: a coast going on after it is partial, from its first sample.
+    resume_index_ = i;
+    resume_pause_s_ = t(i) - t(i - 1);
     return;
   }
   run_note_severity_ = Diagnostic::Severity::warning;
@@ -967,7 +976,9 @@ void RunDetector::standstill_checks(std::size_t i, bool at_end, double mu, doubl
   if (!at_end) {
     const double mean_rate = (v0_ - mu) / std::max(t(i) - run_.t_cut_s, 1e-9);
     // A quantized reading can sit on one value for the whole window (e = 0) while the motor still
-    // turns: its resolution is at best the step's uniform spread.
+    // turns: its resolution is at best the step's uniform spread. A coast so slow that its first
+    // samples showed no step yet learns it here, once.
+    if (coast_step_ == 0) coast_step_ = reading_step(run_.cut_index, i + 1);
     const double e_eff = std::max(e, coast_step_ * 0.2886751345948129);
     resolved = sxx > 0 && e_eff / std::sqrt(sxx) <= slope_resolution * mean_rate;
   }
@@ -1112,6 +1123,17 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
     else hi = mid;
   }
   const std::size_t stop = lo;
+  // A stop that falls in a pause of the recording is known only to lie in it.
+  if (stop > run_.cut_index + 2) {
+    const double pause = t(stop) - t(stop - 1);
+    const double period = (t(stop - 1) - t(run_.cut_index)) / double(stop - 1 - run_.cut_index);
+    if (pause > 1.0 && pause > 25.0 * period) {
+      run_note_ = fmt::format("the stop falls in a pause of the recording ({:.3g} s, from {} to {}): it lies somewhere "
+                              "in it, and the stop time is the pause's end",
+                              pause, fmt_s(t(stop - 1)), fmt_s(t(stop)));
+      run_note_severity_ = Diagnostic::Severity::warning;
+    }
+  }
 
   // A real stop arrives with a finite slope; an exponential creeps in.
   const double t_stop = t(stop);
@@ -1215,7 +1237,8 @@ bool RunDetector::signal_lost(std::size_t i, std::size_t first_in, double z, dou
                               "sensor that gives up at low speed (per-revolution pulses, an encoder, a display)? "
                               "Fitted up to there, as never stopped",
                               level, fmt_s(t(held)),
-                              fmt::format("the reading fell from {:g} to {:g} in one sample", v(last), z), fall),
+                              fmt::format("the reading fell from {:g} to {:g} in one sample", v(last), z),
+                              fall > 1e-9 * amp ? fall : 0.0),
                   Run::End::signal_lost);
   to_idle(i + 1, true);
   // No new run until the reading rises above what the sensor last showed (or after a standstill).
@@ -1350,7 +1373,7 @@ void RunDetector::scan_coast(Run& r, std::size_t coast_end) {
     const double expected = 0.5 * (a + b), off = std::abs(c - expected);
     if (off > floor && off > 0.1 * std::abs(expected) && std::abs(b - a) < 0.5 * off) {
       r.outliers.push_back(k);
-      if (shown++ < 3) where += fmt::format("{}{} at {} (expected {:.3g})", shown > 1 ? ", " : "", c, fmt_s(tk), expected);
+      if (shown++ < 10) where += fmt::format("{}{} at {} (expected {:.3g})", shown > 1 ? ", " : "", c, fmt_s(tk), expected);
     }
   };
   // Samples k of [cut + 1, coast_end - 1), over the ring in stretches whose triples (k - 1, k,
@@ -1408,7 +1431,7 @@ void RunDetector::scan_coast(Run& r, std::size_t coast_end) {
   if (r.outliers.empty()) return;
   emit_diag(Diagnostic::Severity::warning,
             fmt::format("run {}: {} single-sample outlier(s) left out of the fit (dropouts or glitches): {}{}", r.number,
-                        r.outliers.size(), where, r.outliers.size() > 3 ? ", …" : ""));
+                        r.outliers.size(), where, r.outliers.size() > 10 ? ", …" : ""));
 }
 
 std::string RunDetector::gap_before(std::size_t i) const {
