@@ -1546,8 +1546,10 @@ void RunDetector::complete_run(std::size_t end) {
   if (fragment_) {
     e.kind = RunEvent::Kind::ignored;
     e.has_diagnostic = true;
-    e.diagnostic = {Diagnostic::Severity::note, source_, 0,
-                    fmt::format("coast from {} to {} ignored: the rest of a coast after the device clock restarted "
+    // Fragments are said in the default output: the user sees what was left out and why.
+    e.diagnostic = {Diagnostic::Severity::warning, source_, 0,
+                    fmt::format("coast from {} to {} (on the restarted clock) ignored: the rest of a coast after the "
+                                "device clock restarted "
                                 "(reset, reconnect); its cut was not seen",
                                 fmt_s(r.t_cut_s), fmt_s(r.t_end_s))};
     fragment_ = false;
@@ -1560,7 +1562,7 @@ void RunDetector::complete_run(std::size_t end) {
   } else if (const std::string why = fragment_reason(r, coast_end, coast_s); !why.empty()) {
     e.kind = RunEvent::Kind::ignored;
     e.has_diagnostic = true;
-    e.diagnostic = {Diagnostic::Severity::note, source_, 0,
+    e.diagnostic = {Diagnostic::Severity::warning, source_, 0,
                     fmt::format("coast cut at {} ignored as a fragment, not a run: {}", fmt_s(r.t_cut_s), why)};
   } else {
     e.kind = RunEvent::Kind::complete;
