@@ -39,6 +39,8 @@ constexpr double slope_resolution = 0.05;
 // In the tail, a hold-window mean this fraction of the amplitude below the zero level retracts
 // the stop.
 constexpr double retract_fraction = 0.01;
+// The spread of a reading rounded to steps of 1, as uniform rounding error: 1/sqrt(12).
+constexpr double step_sd = 0.2886751345948129;
 // The long hold window spans at least this fraction of the coast before it.
 constexpr double long_hold_fraction = 0.03;
 // Recompute sliding sums from scratch this often (rounding drift).
@@ -800,7 +802,7 @@ std::string RunDetector::start_not_seen(CutSplit& sp) {
       const WindowFit pre = window_over(ring_.get(), mask_, 1e300, a, c);
       // A quantized reading can repeat one value over a few samples of a coast: its spread is at
       // least the step's.
-      const double e = std::max(pre.resid_sd(), reading_step(a, c + 1) * 0.2886751345948129);
+      const double e = std::max(pre.resid_sd(), reading_step(a, c + 1) * step_sd);
       const double s = pre.slope(), se = pre.sxx() > 0 ? e / std::sqrt(pre.sxx()) : 0.0;
       if (s - sp.post_slope > 3.0 * se && s > 0.5 * sp.post_slope) return {};
     }
@@ -979,7 +981,7 @@ void RunDetector::standstill_checks(std::size_t i, bool at_end, double mu, doubl
     // turns: its resolution is at best the step's uniform spread. A coast so slow that its first
     // samples showed no step yet learns it here, once.
     if (coast_step_ == 0) coast_step_ = reading_step(run_.cut_index, i + 1);
-    const double e_eff = std::max(e, coast_step_ * 0.2886751345948129);
+    const double e_eff = std::max(e, coast_step_ * step_sd);
     resolved = sxx > 0 && e_eff / std::sqrt(sxx) <= slope_resolution * mean_rate;
   }
   if (creeping_ && !at_end) resolved = false;  // an asymptotic coast ends when the long window is flat
@@ -1200,13 +1202,13 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
 
 void RunDetector::block_until_rise(double level) {
   need_rise_ = true;
-  block_band_ = std::max(0.1 * std::abs(v0_), 8.0 * coast_sd_);
+  block_band_ = rise_jump_;  // as far above as power coming back
   rise_level_ = level + block_band_;
 }
 
 bool RunDetector::signal_lost(std::size_t i, std::size_t first_in, double z, double amp) {
   if (first_in < run_.cut_index + 8 || !(amp > 0)) return false;
-  const double zero = std::isfinite(lead_in_zero_) ? lead_in_zero_ : 0.0;
+  const double zero = motor_zero();
   // The coast's last reading before the standstill, and the first sample that held it.
   const std::size_t last = first_in - 1;
   std::size_t held = last;
@@ -1308,7 +1310,7 @@ bool RunDetector::still_falling(std::size_t i) const {
   const double sxx = w.sxx();
   if (!(sxx > 0)) return false;
   const double slope = w.slope();
-  const double e = std::max(w.resid_sd(), coast_step_ * 0.2886751345948129);
+  const double e = std::max(w.resid_sd(), coast_step_ * step_sd);
   const double mean_rate = (v0_ - run_.zero_level) / std::max(run_.t_stop_s - run_.t_cut_s, 1e-9);
   return slope < 0 && -slope * std::sqrt(sxx) > 6.0 * e && -slope > 0.1 * mean_rate;
 }
@@ -1439,10 +1441,9 @@ std::string RunDetector::gap_before(std::size_t i) const {
                      fmt_s(t(i)));
 }
 
-std::string RunDetector::fragment_reason(const Run& r, std::size_t coast_end, double coast_s) const {
+std::string RunDetector::fragment_reason(const Run& r, double amp, double coast_s) const {
   // How far the reading fell in this coast, against what the reading can resolve and against the
   // runs already found in this stream (a nudge, a few samples at a crawl, a piece of a coast).
-  const double amp = v0_ - (r.stopped ? r.zero_level : v(coast_end - 1));
   if (amp < 3.0 * coast_step_)
     return fmt::format("it falls {:.3g}, under 3 of the reading's steps ({:.2g})", amp, coast_step_);
   // Beside the runs before it, only a coast seen to stop is judged: one cut short (end of data, a
@@ -1473,7 +1474,7 @@ void RunDetector::warn_of_held_standstill(const Run& r) {
   while (held_from > r.cut_index && v(held_from - 1) == z) --held_from;
   const std::size_t held = r.end_index - held_from;
   if (held < 10 || 5 * held < 4 * (r.end_index - r.stop_index)) return;  // most of the standstill
-  const double zero = std::isfinite(lead_in_zero_) ? lead_in_zero_ : 0.0;
+  const double zero = motor_zero();
   if (!(z - zero > std::max(0.02 * (v0_ - zero), 3.0 * coast_step_))) return;
   // Reached by a jump of many reading steps (an rpm counter's last update), not by the one step
   // a coarse reading takes onto a real offset.
@@ -1541,6 +1542,9 @@ void RunDetector::complete_run(std::size_t end) {
   const std::size_t coast_n = coast_end - r.cut_index;
   const double coast_s = (r.stopped ? r.t_stop_s : (end > r.cut_index ? t(end - 1) : r.t_cut_s)) - r.t_cut_s;
 
+  // How far the reading fell: to the standstill, or to the coast's last sample.
+  const double amp = v0_ - (r.stopped || coast_n == 0 ? r.zero_level : v(coast_end - 1));
+
   RunEvent e;
   e.run = r;
   if (fragment_) {
@@ -1559,7 +1563,7 @@ void RunDetector::complete_run(std::size_t end) {
     e.diagnostic = {Diagnostic::Severity::note, source_, 0,
                     fmt::format("coast cut at {} ignored: {} and {} samples (need {:g} s and {})", fmt_s(r.t_cut_s),
                                 fmt_s(coast_s), coast_n, opt_.min_coast_s, opt_.min_samples)};
-  } else if (const std::string why = fragment_reason(r, coast_end, coast_s); !why.empty()) {
+  } else if (const std::string why = fragment_reason(r, amp, coast_s); !why.empty()) {
     e.kind = RunEvent::Kind::ignored;
     e.has_diagnostic = true;
     e.diagnostic = {Diagnostic::Severity::warning, source_, 0,
@@ -1567,7 +1571,6 @@ void RunDetector::complete_run(std::size_t end) {
   } else {
     e.kind = RunEvent::Kind::complete;
     e.run.number = ++accepted_;
-    const double amp = v0_ - (r.stopped ? r.zero_level : v(coast_end - 1));
     if (r.stopped) {
       warn_of_earlier_fragments(e.run, amp, coast_s);
       warn_of_held_standstill(e.run);

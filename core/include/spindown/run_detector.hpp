@@ -231,10 +231,10 @@ class RunDetector {
   void tail_ends_by_time(std::size_t upto);
   void close_unstopped(std::size_t end, const std::string& why, Run::End reason);
   void complete_run(std::size_t end);
-  // Why the finished coast r (its coast up to coast_end, coast_s long) is a fragment and not a
-  // run: too small for the reading's resolution, or small and short beside the runs found
-  // before it in this stream; empty when it is a run.
-  std::string fragment_reason(const Run& r, std::size_t coast_end, double coast_s) const;
+  // Why the finished coast r (falling amp in coast_s) is a fragment and not a run: too small for
+  // the reading's resolution, or small and short beside the runs found before it in this stream;
+  // empty when it is a run.
+  std::string fragment_reason(const Run& r, double amp, double coast_s) const;
   // Why a stopped coast falling amp in coast_s is small beside runs of up to largest_amp and
   // longest_s; empty when it is not.
   static std::string small_beside(double amp, double coast_s, double largest_amp, double longest_s);
@@ -314,6 +314,8 @@ class RunDetector {
   double coast_sd_ = 0;    // coast noise near the cut
   double coast_step_ = 0;  // the reading's smallest step near the cut (its quantization; 0 if none seen)
   double lead_in_zero_ = 0;  // mean reading of a "zeros" lead-in (the motor at rest); NaN for other lead-ins
+  // The motor's zero reading: the lead-in's when it showed the motor at rest, else 0.
+  double motor_zero() const { return std::isfinite(lead_in_zero_) ? lead_in_zero_ : 0.0; }
   double rise_jump_ = 0;   // a reading this far above level_min_ is power coming back
   double level_min_ = 0;   // lowest hold-window mean seen in this coast
   int rising_ = 0;         // consecutive samples far above level_min_ (power back?)
