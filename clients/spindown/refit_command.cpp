@@ -2,6 +2,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <fmt/format.h>
@@ -148,6 +149,8 @@ FitterOptions fitter_options(const RefitCommandOptions& o) {
   f.bench_regex = o.bench_regex;
   f.ignore_config = o.ignore_config;
   f.max_benches = o.max_benches;
+  f.admit_rate_hz = o.admit_rate_hz;
+  f.silent_s = o.silent_s;
   f.max_rate_hz = 0;  // a log is read as fast as the disk allows; live caps were applied live
   if (o.inertia_given) {
     f.default_bench.inertia_kg_m2 = o.inertia_kg_m2;
@@ -173,7 +176,19 @@ FitterOptions fitter_options(const RefitCommandOptions& o) {
   return f;
 }
 
-std::string run_key(const std::string& bench, int run) { return fmt::format("{}#{:09d}", bench, run); }
+// Seconds of device time two fitted windows share (a recorded FIT as JSON); 0 when apart. A
+// window of one sample counts as a period long.
+double number_in(const Json& j, const char* key) {
+  const auto it = j.find(key);
+  return it != j.end() && it->is_number() ? it->get<double>() : std::numeric_limits<double>::quiet_NaN();
+}
+
+double window_overlap_s(const Run& ours, const Json& theirs) {
+  const double t0 = number_in(theirs, "t_cut_s"), t1 = number_in(theirs, "t_end_s");
+  const double pad = std::max(ours.period_s, 1e-3);
+  const double lo = std::max(ours.t_cut_s, t0), hi = std::min(ours.t_end_s, std::isfinite(t1) ? t1 : t0) + pad;
+  return std::isfinite(lo) && std::isfinite(hi) && hi > lo ? hi - lo : 0.0;
+}
 
 }  // namespace
 
@@ -192,7 +207,7 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
   FitterCore core(options, sink);
   std::map<std::string, std::size_t, std::less<>> order;
   std::vector<char> channel_done;  // by LcmLogEvent::channel_id: its bench's place is known
-  std::int64_t last_utime = 0;
+  std::int64_t last_utime = 0, next_poll = std::numeric_limits<std::int64_t>::min();
   std::size_t file_problems = 0;
   LcmLogEvent ev;
   // Progress every 256 events, counted down (one test per event, none for a caller without one).
@@ -205,6 +220,11 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
       progress(ev.file_offset, reader.file_size(), out.runs_fitted);
     }
     if (ev.number > 0) last_utime = ev.log_utime;
+    // Host time passes as the log's events do: benches gone silent mid-coast are closed as live.
+    if (ev.log_utime >= next_poll) {
+      core.poll(ev.log_utime);
+      next_poll = ev.log_utime + FitterCore::poll_period_us;
+    }
     // A bench's first SAMPLE/CONFIG fixes its place; checked once per channel, not per event.
     const auto id = static_cast<std::size_t>(ev.channel_id);
     if (ev.channel_id < 0 || id >= channel_done.size() || !channel_done[id]) {
@@ -338,6 +358,11 @@ void setup_refit(CLI::App& app) {
   sub->add_option("--max-benches", opt->max_benches,
                   "Benches held at once, as the live spindown-fitter --max-benches (evictions are replayed too)")
       ->check(CLI::PositiveNumber);
+  sub->add_option("--admit-rate", opt->admit_rate_hz, "New benches admitted per second, as spindown-fitter --admit-rate")
+      ->check(CLI::PositiveNumber);
+  sub->add_option("--silent", opt->silent_s,
+                  "Seconds without samples (log time) that close a bench's open run, as spindown-fitter --silent")
+      ->check(CLI::PositiveNumber);
   sub->add_flag("--ignore-config", opt->ignore_config, "Use --inertia/--kb (or the lab's) even where CONFIG says otherwise")
       ->group("Bench");
   sub->callback([opt, j, kb, kv]() {
@@ -397,14 +422,14 @@ int run_refit(const RefitCommandOptions& o) {
                          report.max_diagnostics);
 
     if (o.live || o.compare) {
-      // Recorded results, keyed by bench and run; the refit's likewise.
-      std::multimap<std::string, Json> live;
+      // Recorded results in log order; the refit's likewise.
+      std::vector<std::pair<std::string, Json>> live;
       const std::regex wanted(o.bench_regex);
       for (const fit_t& m : r.live) {
         if (!std::regex_match(m.bench, wanted)) continue;
         std::string why;
         if (auto jf = fit_message_json(m, report, &why))
-          live.emplace(run_key(m.bench, m.run), without_timing_fields(std::move(*jf)));
+          live.emplace_back(m.bench, without_timing_fields(std::move(*jf)));
         else
           std::cerr << path << ": warning: " << why << '\n';
       }
@@ -414,7 +439,7 @@ int run_refit(const RefitCommandOptions& o) {
           ok = false;
         }
         Json runs = Json::array();
-        for (auto& [key, jr] : live) runs.push_back(jr);
+        for (auto& [bench, jr] : live) runs.push_back(jr);
         if (o.json) {
           files.push_back(Json{{"file", path}, {"runs", std::move(runs)}});
         } else {
@@ -427,34 +452,54 @@ int run_refit(const RefitCommandOptions& o) {
         }
         continue;
       }
-      // --compare
+      // --compare: a live FIT and a refitted run are the same run when they are on the same bench
+      // and their fitted windows overlap (run numbers restart with the fitter; the device time
+      // does not), the largest overlap first.
       const Json refit = refit_file_json(r, report);
       std::size_t same = 0, differ = 0, missing_live = 0, missing_refit = 0;
-      std::map<std::string, Json> ours;
-      for (std::size_t i = 0; i < r.runs.size(); ++i)
-        ours.emplace(run_key(r.runs[i].bench, r.runs[i].fit.run.number),
-                     without_timing_fields(refit["runs"][i]));
-      for (const auto& [key, jr] : ours) {
-        auto [lo, hi] = live.equal_range(key);
-        if (lo == hi) {
+      std::vector<bool> live_paired(live.size(), false);
+      for (std::size_t i = 0; i < r.runs.size(); ++i) {
+        const RefitRun& ours = r.runs[i];
+        const Json jr = without_timing_fields(refit["runs"][i]);
+        std::size_t best = live.size();
+        double best_overlap = 0;
+        for (std::size_t k = 0; k < live.size(); ++k) {
+          if (live_paired[k] || live[k].first != ours.bench) continue;
+          const double overlap = window_overlap_s(ours.fit.run, live[k].second);
+          if (overlap > best_overlap) best = k, best_overlap = overlap;
+        }
+        const std::string name = fmt::format("{} run {} (cut at {:.3f} s)", ours.bench, ours.fit.run.number,
+                                             ours.fit.run.t_cut_s);
+        if (best == live.size()) {
           ++missing_live;
-          std::cout << fmt::format("{}: {}: refit found it, no live FIT recorded\n", path, key);
+          std::cout << fmt::format("{}: {}: refit found it, no live FIT recorded\n", path, name);
           continue;
         }
-        for (auto it = lo; it != hi; ++it) {
-          const std::string d = first_difference(jr, it->second, "run");
-          if (d.empty()) {
-            ++same;
-          } else {
-            ++differ;
-            std::cout << fmt::format("{}: {}: differs: {}\n", path, key, d);
-          }
+        live_paired[best] = true;
+        // The run number is the fitter's count since it started, not the run's identity.
+        Json a = jr, b = live[best].second;
+        a.erase("run");
+        b.erase("run");
+        const std::string d = first_difference(a, b, "run");
+        if (d.empty()) {
+          ++same;
+          continue;
         }
+        ++differ;
+        const bool live_partial = b.value("lead_in", "") == "none", ours_partial = ours.fit.run.partial();
+        std::cout << fmt::format("{}: {}: differs: {}{}\n", path, name, d,
+                                 live_partial && !ours_partial
+                                     ? " (live joined this run mid-coast: the fitter started or took the bench "
+                                       "in after its cut; the log holds the whole run)"
+                                     : "");
       }
-      for (const auto& [key, jr] : live)
-        if (!ours.contains(key)) {
+      for (std::size_t k = 0; k < live.size(); ++k)
+        if (!live_paired[k]) {
           ++missing_refit;
-          std::cout << fmt::format("{}: {}: live FIT recorded, the refit did not find this run\n", path, key);
+          std::cout << fmt::format("{}: {} live run {} (cut at {:.3f} s): live FIT recorded, the refit did not find "
+                                   "this run\n",
+                                   path, live[k].first, live[k].second.value("run", 0),
+                                   number_in(live[k].second, "t_cut_s"));
         }
       std::cout << fmt::format("{}: {} runs refitted, {} live FIT messages: {} identical, {} different, {} only "
                                "refitted, {} only live\n",

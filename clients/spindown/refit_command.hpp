@@ -74,6 +74,8 @@ struct RefitCommandOptions {
   bool inertia_given = false, kb_given = false, speed_constant_given = false;
   bool ignore_config = false;
   std::size_t max_benches = FitterOptions{}.max_benches;  // as spindown-fitter --max-benches
+  double admit_rate_hz = FitterOptions{}.admit_rate_hz;   // as spindown-fitter --admit-rate
+  double silent_s = FitterOptions{}.silent_s;             // as spindown-fitter --silent
 };
 
 void setup_refit(CLI::App& app);

@@ -234,6 +234,7 @@ run_t to_run_message(std::string_view bench, const Run& run, std::int8_t state, 
   m.last_seq = last_seq;
   m.samples = samples;
   m.note = std::move(note);
+  m.lead_in = run.lead_in;
   return m;
 }
 

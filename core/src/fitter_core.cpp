@@ -44,6 +44,9 @@ bool FitterOptions::is_valid(std::string* why) const {
   fo.models = models;
   if (!fo.is_valid(&inner)) return fail("fit options: " + inner);
   if (max_benches < 1) return fail("max_benches must be at least 1");
+  if (!(std::isfinite(admit_rate_hz) && admit_rate_hz > 0))
+    return fail(fmt::format("admit_rate_hz must be > 0 (got {})", admit_rate_hz));
+  if (!(silent_s > 0)) return fail(fmt::format("silent_s must be > 0 (got {})", silent_s));
   if (!(std::isfinite(max_rate_hz) && max_rate_hz >= 0))
     return fail(fmt::format("max_rate_hz must be >= 0 (got {})", max_rate_hz));
   if (!(std::isfinite(burst_s) && burst_s > 0)) return fail(fmt::format("burst_s must be > 0 (got {})", burst_s));
@@ -98,6 +101,7 @@ struct FitterCore::Bench {
   RunDetector detector;
   Mirror mirror;  // samples of a run, with the sequence numbers a published run names
   std::uint64_t last_active = 0, arrival = 0;
+  std::int64_t last_sample_utime = 0;  // host time of its last samples (poll(): silent benches)
 
   std::optional<BenchParams> config;
   std::string config_problem;
@@ -181,23 +185,7 @@ FitterCore::Bench* FitterCore::find_bench(std::string_view id, std::int64_t recv
     ++counters_.filtered;
     return nullptr;
   }
-  if (benches_.size() >= opt_.max_benches) {
-    auto victim = std::min_element(benches_.begin(), benches_.end(), [](const auto& a, const auto& b) {
-      return a.second->last_active < b.second->last_active;
-    });
-    Bench& v = *victim->second;
-    if (v.open_state != 0)
-      publish_run(v, v.open_run, run_t::STATE_ABANDONED,
-                  fmt::format("bench evicted: more than {} benches active", opt_.max_benches), recv_utime);
-    ++counters_.dropped_benches;
-    error(fmt::format("SPINDOWN.{}.{}: bench {} is new and {} benches are held (max_benches): least recently "
-                      "active bench {} evicted",
-                      id, kind, id, benches_.size(), v.id),
-          recv_utime);
-    bench_cache_.forget(&v);
-    std::replace(bench_by_channel_.begin(), bench_by_channel_.end(), &v, static_cast<Bench*>(nullptr));
-    benches_.erase(victim);
-  }
+  if (!admit(id, recv_utime, kind)) return nullptr;
   auto b = std::make_unique<Bench>(std::string(id), opt_.runs);
   b->last_active = activity_;
   b->arrival = ++arrivals_;
@@ -205,6 +193,46 @@ FitterCore::Bench* FitterCore::find_bench(std::string_view id, std::int64_t recv
   benches_.emplace(p->id, std::move(b));
   bench_cache_.slot(id) = p;
   return p;
+}
+
+bool FitterCore::admit(std::string_view id, std::int64_t recv_utime, std::string_view kind) {
+  // The admission bucket: max_benches at once (a lab starting), then admit_rate_hz.
+  const double capacity = double(opt_.max_benches);
+  if (admit_tokens_ < 0) {
+    admit_tokens_ = capacity;
+  } else if (recv_utime > admit_utime_) {
+    admit_tokens_ = std::min(capacity, admit_tokens_ + 1e-6 * double(recv_utime - admit_utime_) * opt_.admit_rate_hz);
+  }
+  admit_utime_ = std::max(admit_utime_, recv_utime);
+  auto victim = benches_.end();
+  if (benches_.size() >= opt_.max_benches) {
+    for (auto it = benches_.begin(); it != benches_.end(); ++it)
+      if (it->second->open_state == 0 && (victim == benches_.end() || it->second->last_active < victim->second->last_active))
+        victim = it;
+  }
+  const bool full = benches_.size() >= opt_.max_benches && victim == benches_.end();
+  if (full || admit_tokens_ < 1) {
+    ++counters_.benches_refused;
+    error(fmt::format("SPINDOWN.{}.{}: new bench ids refused: {} so far ({}); a flood of bench ids?", id, kind,
+                      counters_.benches_refused,
+                      full ? fmt::format("all {} places hold a run in progress", opt_.max_benches)
+                           : fmt::format("more than {:g} new benches per second", opt_.admit_rate_hz)),
+          recv_utime);
+    return false;
+  }
+  admit_tokens_ -= 1;
+  if (victim != benches_.end()) {
+    Bench& v = *victim->second;
+    ++counters_.dropped_benches;
+    error(fmt::format("SPINDOWN.{}.{}: bench {} is new and {} benches are held (max_benches): least recently "
+                      "active bench {} (no run in progress) evicted",
+                      id, kind, id, benches_.size(), v.id),
+          recv_utime);
+    bench_cache_.forget(&v);
+    std::replace(bench_by_channel_.begin(), bench_by_channel_.end(), &v, static_cast<Bench*>(nullptr));
+    benches_.erase(victim);
+  }
+  return true;
 }
 
 void FitterCore::on_message(std::string_view channel, const void* data, std::int64_t size, std::int64_t recv_utime) {
@@ -349,6 +377,7 @@ template <class Message>
     }
     b.tokens -= double(n);
   }
+  b.last_sample_utime = recv_utime;
 
   if (!short_string_equal(m.bench, b.id)) {
     ++counters_.bench_mismatch;
@@ -491,7 +520,10 @@ void FitterCore::handle_events(Bench& b, std::int64_t recv_utime) {
         ++counters_.runs_started;
         b.open_state = 1;
         b.open_run = e.run;
-        publish_run(b, e.run, run_t::STATE_COASTING, fmt::format("cut (lead-in: {})", e.run.lead_in), recv_utime);
+        publish_run(b, e.run, run_t::STATE_COASTING,
+                    e.run.partial() ? std::string("cut not seen: joined mid-coast, a partial run from its first sample")
+                                    : fmt::format("cut (lead-in: {})", e.run.lead_in),
+                    recv_utime);
         break;
       case RunEvent::Kind::stop:
         b.open_state = 2;
@@ -500,7 +532,10 @@ void FitterCore::handle_events(Bench& b, std::int64_t recv_utime) {
         break;
       case RunEvent::Kind::complete:
         b.open_state = 0;
-        fit_and_publish(b, e.run, recv_utime);
+        counters_.partial_runs += e.run.partial();
+        counters_.silent_benches += e.run.end == Run::End::silent;
+        fit_and_publish(b, e.run, e.has_diagnostic && !e.run.stopped ? e.diagnostic.message : std::string(),
+                        recv_utime);
         break;
       case RunEvent::Kind::ignored:
         ++counters_.runs_ignored;
@@ -513,7 +548,7 @@ void FitterCore::handle_events(Bench& b, std::int64_t recv_utime) {
   }
 }
 
-void FitterCore::fit_and_publish(Bench& b, const Run& run, std::int64_t recv_utime) {
+void FitterCore::fit_and_publish(Bench& b, const Run& run, const std::string& why_unstopped, std::int64_t recv_utime) {
   ++counters_.runs;
   const Bench::Sample* first = b.at(run.cut_index);
   const Bench::Sample* last = run.end_index > run.cut_index ? b.at(run.end_index - 1) : first;
@@ -524,8 +559,10 @@ void FitterCore::fit_and_publish(Bench& b, const Run& run, std::int64_t recv_uti
           recv_utime);
     return;
   }
-  const std::string note =
-      run.stopped ? std::string("complete: fitted") : std::string("closed without a stop (never stopped); fitted");
+  const std::string note = run.stopped ? std::string("complete: fitted")
+                                       : why_unstopped.empty()
+                                           ? fmt::format("closed without a stop ({}); fitted", end_name(run.end))
+                                           : fmt::format("closed without a stop: {}; fitted", why_unstopped);
   publish_run(b, run, run.stopped ? run_t::STATE_STOPPED : run_t::STATE_ABANDONED, note, recv_utime);
 
   // The run's samples as contiguous arrays, indices relative to the cut.
@@ -608,6 +645,21 @@ void FitterCore::finish(std::int64_t now_utime) {
   }
 }
 
+void FitterCore::poll(std::int64_t now_utime) {
+  const auto silent_us = static_cast<std::int64_t>(opt_.silent_s * 1e6);
+  for (auto& [id, b] : benches_) {
+    if (b->open_state == 0 || now_utime - b->last_sample_utime < silent_us) continue;
+    try {
+      b->detector.went_silent(opt_.silent_s);  // not the silence measured: live and refit say the same
+      handle_events(*b, now_utime);
+    } catch (const std::exception& e) {
+      ++counters_.internal_errors;
+      error(fmt::format("{}: internal error closing a silent bench's run: {}", b->channel, e.what()), now_utime);
+    }
+    trim_mirror(*b);
+  }
+}
+
 status_t FitterCore::make_status(std::int64_t now_utime, std::string_view instance, std::string_view host,
                                  std::int32_t pid, std::string_view state, double uptime_s) const {
   status_t s;
@@ -632,6 +684,8 @@ status_t FitterCore::make_status(std::int64_t now_utime, std::string_view instan
       {"clock_restarts", c.clock_restarts}, {"nan_values", c.nan_values},
       {"time_backwards", c.time_backwards}, {"quantity_errors", c.quantity_errors},
       {"bad_configs", c.bad_configs},     {"dropped_benches", c.dropped_benches},
+      {"benches_refused", c.benches_refused}, {"partial_runs", c.partial_runs},
+      {"silent_benches", c.silent_benches},
       {"flood_drops", c.flood_drops},     {"flood_messages", c.flood_messages},
       {"internal_errors", c.internal_errors},
   };

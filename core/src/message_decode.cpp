@@ -128,7 +128,7 @@ constexpr WireField config_fields[] = {
 constexpr WireField run_fields[] = {
     {"utime", Wire::i64},     {"bench", Wire::string},  {"run", Wire::i32},      {"state", Wire::i8},
     {"t_cut_s", Wire::f64},   {"t_stop_s", Wire::f64},  {"first_seq", Wire::i64}, {"last_seq", Wire::i64},
-    {"samples", Wire::i32},   {"note", Wire::string},
+    {"samples", Wire::i32},   {"note", Wire::string},   {"lead_in", Wire::string},
 };
 
 constexpr WireField status_fields[] = {

@@ -477,6 +477,25 @@ void RunDetector::finish() {
   }
 }
 
+void RunDetector::went_silent(double silent_s) {
+  if (state_ == State::coasting && next_index_ > base_) coast_checks(next_index_ - 1, ring_[(next_index_ - 1) & mask_], true);
+  if (state_ == State::coasting) {
+    run_note_severity_ = Diagnostic::Severity::warning;
+    close_unstopped(next_index_,
+                    fmt::format("no samples for {:g} s: the bench went silent mid-coast; fitted to its last sample, "
+                                "and samples after the silence are not in this run",
+                                silent_s),
+                    Run::End::silent);
+    to_idle(next_index_, false);
+    // What comes after is found afresh: a coast going on is partial, from its first sample.
+    resume_index_ = next_index_;
+    resume_pause_s_ = silent_s;
+  } else if (state_ == State::tail) {
+    complete_run(next_index_);
+    to_idle(next_index_, false);
+  }
+}
+
 void RunDetector::to_idle(std::size_t lo, bool need_quiet) {
   // After a stop, a new coast must start above the standstill: a slow coast's last creep
   // after a premature stop is not a new run.

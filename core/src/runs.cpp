@@ -34,13 +34,14 @@ const char* end_name(Run::End e) {
     case Run::End::power_back: return "power back";
     case Run::End::clock_restart: return "clock restart";
     case Run::End::asymptotic: return "asymptotic";
+    case Run::End::silent: return "silent";
   }
   return "?";
 }
 
 Run::End end_from_name(std::string_view name) {
   for (Run::End e : {Run::End::stopped, Run::End::signal_lost, Run::End::gap, Run::End::end_of_data, Run::End::cap,
-                     Run::End::power_back, Run::End::clock_restart, Run::End::asymptotic})
+                     Run::End::power_back, Run::End::clock_restart, Run::End::asymptotic, Run::End::silent})
     if (name == end_name(e)) return e;
   return Run::End::end_of_data;
 }

@@ -124,7 +124,9 @@ void FitterService::publish_explain(const FitResult& r) {
 }
 
 void FitterService::diagnostic(const std::string& bench, const Diagnostic& d) {
-  if (opt_.verbose) fmt::print(stderr, "spindown-fitter: {}: {}\n", bench, d.to_string());
+  // What changes a result (a run cut short, a coast joined mid-way) is said without -v.
+  if (opt_.verbose || d.severity != Diagnostic::Severity::note)
+    fmt::print(stderr, "spindown-fitter: {}: {}\n", bench, d.to_string());
 }
 
 void FitterService::publish_status(std::int64_t now_us, const char* state) {
@@ -169,12 +171,15 @@ void FitterService::publish_status(std::int64_t now_us, const char* state) {
 void FitterService::worker() {
   const auto period = std::chrono::microseconds(static_cast<std::int64_t>(opt_.status_period_s * 1e6));
   auto next_status = std::chrono::steady_clock::now();
+  constexpr auto poll_wait = std::chrono::microseconds(FitterCore::poll_period_us);
   std::deque<Message> batch;
+  std::int64_t next_poll = 0;
   for (;;) {
     bool stop = false;
     {
       std::unique_lock lock(mu_);
-      cv_.wait_until(lock, next_status, [&] { return stopping_ || !queue_.empty(); });
+      cv_.wait_until(lock, std::min(next_status, std::chrono::steady_clock::now() + poll_wait),
+                     [&] { return stopping_ || !queue_.empty(); });
       batch.swap(queue_);
       queue_bytes_ = 0;
       stop = stopping_;
@@ -182,6 +187,10 @@ void FitterService::worker() {
     for (const Message& m : batch)
       core_.on_message(m.channel, m.data.data(), static_cast<std::int64_t>(m.data.size()), m.recv_utime);
     batch.clear();
+    if (const std::int64_t now = wall_us(); now >= next_poll) {  // benches gone silent mid-coast
+      core_.poll(now);
+      next_poll = now + FitterCore::poll_period_us;
+    }
     if (std::chrono::steady_clock::now() >= next_status) {
       publish_status(wall_us(), "running");
       next_status += period;
@@ -230,9 +239,11 @@ int FitterService::run(const std::atomic<bool>& stop_flag) {
   const FitterCounters& c = core_.counters();
   fmt::print(stderr,
              "spindown-fitter: stopped: {} benches, {} samples, {} runs, {} fits, {} decode errors, {} sequence gaps, "
-             "{} duplicates, {} NaN values, {} time backwards, {} benches evicted, {} flood drops, {} queue drops\n",
+             "{} duplicates, {} NaN values, {} time backwards, {} benches evicted, {} benches refused, {} partial runs, "
+             "{} silent benches, {} flood drops, {} queue drops\n",
              core_.bench_count(), c.samples, c.runs, c.fits, c.decode_errors, c.seq_gaps, c.duplicates, c.nan_values,
-             c.time_backwards, c.dropped_benches, c.flood_drops, queue_drops_);
+             c.time_backwards, c.dropped_benches, c.benches_refused, c.partial_runs, c.silent_benches, c.flood_drops,
+             queue_drops_);
   return 0;
 }
 

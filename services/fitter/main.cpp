@@ -46,7 +46,15 @@ int main(int argc, char** argv) {
                   ->excludes(kb);
   app.add_flag("--ignore-config", o.core.ignore_config, "always use --inertia/--kb, never a bench's CONFIG");
   app.add_option("--models", models, "models: viscous,coulomb,combined (default all)")->delimiter(',');
-  app.add_option("--max-benches", o.core.max_benches, "benches held at once; more evicts the least recently active");
+  app.add_option("--max-benches", o.core.max_benches,
+                 "benches held at once; a new one takes the place of the least recently active bench with no run in "
+                 "progress, or is refused");
+  app.add_option("--admit-rate", o.core.admit_rate_hz,
+                 "new benches admitted per second past the first --max-benches (a flood of bench ids is refused)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--silent", o.core.silent_s, "seconds without samples that close a bench's open run (fitted to its "
+                 "last sample)")
+      ->check(CLI::PositiveNumber);
   app.add_option("--max-rate", o.core.max_rate_hz, "samples/s per bench before messages are dropped (0: no cap)");
   app.add_option("--max-coast", o.core.runs.max_coast_s, "seconds before a coast that never stops is closed");
   app.add_option("--max-buffer", o.core.runs.max_buffer, "samples buffered per bench at most");

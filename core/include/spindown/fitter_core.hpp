@@ -47,7 +47,15 @@ struct FitterOptions {
   BenchParams default_bench;             // J, K_b for a bench without (usable) CONFIG
   bool ignore_config = false;            // always use default_bench (like `spindown fit --inertia`)
   std::string bench_regex = ".*";        // benches handled (full match on the id)
-  std::size_t max_benches = 256;         // more: the least recently active bench is evicted
+  // Benches held at once. A new bench takes a free place, or the place of the least recently
+  // active bench with no run in progress; new benches are admitted at most admit_rate_hz per
+  // second (bucket of max_benches). A new bench that finds neither is refused and counted: a
+  // flood of bench ids never evicts a run in progress.
+  std::size_t max_benches = 256;
+  double admit_rate_hz = 20;
+  // A bench that sends no samples for this long (host time) mid-coast has its run closed and
+  // fitted to its last sample (Run::End::silent); see poll().
+  double silent_s = 10;
   double max_rate_hz = 5000;             // samples per second per bench (host time); 0 = no cap
   double burst_s = 2.0;                  // the cap's bucket holds this many seconds of samples
   // Motor health references per bench id (the benches' TOML files): each fit of such a bench
@@ -80,7 +88,10 @@ struct FitterCounters {
   std::int64_t time_backwards = 0;     // samples whose device time does not advance, skipped
   std::int64_t quantity_errors = 0;    // unknown or changing quantity: message skipped
   std::int64_t bad_configs = 0;        // CONFIG with unusable J/K_b
-  std::int64_t dropped_benches = 0;    // benches evicted (max_benches)
+  std::int64_t dropped_benches = 0;    // benches evicted (max_benches), never one with a run in progress
+  std::int64_t benches_refused = 0;    // messages of new benches refused (table full or admission rate)
+  std::int64_t partial_runs = 0;       // runs completed whose cut was not seen (joined mid-coast)
+  std::int64_t silent_benches = 0;     // runs closed because their bench went silent (silent_s)
   std::int64_t flood_drops = 0;        // samples dropped by the rate cap
   std::int64_t flood_messages = 0;     // messages dropped by the rate cap
   std::int64_t internal_errors = 0;    // exceptions caught from the fit or detector
@@ -138,6 +149,10 @@ class FitterCore {
   // End of the stream (refit, shutdown): open coasts are closed and fitted as `spindown fit`
   // does at the end of a file.
   void finish(std::int64_t now_utime);
+  // The passing of host time (the service calls it a few times a second, refit at the log's
+  // event times): a bench with a run in progress and no samples for silent_s has it closed.
+  void poll(std::int64_t now_utime);
+  static constexpr std::int64_t poll_period_us = 500'000;  // how often poll() is worth calling
 
   const FitterCounters& counters() const { return counters_; }
   std::size_t bench_count() const { return benches_.size(); }
@@ -155,6 +170,7 @@ class FitterCore {
   struct Bench;
   inline Bench* bench_for(std::string_view id, std::int64_t recv_utime, std::string_view kind);
   Bench* find_bench(std::string_view id, std::int64_t recv_utime, std::string_view kind);  // past the cache
+  bool admit(std::string_view id, std::int64_t recv_utime, std::string_view kind);  // room for a new bench?
   // bench_for() for a SAMPLE channel whose id is not yet in bench_by_channel_; remembers the answer.
   Bench* bench_for_channel(std::int32_t channel_id, std::string_view bench, std::int64_t recv_utime);
   void error(std::string text, std::int64_t utime);
@@ -168,7 +184,7 @@ class FitterCore {
   void retract_stop(Bench& b, std::int64_t recv_utime);
   void handle_events(Bench& b, std::int64_t recv_utime);
   void restart_clock(Bench& b, std::int64_t recv_utime);
-  void fit_and_publish(Bench& b, const Run& run, std::int64_t recv_utime);
+  void fit_and_publish(Bench& b, const Run& run, const std::string& why_unstopped, std::int64_t recv_utime);
   void publish_run(Bench& b, const Run& run, std::int8_t state, std::string note, std::int64_t utime);
   inline void trim_mirror(Bench& b);
 
@@ -180,6 +196,8 @@ class FitterCore {
   std::vector<Bench*> bench_by_channel_;  // by a reader's channel id; nullptr: not known (or evicted)
   std::uint64_t activity_ = 0;   // increases per message: least recently active = smallest
   std::uint64_t arrivals_ = 0;   // order of first appearance
+  double admit_tokens_ = -1;     // admission bucket (< 0: not started)
+  std::int64_t admit_utime_ = 0;
   FitterCounters counters_;
   std::string last_error_;
   std::int64_t last_error_utime_ = 0;

@@ -67,6 +67,10 @@ class RunDetector {
   void clock_restart();
   // End of the stream: an open coast is closed (never stopped), a tail is cut short.
   void finish();
+  // Live: no sample came for silent_s (host time). An open coast is closed there (End::silent,
+  // a warning), a tail is cut short; samples that come after are found afresh, a coast going on
+  // as a partial one. Nothing happens when idle.
+  void went_silent(double silent_s);
 
   // Events since the last call, oldest first.
   std::vector<RunEvent> take_events();

@@ -52,6 +52,7 @@ struct Run {
     power_back,     // the reading rose again before standstill
     clock_restart,  // the device clock restarted (reset, reconnect)
     asymptotic,     // the decay was lost in the noise before a stop (pure viscous)
+    silent,         // live: the bench sent no samples for FitterOptions::silent_s mid-coast
   };
   End end = End::end_of_data;
   double t_end_s = std::numeric_limits<double>::quiet_NaN();

@@ -1,0 +1,183 @@
+// FitterCore under the live lab's faults (issue 20): a bench whose samples start arriving in the
+// middle of a coast (the fitter restarted, the bench re-admitted, a reconnect) is never given a
+// cut; a flood of new bench ids never evicts a bench with a run in progress; a bench that goes
+// silent mid-coast has its run closed after a timeout; an Arduino reset mid-coast closes the
+// run there and the rest of that coast is no run. Each case is judged against the generator's
+// truth, not against earlier output.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "fitter_test_support.hpp"
+#include "spindown/fitter_core.hpp"
+#include "spindown/runs.hpp"
+
+namespace spindown {
+namespace {
+
+using namespace test;
+
+// Two generated runs and where the first one's cut and stop are (truth from find_runs on the
+// whole stream, which the corpus tests score against the generator).
+struct TwoRuns {
+  Stream s;
+  Run first, second;
+};
+TwoRuns two_runs(std::uint64_t seed) {
+  TwoRuns r;
+  r.s = make_stream(2, seed);
+  Recording rec;
+  for (std::size_t i = 0; i < r.s.t_us.size(); ++i) rec.push(double(r.s.t_us[i]) / 1e6, r.s.v[i]);
+  const Segmentation seg = find_runs(rec);
+  EXPECT_EQ(seg.runs.size(), 2u);
+  if (seg.runs.size() == 2) {
+    r.first = seg.runs[0];
+    r.second = seg.runs[1];
+  }
+  return r;
+}
+
+// Feeds samples [from, to) of s one per message through on_message, on the given device-time
+// offset and sequence numbers, 20 ms of host time apart.
+void feed_range(FitterCore& core, const std::string& bench, const Stream& s, std::size_t from, std::size_t to,
+                std::int64_t& seq, std::int64_t& utime, std::int64_t shift_us = 0, std::int32_t epoch = 0) {
+  for (std::size_t i = from; i < to && i < s.t_us.size(); ++i) {
+    samples_t m = batch(bench, s, i, 1, seq++);
+    m.device_time_us[0] += shift_us;
+    m.clock_epoch = epoch;
+    const auto bytes = encode(m);
+    utime += 20000;
+    core.on_message("SPINDOWN." + bench + ".SAMPLE", bytes.data(), static_cast<std::int64_t>(bytes.size()), utime);
+  }
+}
+
+bool has_warning(const CollectingSink& sink, const std::string& text) {
+  return std::any_of(sink.diagnostics.begin(), sink.diagnostics.end(), [&](const auto& d) {
+    return d.second.severity == Diagnostic::Severity::warning && d.second.message.find(text) != std::string::npos;
+  });
+}
+
+// The fitter restarted (or the bench was re-admitted) a third into run 1's coast: run 1 is
+// partial everywhere, never a cut at the moment the samples started; run 2 is whole.
+TEST(FitterFaults, JoinedMidCoastIsPartialNeverACut) {
+  const TwoRuns tr = two_runs(31);
+  const std::size_t join = tr.first.cut_index + (tr.first.stop_index - tr.first.cut_index) / 3;
+  CollectingSink sink;
+  FitterCore core({}, sink);
+  std::int64_t seq = std::int64_t(join), utime = 0;
+  feed_range(core, "a", tr.s, join, tr.s.t_us.size(), seq, utime);
+  core.finish(utime);
+
+  ASSERT_EQ(sink.fits.size(), 2u);
+  const spindown::Run& p = sink.fits[0].fit.run;
+  EXPECT_TRUE(p.partial()) << "lead-in " << p.lead_in;
+  EXPECT_EQ(p.cut_index, 0u) << "a partial run is taken from the first sample the fitter saw";
+  EXPECT_DOUBLE_EQ(p.t_cut_s, 1e-6 * double(tr.s.t_us[join]));
+  EXPECT_TRUE(p.stopped);
+  EXPECT_NEAR(p.t_stop_s, tr.first.t_stop_s, 3 * tr.first.period_s);
+  const spindown::Run& w = sink.fits[1].fit.run;
+  EXPECT_FALSE(w.partial());
+  EXPECT_NEAR(w.t_cut_s, tr.second.t_cut_s, tr.second.period_s);
+  EXPECT_EQ(core.counters().partial_runs, 1);
+  EXPECT_TRUE(has_warning(sink, "cut was not recorded"));
+  // Every RUN message of the partial run says so, the first one included.
+  bool first_said = false;
+  for (const run_t& r : sink.runs)
+    if (r.run == 1) {
+      EXPECT_EQ(r.lead_in, "none");
+      first_said = first_said || r.note.find("cut not seen") != std::string::npos;
+    }
+  EXPECT_TRUE(first_said);
+}
+
+// 20,000 new bench ids within 2 s while bench a coasts: a is never evicted, its run is whole,
+// the flood is counted and named, and the table stays bounded.
+TEST(FitterFaults, ABenchIdFloodNeverEvictsARunInProgress) {
+  const TwoRuns tr = two_runs(37);
+  CollectingSink sink;
+  FitterOptions o;
+  o.max_benches = 64;
+  FitterCore core(o, sink);
+  std::int64_t seq = 0, utime = 0;
+  const std::size_t mid = (tr.first.cut_index + tr.first.stop_index) / 2;
+  feed_range(core, "a", tr.s, 0, mid, seq, utime);
+  const Stream junk = make_stream(1, 5);
+  for (int i = 0; i < 20000; ++i) {
+    const samples_t m = batch("bogus" + std::to_string(i), junk, 0, 1, 0);
+    core.on_samples(m.bench, m, utime + i * 100);  // 10,000 new ids per second
+  }
+  utime += 20000 * 100;
+  feed_range(core, "a", tr.s, mid, tr.s.t_us.size(), seq, utime);
+  core.finish(utime);
+
+  const auto a = sink.of("a");
+  ASSERT_EQ(a.size(), 2u);
+  EXPECT_FALSE(a[0]->fit.run.partial());
+  EXPECT_NEAR(a[0]->fit.run.t_cut_s, tr.first.t_cut_s, tr.first.period_s);
+  EXPECT_TRUE(a[0]->fit.run.stopped);
+  for (const run_t& r : sink.runs) EXPECT_EQ(r.note.find("evicted"), std::string::npos) << r.note;
+  EXPECT_LE(core.bench_count(), 64u);
+  EXPECT_GT(core.counters().benches_refused, 19000);
+  EXPECT_NE(core.last_error().find("new bench ids refused"), std::string::npos) << core.last_error();
+}
+
+// Bench a goes silent halfway through run 1's coast: no run is left "coasting" forever; after
+// silent_s of host time it is closed and fitted to its last sample, and a poll before that
+// changes nothing.
+TEST(FitterFaults, ASilentBenchHasItsRunClosedAfterTheTimeout) {
+  const TwoRuns tr = two_runs(41);
+  CollectingSink sink;
+  FitterOptions o;
+  o.silent_s = 10;
+  FitterCore core(o, sink);
+  std::int64_t seq = 0, utime = 0;
+  const std::size_t mid = (tr.first.cut_index + tr.first.stop_index) / 2;
+  feed_range(core, "a", tr.s, 0, mid, seq, utime);
+  core.poll(utime + 9'000'000);
+  EXPECT_TRUE(sink.fits.empty());
+  core.poll(utime + 10'500'000);
+  ASSERT_EQ(sink.fits.size(), 1u);
+  const spindown::Run& r = sink.fits[0].fit.run;
+  EXPECT_EQ(r.end, Run::End::silent);
+  EXPECT_FALSE(r.stopped);
+  EXPECT_EQ(r.end_index, mid);
+  EXPECT_NEAR(r.t_cut_s, tr.first.t_cut_s, tr.first.period_s);
+  EXPECT_EQ(int(sink.runs.back().state), int(run_t::STATE_ABANDONED));
+  EXPECT_NE(sink.runs.back().note.find("no samples for"), std::string::npos) << sink.runs.back().note;
+  EXPECT_TRUE(has_warning(sink, "no samples for"));
+  EXPECT_EQ(core.counters().silent_benches, 1);
+  // Once is enough: later polls do not close it again.
+  core.poll(utime + 30'000'000);
+  EXPECT_EQ(sink.fits.size(), 1u);
+}
+
+// An Arduino reset (or a USB unplug and replug) a third into run 1's coast: the device clock
+// and the sequence numbers start again. Run 1 ends there with the reason; the rest of that coast
+// is never a run of its own; run 2 is whole.
+TEST(FitterFaults, AResetMidCoastClosesTheRunAndInventsNone) {
+  const TwoRuns tr = two_runs(43);
+  CollectingSink sink;
+  FitterCore core({}, sink);
+  std::int64_t seq = 0, utime = 0;
+  const std::size_t reset = tr.first.cut_index + (tr.first.stop_index - tr.first.cut_index) / 3;
+  feed_range(core, "a", tr.s, 0, reset, seq, utime);
+  // After the reset the board's millis() starts near 0 and the bridge's sequence restarts.
+  std::int64_t seq2 = 0;
+  const std::int64_t shift = 71'000 - tr.s.t_us[reset];
+  feed_range(core, "a", tr.s, reset, tr.s.t_us.size(), seq2, utime, shift, 1);
+  core.finish(utime);
+
+  const auto a = sink.of("a");
+  ASSERT_EQ(a.size(), 2u) << "run 1 closed at the reset, run 2; nothing else";
+  EXPECT_EQ(a[0]->fit.run.end, Run::End::clock_restart);
+  EXPECT_NEAR(a[0]->fit.run.t_cut_s, tr.first.t_cut_s, tr.first.period_s);
+  EXPECT_FALSE(a[1]->fit.run.partial());
+  EXPECT_NEAR(a[1]->fit.run.t_cut_s, tr.second.t_cut_s + 1e-6 * double(shift), tr.second.period_s);
+  EXPECT_TRUE(has_warning(sink, "clock restarted"));
+}
+
+}  // namespace
+}  // namespace spindown
