@@ -113,6 +113,28 @@ TEST(LabTable, RunLifeBecomesStateAndEvents) {
   EXPECT_TRUE(contains(table.render(t0 + 2 * sec), "1 stopped"));
 }
 
+// A run the fitter joined mid-coast (it started, or took the bench in, after the cut) is
+// partial in the table, the events and the fit's line: never shown as if its cut were seen.
+TEST(LabTable, APartialRunIsSaidEverywhere) {
+  LabTable table;
+  run_t coasting = run_msg("bench-a", 1, run_t::STATE_COASTING);
+  coasting.lead_in = "none";
+  table.on_run("bench-a", coasting, t0);
+  EXPECT_TRUE(contains(table.render(t0), "1 coasting (partial)")) << table.render(t0);
+  run_t stopped = run_msg("bench-a", 1, run_t::STATE_STOPPED);
+  stopped.lead_in = "none";
+  table.on_run("bench-a", stopped, t0 + sec);
+  fit_t f = fit_msg("bench-a", 1);
+  f.lead_in = "none";
+  table.on_fit("bench-a", f, t0 + sec);
+  const auto events = table.take_events();
+  ASSERT_EQ(events.size(), 3u) << joined(events);
+  EXPECT_EQ(events[0], "bench-a: run 1 coasting (joined mid-coast at t = 1.50 s: the cut was not seen, a partial run)");
+  EXPECT_TRUE(contains(events[1], "7.75 s after the first sample")) << events[1];
+  EXPECT_TRUE(contains(events[2], "run 1 fit (partial: the cut was not seen")) << events[2];
+  EXPECT_TRUE(contains(table.render(t0 + sec), "run 1 (partial) combined")) << table.render(t0 + sec);
+}
+
 TEST(LabTable, FitShowsBestModelCoefficientsAndRmse) {
   LabTable table;
   table.on_fit("bench-a", fit_msg("bench-a", 2), t0);

@@ -42,13 +42,13 @@ std::string age_text(std::int64_t last_us, std::int64_t now_us, double stale_s) 
 
 std::string run_state_text(const LabBenchRow& r) {
   if (!r.has_run) return r.has_samples ? "-" : "no data";
-  return fmt::format("{} {}", r.run, run_state_name(r.run_state));
+  return fmt::format("{} {}{}", r.run, run_state_name(r.run_state), r.run_partial ? " (partial)" : "");
 }
 
 std::string fit_text(const LabBenchRow& r) {
   if (!r.has_fit) return "-";
   if (r.best.empty()) return fmt::format("run {}: no model converged", r.fit_run);
-  std::string s = fmt::format("run {} {}", r.fit_run, r.best);
+  std::string s = fmt::format("run {}{} {}", r.fit_run, r.fit_partial ? " (partial)" : "", r.best);
   if (!r.coefficients.empty()) s += ": " + r.coefficients;
   if (r.bench_source != "config" && !r.bench_source.empty()) s += " (default J/K_b)";
   if (!r.health.empty()) s += "; health " + r.health;
@@ -225,16 +225,20 @@ void LabTable::on_run(std::string_view bench, const run_t& msg, std::int64_t now
   r.t_cut_s = msg.t_cut_s;
   r.t_stop_s = msg.t_stop_s;
   r.run_samples = msg.samples;
+  r.run_partial = msg.lead_in == "none";
   if (!news) return;
   std::string text = fmt::format("{}: run {} {}", r.bench, msg.run, run_state_name(msg.state));
   switch (msg.state) {
     case run_t::STATE_COASTING:
-      if (std::isfinite(msg.t_cut_s)) text += fmt::format(" (cut at t = {:.2f} s)", msg.t_cut_s);
+      if (r.run_partial && std::isfinite(msg.t_cut_s))
+        text += fmt::format(" (joined mid-coast at t = {:.2f} s: the cut was not seen, a partial run)", msg.t_cut_s);
+      else if (std::isfinite(msg.t_cut_s))
+        text += fmt::format(" (cut at t = {:.2f} s)", msg.t_cut_s);
       break;
     case run_t::STATE_STOPPED:
       if (std::isfinite(msg.t_stop_s) && std::isfinite(msg.t_cut_s))
-        text += fmt::format(" (stop at t = {:.2f} s, {:.2f} s after the cut, {} samples)", msg.t_stop_s,
-                            msg.t_stop_s - msg.t_cut_s, msg.samples);
+        text += fmt::format(" (stop at t = {:.2f} s, {:.2f} s after the {}, {} samples)", msg.t_stop_s,
+                            msg.t_stop_s - msg.t_cut_s, r.run_partial ? "first sample" : "cut", msg.samples);
       break;
     case run_t::STATE_ABANDONED:
       if (!msg.note.empty()) text += ": " + msg.note;
@@ -250,6 +254,7 @@ void LabTable::on_fit(std::string_view bench, const fit_t& msg, std::int64_t now
   r.has_fit = true;
   ++r.fits;
   r.fit_run = msg.run;
+  r.fit_partial = msg.lead_in == "none";
   r.best = msg.best;
   r.coefficients = fit_coefficients_text(msg, opt_.lab_units, false);
   const std::string with_units = fit_coefficients_text(msg, opt_.lab_units, true);
@@ -264,7 +269,8 @@ void LabTable::on_fit(std::string_view bench, const fit_t& msg, std::int64_t now
   if (msg.best.empty()) {
     text = fmt::format("{}: run {} fit: no model converged", r.bench, msg.run);
   } else {
-    text = fmt::format("{}: run {} fit: best {}", r.bench, msg.run, msg.best);
+    text = fmt::format("{}: run {} fit{}: best {}", r.bench, msg.run,
+                       r.fit_partial ? " (partial: the cut was not seen, fitted from the first sample)" : "", msg.best);
     if (!with_units.empty()) text += ": " + with_units;
     if (std::isfinite(r.rmse)) text += fmt::format(", RMSE {:.3g} {}", r.rmse, r.residual_unit);
   }

@@ -16,7 +16,7 @@ PIDS=()
 cleanup() {
   for p in "${PIDS[@]}"; do kill "$p" 2>/dev/null || true; done
   wait 2>/dev/null || true
-  rm -rf "$T"
+  [ -n "${SPINDOWN_KEEP_WORK:-}" ] && echo "work kept in $T" >&2 || rm -rf "$T"
 }
 trap cleanup EXIT
 # fail MESSAGE: says what failed, shows the end of every program's output, exits 1.

@@ -44,10 +44,12 @@ struct LabBenchRow {
   std::int8_t run_state = run_t::STATE_POWERED;
   double t_cut_s = 0, t_stop_s = 0;
   std::int32_t run_samples = 0;
+  bool run_partial = false;          // the cut was not seen (joined mid-coast)
 
   // From SPINDOWN.<bench>.FIT: the latest fit.
   bool has_fit = false;
   std::int32_t fit_run = 0;
+  bool fit_partial = false;          // fitted from its first sample: the cut was not seen
   std::int32_t fits = 0;             // FIT messages seen
   std::string best;                  // best model ("" when none converged)
   std::string coefficients;          // the best model's friction coefficients ± error (no units)
