@@ -10,6 +10,7 @@
 #include "spindown/explain_message.hpp"
 #include "spindown/fit_message.hpp"
 #include "spindown/lcm_channels.hpp"
+#include "spindown/network_checks.hpp"
 
 namespace spindown {
 
@@ -151,6 +152,12 @@ void FitterService::publish_status(std::int64_t now_us, const char* state) {
   s.counter_value.push_back(explains_);
   s.counter_name.emplace_back("explain_failures");
   s.counter_value.push_back(explain_failures_);
+  // Datagrams the kernel dropped on the fitter's own sockets (a full receive buffer): lost
+  // before LCM read them, so only sequence gaps would show them otherwise.
+  if (const auto kernel = own_udp_socket_drops()) {
+    s.counter_name.emplace_back("udp_drops");
+    s.counter_value.push_back(kernel->drops);
+  }
   s.ncounters = static_cast<std::int32_t>(s.counter_name.size());
   const std::pair<const char*, double> gauges[] = {
       {"sample_rate_hz", rate_hz_},           {"queue_depth", double(depth)},
@@ -230,9 +237,11 @@ int FitterService::run(const std::atomic<bool>& stop_flag) {
   const FitterCounters& c = core_.counters();
   fmt::print(stderr,
              "spindown-fitter: stopped: {} benches, {} samples, {} runs, {} fits, {} decode errors, {} sequence gaps, "
-             "{} duplicates, {} NaN values, {} time backwards, {} benches evicted, {} flood drops, {} queue drops\n",
+             "{} duplicates, {} NaN values, {} time backwards, {} benches evicted, {} flood drops, {} queue drops, "
+             "{} datagrams dropped by the kernel on the fitter's socket\n",
              core_.bench_count(), c.samples, c.runs, c.fits, c.decode_errors, c.seq_gaps, c.duplicates, c.nan_values,
-             c.time_backwards, c.dropped_benches, c.flood_drops, queue_drops_);
+             c.time_backwards, c.dropped_benches, c.flood_drops, queue_drops_,
+             own_udp_socket_drops().value_or(UdpSocketDrops{0, -1}).drops);
   return 0;
 }
 
