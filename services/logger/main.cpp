@@ -134,7 +134,8 @@ int main(int argc, char** argv) {
                w.rotate_time_s > 0 ? fmt::format(", rotate every {} s", w.rotate_time_s) : "");
 
   spindown::StatusHeartbeat beat("logger", "", start);  // only its schedule is used
-  std::string reported_error;
+  std::string reported_error, reported_state;
+  std::int64_t lost_when_full = 0;
   // Datagrams the kernel dropped on the logger's own sockets (its receive buffer was full):
   // traffic that never reached the logger, so no counter of its own can see it.
   auto kernel_drops = [] {
@@ -155,6 +156,15 @@ int main(int argc, char** argv) {
       reported_error = st.last_error;
       if (!reported_error.empty()) fmt::print(stderr, "spindown-logger: {}\n", reported_error);
     }
+    // A full disk is said once when it fills (last_error above) and once when space is back.
+    const std::int64_t lost = spindown::find_counter(st, "events_lost").value_or(0);
+    if (st.state == "disk full" && reported_state != "disk full") lost_when_full = lost;
+    if (reported_state == "disk full" && st.state == "running")
+      fmt::print(stderr,
+                 "spindown-logger: space is back: writing on to the same file ({} events lost while the disk was "
+                 "full)\n",
+                 lost - lost_when_full);
+    reported_state = st.state;
   };
   while (!g_stop) {
     lcm.handleTimeout(100);
