@@ -168,17 +168,64 @@ TEST(BridgeLogic, TenMegabyteLineKeepsMemoryBounded) {
   s.max_line_bytes = 256;
   SerialBridge b(s, sink);
   b.start(T0);
+  b.connected(T0);
   const std::string chunk(64 * 1024, '7');  // digits: would be "a number" if kept
   for (int i = 0; i < 160; ++i) {  // 10 MiB, no newline
     b.feed(chunk, T0);
     ASSERT_LE(b.buffered_bytes(), 256u);
   }
+  EXPECT_FALSE(b.looks_like_wrong_baud()) << b.state();  // text, only too long
   b.feed("\r\n100\t1.00\r\n", T0);
   EXPECT_EQ(b.counters().oversize_lines, 1);
   EXPECT_EQ(b.counters().lines_bad, 1);
   ASSERT_EQ(sink.flat().size(), 1u);
   EXPECT_EQ(sink.flat()[0].t_us, 100'000);
   EXPECT_NE(b.last_error().find("longer than 256 bytes"), std::string::npos);
+}
+
+// The lab sketch at 9600 baud read at 115200: every byte garbled (what a real port shows), no
+// line valid. The state says so once 256 bytes came without a valid line, and goes back to
+// "connected" with the first valid line.
+TEST(BridgeLogic, WrongBaudIsSaidInTheStateUntilAValidLineArrives) {
+  CaptureSink sink;
+  BridgeSettings s = settings();
+  s.baud = 115200;
+  SerialBridge b(s, sink);
+  b.start(T0);
+  b.connected(T0);
+  using namespace std::string_literals;
+  const std::string garbled = "\xc0\xf0\x80\xfe\x00\xe0\xf8\xfc\x80\xc0\xf0\x00\xfe\xff\x80\xe0"s;  // 16 bytes
+  for (int i = 0; i < 15; ++i) b.feed(garbled, T0 + i);  // 240 bytes
+  EXPECT_FALSE(b.looks_like_wrong_baud());
+  EXPECT_EQ(b.state(), "connected");
+  b.feed(garbled + "\n" + garbled, T0 + 100);  // a stray newline: one garbled line, still nothing valid
+  ASSERT_TRUE(b.looks_like_wrong_baud());
+  EXPECT_EQ(b.state(), "no valid line in 273 bytes at 115200 baud — wrong baud? the lab sketch uses 9600");
+  b.tick(T0 + 100);  // as spindown-bridge does after every read
+  ASSERT_FALSE(sink.statuses.empty());
+  EXPECT_EQ(sink.statuses.back().state, b.state());  // published at once, not at the next beat
+  EXPECT_NE(b.last_error().find("/dev/ttyTEST: no valid line in 273 bytes"), std::string::npos) << b.last_error();
+  EXPECT_TRUE(sink.samples.empty());
+  for (int i = 0; i < 100; ++i) b.feed(garbled, T0 + 200);  // said once: the state does not change
+  EXPECT_EQ(b.state(), "no valid line in 273 bytes at 115200 baud — wrong baud? the lab sketch uses 9600");
+
+  b.feed("\r\n5234\t0.00\r\n5254\t2.81\r\n", T0 + 300);  // the baud fixed on the other side
+  EXPECT_FALSE(b.looks_like_wrong_baud());
+  EXPECT_EQ(b.state(), "connected");
+  b.tick(T0 + 300);
+  EXPECT_EQ(sink.statuses.back().state, "connected");
+  EXPECT_EQ(sink.flat().size(), 2u);
+
+  BridgeSettings lab = settings();  // 9600: the other way round
+  SerialBridge b2(lab, sink);
+  b2.start(T0);
+  b2.connected(T0);
+  for (int i = 0; i < 20; ++i) b2.feed(garbled, T0);
+  EXPECT_NE(b2.state().find("at 9600 baud — wrong baud? spindown-v1 firmware uses 115200"), std::string::npos)
+      << b2.state();
+  b2.disconnected(T0 + 1, "unplugged");
+  EXPECT_FALSE(b2.looks_like_wrong_baud());
+  EXPECT_EQ(b2.state(), "disconnected");
 }
 
 TEST(BridgeLogic, DisconnectDropsThePartialLineAndReconnectIsCounted) {

@@ -4,12 +4,17 @@
 // own status events in the log carry the counters.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <lcm/lcm-cpp.hpp>
 #include <regex>
+#include <sched.h>
+#include <sys/mount.h>
 #include <sys/resource.h>
 #include <thread>
 #include <unistd.h>
@@ -323,6 +328,66 @@ TEST(EventLogWriter, WriteErrorsAreCountedWithPathAndErrnoAndLoggingResumes) {
   ASSERT_FALSE(st2.empty());
   EXPECT_NE(st2.front().last_error.find("File too large"), std::string::npos);
   EXPECT_GE(find_counter(st2.front(), "write_errors").value_or(0), 1);
+}
+
+// A full disk (a 256 kB tmpfs in a private mount namespace, most of it taken by a filler file):
+// one file, cut at its last whole event, events counted as lost with one error naming the file
+// and ENOSPC, and written on to the same file once the filler is deleted.
+TEST(EventLogWriter, AFullDiskKeepsOneValidFileAndWritesOnWhenSpaceReturns) {
+  TempDir dir;
+  if (::unshare(CLONE_NEWNS) != 0 || ::mount(nullptr, "/", nullptr, MS_REC | MS_PRIVATE, nullptr) != 0 ||
+      ::mount("tmpfs", dir.path().c_str(), "tmpfs", 0, "size=256k") != 0)
+    GTEST_SKIP() << "needs a private mount namespace and a tmpfs (root): " << std::strerror(errno);
+  struct Unmount {
+    std::string path;
+    ~Unmount() { ::umount2(path.c_str(), MNT_DETACH); }
+  } unmount{dir.path()};
+  const std::string filler = dir.path() + "/filler";
+  {
+    std::ofstream f(filler, std::ios::binary);
+    f << std::string(200 * 1024, 'f');
+  }
+  auto o = options_in(dir);
+  o.buffer_bytes = 4096;
+  o.reopen_interval_s = 1.0;
+  EventLogWriter w(o, kT0);
+  w.open(kT0);
+  std::int64_t t = kT0, failed = 0;
+  for (int i = 0; i < 400; ++i, t += 10'000)  // 400 kB of events into the ~50 kB left, over 4 s of retries
+    if (!w.write(t, "CH", payload(i, 1000).data(), 1000, t)) ++failed;
+  w.flush(t);
+  ASSERT_TRUE(w.disk_full());
+  EXPECT_GT(failed, 300);
+  EXPECT_EQ(w.counters().write_errors, 1);  // one error however long the disk stays full
+  EXPECT_EQ(w.counters().disk_full_episodes, 1);
+  EXPECT_NE(w.last_error().find(w.current_path()), std::string::npos) << w.last_error();
+  EXPECT_NE(w.last_error().find("No space left on device"), std::string::npos) << w.last_error();
+  EXPECT_EQ(w.make_status(t).state, "disk full");
+  ASSERT_EQ(w.files().size(), 1u);
+  EXPECT_EQ(problems_in(w.current_path()), 0);  // cut at its last whole event
+  const auto before = data_events(read_with_logfile(w.current_path()), o.status_channel).size();
+  EXPECT_GT(before, 20u);
+  EXPECT_EQ(std::int64_t(before) + w.counters().events_lost, 400);
+  EXPECT_EQ(w.counters().events, std::int64_t(before));
+
+  // Space returns: after the retry interval the events go into the same file.
+  ASSERT_EQ(std::remove(filler.c_str()), 0);
+  t += 1'100'000;
+  for (int i = 400; i < 450; ++i, t += 1000) EXPECT_TRUE(w.write(t, "CH", payload(i, 1000).data(), 1000, t));
+  EXPECT_FALSE(w.disk_full());
+  EXPECT_EQ(w.make_status(t).state, "running");
+  w.close(t);
+  ASSERT_EQ(w.files().size(), 1u);
+  EXPECT_EQ(problems_in(w.files().front()), 0);
+  const auto all = read_with_logfile(w.files().front());
+  const auto data = data_events(all, o.status_channel);
+  ASSERT_EQ(data.size(), before + 50);
+  EXPECT_EQ(data.back().data, payload(449, 1000));
+  const auto st = status_events(all, o.status_channel);
+  const auto resumed = std::find_if(st.begin(), st.end(), [](const status_t& s) { return s.state == "resumed"; });
+  ASSERT_NE(resumed, st.end());
+  EXPECT_EQ(find_counter(*resumed, "events_lost"), 400 - std::int64_t(before));
+  EXPECT_NE(resumed->last_error.find("No space left on device"), std::string::npos);
 }
 
 TEST(EventLogWriter, CountsSampleSequenceGapsPerBench) {

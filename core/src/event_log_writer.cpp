@@ -8,6 +8,8 @@
 #include <fcntl.h>
 #include <fmt/format.h>
 #include <lcm/eventlog.h>
+#include <stdio_ext.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include <spindown/samples_t.hpp>
@@ -23,6 +25,8 @@ namespace {
 constexpr std::int64_t kEventHeaderBytes = 4 + 8 + 8 + 4 + 4;
 
 std::string errno_text(int err) { return std::strerror(err); }
+
+bool is_out_of_space(int err) { return err == ENOSPC || err == EDQUOT; }
 
 std::string instance_name(const EventLogWriterOptions& o) {
   if (!o.instance.empty()) return o.instance;
@@ -111,11 +115,16 @@ void EventLogWriter::open_new_file(std::int64_t now_us) {
   file_events_ = 0;
   pending_bytes_ = 0;
   unflushed_events_ = 0;
+  committed_bytes_ = 0;
+  committed_eventcount_ = 0;
+  committed_file_events_ = 0;
+  disk_full_ = false;
   write_status_event(now_us, "opened");
 }
 
 bool EventLogWriter::rotation_due(std::int64_t now_us, std::int64_t next_event_bytes) const {
   if (!log_ || file_events_ == 0) return false;  // never leave a file with no events
+  if (disk_full_) return false;                   // a new file would not fit either
   if (o_.rotate_size_mb > 0 && double(file_bytes_ + next_event_bytes) > o_.rotate_size_mb * 1e6) return true;
   if (o_.rotate_time_s > 0 && double(now_us - file_open_us_) >= o_.rotate_time_s * 1e6) return true;
   return false;
@@ -124,6 +133,11 @@ bool EventLogWriter::rotation_due(std::int64_t now_us, std::int64_t next_event_b
 bool EventLogWriter::write(std::int64_t recv_utime, std::string_view channel, const void* data,
                            std::int32_t size, std::int64_t now_us) {
   track_samples(channel, data, size);
+  resume_if_due(now_us);
+  if (disk_full_) {
+    ++counters_.events_lost;
+    return false;
+  }
   if (!log_ && now_us >= next_reopen_us_) {
     try {
       open_new_file(now_us);
@@ -187,6 +201,9 @@ bool EventLogWriter::fflush_pending(std::int64_t now_us) {
   ++counters_.flushes;
   pending_bytes_ = 0;
   unflushed_events_ = 0;
+  committed_bytes_ = file_bytes_;
+  committed_eventcount_ = log_->eventcount;
+  committed_file_events_ = file_events_;
   return true;
 }
 
@@ -207,7 +224,29 @@ bool EventLogWriter::flush(std::int64_t now_us) {
 }
 
 void EventLogWriter::tick(std::int64_t now_us) {
+  resume_if_due(now_us);
   if (rotation_due(now_us, 0)) rotate(now_us, "rotating");
+}
+
+void EventLogWriter::resume_if_due(std::int64_t now_us) {
+  if (!disk_full_ || !log_ || now_us < next_reopen_us_) return;
+  // Space is back when a buffer's worth is free: the last page of the file may still take a
+  // small event while the disk is full, and writing on into it would only fill it again.
+  struct statvfs fs {};
+  if (::fstatvfs(fileno(log_->f), &fs) == 0 && double(fs.f_bavail) * double(fs.f_frsize) < double(o_.buffer_bytes)) {
+    next_reopen_us_ = now_us + static_cast<std::int64_t>(o_.reopen_interval_s * 1e6);
+    return;
+  }
+  // A status event is the probe: when it reaches the kernel, space is back, and the log says
+  // so with the counters of what was lost meanwhile. When it does not, pause_for_space cuts it
+  // off again and waits another interval (no new error: the same disk is still full).
+  const std::int64_t written = counters_.status_events;
+  write_status_event(now_us, "resumed");
+  if (counters_.status_events == written) return;  // it did not fit in the file's buffer
+  if (fflush_pending(now_us))
+    disk_full_ = false;
+  else
+    --counters_.status_events;  // cut off again
 }
 
 void EventLogWriter::rotate(std::int64_t now_us, std::string_view why) {
@@ -242,7 +281,47 @@ void EventLogWriter::write_status_event(std::int64_t now_us, std::string_view st
 }
 
 void EventLogWriter::fail(std::int64_t now_us, std::string what, int err) {
+  if (log_ && is_out_of_space(err)) {
+    pause_for_space(now_us, what, err);
+    return;
+  }
   fail_text(now_us, fmt::format("{}: {}", what, errno_text(err)));
+}
+
+// Drops what did not reach the file (the stdio buffer, and any part of an event the kernel
+// took before the disk filled), so the file ends on the last whole event flushed.
+bool EventLogWriter::cut_back_to_committed() {
+  std::FILE* f = log_->f;
+  __fpurge(f);
+  std::clearerr(f);
+  if (::ftruncate(fileno(f), committed_bytes_) != 0 || ::fseeko(f, committed_bytes_, SEEK_SET) != 0) return false;
+  log_->eventcount = committed_eventcount_;
+  counters_.bytes -= file_bytes_ - committed_bytes_;
+  file_bytes_ = committed_bytes_;
+  file_events_ = committed_file_events_;
+  return true;
+}
+
+void EventLogWriter::pause_for_space(std::int64_t now_us, const std::string& what, int err) {
+  const std::int64_t lost = unflushed_events_;
+  unflushed_events_ = 0;
+  pending_bytes_ = 0;
+  if (!cut_back_to_committed()) {
+    unflushed_events_ = lost;  // counted as lost by fail_text
+    fail_text(now_us, fmt::format("{}: {}; and cutting it back to its last whole event failed: {}", what,
+                                  errno_text(err), errno_text(errno)));
+    return;
+  }
+  counters_.events -= lost;  // not in the file: lost, not written
+  counters_.events_lost += lost;
+  next_reopen_us_ = now_us + static_cast<std::int64_t>(o_.reopen_interval_s * 1e6);
+  if (disk_full_) return;  // still full: said once per episode
+  disk_full_ = true;
+  ++counters_.disk_full_episodes;
+  ++counters_.write_errors;
+  last_error_ = fmt::format("{}: {}: events are counted as lost until space returns, then written on to the same file",
+                            what, errno_text(err));
+  last_error_utime_ = now_us;
 }
 
 void EventLogWriter::fail_text(std::int64_t now_us, std::string text) {
@@ -287,7 +366,7 @@ void EventLogWriter::track_samples(std::string_view channel, const void* data, s
 }
 
 status_t EventLogWriter::make_status(std::int64_t now_us) const {
-  status_.set_state(log_ ? "running" : (files_.empty() ? "starting" : "error"));
+  status_.set_state(log_ ? (disk_full_ ? "disk full" : "running") : (files_.empty() ? "starting" : "error"));
   const std::pair<const char*, std::int64_t> counters[] = {
       {"events", counters_.events},
       {"bytes", counters_.bytes},
@@ -303,6 +382,7 @@ status_t EventLogWriter::make_status(std::int64_t now_us) const {
       {"samples_missing", counters_.samples_missing},
       {"seq_repeats", counters_.seq_repeats},
       {"benches_untracked", counters_.benches_untracked},
+      {"disk_full_episodes", counters_.disk_full_episodes},
   };
   for (const auto& [name, value] : counters) status_.set_counter(name, value);
   status_.set_gauge("queue_depth", queue_depth_);

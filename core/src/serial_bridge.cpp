@@ -77,6 +77,7 @@ void SerialBridge::connected(std::int64_t now_us) {
   if (ever_connected_) ++counters_.reconnects;
   ever_connected_ = true;
   connected_ = true;
+  forget_wrong_baud();
   state_ = "connected";
   next_status_us_ = now_us;  // say so now, not at the next heartbeat
   tick(now_us);
@@ -87,6 +88,7 @@ void SerialBridge::disconnected(std::int64_t now_us, std::string_view why) {
   if (splitter_.reset() > 0) ++counters_.partial_lines;
   if (connected_) ++counters_.disconnects;
   connected_ = false;
+  forget_wrong_baud();
   state_ = "disconnected";
   error(std::string(why), now_us);
   next_status_us_ = now_us;
@@ -112,8 +114,41 @@ void SerialBridge::error(std::string text, std::int64_t now_us) {
 void SerialBridge::feed(std::string_view bytes, std::int64_t now_us) {
   feed_start_ns_ = steady_ns();
   counters_.bytes += static_cast<std::int64_t>(bytes.size());
+  bytes_since_good_ += static_cast<std::int64_t>(bytes.size());
+  for (const char ch : bytes) {
+    const auto c = static_cast<unsigned char>(ch);
+    if (!(c == '\t' || c == '\r' || c == '\n' || (c >= 0x20 && c < 0x7f))) ++nontext_since_good_;
+  }
   splitter_.feed(bytes, [&](const LineSplitter::Line& line) { on_line(line, now_us); });
   flush();
+  check_wrong_baud(now_us);
+}
+
+void SerialBridge::good_line(std::int64_t now_us) {
+  ++counters_.lines_good;
+  bytes_since_good_ = 0;
+  nontext_since_good_ = 0;
+  if (!wrong_baud_) return;
+  forget_wrong_baud();
+  if (connected_) state_ = "connected";
+  next_status_us_ = now_us;  // say so now
+}
+
+void SerialBridge::forget_wrong_baud() {
+  wrong_baud_ = false;
+  bytes_since_good_ = 0;
+  nontext_since_good_ = 0;
+}
+
+void SerialBridge::check_wrong_baud(std::int64_t now_us) {
+  if (wrong_baud_ || !connected_ || bytes_since_good_ < wrong_baud_bytes || nontext_since_good_ * 4 < bytes_since_good_)
+    return;
+  wrong_baud_ = true;
+  const char* hint = s_.baud == 9600 ? "spindown-v1 firmware uses 115200" : "the lab sketch uses 9600";
+  state_ = fmt::format("no valid line in {} bytes at {} baud — wrong baud? {}", bytes_since_good_, s_.baud, hint);
+  error(fmt::format("{}: {} ({}% of them not text)", s_.device, state_, 100 * nontext_since_good_ / bytes_since_good_),
+        now_us);
+  next_status_us_ = now_us;  // say so now
 }
 
 void SerialBridge::on_line(const LineSplitter::Line& line, std::int64_t now_us) {
@@ -155,7 +190,7 @@ void SerialBridge::on_lab_line(std::string_view text, std::int64_t now_us) {
     case LabLine::Kind::garbled: bad_line(text, l.why, now_us); return;
     case LabLine::Kind::sample: break;
   }
-  ++counters_.lines_good;
+  good_line(now_us);
   set_protocol(WireProtocol::lab, now_us);
   const auto r = clock_.update(static_cast<std::uint64_t>(l.millis));
   add_sample(r, now_us, l.value, -1);
@@ -166,9 +201,9 @@ void SerialBridge::on_spindown_line(std::string_view text, std::int64_t now_us) 
   switch (l.kind) {
     case SpindownLine::Kind::blank: ++counters_.lines_blank; return;
     case SpindownLine::Kind::garbled: bad_line(text, l.why, now_us); return;
-    case SpindownLine::Kind::note: ++counters_.lines_good; return;
+    case SpindownLine::Kind::note: good_line(now_us); return;
     case SpindownLine::Kind::banner:
-      ++counters_.lines_good;
+      good_line(now_us);
       set_protocol(WireProtocol::spindown_v1, now_us);
       banner_ = l.banner;
       banner_seen_ = true;
@@ -182,7 +217,7 @@ void SerialBridge::on_spindown_line(std::string_view text, std::int64_t now_us) 
     bad_line(text, "ADC count above the converter's range", now_us);
     return;
   }
-  ++counters_.lines_good;
+  good_line(now_us);
   set_protocol(WireProtocol::spindown_v1, now_us);
   const auto r = clock_.update(l.time_us);
   if (have_device_seq_ && !r.reset) {

@@ -106,6 +106,7 @@ int main(int argc, char** argv) {
   const auto retry_every = std::chrono::microseconds(static_cast<long>(retry_s * 1e6));
   auto next_try = std::chrono::steady_clock::now();
   std::string last_open_error;
+  bool said_wrong_baud = false;
   int rc = 0;
   while (!g_stop) {
     if (!port.is_open()) {
@@ -138,9 +139,17 @@ int main(int argc, char** argv) {
     try {
       const std::size_t got = port.read_some(buf, std::chrono::milliseconds(100));
       if (got > 0) bridge.feed(std::string_view(buf.data(), got), wall_us());
+      if (bridge.looks_like_wrong_baud() != said_wrong_baud) {  // said once, and once when it ends
+        said_wrong_baud = bridge.looks_like_wrong_baud();
+        if (said_wrong_baud)
+          fmt::print(stderr, "spindown-bridge: {}: {}\n", s.device, bridge.state());
+        else
+          fmt::print(stderr, "spindown-bridge: {}: valid lines again at {} baud\n", s.device, s.baud);
+      }
     } catch (const spindown::SerialError& e) {
       port.close();
       bridge.disconnected(wall_us(), e.what());
+      said_wrong_baud = false;  // a new connection starts afresh
       fmt::print(stderr, "spindown-bridge: {}; reopening\n", e.what());
       next_try = std::chrono::steady_clock::now();  // try at once, then every retry interval
     }

@@ -10,6 +10,7 @@
 #include "spindown/explain_message.hpp"
 #include "spindown/fit_message.hpp"
 #include "spindown/lcm_channels.hpp"
+#include "spindown/network_checks.hpp"
 
 namespace spindown {
 
@@ -53,6 +54,15 @@ void FitterService::enqueue(const lcm_recv_buf_t* rbuf, const char* channel) {
   const std::size_t size = rbuf->data_size;
   {
     std::lock_guard lock(mu_);
+    // A message larger than the whole queue may hold is no sign of a full queue: LCM 1.3.1
+    // assembles a fragmented message of whatever size its first fragment claims (up to 256 MB),
+    // and a first fragment that also claims to be the only one is delivered at once, the rest
+    // of the claimed size left zero — one forged 1 kB datagram becomes a 100 MB message.
+    if (size > opt_.max_queue_bytes) {
+      ++oversize_drops_;
+      oversize_last_ = fmt::format("{} bytes on {}", size, channel);
+      return;
+    }
     if (queue_.size() >= opt_.max_queue_messages || queue_bytes_ + size > opt_.max_queue_bytes) {
       ++queue_drops_;
       return;
@@ -133,12 +143,15 @@ void FitterService::publish_status(std::int64_t now_us, const char* state) {
   status_t s = core_.make_status(now_us, opt_.instance, host_, static_cast<std::int32_t>(::getpid()), state,
                                  1e-6 * double(now_us - start_us_));
   std::size_t depth = 0, high = 0;
-  std::int64_t drops = 0;
+  std::int64_t drops = 0, oversize = 0;
+  std::string oversize_last;
   {
     std::lock_guard lock(mu_);
     depth = queue_.size();
     high = queue_high_water_;
     drops = queue_drops_;
+    oversize = oversize_drops_;
+    oversize_last = oversize_last_;
   }
   const std::int64_t samples = core_.counters().samples;
   if (last_rate_us_ > 0 && now_us > last_rate_us_)
@@ -147,12 +160,20 @@ void FitterService::publish_status(std::int64_t now_us, const char* state) {
   last_samples_ = samples;
   s.counter_name.emplace_back("queue_drops");
   s.counter_value.push_back(drops);
+  s.counter_name.emplace_back("oversize_drops");
+  s.counter_value.push_back(oversize);
   s.counter_name.emplace_back("publish_failures");
   s.counter_value.push_back(publish_failures_);
   s.counter_name.emplace_back("explains");
   s.counter_value.push_back(explains_);
   s.counter_name.emplace_back("explain_failures");
   s.counter_value.push_back(explain_failures_);
+  // Datagrams the kernel dropped on the fitter's own sockets (a full receive buffer): lost
+  // before LCM read them, so only sequence gaps would show them otherwise.
+  if (const auto kernel = own_udp_socket_drops()) {
+    s.counter_name.emplace_back("udp_drops");
+    s.counter_value.push_back(kernel->drops);
+  }
   s.ncounters = static_cast<std::int32_t>(s.counter_name.size());
   const std::pair<const char*, double> gauges[] = {
       {"sample_rate_hz", rate_hz_},           {"queue_depth", double(depth)},
@@ -164,6 +185,10 @@ void FitterService::publish_status(std::int64_t now_us, const char* state) {
     s.gauge_value.push_back(value);
   }
   s.ngauges = static_cast<std::int32_t>(s.gauge_name.size());
+  if (s.last_error.empty() && oversize > 0)
+    s.last_error = fmt::format("{} messages dropped: larger than the receive queue's limit of {} bytes (last: {}; "
+                               "a forged LCM fragment header claims any size)",
+                               oversize, opt_.max_queue_bytes, oversize_last);
   if (s.last_error.empty() && drops > 0) s.last_error = fmt::format("{} messages dropped: receive queue full", drops);
   if (lcm_.publish(channel_name(opt_.instance, ChannelKind::status), &s) != 0) ++publish_failures_;
 }
@@ -240,10 +265,11 @@ int FitterService::run(const std::atomic<bool>& stop_flag) {
   fmt::print(stderr,
              "spindown-fitter: stopped: {} benches, {} samples, {} runs, {} fits, {} decode errors, {} sequence gaps, "
              "{} duplicates, {} NaN values, {} time backwards, {} benches evicted, {} benches refused, {} partial runs, "
-             "{} silent benches, {} flood drops, {} queue drops\n",
+             "{} silent benches, {} flood drops, {} queue drops, {} oversize drops, {} datagrams dropped by the kernel "
+             "on the fitter's socket\n",
              core_.bench_count(), c.samples, c.runs, c.fits, c.decode_errors, c.seq_gaps, c.duplicates, c.nan_values,
              c.time_backwards, c.dropped_benches, c.benches_refused, c.partial_runs, c.silent_benches, c.flood_drops,
-             queue_drops_);
+             queue_drops_, oversize_drops_, own_udp_socket_drops().value_or(UdpSocketDrops{0, -1}).drops);
   return 0;
 }
 

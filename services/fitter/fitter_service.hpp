@@ -72,6 +72,8 @@ class FitterService final : public FitterSink {
   std::deque<Message> queue_;
   std::size_t queue_bytes_ = 0;
   std::int64_t queue_drops_ = 0;       // messages dropped because the queue was full
+  std::int64_t oversize_drops_ = 0;    // messages larger than the queue's byte limit
+  std::string oversize_last_;          // the last of them: "<size> bytes on <channel>"
   std::size_t queue_high_water_ = 0;
   bool stopping_ = false;
 

@@ -10,14 +10,13 @@
 #include <fmt/format.h>
 #include <lcm/lcm-cpp.hpp>
 #include <cstdio>
-#include <cstring>
 #include <pthread.h>
-#include <sstream>
 
 #include "spindown/event_log_writer.hpp"
 #include "spindown/lcm_status.hpp"
 #include "spindown/lcm_url.hpp"
 #include "spindown/log_recorder.hpp"
+#include "spindown/network_checks.hpp"
 
 namespace {
 
@@ -29,26 +28,6 @@ std::int64_t wall_us() {
       .count();
 }
 
-
-// Datagrams the kernel dropped because a UDP receive buffer was full, in this network
-// namespace (all sockets, not only ours): the part of LCM's loss that can be seen at all.
-long udp_receive_buffer_errors() {
-  std::FILE* f = std::fopen("/proc/net/snmp", "r");
-  if (!f) return -1;
-  char header[1024], values[1024];
-  long result = -1;
-  while (std::fgets(header, sizeof header, f) && std::fgets(values, sizeof values, f)) {
-    if (std::strncmp(header, "Udp:", 4) != 0) continue;
-    std::istringstream names(header + 4), numbers(values + 4);
-    std::string name;
-    long value = 0;
-    while (names >> name && numbers >> value)
-      if (name == "RcvbufErrors") result = value;
-    break;
-  }
-  std::fclose(f);
-  return result;
-}
 
 // A plain C callback on lcm_subscribe: LCM 1.3.1's C++ subscribe templates trip UBSan's vptr
 // check inside LCM's own header, and a raw subscription is all the logger needs.
@@ -155,14 +134,20 @@ int main(int argc, char** argv) {
                w.rotate_time_s > 0 ? fmt::format(", rotate every {} s", w.rotate_time_s) : "");
 
   spindown::StatusHeartbeat beat("logger", "", start);  // only its schedule is used
-  std::string reported_error;
-  const long rcvbuf_errors_at_start = udp_receive_buffer_errors();
+  std::string reported_error, reported_state;
+  std::int64_t lost_when_full = 0;
+  // Datagrams the kernel dropped on the logger's own sockets (its receive buffer was full):
+  // traffic that never reached the logger, so no counter of its own can see it.
+  auto kernel_drops = [] {
+    const auto d = spindown::own_udp_socket_drops();
+    return d ? d->drops : std::int64_t{-1};
+  };
   auto heartbeat = [&](std::int64_t now, const char* state) {
     spindown::status_t st = recorder.status(now);
     if (state) st.state = state;
-    if (rcvbuf_errors_at_start >= 0) {
-      st.gauge_name.emplace_back("udp_rcvbuf_errors_netns");
-      st.gauge_value.push_back(double(udp_receive_buffer_errors() - rcvbuf_errors_at_start));
+    if (const std::int64_t drops = kernel_drops(); drops >= 0) {
+      st.gauge_name.emplace_back("udp_drops");
+      st.gauge_value.push_back(double(drops));
       st.ngauges = static_cast<std::int32_t>(st.gauge_name.size());
     }
     lcm.publish(w.status_channel, &st);
@@ -171,6 +156,15 @@ int main(int argc, char** argv) {
       reported_error = st.last_error;
       if (!reported_error.empty()) fmt::print(stderr, "spindown-logger: {}\n", reported_error);
     }
+    // A full disk is said once when it fills (last_error above) and once when space is back.
+    const std::int64_t lost = spindown::find_counter(st, "events_lost").value_or(0);
+    if (st.state == "disk full" && reported_state != "disk full") lost_when_full = lost;
+    if (reported_state == "disk full" && st.state == "running")
+      fmt::print(stderr,
+                 "spindown-logger: space is back: writing on to the same file ({} events lost while the disk was "
+                 "full)\n",
+                 lost - lost_when_full);
+    reported_state = st.state;
   };
   while (!g_stop) {
     lcm.handleTimeout(100);
@@ -192,9 +186,9 @@ int main(int argc, char** argv) {
   if (!quiet) {
     fmt::print(stderr,
                "spindown-logger: stopped: {} events, {} bytes in {} files, {} drops, {} write errors, "
-               "{} samples missing by sequence number, {} datagrams dropped by the kernel in this network namespace\n",
+               "{} samples missing by sequence number, {} datagrams dropped by the kernel on the logger's socket\n",
                c.events, c.bytes, c.files, c.queue_drops + c.events_lost, c.write_errors, c.samples_missing,
-               rcvbuf_errors_at_start >= 0 ? udp_receive_buffer_errors() - rcvbuf_errors_at_start : -1);
+               kernel_drops());
     for (const auto& f : writer.files()) fmt::print(stderr, "spindown-logger: wrote {}\n", f);
   }
   if (c.write_errors > 0) {

@@ -206,6 +206,66 @@ PY
 then echo "FAIL mixed files --json: exit $rc"; fail=1; fi
 echo "ok mixed files (exit 1)"
 
+# Live, on the network: one 1 kB datagram whose LCM fragment header claims a 100 MB message.
+# LCM 1.3.1 (lcm_udpm.c) takes the claimed size as it is, up to LCM_MAX_MESSAGE_SIZE (256 MB):
+# it mallocs a fragment buffer that large (address space only: untouched pages cost no memory)
+# and, when the header also claims that this is the message's only fragment, delivers it at
+# once: a 100 MB message, zeros past the first kB. Claiming more fragments, the buffer waits
+# for fragments that never come until later ones evict it: nothing is delivered and LCM says
+# nothing (its "rejecting huge message" is a debug print, for claims above 256 MB only).
+# spindown-fitter must name the delivered one as too large for its queue (before: "receive
+# queue full"), say nothing of the other, and stay small. Private network namespace, ttl=0.
+if ! unshare -n true 2>/dev/null; then
+  echo "skip forged fragment header: cannot create a network namespace (unshare -n)"
+elif ! unshare -n bash -s -- "$(dirname "$bin")" "$tmp" <<'LIVE'; then fail=1; fi
+set -euo pipefail
+B=$1 T=$2
+ip link set lo up
+ip route add 224.0.0.0/4 dev lo
+URL='udpm://239.255.76.67:7667?ttl=0'
+"$B/spindown-bridge-tap" --bench fitter --lcm-url "$URL" --status "$T/fitter.status.jsonl" --timeout 30 \
+  --ready "$T/tap.ready" </dev/null 2>/dev/null &
+tap=$!
+"$B/spindown-fitter" --lcm-url "$URL" --status-period 0.2 </dev/null 2>"$T/fitter.err" &
+fitter=$!
+trap 'kill -KILL $tap $fitter 2>/dev/null || true' EXIT
+for _ in $(seq 100); do [[ -e "$T/tap.ready" ]] && grep -qs fitter "$T/fitter.status.jsonl" && break; sleep 0.05; done
+rss_kb() { awk '/^VmRSS/ {print $2}' "/proc/$fitter/status"; }
+# send CLAIMED_FRAGMENTS SEQNO: the forged datagram (header "LC03", seqno, 100 MB, offset 0,
+# fragment 0 of CLAIMED_FRAGMENTS, a bench's SAMPLE channel, 1000 bytes).
+send() {
+  python3 - "$1" "$2" <<'PY'
+import socket, struct, sys
+s = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+s.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 0)
+s.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
+header = struct.pack(">IIIIHH", 0x4C433033, int(sys.argv[2]), 100_000_000, 0, 0, int(sys.argv[1]))
+s.sendto(header + b"SPINDOWN.hostile.SAMPLE\0" + b"\x5a" * 1000, ("239.255.76.67", 7667))
+PY
+}
+# last_status EXPR: a Python expression over the fitter's last heartbeat d.
+last_status() { python3 -c "import json,sys; d=[json.loads(l) for l in open(sys.argv[1])][-1]; print($1)" "$T/fitter.status.jsonl"; }
+rss0=$(rss_kb)
+send 65535 1  # 100 MB in 65535 fragments (the most a header can say): only the first ever comes
+sleep 0.6
+[[ $(last_status 'd["counters"]["oversize_drops"], d["counters"]["queue_drops"], d["last_error"]') == "0 0 " ]] ||
+  { echo "FAIL forged fragment header (more fragments claimed): $(last_status 'd["counters"], d["last_error"]')"; exit 1; }
+rss1=$(rss_kb)
+send 1 2  # 100 MB claimed to be in this one fragment
+sleep 0.6
+rss2=$(rss_kb)
+want="1 messages dropped: larger than the receive queue's limit of 67108864 bytes (last: 100000000 bytes on SPINDOWN.hostile.SAMPLE"
+got=$(last_status 'd["last_error"]')
+[[ $got == "$want"* && $(last_status 'd["counters"]["oversize_drops"], d["counters"]["queue_drops"]') == "1 0" ]] ||
+  { echo "FAIL forged fragment header (one fragment claimed): $(last_status 'd["counters"]["oversize_drops"], d["counters"]["queue_drops"]'), '$got'"; exit 1; }
+(( rss2 - rss0 < 20000 )) || { echo "FAIL forged fragment header: the fitter grew from $rss0 to $rss2 kB"; exit 1; }
+kill -TERM $fitter
+wait $fitter
+grep -q "0 queue drops, 1 oversize drops" "$T/fitter.err" || { echo "FAIL forged fragment header: stop summary: $(tail -1 "$T/fitter.err")"; exit 1; }
+echo "ok forged fragment header claiming 100 MB: more fragments claimed: nothing delivered, nothing said;" \
+  "one claimed: '$got'; fitter VmRSS $rss0 -> $rss1 -> $rss2 kB"
+LIVE
+
 if ((write_doc)); then
   ((fail == 0)) || { echo "hostile_inputs.sh: not writing $doc while a case fails" >&2; exit 1; }
   mkdir -p "$(dirname "$doc")"
@@ -229,6 +289,14 @@ beyond the first 20 problem lines are summarised as a count.
 EOF
     printf '%s\n' "${rows[@]}"
     cat <<'EOF'
+
+Live, `spindown-fitter` is sent one 1 kB datagram whose LCM fragment header claims a 100 MB
+message. LCM 1.3.1 believes the claim (up to 256 MB): claiming more fragments, it waits for
+them and delivers nothing; claiming this one fragment, it delivers a 100 MB message at once
+(zeros past the first kB). The fitter drops that one and says `1 messages dropped: larger than
+the receive queue's limit of 67108864 bytes (last: 100000000 bytes on SPINDOWN.hostile.SAMPLE;
+…)`, using no memory for it. (spindown-logger records such a message as it came: 100 MB in the
+log for 1 kB on the wire.)
 
 Below the CLI, the parsers and decoders are fuzzed continuously (`fuzz/`, see README's
 Robustness section); every crash the fuzzers found has a regression case in `tests/` and its

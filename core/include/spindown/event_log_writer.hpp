@@ -12,8 +12,12 @@
 // - a status_t event on the status channel at the start and end of every file, after a write
 //   error and at exit, so the log itself says what the logger saw (events, drops, errors);
 // - sequence gaps of samples_t per bench (what it can see of loss upstream of the logger);
-// - write errors (disk full, directory removed) are counted with the path and errno text; the
-//   file is closed and a new one tried every reopen_interval_s.
+// - a full disk (ENOSPC, EDQUOT) keeps the file: what did not fit is cut off at the last whole
+//   event (the file stays a valid log), events are counted as lost while the disk stays full
+//   (state "disk full", one error naming the file), and every reopen_interval_s a status event
+//   tries whether space is back; then writing goes on in the same file;
+// - other write errors (directory removed, I/O error) are counted with the path and errno text;
+//   the file is closed and a new one tried every reopen_interval_s.
 #include <cstdint>
 #include <cstdio>
 #include <ctime>
@@ -67,6 +71,7 @@ struct EventLogCounters {
   std::int64_t samples_missing = 0;  // samples missing by sequence number
   std::int64_t seq_repeats = 0;      // SAMPLE messages with a sequence number already seen (restart, duplicate)
   std::int64_t benches_untracked = 0;// SAMPLE messages of benches beyond max_tracked_benches
+  std::int64_t disk_full_episodes = 0;  // times the disk filled up (each one write error)
 };
 
 // File name for a log opened at unix_time (local time), without the directory; suffix 0 = none.
@@ -105,6 +110,7 @@ class EventLogWriter {
   status_t make_status(std::int64_t now_us) const;
 
   bool is_open() const { return log_ != nullptr; }
+  bool disk_full() const { return disk_full_; }  // waiting for space, the file kept open
   bool has_unflushed() const { return unflushed_events_ > 0 || pending_bytes_ > 0; }
   const EventLogCounters& counters() const { return counters_; }
   const std::string& current_path() const { return path_; }
@@ -124,6 +130,9 @@ class EventLogWriter {
   void write_status_event(std::int64_t now_us, std::string_view state);
   void fail(std::int64_t now_us, std::string what, int err);
   void fail_text(std::int64_t now_us, std::string text);
+  void pause_for_space(std::int64_t now_us, const std::string& what, int err);
+  bool cut_back_to_committed();
+  void resume_if_due(std::int64_t now_us);
   void track_samples(std::string_view channel, const void* data, std::int32_t size);
   bool rotation_due(std::int64_t now_us, std::int64_t next_event_bytes) const;
 
@@ -139,6 +148,11 @@ class EventLogWriter {
   std::int64_t pending_bytes_ = 0;      // written to the FILE* buffer, not yet to the kernel
   std::int64_t unflushed_events_ = 0;   // received events among them
   std::int64_t next_reopen_us_ = 0;
+  // The file as it was after the last successful flush: whole events only.
+  std::int64_t committed_bytes_ = 0;
+  std::int64_t committed_eventcount_ = 0;
+  std::int64_t committed_file_events_ = 0;
+  bool disk_full_ = false;
   double queue_depth_ = 0;
   EventLogCounters counters_;
   std::unordered_map<std::string, std::int64_t> next_seq_;  // bench -> expected samples_t.seq

@@ -66,6 +66,19 @@ DoctorCheck check_receive_buffer(std::optional<long> rmem_max, std::optional<lon
 // Udp RcvbufErrors from the text of /proc/net/snmp.
 std::optional<long> parse_udp_rcvbuf_errors(std::string_view proc_net_snmp);
 
+// Datagrams the kernel dropped on particular UDP sockets (a full receive buffer, a bad
+// checksum): the `drops` column of /proc/net/udp and udp6, unlike RcvbufErrors, which counts
+// every socket of the network namespace (another program's drops too).
+struct UdpSocketDrops {
+  std::size_t sockets = 0;  // sockets found among the inodes asked for
+  std::int64_t drops = 0;   // their drops, summed
+};
+// From the text of /proc/net/udp or /proc/net/udp6: the lines whose inode is one of inodes.
+UdpSocketDrops parse_udp_socket_drops(std::string_view proc_net_udp, const std::vector<std::uint64_t>& inodes);
+// This process's own UDP sockets: the inodes of /proc/self/fd's "socket:[N]" links, looked up
+// in /proc/self/net/udp and udp6. Nullopt when /proc cannot be read.
+std::optional<UdpSocketDrops> own_udp_socket_drops();
+
 // The firewall as `nft list ruleset` and/or `iptables-save` print it (nullopt: not available;
 // unreadable is the caller's skip). fail: a rule that drops or rejects the LCM port, the group,
 // 224.0.0.0/4, multicast, all UDP or everything, before any rule accepting LCM; warn: a chain

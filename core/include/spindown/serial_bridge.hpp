@@ -7,6 +7,11 @@
 // the lab sketch's "millis<TAB>volts" (lab_line.hpp). The protocol is detected from the lines
 // themselves and may change (a reflashed board). Only lines that parse become samples; every
 // other line is counted and the last one reported with the reason.
+//
+// A wrong baud rate garbles every byte: no line is ever valid and most bytes are not text. Once
+// wrong_baud_bytes arrived since the last valid line and at least a quarter of them are not
+// text, the state says so ("no valid line in N bytes at B baud — wrong baud? …"), in the status
+// and last_error, until a valid line arrives. (A long line of text is not a baud problem.)
 #include <array>
 #include <cstdint>
 #include <string>
@@ -70,6 +75,10 @@ class SerialBridge {
   const BridgeCounters& counters() const { return counters_; }
   WireProtocol protocol() const { return protocol_; }
   bool is_connected() const { return connected_; }
+  const std::string& state() const { return state_; }
+  // No valid line in wrong_baud_bytes, mostly not text (state() says what and why).
+  bool looks_like_wrong_baud() const { return wrong_baud_; }
+  static constexpr std::int64_t wrong_baud_bytes = 256;
   std::int64_t next_seq() const { return next_seq_; }
   const std::string& last_error() const { return last_error_; }
   std::size_t buffered_bytes() const { return splitter_.buffered(); }
@@ -87,6 +96,9 @@ class SerialBridge {
   void add_sample(const DeviceClock::Reading& r, std::int64_t host_us, double value, std::int32_t raw);
   void flush();
   void bad_line(std::string_view text, std::string_view why, std::int64_t now_us);
+  void good_line(std::int64_t now_us);
+  void check_wrong_baud(std::int64_t now_us);
+  void forget_wrong_baud();
   void error(std::string text, std::int64_t now_us);
 
   BridgeSettings s_;
@@ -111,6 +123,9 @@ class SerialBridge {
   std::string last_error_;
   std::int64_t last_error_utime_ = 0;
   std::int64_t lines_seen_ = 0;
+  std::int64_t bytes_since_good_ = 0;    // bytes since the last valid line (or the connect)
+  std::int64_t nontext_since_good_ = 0;  // of them, not printable ASCII, tab, CR or LF
+  bool wrong_baud_ = false;
 
   std::int64_t start_us_ = 0;
   std::int64_t next_status_us_ = 0;
