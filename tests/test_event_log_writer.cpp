@@ -453,6 +453,32 @@ TEST(LogRecorder, DropsPastTheQueueAreCountedInStatusAndLog) {
   EXPECT_EQ(find_counter(st.back(), "drops"), 7);
 }
 
+// A message larger than max_event_bytes (LCM assembling what a forged fragment header claims)
+// is not recorded: counted as oversize_drops, named in the status and the log's heartbeat; the
+// messages around it are kept.
+TEST(LogRecorder, AnOversizeMessageIsCountedAndNamedNotRecorded) {
+  TempDir dir;
+  EventLogWriter w(options_in(dir), kT0);
+  w.open(kT0);
+  LogRecorderOptions ro;
+  ro.max_event_bytes = 4096;
+  LogRecorder r(w, ro);
+  r.start();
+  const std::vector<char> big(5000, 'z');
+  EXPECT_TRUE(r.offer(kT0, "CH", payload(0).data(), 100));
+  EXPECT_FALSE(r.offer(kT0 + 1, "SPINDOWN.x.SAMPLE", big.data(), static_cast<std::int32_t>(big.size())));
+  EXPECT_TRUE(r.offer(kT0 + 2, "CH", payload(1).data(), 100));
+  r.stop("stopped");
+  EXPECT_EQ(w.counters().events, 2);
+  EXPECT_EQ(w.counters().oversize_drops, 1);
+  const auto st = status_events(read_with_logfile(w.files().front()), w.options().status_channel);
+  ASSERT_FALSE(st.empty());
+  EXPECT_EQ(find_counter(st.back(), "oversize_drops"), 1);
+  EXPECT_NE(st.back().last_error.find("message of 5000 bytes on SPINDOWN.x.SAMPLE not recorded"), std::string::npos)
+      << st.back().last_error;
+  EXPECT_EQ(data_events(read_with_logfile(w.files().front()), w.options().status_channel).size(), 2u);
+}
+
 TEST(LogRecorder, FlushesOnItsTimerWithoutFurtherMessages) {
   TempDir dir;
   EventLogWriter w(options_in(dir), kT0);

@@ -324,6 +324,13 @@ void EventLogWriter::pause_for_space(std::int64_t now_us, const std::string& wha
   last_error_utime_ = now_us;
 }
 
+void EventLogWriter::add_oversize_drops(std::int64_t n, std::int64_t now_us, std::string what) {
+  if (n <= 0) return;
+  counters_.oversize_drops += n;
+  last_error_ = std::move(what);
+  last_error_utime_ = now_us;
+}
+
 void EventLogWriter::fail_text(std::int64_t now_us, std::string text) {
   ++counters_.write_errors;
   last_error_ = std::move(text);
@@ -375,6 +382,7 @@ status_t EventLogWriter::make_status(std::int64_t now_us) const {
       {"write_errors", counters_.write_errors},
       {"flushes", counters_.flushes},
       {"queue_drops", counters_.queue_drops},
+      {"oversize_drops", counters_.oversize_drops},
       {"events_lost", counters_.events_lost},
       {"status_events", counters_.status_events},
       {"decode_errors", counters_.decode_errors},

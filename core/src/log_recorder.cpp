@@ -21,6 +21,7 @@ bool LogRecorderOptions::is_valid(std::string* why) const {
   };
   if (queue_capacity < 1) return fail("queue capacity must be at least 1 event");
   if (queue_max_bytes < 1024) return fail(fmt::format("queue byte limit {} is below 1024", queue_max_bytes));
+  if (max_event_bytes < 1024) return fail(fmt::format("largest event {} bytes is below 1024", max_event_bytes));
   if (!std::isfinite(flush_interval_s) || flush_interval_s <= 0 || flush_interval_s > 3600)
     return fail(fmt::format("flush interval {} s must be in (0, 3600]", flush_interval_s));
   if (!std::isfinite(status_interval_s) || status_interval_s <= 0)
@@ -44,6 +45,14 @@ void LogRecorder::start() {
 bool LogRecorder::offer(std::int64_t recv_utime, std::string_view channel, const void* data,
                         std::int32_t size) {
   const std::size_t n = size > 0 ? static_cast<std::size_t>(size) : 0;
+  if (n > o_.max_event_bytes) {
+    std::lock_guard lock(queue_mutex_);
+    ++oversize_;
+    last_oversize_ = fmt::format("message of {} bytes on {} not recorded: larger than the largest event kept ({} "
+                                 "bytes; a fragment header claiming more than was sent?)",
+                                 n, channel.substr(0, 80), o_.max_event_bytes);
+    return false;
+  }
   Event ev{recv_utime, std::string(channel), {}};
   ev.data.assign(static_cast<const std::uint8_t*>(data), static_cast<const std::uint8_t*>(data) + n);
   bool was_empty = false;
@@ -89,6 +98,17 @@ void LogRecorder::refresh_status(std::int64_t now_us) {
   const std::int64_t dropped = dropped_.load();
   writer_.add_queue_drops(dropped - dropped_reported_);
   dropped_reported_ = dropped;
+  {
+    std::string what;
+    std::int64_t oversize = 0;
+    {
+      std::lock_guard lock(queue_mutex_);
+      oversize = oversize_;
+      what = last_oversize_;
+    }
+    writer_.add_oversize_drops(oversize - oversize_reported_, now_us, std::move(what));
+    oversize_reported_ = oversize;
+  }
   writer_.set_queue_depth(double(queue_depth()));
   status_t st = writer_.make_status(now_us);
   std::lock_guard lock(status_mutex_);

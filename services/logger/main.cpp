@@ -60,6 +60,9 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::Range(0.001, 3600.0));
   app.add_flag("--fsync", w.sync_on_flush, "also fdatasync at every flush (always done at rotation and exit)");
+  app.add_option("--max-event-bytes", r.max_event_bytes,
+                 "larger messages are not recorded (counted as oversize_drops and named in the heartbeat)")
+      ->capture_default_str();
   app.add_option("--queue", r.queue_capacity, "events queued for the writer before drops are counted")
       ->capture_default_str()
       ->check(CLI::Range(1, 10000000));
@@ -185,10 +188,11 @@ int main(int argc, char** argv) {
   const auto& c = writer.counters();
   if (!quiet) {
     fmt::print(stderr,
-               "spindown-logger: stopped: {} events, {} bytes in {} files, {} drops, {} write errors, "
-               "{} samples missing by sequence number, {} datagrams dropped by the kernel on the logger's socket\n",
-               c.events, c.bytes, c.files, c.queue_drops + c.events_lost, c.write_errors, c.samples_missing,
-               kernel_drops());
+               "spindown-logger: stopped: {} events, {} bytes in {} files, {} drops, {} oversize drops, {} write "
+               "errors, {} samples missing by sequence number, {} datagrams dropped by the kernel on the logger's "
+               "socket\n",
+               c.events, c.bytes, c.files, c.queue_drops + c.events_lost, c.oversize_drops, c.write_errors,
+               c.samples_missing, kernel_drops());
     for (const auto& f : writer.files()) fmt::print(stderr, "spindown-logger: wrote {}\n", f);
   }
   if (c.write_errors > 0) {

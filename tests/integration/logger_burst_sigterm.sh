@@ -55,7 +55,7 @@ burst() {
     || fail "burst $a: the logger lost $((SENT - logged - KERNEL_DROPS)) messages that reached it" \
       "($((SENT - logged)) missing, $KERNEL_DROPS dropped by the kernel, $drops counted by the logger)"
   [[ $state == stopped && $drops == 0 ]] || fail "burst $a: last status event: state $state, drops $drops"
-  grep -q "stopped: .* 0 drops, 0 write errors" "$WORK/logger$a.err" \
+  grep -q "stopped: .* 0 drops, 0 oversize drops, 0 write errors" "$WORK/logger$a.err" \
     || fail "burst $a: summary line: $(cat "$WORK/logger$a.err")"
   if (( KERNEL_DROPS == 0 )); then
     (( complete )) || fail "burst $a: messages missing although the kernel dropped none"

@@ -72,6 +72,7 @@ struct EventLogCounters {
   std::int64_t seq_repeats = 0;      // SAMPLE messages with a sequence number already seen (restart, duplicate)
   std::int64_t benches_untracked = 0;// SAMPLE messages of benches beyond max_tracked_benches
   std::int64_t disk_full_episodes = 0;  // times the disk filled up (each one write error)
+  std::int64_t oversize_drops = 0;   // events larger than the recorder's max_event_bytes, not recorded
 };
 
 // File name for a log opened at unix_time (local time), without the directory; suffix 0 = none.
@@ -105,6 +106,8 @@ class EventLogWriter {
 
   // Drops counted before the writer (queue full) and the queue's depth, for the status.
   void add_queue_drops(std::int64_t n) { counters_.queue_drops += n; }
+  // Events refused for their size before the writer: counted, and what the last one was said.
+  void add_oversize_drops(std::int64_t n, std::int64_t now_us, std::string what);
   void set_queue_depth(double depth) { queue_depth_ = depth; }
 
   status_t make_status(std::int64_t now_us) const;

@@ -25,6 +25,10 @@ namespace spindown {
 struct LogRecorderOptions {
   std::size_t queue_capacity = 10000;        // events waiting for the writer, at most
   std::size_t queue_max_bytes = 256u << 20;  // and their payload bytes, at most
+  // A larger message is not recorded (counted, named in the status): LCM 1.3.1 assembles what a
+  // single datagram's fragment header claims (up to 256 MB), so one 1 KB datagram could
+  // otherwise put 100 MB of zeros into the log. spindown's messages are at most a few kB.
+  std::size_t max_event_bytes = 8u << 20;
   double flush_interval_s = 0.5;             // buffered events reach the kernel at least this often
   double status_interval_s = 0.1;            // how often status() is refreshed by the writer thread
 
@@ -72,6 +76,8 @@ class LogRecorder {
   std::string stop_why_ = "stopped";
   std::atomic<std::int64_t> dropped_{0};
   std::int64_t dropped_reported_ = 0;
+  std::int64_t oversize_ = 0, oversize_reported_ = 0;  // under queue_mutex_ / writer thread
+  std::string last_oversize_;                          // under queue_mutex_
 
   mutable std::mutex status_mutex_;
   status_t status_;
