@@ -85,6 +85,9 @@ BenchPlan make_plan(const Options& o, int b) {
     spec.period_s = o.period_s;
     spec.e0_v = 2.4 + 0.1 * ((b + r) % 8);
     spec.lead_in = (b + r) % 3 == 0 ? spindown::LeadIn::supply : spindown::LeadIn::zeros;
+    // Powered, the pin reads the supply, above the back-EMF by the winding's I·R drop (3.1 V of
+    // back-EMF under a 3.0 V supply, as this plan once made, is no motor: it rises at the "cut").
+    spec.supply_v = spec.e0_v + 0.2;
     spec.friction.viscous = 1.822e-7 * (0.8 + 0.05 * (b % 9));
     spec.friction.coulomb = 1.1389e-4 * (0.8 + 0.05 * ((b + 3) % 9));
     spec.t0_ms = t0_ms;
