@@ -262,7 +262,9 @@ want="1 messages dropped: larger than the receive queue's limit of 67108864 byte
 got=$(last_status 'd["last_error"]')
 [[ $got == "$want"* && $(last_status 'd["counters"]["oversize_drops"], d["counters"]["queue_drops"]') == "1 0" ]] ||
   { echo "FAIL forged fragment header (one fragment claimed): $(last_status 'd["counters"]["oversize_drops"], d["counters"]["queue_drops"]'), '$got'"; exit 1; }
-(( rss2 - rss0 < 20000 )) || { echo "FAIL forged fragment header: the fitter grew from $rss0 to $rss2 kB"; exit 1; }
+# A copy of the message would add 100 MB; LCM's own untouched buffer adds nothing (under ASan
+# its shadow and poisoning add ~25 MB).
+(( rss2 - rss0 < 50000 )) || { echo "FAIL forged fragment header: the fitter grew from $rss0 to $rss2 kB"; exit 1; }
 kill -TERM $fitter $logger
 wait $fitter
 wait $logger
