@@ -6,7 +6,7 @@
 // usage: make_runs OUT_DIR [COUNT=1000] [SEED=1]
 // Runs differ in seed (noise, jitter), back-EMF at the cut (2.5–3.3 V) and lead-in kind
 // (zeros, floating pin, supply); friction is the lab's 3 V run (design §1), noise 4 mV and
-// 1 % commutator ripple as in shared/data/seed-3v-run1, ~1500 samples per file.
+// 1 % commutator ripple as in data/seed-3v-run1, ~1500 samples per file.
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>

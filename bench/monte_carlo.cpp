@@ -21,7 +21,7 @@
 // looser where the ripple is small, tighter where it is large.)
 //
 // usage: monte_carlo OUT_DIR [RUNS=500] [SEED=1] [TRUTH_JSON] [ADC_BITS=10] [DECIMALS=2]
-//   TRUTH_JSON: a shared/data *.truth.json (c_v, c_c, e0, noise_v, ripple); default the lab's 3 V run.
+//   TRUTH_JSON: a data/*.truth.json (c_v, c_c, e0, noise_v, ripple); default the lab's 3 V run.
 //   ADC_BITS 0 and DECIMALS −1 (printed to 6) take the quantization out, to see what it costs.
 #include <Eigen/Dense>
 #include <chrono>
@@ -85,7 +85,7 @@ int main(int argc, char** argv) {
       const auto j = nlohmann::json::parse(f);
       truth.c_v = j.at("c_v");
       truth.c_c = j.at("c_c");
-      truth.e0 = j.at("e0");
+      truth.e0 = j.contains("runs") ? j.at("runs").at(0).at("e0") : j.at("e0");
       truth.noise_v = j.value("noise_v", truth.noise_v);
       truth.ripple = j.value("ripple", truth.ripple);
     } catch (const std::exception& e) {

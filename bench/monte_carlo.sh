@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The accuracy study of issue 6: RUNS (500) simulated lab runs at the lab's noise and
-# quantization (truth: shared/data/seed-3v-run1, combined friction), fitted by spindown
+# quantization (truth: data/seed-3v-run1, combined friction), fitted by spindown
 # (bench/monte_carlo, as `spindown fit` does it) and by SciPy curve_fit of the lab's combined
 # curve on the same printed files (bench/scipy_lab_fits.py, cut and stop given for free), with
 # the Cramér–Rao bound for the same sampling and noise. Prints bias, spread, efficiency and the
@@ -14,10 +14,10 @@ source "$ROOT/bench/bench_common.bash"
 BIN=${1:-${SPINDOWN_BIN_DIR:-$ROOT/build/bin}}
 RUNS=${RUNS:-500}
 SEED=${SEED:-1}
-DATA=${SPINDOWN_SHARED_DATA:-$ROOT/../shared/data}
+DATA=${SPINDOWN_SAMPLE_DATA:-$ROOT/data}
 TRUTH=${TRUTH:-$DATA/seed-3v-run1.tsv.truth.json}
 [[ -x $BIN/monte_carlo ]] || { echo "missing $BIN/monte_carlo (build it first)" >&2; exit 2; }
-[[ -r $TRUTH ]] || { echo "no truth file $TRUTH (set TRUTH=… or SPINDOWN_SHARED_DATA)" >&2; exit 2; }
+[[ -r $TRUTH ]] || { echo "no truth file $TRUTH (set TRUTH=… or SPINDOWN_SAMPLE_DATA)" >&2; exit 2; }
 bench_work_dir mc
 "$BIN/monte_carlo" "$WORK" "$RUNS" "$SEED" "$TRUTH" "${ADC_BITS:-10}" "${DECIMALS:-2}" >/dev/null
 /usr/bin/python3 "$ROOT/bench/scipy_lab_fits.py" fit "$WORK" >"$WORK/scipy.tsv" 2>"$WORK/scipy.err" || true

@@ -1,5 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -19,7 +23,7 @@ using Severity = Diagnostic::Severity;
 
 namespace {
 
-const std::string data_dir = SPINDOWN_SHARED_DATA;
+const std::string data_dir = SPINDOWN_SAMPLE_DATA;
 
 std::vector<const Diagnostic*> with(const Recording& r, Severity s) {
   std::vector<const Diagnostic*> out;
@@ -77,33 +81,38 @@ TEST(ArduinoText, EverySampleFileReadsCleanly) {
     EXPECT_EQ(r.t_s.size(), r.value.size());
     EXPECT_TRUE(strictly_increasing(r.t_s));
     EXPECT_TRUE(r.clock_restarts.empty());
-    // Every file's first line is PuTTY's cut "3\t0.00": dropped, so the clock starts at 5.234 s.
-    EXPECT_DOUBLE_EQ(r.t_s.front(), 5.234);
-    EXPECT_TRUE(mentions(r, "cut short"));
+    // The simulator's first sample is 0.5 s after boot. A PuTTY log's first line is the end of
+    // the line before it ("0<TAB>0.00"): dropped as cut short.
+    EXPECT_DOUBLE_EQ(r.t_s.front(), 0.5);
+    EXPECT_EQ(mentions(r, "cut short"), mentions(r, "PuTTY log header"));
     EXPECT_EQ(r.lines_read, r.size() + r.lines_skipped);
     for (double v : r.value) ASSERT_TRUE(std::isfinite(v) && v > -1 && v < 6);
   }
   EXPECT_EQ(files, 7);
 }
 
-TEST(ArduinoText, SupplyLeadInReportsItsThreeGarbledLines) {
+TEST(ArduinoText, SupplyLeadInReportsEachGarbledLine) {
   const Recording r = read_arduino_text_file(data_dir + "/supply-leadin.tsv");
   SCOPED_TRACE(all_diagnostics(r));
+  std::ifstream tj(data_dir + "/supply-leadin.tsv.truth.json");
+  const auto truth = nlohmann::json::parse(tj);
+  const std::size_t garbage = truth.at("faults").at("garbage_lines"), samples = truth.at("samples");
+  ASSERT_GE(garbage, 3u);
+  // One warning per garbled line, naming the file and the line.
   const auto warnings = with(r, Severity::warning);
-  ASSERT_EQ(warnings.size(), 3u);
-  EXPECT_EQ(warnings[0]->line, 47);
-  EXPECT_EQ(warnings[1]->line, 1077);
-  EXPECT_EQ(warnings[2]->line, 1614);
-  EXPECT_NE(warnings[0]->message.find("missing value"), std::string::npos);
-  EXPECT_NE(warnings[0]->to_string().find("supply-leadin.tsv:47: warning:"), std::string::npos);
-  // 1667 lines: header, cut first line, three garbled lines.
-  EXPECT_EQ(r.lines_read, 1667u);
-  EXPECT_EQ(r.size(), 1667u - 5u);
+  ASSERT_EQ(warnings.size(), garbage);
+  for (const auto* w : warnings) {
+    EXPECT_NE(w->message.find("time is not a number; skipped"), std::string::npos) << w->message;
+    EXPECT_NE(w->to_string().find(fmt::format("supply-leadin.tsv:{}: warning:", w->line)), std::string::npos);
+  }
+  // Every line: the header, the cut first line, the garbled lines, the samples.
+  EXPECT_EQ(r.lines_read, samples + 2 + garbage);
+  EXPECT_EQ(r.size(), samples);
   EXPECT_TRUE(mentions(r, "PuTTY log header"));
   EXPECT_NE(at_line(r, 1), nullptr);
   EXPECT_EQ(at_line(r, 1)->severity, Severity::note);
-  // Reads the supply (3 V) before the cut at 8234 ms, then the coast.
-  EXPECT_NEAR(r.value[0], 3.0, 0.05);
+  // Reads the supply before the cut, then the coast.
+  EXPECT_NEAR(r.value[0], truth.at("supply_v").get<double>(), 0.05);
   EXPECT_LT(r.value.back(), 0.05);
 }
 

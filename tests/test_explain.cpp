@@ -1,6 +1,6 @@
 // The discrepancy workflow on generated runs in which an effect is hidden from the base model
 // (across benches, loop periods 10–50 ms, noise, ripple, lead-ins and strengths), on runs that
-// need nothing, on the shared sample data, and its JSON/text/SVG reports.
+// need nothing, on the sample data (data/), and its JSON/text/SVG reports.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -79,7 +79,7 @@ TEST(Explain, AddsNothingToARunThatNeedsNothing) {
 
 // The lab's story: believed viscous, the data need Coulomb friction too.
 TEST(Explain, TellsTheLabStoryOnTheSeedData) {
-  const auto recs = read_recordings(std::string(SPINDOWN_SHARED_DATA) + "/seed-3v-run1.tsv");
+  const auto recs = read_recordings(std::string(SPINDOWN_SAMPLE_DATA) + "/seed-3v-run1.tsv");
   ASSERT_EQ(recs.size(), 1u);
   const Segmentation seg = find_runs(recs[0]);
   ASSERT_EQ(seg.runs.size(), 1u);

@@ -17,7 +17,7 @@ using namespace spindown;
 
 namespace {
 
-const std::string data_dir = SPINDOWN_SHARED_DATA;
+const std::string data_dir = SPINDOWN_SAMPLE_DATA;
 
 struct TempFile {
   std::string path;

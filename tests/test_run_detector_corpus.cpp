@@ -1,5 +1,5 @@
 // The run detector finds exactly the same runs as before over a large, varied set of recordings
-// (tests/run_detector_corpus.hpp): the shared sample data and 400 generated recordings with
+// (tests/run_detector_corpus.hpp): the sample data (data/) and 400 generated recordings with
 // every lead-in kind, noise, ripple, jitter, clipping, packet loss, NaNs, clock restarts, runs
 // that never stop and non-default options. Everything it says — each event and when it came, every
 // Run field to the last bit, each diagnostic, its buffer after every sample — is hashed and
@@ -39,11 +39,15 @@ namespace {
 // reading held at the coast's start for about as long as one step lasts there is not a clip;
 // fragments (the rest of a coast after a restart, a nudge) are warnings, not notes.
 // Before: 0x0df837417b92c5e0.
-constexpr std::uint64_t recorded_hash = 0x7125c5e71c00a438ull;
+// Re-recorded on 2026-11-25 (late) when the sample recordings moved into the repository (data/,
+// made by the project's own simulator with data/make-samples, no longer ../shared/data): the
+// input changed, the detector did not; test_runs' SampleLogsMatchTheirTruth and test_sample_data
+// judge the new files against their truth. Before: 0x7125c5e71c00a438.
+constexpr std::uint64_t recorded_hash = 0x2ffda9128e6ef472ull;
 constexpr int generated_recordings = 400;
 
 TEST(RunDetectorCorpus, FindsTheRecordedRunsBitForBit) {
-  const auto cases = corpus::make_cases(SPINDOWN_SHARED_DATA, generated_recordings);
+  const auto cases = corpus::make_cases(SPINDOWN_SAMPLE_DATA, generated_recordings);
   ASSERT_GT(cases.size(), std::size_t(generated_recordings));
   std::uint64_t h = 1469598103934665603ull;
   std::size_t runs = 0;
@@ -59,7 +63,7 @@ TEST(RunDetectorCorpus, FindsTheRecordedRunsBitForBit) {
 
 // find_runs and the streaming detector (as the live fitter feeds it) complete the same runs.
 TEST(RunDetectorCorpus, StreamingMatchesFindRuns) {
-  const auto cases = corpus::make_cases(SPINDOWN_SHARED_DATA, 60);
+  const auto cases = corpus::make_cases(SPINDOWN_SAMPLE_DATA, 60);
   for (const auto& c : cases) {
     if (!c.rec.clock_restarts.empty()) continue;  // find_runs restarts at declared indices
     bool finite = true;
@@ -87,7 +91,7 @@ TEST(RunDetectorCorpus, StreamingMatchesFindRuns) {
 // anywhere, mid-coast too), the detector says exactly what it says sample by sample, and its
 // state and buffer agree at every chunk's end.
 TEST(RunDetectorCorpus, PushManyIsPushOneByOne) {
-  const auto cases = corpus::make_cases(SPINDOWN_SHARED_DATA, 120);
+  const auto cases = corpus::make_cases(SPINDOWN_SAMPLE_DATA, 120);
   std::mt19937_64 rng(7);
   std::size_t chunks = 0;
   for (const auto& c : cases) {

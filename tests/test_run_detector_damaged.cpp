@@ -1,4 +1,4 @@
-// The run detector says exactly what it said when its last speed-up was checked, on the shared
+// The run detector says exactly what it said when its last speed-up was checked, on the sample
 // sample data read as files and each damaged in the corpus's seven ways under varied options
 // (tests/run_detector_corpus.hpp): every event and when it came, every Run field to the last bit,
 // every diagnostic, and a hash of buffered()/state() after every sample. Together with
@@ -34,12 +34,14 @@ namespace {
 // Re-recorded on 2026-11-25 with run finding scored against truth (see test_run_detector_corpus.cpp
 // for what changed and why; a run cut short by a clock restart now says so as a warning). Before:
 // 0xba8bc83497a25bed.
-constexpr std::uint64_t recorded_hash = 0x8988ef6342a32a4bull;
+// Re-recorded on 2026-11-25 (late): the sample recordings are now data/ (made by data/make-samples),
+// not ../shared/data; the detector is unchanged. Before: 0x8988ef6342a32a4b.
+constexpr std::uint64_t recorded_hash = 0xcee5a9288e1b65bfull;
 
-// Each recording of the shared data as read, then damaged in each of the corpus's ways.
+// Each recording of the sample data (data/) as read, then damaged in each of the corpus's ways.
 std::vector<corpus::Case> plain_and_damaged() {
   std::vector<std::string> files;
-  for (const auto& e : std::filesystem::directory_iterator(SPINDOWN_SHARED_DATA))
+  for (const auto& e : std::filesystem::directory_iterator(SPINDOWN_SAMPLE_DATA))
     if (e.is_regular_file() && (e.path().extension() == ".tsv" || e.path().extension() == ".txt"))
       files.push_back(e.path().string());
   std::sort(files.begin(), files.end());
@@ -60,7 +62,7 @@ std::vector<corpus::Case> plain_and_damaged() {
 
 TEST(RunDetectorCorpus, DamagedSharedDataGivesTheRecordedOutput) {
   const auto cases = plain_and_damaged();
-  ASSERT_GT(cases.size(), 7u);  // the shared data holds several recordings
+  ASSERT_GT(cases.size(), 7u);  // data/ holds several recordings
   std::uint64_t h = 1469598103934665603ull;
   std::size_t samples = 0;
   for (const auto& c : cases) {
@@ -68,7 +70,7 @@ TEST(RunDetectorCorpus, DamagedSharedDataGivesTheRecordedOutput) {
     h = corpus::fnv1a(h, c.name + "\n" + corpus::stream_events<RunDetector>(c.rec, c.opt));
   }
   if (std::getenv("SPINDOWN_PRINT_CORPUS_HASH"))
-    std::printf("damaged shared data: %zu recordings, %zu samples, hash %016llx\n", cases.size(), samples,
+    std::printf("damaged sample data: %zu recordings, %zu samples, hash %016llx\n", cases.size(), samples,
                 (unsigned long long)h);
   EXPECT_EQ(h, recorded_hash) << "the run detector's output changed (see the comment at the top of this file)";
 }

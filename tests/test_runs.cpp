@@ -1,4 +1,4 @@
-// Segmentation of recordings into spin-down runs: the shared sample logs (against their
+// Segmentation of recordings into spin-down runs: the sample logs in data/ (against their
 // ground truth) and generated data over lead-ins, loop periods, noise, benches, quantities,
 // several runs, clock restarts, clipping and garbage.
 #include <gtest/gtest.h>
@@ -98,8 +98,8 @@ TEST(RunOptions, ValidatesItself) {
   EXPECT_EQ(seg.diagnostics[0].severity, Diagnostic::Severity::error);
 }
 
-TEST(FindRuns, SharedSampleLogsMatchTheirTruth) {
-  const std::filesystem::path dir = SPINDOWN_SHARED_DATA;
+TEST(FindRuns, SampleLogsMatchTheirTruth) {
+  const std::filesystem::path dir = SPINDOWN_SAMPLE_DATA;
   int files = 0;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     if (entry.path().extension() != ".tsv") continue;
@@ -113,11 +113,13 @@ TEST(FindRuns, SharedSampleLogsMatchTheirTruth) {
     const auto seg = find_runs(rec);
     ASSERT_EQ(seg.runs.size(), 1u) << name;
     const spindown::Run& r = seg.runs[0];
-    const double t_cut = truth["t_cut_ms"].get<double>() / 1000.0;
-    const double t_stop = truth["t_stop_s"].get<double>();
+    // The simulator's truth (data/make-samples): one run, its cut in device time.
+    const auto& run = truth.at("runs").at(0);
+    const double t_cut = run.at("cut_device_us").get<double>() / 1e6;
+    const double t_stop = run.at("t_stop_s").get<double>();
     EXPECT_NEAR(r.period_s, 0.020, 0.002) << name;
     expect_cut(rec, r, t_cut, name);
-    const std::string pre = truth.value("pre_mode", std::string("zeros"));
+    const std::string pre = truth.at("lead_in").get<std::string>();
     EXPECT_EQ(r.lead_in, pre) << name;
     if (name == "viscous-only.tsv") {
       // Exponential decay for 120 s: never a stop.

@@ -1,4 +1,4 @@
-// Issue 2's acceptance on the lab's sample logs (../shared/data): read → find the run → fit,
+// Issue 2's acceptance on the sample logs (data/, made by the project's simulator): read → find the run → fit,
 // checked against each file's truth. Where the truth is in the combined model's class
 // (viscous + Coulomb, with or without a sensor offset), c3 and c4 must come within 3·stderr
 // and 5 % of c_v, c_c; the cut within one sample period. Files whose truth holds an effect
@@ -20,7 +20,7 @@ using namespace spindown;
 
 namespace {
 
-const std::string data_dir = SPINDOWN_SHARED_DATA;
+const std::string data_dir = SPINDOWN_SAMPLE_DATA;
 
 struct Truth {
   double c_v = 0, c_c = 0, c_s = 0, c_w = 0, offset = 0, t_cut_s = 0, t_stop_s = 0;
@@ -35,8 +35,10 @@ Truth load_truth(const std::string& file) {
   t.c_s = j.value("c_s", 0.0);
   t.c_w = j.value("c_w", 0.0);
   t.offset = j.value("offset", 0.0);
-  t.t_cut_s = j.at("t_cut_ms").get<double>() / 1000.0;
-  t.t_stop_s = j.at("t_stop_s");
+  // The simulator's truth (data/make-samples): one run, its cut in device time.
+  const auto& run = j.at("runs").at(0);
+  t.t_cut_s = run.at("cut_device_us").get<double>() / 1e6;
+  t.t_stop_s = run.at("t_stop_s");
   return t;
 }
 
@@ -68,7 +70,7 @@ class CombinedClassFile : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(CombinedClassFile, RecoversTruthWithinThreeStandardErrorsAndFivePercent) {
   const std::string name = GetParam();
-  if (!std::filesystem::exists(data_dir + "/" + name)) GTEST_SKIP() << "no shared data at " << data_dir;
+  if (!std::filesystem::exists(data_dir + "/" + name)) GTEST_SKIP() << "no sample data at " << data_dir;
   const Truth truth = load_truth(data_dir + "/" + name);
   const Fitted f = read_and_fit(name);
   ASSERT_TRUE(f.run.stopped) << name;
@@ -94,7 +96,7 @@ INSTANTIATE_TEST_SUITE_P(SharedData, CombinedClassFile,
 
 TEST(SampleData, ViscousOnlyRunNeedsNoCoulombTerm) {
   const std::string name = "viscous-only.tsv";
-  if (!std::filesystem::exists(data_dir + "/" + name)) GTEST_SKIP() << "no shared data";
+  if (!std::filesystem::exists(data_dir + "/" + name)) GTEST_SKIP() << "no sample data";
   const Truth truth = load_truth(data_dir + "/" + name);
   const Fitted f = read_and_fit(name);
   EXPECT_LT(std::abs(f.run.t_cut_s - truth.t_cut_s), period_of(f.rec, f.run.cut_index));
@@ -120,7 +122,7 @@ class HiddenEffectFile : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(HiddenEffectFile, IsFittedAndTheMisfitShows) {
   const std::string name = GetParam();
-  if (!std::filesystem::exists(data_dir + "/" + name)) GTEST_SKIP() << "no shared data";
+  if (!std::filesystem::exists(data_dir + "/" + name)) GTEST_SKIP() << "no sample data";
   const Truth truth = load_truth(data_dir + "/" + name);
   const Fitted f = read_and_fit(name);
   EXPECT_LT(std::abs(f.run.t_cut_s - truth.t_cut_s), period_of(f.rec, f.run.cut_index));

@@ -2,6 +2,8 @@
 
 #include <CLI/CLI.hpp>
 #include <cerrno>
+#include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fmt/format.h>
@@ -47,7 +49,21 @@ int run_simulate(SimulateCommandOptions o) {
     return exit_bad_usage;
   }
   std::string text;
-  if (o.putty_header) text += putty_log_header;
+  if (o.putty_header) {
+    text += putty_log_header;
+    // PuTTY starts logging mid-line: the first line is the end of the one before the first
+    // whole sample (the lab's logs begin "3<TAB>0.00"; readers drop it as cut short).
+    for (const BenchEmission& e : bench->emissions())
+      if (e.kind == BenchEmission::Kind::sample && o.bench.protocol == BenchProtocol::lab) {
+        const std::size_t tab = e.bytes.find('\t');
+        if (tab != std::string::npos && tab > 0) {
+          const long first_ms = std::atol(e.bytes.substr(0, tab).c_str());
+          const long before_ms = first_ms - std::lround(o.bench.spec.period_s * 1000.0);
+          text += std::to_string(before_ms).back() + e.bytes.substr(tab);
+        }
+        break;
+      }
+  }
   for (const BenchEmission& e : bench->emissions()) text += e.bytes;
   if (to_stdout) std::cout << text << std::flush;
   // The recording and its truth, both or neither: each is written beside its name and renamed

@@ -137,6 +137,12 @@ VirtualBench::VirtualBench(VirtualBenchOptions options) : o_(std::move(options))
   truth_["w_s"] = o_.spec.friction.stribeck_speed;
   truth_["c_w"] = o_.spec.friction.windage;
   truth_["offset"] = o_.spec.offset_v;
+  // What the pin reads before each cut (the runs' lead-in), and the supply it reads with "supply".
+  truth_["lead_in"] = o_.spec.lead_in == LeadIn::zeros      ? "zeros"
+                      : o_.spec.lead_in == LeadIn::floating ? "floating"
+                      : o_.spec.lead_in == LeadIn::supply   ? "supply"
+                                                            : "spin-up";
+  truth_["supply_v"] = o_.spec.supply_v;
   truth_["noise_v"] = o_.spec.noise_v;
   truth_["ripple"] = o_.spec.ripple;
   truth_["period_s"] = o_.spec.period_s;

@@ -4,7 +4,7 @@
 # other files still explained).
 set -euo pipefail
 bin="${SPINDOWN_BIN_DIR:?}/spindown"
-data="${SPINDOWN_SHARED_DATA:?}"
+data="${SPINDOWN_SAMPLE_DATA:?}"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 fail() { echo "FAIL: $*" >&2; exit 1; }

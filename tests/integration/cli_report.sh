@@ -6,7 +6,7 @@
 # references, text from files escaped, one run figure per run, ± coefficients, verdicts, the
 # benches of the log grouped, and no progress output when stderr is not a terminal.
 source "$(dirname "${BASH_SOURCE[0]}")/netns_common.bash"
-D=${SPINDOWN_SHARED_DATA:?}
+D=${SPINDOWN_SAMPLE_DATA:?}
 
 # The page parses, its tags balance, and it reaches nothing outside itself.
 check_page() {

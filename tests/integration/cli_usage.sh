@@ -4,7 +4,7 @@
 # delimited text with named columns and units gives the same fit as the Arduino log.
 set -euo pipefail
 bin="${SPINDOWN_BIN_DIR:?}/spindown"
-data="${SPINDOWN_SHARED_DATA:?}"
+data="${SPINDOWN_SAMPLE_DATA:?}"
 seed="$data/seed-3v-run1.tsv"
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT

@@ -10,7 +10,7 @@
 set -euo pipefail
 src="${SPINDOWN_SOURCE_DIR:-$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)}"
 bin="${SPINDOWN_BIN_DIR:-$src/build/bin}/spindown"
-data="${SPINDOWN_SHARED_DATA:-$src/../shared/data}"
+data="${SPINDOWN_SAMPLE_DATA:-$src/data}"
 doc="$src/docs/hostile-inputs.md"
 write_doc=0
 [[ "${1:-}" == "--write-doc" ]] && write_doc=1
