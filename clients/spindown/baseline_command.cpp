@@ -105,34 +105,23 @@ int run_baseline(const BaselineCommandOptions& o) {
   if (!o.output.empty() && std::filesystem::exists(o.output))
     bad_usage(fmt::format("-o {}: the file exists; use --update {} to replace its [baseline]", o.output, o.output));
 
-  // J and K_b: flags, else the bench file being updated, else an LCM log's CONFIG, else the lab's.
+  // J and K_b by the one rule (choose_bench_params): flags, else the bench file being updated,
+  // else an LCM log's CONFIG, else the lab's.
   FitOptions fit_opt;
   fit_opt.models = {ModelKind::combined};
-  fit_opt.bench = bench_from(o.input);
-  const bool inertia_from_user = o.input.inertia_given || o.input.flywheel_given;
-  const bool kb_from_user = o.input.kb_given || o.input.speed_constant_given;
-  bool bench_from_file = false;
+  const BenchChoice choice = bench_choice_from(o.input);
+  fit_opt.bench = choice.given;
+  std::optional<BenchFile> update_file;
   if (!o.update.empty()) {
     try {
-      const BenchFile f = load_bench_file(o.update);
-      if (f.bench != o.bench)
+      update_file = load_bench_file(o.update);
+      if (update_file->bench != o.bench)
         std::cerr << fmt::format("{}: warning: the file describes bench '{}', the baseline is for --bench {}\n",
-                                 o.update, f.bench, o.bench);
-      if (f.sets_inertia && !inertia_from_user) {
-        fit_opt.bench.inertia_kg_m2 = f.params.inertia_kg_m2;
-        fit_opt.bench.inertia_source = f.params.inertia_source;
-        bench_from_file = true;
-      }
-      if (f.sets_kb && !kb_from_user) {
-        fit_opt.bench.kb_v_s_per_rad = f.params.kb_v_s_per_rad;
-        fit_opt.bench.kb_source = f.params.kb_source;
-        bench_from_file = true;
-      }
+                                 o.update, update_file->bench, o.bench);
     } catch (const std::exception& e) {
       bad_usage(fmt::format("--update: {}", e.what()));
     }
   }
-  const bool bench_fixed = inertia_from_user || kb_from_user || bench_from_file;
   const ReadOptions read = read_options_from(o.input);
 
   std::vector<BaselineRun> good;
@@ -154,8 +143,10 @@ int run_baseline(const BaselineCommandOptions& o) {
         continue;
       }
       FitOptions this_fit = fit_opt;
-      if (!bench_fixed && about && about->config)
-        if (auto b = bench_params_from_config(*about->config)) this_fit.bench = *b;
+      std::vector<Diagnostic> config_problems;
+      this_fit.bench = choose_bench_params(choice, update_file ? &*update_file : nullptr,
+                                           config_bench_params(about, rec.source, config_problems));
+      for (const auto& d : config_problems) std::cerr << d.to_string() << '\n';
       const Segmentation seg = find_runs(rec);
       if (seg.runs.empty()) std::cerr << fmt::format("{}: no spin-down run found\n", path);
       for (const Run& run : seg.runs) {

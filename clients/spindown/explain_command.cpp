@@ -27,13 +27,13 @@ namespace {
 struct ExplainPlan {
   ReadOptions read;
   ExplainOptions explain;
-  bool bench_from_user = false;  // J or K_b given on the command line: never taken from a log's config
+  BenchChoice bench;             // the command line's J and K_b (choose_bench_params)
 };
 
 ExplainPlan plan_from(const ExplainCommandOptions& o) {
   ExplainPlan plan;
-  plan.explain.bench = bench_from(o.input);
-  plan.bench_from_user = o.input.bench_from_user();
+  plan.bench = bench_choice_from(o.input);
+  plan.explain.bench = plan.bench.given;
   std::string why;
   plan.explain.base = parse_effect_list(o.base, &why);
   if (plan.explain.base.empty()) bad_usage(fmt::format("--base: {}", why));
@@ -66,14 +66,9 @@ FileExplain explain_file(const std::string& path, const ExplainPlan& plan) {
         continue;
       }
       ExplainOptions opt = plan.explain;
-      if (!plan.bench_from_user && k < info.size() && info[k].config) {
-        std::string why;
-        if (auto b = bench_params_from_config(*info[k].config, &why))
-          opt.bench = *b;
-        else
-          out.diagnostics.push_back({Diagnostic::Severity::warning, rec.source, 0,
-                                     fmt::format("bench config not used ({}); lab defaults assumed", why)});
-      }
+      opt.bench = choose_bench_params(plan.bench, nullptr,
+                                      config_bench_params(k < info.size() ? &info[k] : nullptr, rec.source,
+                                                          out.diagnostics));
       const Segmentation seg = find_runs(rec);
       out.diagnostics.insert(out.diagnostics.end(), seg.diagnostics.begin(), seg.diagnostics.end());
       if (seg.runs.empty()) {

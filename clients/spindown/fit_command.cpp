@@ -32,10 +32,9 @@ namespace {
 struct FitPlan {
   ReadOptions read;
   FitOptions fit;
-  bool bench_from_user = false;  // J or K_b given on the command line: never taken from a log's config
+  BenchChoice bench;             // the command line's J and K_b (choose_bench_params)
   ReportOptions report;
   BenchFiles bench_files;        // --bench-config, by bench id
-  bool inertia_from_user = false, kb_from_user = false;  // flags win over a bench file
 };
 
 // The bench file for a recording: its bench id's (LCM logs), or the only one given (text files).
@@ -49,10 +48,8 @@ const BenchFile* bench_file_for(const FitPlan& plan, const std::string& bench) {
 
 FitPlan plan_from(const FitCommandOptions& o) {
   FitPlan plan;
-  plan.fit.bench = bench_from(o.input);
-  plan.bench_from_user = o.input.bench_from_user();
-  plan.inertia_from_user = o.input.inertia_given || o.input.flywheel_given;
-  plan.kb_from_user = o.input.kb_given || o.input.speed_constant_given;
+  plan.bench = bench_choice_from(o.input);
+  plan.fit.bench = plan.bench.given;
   std::string why;
   if (!o.models.empty()) plan.fit.models = models_from(o.models);
   if (!plan.fit.is_valid(&why)) bad_usage(why);
@@ -97,26 +94,10 @@ FileFit fit_file(const std::string& path, const FitPlan& plan) {
         continue;
       }
       FitOptions fit_opt = plan.fit;
-      if (!plan.bench_from_user && k < info.size() && info[k].config) {
-        std::string why;
-        if (auto b = bench_params_from_config(*info[k].config, &why))
-          fit_opt.bench = *b;
-        else
-          out.diagnostics.push_back({Diagnostic::Severity::warning, rec.source, 0,
-                                     fmt::format("bench config not used ({}); lab defaults assumed", why)});
-      }
-      // A bench file's [bench] J and K_b win over the log's CONFIG; flags win over both.
       const BenchFile* bench_file = bench_file_for(plan, k < info.size() ? info[k].bench : std::string{});
-      if (bench_file) {
-        if (bench_file->sets_inertia && !plan.inertia_from_user) {
-          fit_opt.bench.inertia_kg_m2 = bench_file->params.inertia_kg_m2;
-          fit_opt.bench.inertia_source = bench_file->params.inertia_source + " (" + bench_file->path + ")";
-        }
-        if (bench_file->sets_kb && !plan.kb_from_user) {
-          fit_opt.bench.kb_v_s_per_rad = bench_file->params.kb_v_s_per_rad;
-          fit_opt.bench.kb_source = bench_file->params.kb_source + " (" + bench_file->path + ")";
-        }
-      } else if (!plan.bench_files.files.empty()) {
+      fit_opt.bench = choose_bench_params(
+          plan.bench, bench_file, config_bench_params(k < info.size() ? &info[k] : nullptr, rec.source, out.diagnostics));
+      if (!bench_file && !plan.bench_files.files.empty()) {
         out.diagnostics.push_back({Diagnostic::Severity::warning, rec.source, 0,
                                    fmt::format("no --bench-config file for bench '{}': no health verdict",
                                                k < info.size() ? info[k].bench : std::string{})});

@@ -42,7 +42,8 @@ void bad_usage(const std::string& why) { throw CLI::ValidationError(why); }
 std::function<void()> add_input_options(CLI::App* sub, InputOptions& opt) {
   const CLI::Validator positive = number_check(false);
   const CLI::Validator non_negative = number_check(true);
-  auto* inertia = sub->add_option("--inertia", opt.inertia_kg_m2, "Moment of inertia J (kg·m²)")
+  auto* inertia = sub->add_option("--inertia", opt.inertia_kg_m2, "Moment of inertia J (kg·m²). J and K_b, each on its own: this command line, else the bench's "
+                                  "--bench-config file, else the log's CONFIG, else the lab's defaults")
                       ->check(positive)
                       ->group("Bench");
   auto* radius = sub->add_option("--flywheel-radius", opt.flywheel_radius_m, "Flywheel cylinder radius (m)")
@@ -83,6 +84,10 @@ std::function<void()> add_input_options(CLI::App* sub, InputOptions& opt) {
     opt.kb_given = kb->count() > 0;
     opt.speed_constant_given = kv->count() > 0;
   };
+}
+
+BenchChoice bench_choice_from(const InputOptions& o) {
+  return {bench_from(o), o.inertia_given || o.flywheel_given, o.kb_given || o.speed_constant_given};
 }
 
 BenchParams bench_from(const InputOptions& o) {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "spindown/bench.hpp"
+#include "spindown/bench_file.hpp"
 #include "spindown/fit.hpp"
 #include "spindown/read_recording.hpp"
 
@@ -27,8 +28,6 @@ struct InputOptions {
   // Delimited text: columns and units when they are not obvious from the header.
   std::string time_column, value_column, time_unit, value_unit, delimiter;
 
-  // J or K_b given on the command line: never taken from a log's config.
-  bool bench_from_user() const { return inertia_given || flywheel_given || kb_given || speed_constant_given; }
 };
 
 // Adds the bench ("Bench" group) and delimited-text options to sub, bound to opt. Call the
@@ -38,6 +37,8 @@ std::function<void()> add_input_options(CLI::App* sub, InputOptions& opt);
 // The bench the options describe (lab defaults where not given). Bad usage throws
 // CLI::ValidationError (exit code 2).
 BenchParams bench_from(const InputOptions& opt);
+// The command line's part of the J/K_b rule (choose_bench_params): its values and which it gave.
+BenchChoice bench_choice_from(const InputOptions& opt);
 // Reading options for the delimited-text columns and units. Bad usage throws CLI::ValidationError.
 ReadOptions read_options_from(const InputOptions& opt);
 

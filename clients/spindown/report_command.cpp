@@ -22,8 +22,8 @@ namespace {
 
 SessionReportOptions plan_from(const ReportCommandOptions& o) {
   SessionReportOptions plan;
-  plan.fit.bench = bench_from(o.input);
-  plan.bench_from_user = o.input.bench_from_user();
+  plan.bench = bench_choice_from(o.input);
+  plan.fit.bench = plan.bench.given;
   plan.read = read_options_from(o.input);
   std::string why;
   if (!o.models.empty()) plan.fit.models = models_from(o.models);

@@ -12,6 +12,29 @@
 
 namespace spindown {
 
+BenchParams choose_bench_params(const BenchChoice& cli, const BenchFile* file, const std::optional<BenchParams>& config) {
+  BenchParams p = cli.given;  // the command line's values, the lab's where it gave none
+  if (!cli.inertia_given) {
+    if (file && file->sets_inertia) {
+      p.inertia_kg_m2 = file->params.inertia_kg_m2;
+      p.inertia_source = file->params.inertia_source + " (" + file->path + ")";
+    } else if (config) {
+      p.inertia_kg_m2 = config->inertia_kg_m2;
+      p.inertia_source = config->inertia_source;
+    }
+  }
+  if (!cli.kb_given) {
+    if (file && file->sets_kb) {
+      p.kb_v_s_per_rad = file->params.kb_v_s_per_rad;
+      p.kb_source = file->params.kb_source + " (" + file->path + ")";
+    } else if (config) {
+      p.kb_v_s_per_rad = config->kb_v_s_per_rad;
+      p.kb_source = config->kb_source;
+    }
+  }
+  return p;
+}
+
 BenchFile load_bench_file(const std::string& path) {
   BenchFile f;
   f.path = path;

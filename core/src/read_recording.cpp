@@ -280,4 +280,16 @@ std::vector<Recording> read_recordings(const std::string& path, const ReadOption
   return out;
 }
 
+std::optional<BenchParams> config_bench_params(const RecordingInfo* info, const std::string& source,
+                                               std::vector<Diagnostic>& diags) {
+  if (!info || !info->config) return std::nullopt;
+  std::string why;
+  if (auto b = bench_params_from_config(*info->config, &why)) return b;
+  diags.push_back({Diagnostic::Severity::warning, source, 0,
+                   fmt::format("bench config not used ({}); J and K_b from the command line, the bench file or the "
+                               "lab's defaults",
+                               why)});
+  return std::nullopt;
+}
+
 }  // namespace spindown

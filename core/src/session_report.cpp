@@ -68,7 +68,7 @@ BenchReference bench_reference(const BenchFile& file) {
   BenchReference ref;
   ref.file = file.path;
   ref.health = file.health;
-  if (file.sets_inertia || file.sets_kb) ref.params = file.params;
+  if (file.sets_inertia || file.sets_kb) ref.bench = file;
   return ref;
 }
 
@@ -325,30 +325,16 @@ SessionReport build_session_report(std::span<const std::string> paths, const Ses
           file.failures.push_back(where + first_error(rec));
           continue;
         }
-        // J and K_b: command line, else the log's CONFIG, else the bench's file, else the lab's.
-        BenchParams params = options.fit.bench;
+        // J and K_b by the one rule (choose_bench_params): command line, else the bench's file,
+        // else the log's CONFIG, else the lab's.
         const auto ref = options.references.find(bench);
         if (ref != options.references.end())
           reference_used[static_cast<std::size_t>(std::distance(options.references.begin(), ref))] = true;
-        if (!options.bench_from_user) {
-          bool from_config = false;
-          if (ri && ri->config) {
-            std::string why;
-            if (auto b = bench_params_from_config(*ri->config, &why)) {
-              params = *b;
-              from_config = true;
-            } else {
-              keep_diagnostics(file,
-                               {{Diagnostic::Severity::warning, rec.source, 0,
-                                 fmt::format("bench config not used ({}); {}", why,
-                                             ref != options.references.end() && ref->second.params
-                                                 ? "the bench file's J and K_b used"
-                                                 : "lab defaults assumed")}},
-                               options.max_diagnostics_per_file);
-            }
-          }
-          if (!from_config && ref != options.references.end() && ref->second.params) params = *ref->second.params;
-        }
+        std::vector<Diagnostic> config_problems;
+        const BenchParams params = choose_bench_params(
+            options.bench, ref != options.references.end() && ref->second.bench ? &*ref->second.bench : nullptr,
+            config_bench_params(ri, rec.source, config_problems));
+        keep_diagnostics(file, config_problems, options.max_diagnostics_per_file);
         const Segmentation& seg = segs[k];
         keep_diagnostics(file, seg.diagnostics, options.max_diagnostics_per_file);
         if (seg.runs.empty()) {

@@ -119,6 +119,33 @@ no_progress "$T/log.err"
 grep -q 'id="bench-lab-000"' "$T/log.html" && grep -q 'id="bench-lab-001"' "$T/log.html" || fail "bench ids"
 echo "LCM log: $(cat "$T/log.out")"
 
+# J and K_b by one rule in fit and report: the log's CONFIG says J = 1.12687602e-5 (the lab's);
+# a bench file for lab-000 says J = 2.5e-5 and no K_b. Both commands take J from the file and
+# K_b from the CONFIG, and print the same friction.
+cat >"$T/lab-000.toml" <<'EOF'
+bench_id = "lab-000"
+[bench]
+inertia_kg_m2 = 2.5e-5
+EOF
+"$B/spindown" fit "$LOG" --bench-config "$T/lab-000.toml" --json >"$T/rule.json" 2>"$T/rule.err" || true
+"$B/spindown" report "$LOG" --bench-config "$T/lab-000.toml" --no-explain -o "$T/rule.html" >/dev/null 2>&1 ||
+  fail "report with a bench file exited $?"
+python3 - "$T/rule.json" "$T/rule.html" <<'EOF' || fail "fit and report take J and K_b by different rules"
+import json, re, sys
+doc = json.load(open(sys.argv[1]))
+runs = [r for f in doc["files"] for r in f["runs"] if "lab-000" in json.dumps(r.get("bench", {})) or r.get("bench_id") == "lab-000"]
+assert runs, "no run of lab-000 in fit --json"
+js = {r["bench"]["J"] for r in runs}
+assert js == {2.5e-5}, f"fit took J = {js}, not the bench file's"
+page = open(sys.argv[2], encoding="utf-8").read()
+sec = page[page.index('id="bench-lab-000"'):]
+nxt = sec.find('<section class="bench"', 10)
+sec = sec if nxt < 0 else sec[:nxt]
+j_page = set(re.findall(r"J = ([0-9.e+-]+) kg·m²", sec))
+assert j_page == {"2.5e-05"}, f"report took J = {j_page}"
+print(f"fit and report agree: J = 2.5e-5 from the bench file (over the CONFIG), K_b from the CONFIG")
+EOF
+
 # Files of both kinds in one report; refit with --no-progress prints no progress either.
 "$B/spindown" report "$LOG" "$D/seed-3v-run1.tsv" -o "$T/both.html" --no-progress >"$T/both.out" 2>"$T/both.err" \
   || fail "mixed report exited $?"

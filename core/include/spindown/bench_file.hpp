@@ -4,6 +4,7 @@
 // [bench], …) and by the fitters for J/K_b and the motor health references ([motor],
 // [baseline], [health]). A bench's id is its bench_id key, else the file name without ".toml".
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,17 @@ struct BenchFile {
 struct BenchFiles {
   std::map<std::string, BenchFile, std::less<>> files;  // by bench id
 };
+
+// J and K_b for one recording, by the one rule every offline command follows (fit, explain,
+// baseline, report), each parameter on its own: the command line (--inertia or --flywheel…,
+// --kb or --speed-constant), else the bench's file ([bench] of its --bench-config TOML), else
+// the log's CONFIG, else the lab's defaults. inertia_source and kb_source name where each came
+// from. (refit and export reproduce the live fitter, which takes CONFIG, else its defaults.)
+struct BenchChoice {
+  BenchParams given;  // the lab's defaults with the command line's values applied
+  bool inertia_given = false, kb_given = false;
+};
+BenchParams choose_bench_params(const BenchChoice& cli, const BenchFile* file, const std::optional<BenchParams>& config);
 
 // Reads one bench file. Throws std::runtime_error naming the file and key.
 BenchFile load_bench_file(const std::string& path);

@@ -36,6 +36,11 @@ struct RecordingInfo {
   std::int64_t samples_lost = 0;   // LCM logs: from sequence gaps
 };
 
+// J and K_b of a recording's CONFIG (LCM logs) when it has a usable one; an unusable one is a
+// warning in diags naming source. For choose_bench_params (bench_file.hpp).
+std::optional<BenchParams> config_bench_params(const RecordingInfo* info, const std::string& source,
+                                               std::vector<Diagnostic>& diags);
+
 // Never throws for bad input: an unreadable or missing file gives one Recording whose error
 // diagnostic names the file and the errno text; a file with nothing usable one with an error
 // "no samples: …". Diagnostics about an LCM log as a whole are copied into every Recording.

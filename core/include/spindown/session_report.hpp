@@ -17,6 +17,7 @@
 
 #include "spindown/bench.hpp"
 #include "spindown/bench_file.hpp"
+#include "spindown/bench_file.hpp"
 #include "spindown/explain.hpp"
 #include "spindown/fit.hpp"
 #include "spindown/motor_health.hpp"
@@ -30,7 +31,7 @@ namespace spindown {
 struct BenchReference {
   std::string file;
   MotorHealthConfig health;           // datasheet / baseline / thresholds
-  std::optional<BenchParams> params;  // J, K_b when its [bench] section sets them
+  std::optional<BenchFile> bench;     // its [bench] J and K_b (for choose_bench_params), when it sets either
 };
 
 // What a report needs of a bench file (load_bench_file): its health references, and J, K_b
@@ -42,7 +43,7 @@ struct SessionReportOptions {
   FitOptions fit;               // models and the default bench (lab defaults or the command line's)
   ExplainOptions explain;       // base model and workflow settings (bench set per run)
   bool explain_runs = true;
-  bool bench_from_user = false; // J/K_b from the command line: never from a log's CONFIG or a bench file
+  BenchChoice bench;            // the command line's J and K_b (choose_bench_params; fit.bench is its given)
   std::string text_bench;       // bench id for text files; empty: the file name without its extension
   std::map<std::string, BenchReference, std::less<>> references;  // by bench id
   std::size_t max_diagnostics_per_file = 200;  // kept per file; the rest are counted
