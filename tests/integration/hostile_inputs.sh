@@ -313,7 +313,7 @@ the receive queue's limit of 67108864 bytes (last: 100000000 bytes on SPINDOWN.h
 in its heartbeat, and its log stays small.
 
 Below the CLI, the parsers and decoders are fuzzed continuously (`fuzz/`, see README's
-Robustness section); every crash the fuzzers found has a regression case in `tests/` and its
+"What it promises"); every crash the fuzzers found has a regression case in `tests/` and its
 input in `fuzz/corpus/`.
 EOF
   } >"$doc"
