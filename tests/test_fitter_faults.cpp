@@ -54,6 +54,13 @@ void feed_range(FitterCore& core, const std::string& bench, const Stream& s, std
   }
 }
 
+// Feeds bench a from the stream's start to halfway through run 1's coast; returns that index.
+std::size_t feed_to_mid_coast(FitterCore& core, const TwoRuns& tr, std::int64_t& seq, std::int64_t& utime) {
+  const std::size_t mid = (tr.first.cut_index + tr.first.stop_index) / 2;
+  feed_range(core, "a", tr.s, 0, mid, seq, utime);
+  return mid;
+}
+
 bool has_warning(const CollectingSink& sink, const std::string& text) {
   return std::any_of(sink.diagnostics.begin(), sink.diagnostics.end(), [&](const auto& d) {
     return d.second.severity == Diagnostic::Severity::warning && d.second.message.find(text) != std::string::npos;
@@ -102,8 +109,7 @@ TEST(FitterFaults, ABenchIdFloodNeverEvictsARunInProgress) {
   o.max_benches = 64;
   FitterCore core(o, sink);
   std::int64_t seq = 0, utime = 0;
-  const std::size_t mid = (tr.first.cut_index + tr.first.stop_index) / 2;
-  feed_range(core, "a", tr.s, 0, mid, seq, utime);
+  const std::size_t mid = feed_to_mid_coast(core, tr, seq, utime);
   const Stream junk = make_stream(1, 5);
   for (int i = 0; i < 20000; ++i) {
     const samples_t m = batch("bogus" + std::to_string(i), junk, 0, 1, 0);
@@ -134,8 +140,7 @@ TEST(FitterFaults, ASilentBenchHasItsRunClosedAfterTheTimeout) {
   o.silent_s = 10;
   FitterCore core(o, sink);
   std::int64_t seq = 0, utime = 0;
-  const std::size_t mid = (tr.first.cut_index + tr.first.stop_index) / 2;
-  feed_range(core, "a", tr.s, 0, mid, seq, utime);
+  const std::size_t mid = feed_to_mid_coast(core, tr, seq, utime);
   core.poll(utime + 9'000'000);
   EXPECT_TRUE(sink.fits.empty());
   core.poll(utime + 10'500'000);

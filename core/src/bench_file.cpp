@@ -12,26 +12,29 @@
 
 namespace spindown {
 
+namespace {
+
+// One parameter by the rule: the command line's (already in p), else the file's, else the CONFIG's.
+void choose_one(bool given, bool file_sets, const BenchFile* file, const std::optional<BenchParams>& config,
+                double BenchParams::*value, std::string BenchParams::*source, BenchParams& p) {
+  if (given) return;
+  if (file && file_sets) {
+    p.*value = file->params.*value;
+    p.*source = file->params.*source + " (" + file->path + ")";
+  } else if (config) {
+    p.*value = (*config).*value;
+    p.*source = (*config).*source;
+  }
+}
+
+}  // namespace
+
 BenchParams choose_bench_params(const BenchChoice& cli, const BenchFile* file, const std::optional<BenchParams>& config) {
   BenchParams p = cli.given;  // the command line's values, the lab's where it gave none
-  if (!cli.inertia_given) {
-    if (file && file->sets_inertia) {
-      p.inertia_kg_m2 = file->params.inertia_kg_m2;
-      p.inertia_source = file->params.inertia_source + " (" + file->path + ")";
-    } else if (config) {
-      p.inertia_kg_m2 = config->inertia_kg_m2;
-      p.inertia_source = config->inertia_source;
-    }
-  }
-  if (!cli.kb_given) {
-    if (file && file->sets_kb) {
-      p.kb_v_s_per_rad = file->params.kb_v_s_per_rad;
-      p.kb_source = file->params.kb_source + " (" + file->path + ")";
-    } else if (config) {
-      p.kb_v_s_per_rad = config->kb_v_s_per_rad;
-      p.kb_source = config->kb_source;
-    }
-  }
+  choose_one(cli.inertia_given, file && file->sets_inertia, file, config, &BenchParams::inertia_kg_m2,
+             &BenchParams::inertia_source, p);
+  choose_one(cli.kb_given, file && file->sets_kb, file, config, &BenchParams::kb_v_s_per_rad, &BenchParams::kb_source,
+             p);
   return p;
 }
 
