@@ -1,0 +1,188 @@
+#include "spindown/log_refit.hpp"
+
+#include <algorithm>
+#include <fmt/format.h>
+#include <limits>
+#include <map>
+
+#include "spindown/fit_message.hpp"
+
+namespace spindown {
+
+namespace {
+
+constexpr std::size_t max_problems_listed = 20;  // per file, then counted
+
+constexpr std::size_t max_detector_notes = 1000;  // per file, then counted (memory flat)
+
+class RefitSink final : public FitterSink {
+ public:
+  RefitSink(LogRefit& out, const std::string& path, const RefitRunFn& each_run)
+      : out_(out), path_(path), each_run_(each_run) {}
+  void run_changed(const run_t&) override {}
+  void fit_ready(const FitResult& r) override {
+    ++out_.runs_fitted;
+    if (!each_run_) {
+      out_.runs.push_back({r.bench, r.fit, r.bench_source, r.first_seq, r.last_seq});
+      return;
+    }
+    if (r.fit.best.empty())
+      out_.file.failures.push_back(fmt::format("SPINDOWN.{}.SAMPLE: run {}: no model converged", r.bench,
+                                               r.fit.run.number));
+    each_run_(RefitRun{r.bench, r.fit, r.bench_source, r.first_seq, r.last_seq});
+  }
+  void problem(const std::string& text) override {
+    if (++problems_ <= max_problems_listed)
+      out_.file.diagnostics.push_back({Diagnostic::Severity::warning, path_, 0, text});
+  }
+  void diagnostic(const std::string&, const Diagnostic& d) override {
+    if (++notes_ > max_detector_notes) return;
+    Diagnostic copy = d;
+    copy.source = path_ + " " + d.source;
+    out_.file.diagnostics.push_back(std::move(copy));
+  }
+  std::size_t problems() const { return problems_; }
+  std::size_t notes() const { return notes_; }
+
+ private:
+  LogRefit& out_;
+  const std::string& path_;
+  const RefitRunFn& each_run_;
+  std::size_t problems_ = 0, notes_ = 0;
+};
+
+}  // namespace
+
+LogRefit refit_log(const std::string& path, const FitterOptions& options, bool keep_live_fits,
+                   const std::function<void(const LcmLogEvent&)>& each_event, const RefitProgressFn& progress,
+                   const RefitRunFn& each_run) {
+  LogRefit out;
+  out.file.file = path;
+  // The core reads samples in place; a caller that sees each event may want the samples_t.
+  LcmLogReader reader(path, each_event ? LcmSamples::view_and_message : LcmSamples::view_only);
+  if (!reader.good()) {
+    out.file.failures.push_back(reader.open_error());
+    return out;
+  }
+  RefitSink sink(out, path, each_run);
+  FitterCore core(options, sink);
+  std::map<std::string, std::size_t, std::less<>> order;
+  std::vector<char> channel_done;  // by LcmLogEvent::channel_id: its bench's place is known
+  std::int64_t last_utime = 0, next_poll = std::numeric_limits<std::int64_t>::min();
+  std::size_t file_problems = 0;
+  LcmLogEvent ev;
+  // Progress every 256 events, counted down (one test per event, none for a caller without one).
+  constexpr std::size_t progress_every = 256;
+  std::size_t until_progress = progress ? progress_every : std::numeric_limits<std::size_t>::max();
+  while (reader.next(ev)) {
+    if (each_event) each_event(ev);
+    if (--until_progress == 0) {
+      until_progress = progress_every;
+      progress(ev.file_offset, reader.file_size(), out.runs_fitted);
+    }
+    if (ev.number > 0) last_utime = ev.log_utime;
+    // Host time passes as the log's events do: benches gone silent mid-coast are closed as live.
+    if (ev.log_utime >= next_poll) {
+      core.poll(ev.log_utime);
+      next_poll = ev.log_utime + FitterCore::poll_period_us;
+    }
+    // A bench's first SAMPLE/CONFIG fixes its place; checked once per channel, not per event.
+    const auto id = static_cast<std::size_t>(ev.channel_id);
+    if (ev.channel_id < 0 || id >= channel_done.size() || !channel_done[id]) {
+      if (!ev.bench.empty() && (ev.channel.ends_with(".SAMPLE") || ev.channel.ends_with(".CONFIG")) &&
+          !order.contains(ev.bench)) {
+        order.emplace(ev.bench, order.size());
+        out.bench_order.emplace_back(ev.bench);
+      }
+      if (ev.channel_id >= 0) {
+        if (id >= channel_done.size()) channel_done.resize(id + 1, 0);
+        channel_done[id] = 1;
+      }
+    }
+    switch (ev.kind) {
+      // Decoded (and checked) once, by the reader: the core takes the message as it is.
+      case LcmLogEvent::Kind::samples:
+        core.on_samples(ev.channel_id, ev.bench, ev.samples_view, ev.log_utime);
+        break;
+      case LcmLogEvent::Kind::config:
+        core.on_config(ev.bench, ev.config, ev.log_utime);
+        break;
+      case LcmLogEvent::Kind::problem:
+        if (ev.number > 0 && ev.data) {  // a message that does not decode: the core counts it
+          core.on_message(ev.channel, ev.data, ev.data_size, ev.log_utime);
+        } else if (++file_problems <= max_problems_listed) {
+          out.file.diagnostics.push_back({Diagnostic::Severity::warning, path, ev.number, ev.problem});
+        }
+        break;
+      case LcmLogEvent::Kind::other:
+        if (keep_live_fits && ev.channel.starts_with("SPINDOWN.") && ev.channel.ends_with(".FIT")) {
+          fit_t m;
+          try {
+            if (m.decode(ev.data, 0, ev.data_size) >= 0) {
+              out.live.push_back(std::move(m));
+              break;
+            }
+          } catch (const std::exception&) {
+          }
+          out.file.diagnostics.push_back({Diagnostic::Severity::warning, path, ev.number,
+                                          fmt::format("event {} on {}: not a decodable fit_t; skipped", ev.number,
+                                                      ev.channel)});
+        }
+        break;
+    }
+  }
+  core.finish(last_utime);
+  out.counters = core.counters();
+  const FitterCounters& c = out.counters;
+  if (file_problems > max_problems_listed)
+    out.file.diagnostics.push_back({Diagnostic::Severity::warning, path, 0,
+                                    fmt::format("{} damaged parts of the file in all", file_problems)});
+  if (sink.problems() > max_problems_listed)
+    out.file.diagnostics.push_back({Diagnostic::Severity::warning, path, 0,
+                                    fmt::format("{} unusable messages or samples in all (first {} listed)",
+                                                sink.problems(), max_problems_listed)});
+  if (sink.notes() > max_detector_notes)
+    out.file.diagnostics.push_back({Diagnostic::Severity::note, path, 0,
+                                    fmt::format("{} run detector notes in all (first {} listed)", sink.notes(),
+                                                max_detector_notes)});
+  out.file.diagnostics.push_back(
+      {Diagnostic::Severity::note, path, 0,
+       fmt::format("{} events: {} sample messages, {} config messages, {} samples used; {} decode errors, {} sequence "
+                   "gaps ({} samples lost), {} repeated messages, {} NaN values, {} samples with time going back, "
+                   "{} clock restarts",
+                   reader.events_read(), c.sample_messages, c.config_messages, c.samples, c.decode_errors, c.seq_gaps,
+                   c.samples_lost, c.duplicates, c.nan_values, c.time_backwards, c.clock_restarts)});
+
+  // Runs in the order `spindown fit` lists them: by bench (first appearance), then number.
+  auto rank = [&](const std::string& bench) {
+    auto it = order.find(bench);
+    return it == order.end() ? order.size() : it->second;
+  };
+  std::stable_sort(out.runs.begin(), out.runs.end(), [&](const RefitRun& a, const RefitRun& b) {
+    const auto ra = rank(a.bench), rb = rank(b.bench);
+    return ra != rb ? ra < rb : a.fit.run.number < b.fit.run.number;
+  });
+  out.file.samples = static_cast<std::size_t>(c.samples);
+  out.file.lines_read = static_cast<std::size_t>(c.sample_messages);
+  out.file.lines_skipped = static_cast<std::size_t>(c.decode_errors + c.duplicates + c.quantity_errors);
+  for (const RefitRun& r : out.runs) {
+    out.file.runs.push_back(r.fit);
+    if (r.fit.best.empty())
+      out.file.failures.push_back(fmt::format("SPINDOWN.{}.SAMPLE: run {}: no model converged", r.bench,
+                                              r.fit.run.number));
+  }
+  if (out.runs_fitted == 0)
+    out.file.failures.push_back(c.samples > 0 ? fmt::format("no spin-down run found in {} samples", c.samples)
+                                              : std::string("no samples on SPINDOWN.<bench>.SAMPLE channels"));
+  return out;
+}
+
+Json refit_file_json(const LogRefit& refit, const ReportOptions& opt) {
+  Json j = file_fit_json(refit.file, opt);
+  Json& runs = j["runs"];
+  for (std::size_t i = 0; i < refit.runs.size() && i < runs.size(); ++i)
+    tag_run_json(runs[i], {refit.runs[i].bench, refit.runs[i].first_seq, refit.runs[i].last_seq});
+  return j;
+}
+
+}  // namespace spindown
