@@ -211,8 +211,11 @@ void FitterService::worker() {
     }
     for (const Message& m : batch)
       core_.on_message(m.channel, m.data.data(), static_cast<std::int64_t>(m.data.size()), m.recv_utime);
+    // Benches gone silent mid-coast, by the time of the traffic just handled (as refit does with
+    // a log), so a backlog in the queue is never taken for silence; the clock when none came.
+    const std::int64_t now = batch.empty() ? wall_us() : batch.back().recv_utime;
     batch.clear();
-    if (const std::int64_t now = wall_us(); now >= next_poll) {  // benches gone silent mid-coast
+    if (now >= next_poll) {
       core_.poll(now);
       next_poll = now + FitterCore::poll_period_us;
     }
