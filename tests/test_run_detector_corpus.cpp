@@ -40,7 +40,7 @@ namespace {
 // fragments (the rest of a coast after a restart, a nudge) are warnings, not notes.
 // Before: 0x0df837417b92c5e0.
 // Re-recorded on 2026-11-25 (late) when the sample recordings moved into the repository (data/,
-// made by the project's own simulator with data/make-samples, no longer ../shared/data): the
+// made by the project's own simulator with data/make-samples, no longer a folder outside it): the
 // input changed, the detector did not; test_runs' SampleLogsMatchTheirTruth and test_sample_data
 // judge the new files against their truth. Before: 0x7125c5e71c00a438.
 constexpr std::uint64_t recorded_hash = 0x2ffda9128e6ef472ull;

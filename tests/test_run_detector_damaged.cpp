@@ -35,7 +35,7 @@ namespace {
 // for what changed and why; a run cut short by a clock restart now says so as a warning). Before:
 // 0xba8bc83497a25bed.
 // Re-recorded on 2026-11-25 (late): the sample recordings are now data/ (made by data/make-samples),
-// not ../shared/data; the detector is unchanged. Before: 0x8988ef6342a32a4b.
+// not a folder outside the repository; the detector is unchanged. Before: 0x8988ef6342a32a4b.
 constexpr std::uint64_t recorded_hash = 0xcee5a9288e1b65bfull;
 
 // Each recording of the sample data (data/) as read, then damaged in each of the corpus's ways.
