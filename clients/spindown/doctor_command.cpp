@@ -2,32 +2,21 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <fcntl.h>
 #include <filesystem>
 #include <fmt/format.h>
-#include <fstream>
-#include <ifaddrs.h>
 #include <iostream>
-#include <lcm/lcm.h>
 #include <memory>
-#include <sstream>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include "exit_codes.hpp"
 #include "spindown/clock_checks.hpp"
-#include "spindown/config_t.hpp"
 #include "spindown/doctor_check.hpp"
-#include "spindown/message_decode.hpp"
-#include "spindown/lcm_channels.hpp"
 #include "spindown/lcm_self_test.hpp"
 #include "spindown/lcm_url.hpp"
 #include "spindown/network_checks.hpp"
 #include "spindown/serial_inventory.hpp"
-#include "spindown/status_t.hpp"
 #include "spindown/system_probes.hpp"
 
 namespace spindown::cli {

@@ -8,7 +8,6 @@
 #include <fmt/format.h>
 #include <iostream>
 #include <limits>
-#include <map>
 #include <memory>
 #include <regex>
 #include <string_view>
