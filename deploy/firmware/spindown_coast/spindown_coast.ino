@@ -1,5 +1,5 @@
 // spindown-coast: the improved spin-down firmware, protocol spindown-v1 (README.md here is the
-// normative definition; core/src/spindown_protocol.cpp parses exactly that).
+// normative definition; core/sources/src/spindown_protocol.cpp parses exactly that).
 //   - raw ADC counts (the lab sketch's 2-decimal volts lose half the 10-bit resolution)
 //   - micros() time stamps on a fixed schedule (not delay(): the loop period does not drift)
 //   - a sequence number and a CRC-8 per line, 115200 baud

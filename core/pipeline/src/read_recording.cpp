@@ -1,0 +1,219 @@
+#include "spindown/read_recording.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdint>
+#include <cstring>
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <memory>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "spindown/file_bytes.hpp"
+#include "spindown/lab_line.hpp"
+#include "spindown/text_support.hpp"
+
+namespace spindown {
+
+std::string_view file_format_name(FileFormat format) {
+  switch (format) {
+    case FileFormat::automatic: return "auto";
+    case FileFormat::arduino_text: return "arduino";
+    case FileFormat::delimited_text: return "delimited";
+    case FileFormat::lcm_log: return "lcm";
+  }
+  return "?";
+}
+
+std::optional<FileFormat> parse_file_format(std::string_view name) {
+  if (name == "auto") return FileFormat::automatic;
+  if (name == "arduino" || name == "putty" || name == "lab") return FileFormat::arduino_text;
+  if (name == "delimited" || name == "csv" || name == "tsv" || name == "text") return FileFormat::delimited_text;
+  if (name == "lcm" || name == "lcm-log" || name == "log") return FileFormat::lcm_log;
+  return std::nullopt;
+}
+
+bool ReadOptions::is_valid(std::string* why) const {
+  std::string w;
+  if (!arduino.is_valid(&w)) {
+    if (why) *why = "Arduino text: " + w;
+    return false;
+  }
+  if (!delimited.is_valid(&w)) {
+    if (why) *why = "delimited text: " + w;
+    return false;
+  }
+  if (!lcm.is_valid(&w)) {
+    if (why) *why = "LCM log: " + w;
+    return false;
+  }
+  return true;
+}
+
+namespace {
+
+// Regular files up to this size are read whole before their format is known.
+constexpr std::uintmax_t whole_read_bytes = 1 << 20;
+
+}  // namespace
+
+
+FileFormat detect_format(std::string_view head, const ReadOptions& options) {
+  if (head.size() >= 4) {
+    const auto* p = reinterpret_cast<const unsigned char*>(head.data());
+    const std::uint32_t word =
+        (std::uint32_t(p[0]) << 24) | (std::uint32_t(p[1]) << 16) | (std::uint32_t(p[2]) << 8) | p[3];
+    if (word == lcm_log_magic) return FileFormat::lcm_log;
+  }
+  if (options.format != FileFormat::automatic) return options.format;
+  if (options.delimited.names_columns()) return FileFormat::delimited_text;
+  // Arduino text when at least half of the first 50 lines with content are lab samples.
+  std::size_t content = 0, samples = 0;
+  text::LineCursor lines(head.substr(0, 64 * 1024));
+  while (content < 50 && !lines.at_end()) {  // stop there: splitting the rest cost as much as parsing it
+    LabLine printed;
+    if (const std::size_t length = parse_printed_sample(lines.rest(), printed)) {  // the usual line, quickly
+      lines.skip_line(length);
+      ++content;
+      ++samples;
+      continue;
+    }
+    const std::string_view line = lines.next_line();
+    if (line.starts_with("=~=~=~")) continue;
+    const LabLine parsed = parse_lab_line(line);
+    if (parsed.kind == LabLine::Kind::blank) continue;
+    ++content;
+    samples += parsed.kind == LabLine::Kind::sample;
+  }
+  if (content == 0 || samples * 2 >= content) return FileFormat::arduino_text;
+  return FileFormat::delimited_text;
+}
+
+namespace {
+
+Recording failed(const std::string& path, std::string message) {
+  Recording rec;
+  rec.source = path;
+  rec.error(0, std::move(message));
+  return rec;
+}
+
+}  // namespace
+
+std::vector<Recording> read_recordings(const std::string& path, const ReadOptions& options,
+                                       std::vector<RecordingInfo>* info) {
+  std::vector<Recording> out;
+  auto add = [&](Recording rec, RecordingInfo i) {
+    out.push_back(std::move(rec));
+    if (info) info->push_back(std::move(i));
+  };
+  if (info) info->clear();
+  std::string why;
+  if (!options.is_valid(&why)) {
+    add(failed(path, "invalid read options: " + why), {});
+    return out;
+  }
+
+  // An LCM log is streamed by lcm::LogFile, which seeks (so it cannot come through a pipe); its
+  // first word says what it is. Text is read whole through the same descriptor (one open per file).
+  std::optional<FileBytes> text_bytes;
+  bool lcm_log = false;
+  {
+    const int fd = open_for_reading(path);
+    if (fd < 0) {
+      add(failed(path, fmt::format("cannot open {}: {}", path, std::strerror(errno))), {});
+      return out;
+    }
+    FdCloser closer{fd};
+    struct stat st {};
+    if (::fstat(fd, &st) != 0) {
+      add(failed(path, fmt::format("cannot read {}: {}", path, std::strerror(errno))), {});
+      return out;
+    }
+    reads_blocking(fd, st);
+    if (S_ISDIR(st.st_mode)) {
+      add(failed(path, fmt::format("cannot read {}: it is a directory", path)), {});
+      return out;
+    }
+    const auto read_whole = [&] {
+      text_bytes = read_fd_bytes(fd, st, path, &why, std::size_t{1} << 30);
+      if (!text_bytes) add(failed(path, why), {});
+      return text_bytes.has_value();
+    };
+    // Read whole first: a pipe, FIFO or device (it can be read only once), or a small regular
+    // file (a lab's text file is ~20 kB: its first word is then looked at in its bytes, one
+    // system call fewer than reading the word first). Otherwise the first word is read alone.
+    const bool regular = S_ISREG(st.st_mode);
+    char head[4] = {};
+    std::string_view first_word;
+    if (!regular ||
+        (options.format != FileFormat::lcm_log && static_cast<std::uintmax_t>(st.st_size) <= whole_read_bytes)) {
+      if (!read_whole()) return out;
+      first_word = text_bytes->view().substr(0, sizeof head);
+    } else {
+      const ssize_t n = ::pread(fd, head, sizeof head, 0);
+      first_word = std::string_view(head, n > 0 ? static_cast<std::size_t>(n) : 0);
+    }
+    lcm_log = detect_format(first_word, options) == FileFormat::lcm_log || options.format == FileFormat::lcm_log;
+    if (lcm_log && !regular) {
+      add(failed(path, fmt::format("cannot read {} as an LCM log: it is a pipe or device, and lcm::LogFile needs a "
+                                   "regular file",
+                                   path)),
+          {});
+      return out;
+    }
+    if (lcm_log) text_bytes.reset();  // a small log read whole: streamed as any log is
+    else if (!text_bytes && !read_whole()) return out;
+  }
+
+  if (lcm_log) {
+    LcmLogContents log = read_lcm_log(path, options.lcm);
+    for (BenchLog& b : log.benches) {
+      if (b.sample_messages == 0) continue;
+      Recording rec = std::move(b.recording);
+      rec.diagnostics.insert(rec.diagnostics.begin(), log.diagnostics.begin(), log.diagnostics.end());
+      add(std::move(rec), {FileFormat::lcm_log, b.bench, std::move(b.config), b.samples_lost});
+    }
+    if (out.empty()) {
+      Recording rec;
+      rec.source = path;
+      rec.diagnostics = log.diagnostics;
+      if (!log.has_errors()) {
+        std::string channels;
+        for (const auto& [name, count] : log.other_channels)
+          if (channels.size() < 300)
+            channels += fmt::format("{}{} ({})", channels.empty() ? "" : ", ", text::escape_invalid_utf8(name), count);
+        for (const BenchLog& b : log.benches)
+          channels += fmt::format("{}SPINDOWN.{}.CONFIG ({})", channels.empty() ? "" : ", ", b.bench,
+                                  b.config_messages);
+        rec.error(0, fmt::format("no samples: {} events, none on SPINDOWN.<bench>.SAMPLE{}", log.events,
+                                 channels.empty() ? std::string() : " (channels: " + channels + ")"));
+      }
+      add(std::move(rec), {FileFormat::lcm_log, {}, {}, 0});
+    }
+    return out;
+  }
+
+  const std::string_view bytes = text_bytes->view();
+  const FileFormat format = detect_format(bytes, options);
+  if (format == FileFormat::delimited_text)
+    add(read_delimited_text(bytes, path, options.delimited), {FileFormat::delimited_text, {}, {}, 0});
+  else
+    add(read_arduino_text(bytes, path, options.arduino), {FileFormat::arduino_text, {}, {}, 0});
+  return out;
+}
+
+std::optional<BenchParams> config_bench_params(const RecordingInfo* info, const std::string& source,
+                                               std::vector<Diagnostic>& diags) {
+  if (!info || !info->config) return std::nullopt;
+  std::string why;
+  if (auto b = bench_params_from_config(*info->config, &why)) return b;
+  diags.push_back({Diagnostic::Severity::warning, source, 0,
+                   fmt::format("bench config not used ({}); J and K_b from the command line, the bench file or the "
+                               "lab's defaults",
+                               why)});
+  return std::nullopt;
+}
+
+}  // namespace spindown
