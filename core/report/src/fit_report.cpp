@@ -19,9 +19,6 @@ namespace spindown {
 
 namespace {
 
-// JSON has no inf/NaN: a stop that never comes or an undefined R² is null.
-Json number(double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); }
-
 bool is_curve_constant(const Parameter& p) { return p.name == "A" || p.name == "B" || p.name == "C"; }
 
 const char* severity_name(Diagnostic::Severity s) {
@@ -184,106 +181,6 @@ std::string explain_best(const RunFit& fit) {
                      model_name(second->kind), evidence(delta), best->rmse, second->rmse);
 }
 
-Json run_fit_json(const RunFit& fit, const ReportOptions& opt) {
-  const std::string residual_unit(quantity_unit(fit.quantity));
-  Json models = Json::array();
-  for (const auto& m : fit.models) {
-    Json params = Json::object();
-    for (const auto& p : m.params) {
-      Json jp = {{"value", number(p.value)}, {"stderr", number(p.std_error)}, {"unit", p.unit}};
-      if (opt.lab_units)
-        if (auto lab = lab_unit_for(p.unit))
-          jp["lab"] = {{"value", number(p.value * lab->per_si)},
-                       {"stderr", number(p.std_error * lab->per_si)},
-                       {"unit", lab->ascii}};
-      params[p.name] = std::move(jp);
-    }
-    Json jm = {{"name", model_name(m.kind)},
-               {"params", std::move(params)},
-               {"rmse", number(m.rmse)},
-               {"residual_unit", residual_unit},
-               {"r2", number(m.r2)},
-               {"aic", number(m.aic)},
-               {"bic", number(m.bic)},
-               {"t_stop_pred_s", number(m.t_stop_pred_s)},
-               {"n", m.n},
-               {"converged", m.converged}};
-    if (!m.message.empty()) jm["message"] = m.message;
-    models.push_back(std::move(jm));
-  }
-  const Run& run = fit.run;
-  Json j = {{"run", run.number},
-            {"t_cut_s", number(run.t_cut_s)},
-            {"t_stop_s", run.stopped ? number(run.t_stop_s) : Json(nullptr)},
-            {"samples", samples_in(run)},
-            {"models", std::move(models)},
-            {"best", fit.best.empty() ? Json(nullptr) : Json(fit.best)},
-            {"best_reason", explain_best(fit)},
-            {"stopped", run.stopped},
-            {"end", end_name(run.end)},
-            {"t_end_s", number(run.t_end_s)},
-            {"lead_in", run.lead_in},
-            {"zero_level", number(run.zero_level)},
-            {"noise_level", number(run.noise_level)},
-            {"period_s", number(run.period_s)},
-            {"quantity", residual_unit},
-            {"bench",
-             {{"J", number(fit.bench.inertia_kg_m2)},
-              {"J_unit", "kg*m^2"},
-              {"J_source", fit.bench.inertia_source},
-              {"Kb", number(fit.bench.kb_v_s_per_rad)},
-              {"Kb_unit", "V*s/rad"},
-              {"Kb_source", fit.bench.kb_source}}}};
-  if (opt.lab_units) j["bench"]["J_lab"] = {{"value", number(inertia_to_g_cm2(fit.bench.inertia_kg_m2))},
-                                            {"unit", "g*cm^2"}};
-  return j;
-}
-
-Json health_json(const HealthVerdict& v) {
-  Json findings = Json::array();
-  for (const auto& f : v.findings)
-    findings.push_back({{"what", f.what},
-                        {"level", health_level_name(f.level)},
-                        {"reason", f.reason},
-                        {"value", number(f.value)},
-                        {"stderr", number(f.std_error)},
-                        {"reference", number(f.reference)},
-                        {"reference_stderr", number(f.reference_std_error)},
-                        {"reference_name", f.reference_name},
-                        {"ratio", number(f.ratio)},
-                        {"ratio_stderr", number(f.ratio_std_error)},
-                        {"unit", f.unit}});
-  return Json{{"level", health_level_name(v.level)},
-              {"reason", v.reason},
-              {"has_reference", v.has_reference},
-              {"findings", std::move(findings)}};
-}
-
-Json file_fit_json(const FileFit& file, const ReportOptions& opt) {
-  Json runs = Json::array();
-  for (std::size_t i = 0; i < file.runs.size(); ++i) {
-    runs.push_back(run_fit_json(file.runs[i], opt));
-    if (i < file.run_bench.size()) tag_run_json(runs.back(), {file.run_bench[i], 0, 0, false});
-    if (i < file.health.size() && file.health[i]) runs.back()["health"] = health_json(*file.health[i]);
-  }
-  Json diagnostics = Json::array();
-  for (const auto& d : file.diagnostics)
-    diagnostics.push_back({{"severity", severity_name(d.severity)}, {"line", d.line}, {"message", d.message}});
-  return Json{{"file", file.file},
-              {"runs", std::move(runs)},
-              {"samples_read", file.samples},
-              {"lines_read", file.lines_read},
-              {"lines_skipped", file.lines_skipped},
-              {"diagnostics", std::move(diagnostics)},
-              {"failures", file.failures}};
-}
-
-Json fit_report_json(std::span<const FileFit> files, const ReportOptions& opt) {
-  Json list = Json::array();
-  for (const auto& f : files) list.push_back(file_fit_json(f, opt));
-  return Json{{"files", std::move(list)}};
-}
-
 namespace {
 
 constexpr bool is_plain_char(unsigned char c) { return c >= 0x20 && c <= 0x7E && c != '"' && c != '\\'; }
@@ -373,7 +270,7 @@ class PrettyJsonWriter {
       put(Json(s).dump(-1, ' ', false, Json::error_handler_t::replace));
     }
   }
-  void number(double x) {  // non-finite is null, as the document's number() makes it
+  void number(double x) {  // JSON has no inf/NaN: a stop that never comes or an undefined R² is null
     if (!std::isfinite(x)) {
       put("null");
       return;
@@ -467,7 +364,7 @@ class PrettyJsonWriter {
 };
 
 // A Json object keeps one member per key (a repeated key overwrites the first in place); the
-// writer does not, so a run with repeated parameter names goes through the document.
+// writer does not, so the text of a run with repeated parameter names is its document's dump.
 
 bool has_repeated_param_names(const RunFit& run) {
   for (const auto& m : run.models)
@@ -482,8 +379,8 @@ bool has_repeated_param_names(const FileFit& file) {
                      [](const RunFit& run) { return has_repeated_param_names(run); });
 }
 
-// run_fit_json(fit, opt) (with the tags when given), member for member; leaves the run's object
-// open (file_fit_json adds "health" last).
+// The `fit --json` contract of one run (with the tags when given); leaves the run's object open
+// (a file's entry adds "health" last).
 void write_run_fit(PrettyJsonWriter& w, const RunFit& fit, const ReportOptions& opt, const RunTags* tags = nullptr) {
   const std::string_view residual_unit = quantity_unit(fit.quantity);
   const Run& run = fit.run;
@@ -567,7 +464,7 @@ void write_run_fit(PrettyJsonWriter& w, const RunFit& fit, const ReportOptions& 
   }
 }
 
-// health_json(v), member for member.
+// A run's "health" object.
 void write_health(PrettyJsonWriter& w, const HealthVerdict& v) {
   w.begin_object();
   w.member("level", health_level_name(v.level));
@@ -595,7 +492,7 @@ void write_health(PrettyJsonWriter& w, const HealthVerdict& v) {
   w.end_object();
 }
 
-// file_fit_json(file, opt), member for member; the writer is done (out cut to its text) on return.
+// One file's entry of the contract; the writer is done (out cut to its text) on return.
 void write_file_fit(std::string& out, std::size_t indent, const FileFit& file, const ReportOptions& opt) {
   PrettyJsonWriter w(out, indent);
   w.begin_object();
@@ -659,17 +556,55 @@ std::string file_fit_json_text(const FileFit& file, const ReportOptions& opt) {
   return out;
 }
 
+namespace {
+
+// The writer's text of one run (tags when given), its object closed.
+std::string run_fit_text(const RunFit& fit, const ReportOptions& opt, const RunTags* tags) {
+  std::string out;
+  {
+    PrettyJsonWriter w(out, 0);
+    write_run_fit(w, fit, opt, tags);
+    w.end_object();
+  }
+  return out;
+}
+
+}  // namespace
+
+// The documents are the writer's text read back: one writer of the contract. Numbers are the
+// shortest digits that read back as the same double, so nothing is lost on the way.
+Json run_fit_json(const RunFit& fit, const ReportOptions& opt) { return Json::parse(run_fit_text(fit, opt, nullptr)); }
+
+Json tagged_run_fit_json(const RunFit& fit, const RunTags& tags, const ReportOptions& opt) {
+  return Json::parse(run_fit_text(fit, opt, &tags));
+}
+
+Json health_json(const HealthVerdict& v) {
+  std::string out;
+  {
+    PrettyJsonWriter w(out, 0);
+    write_health(w, v);
+  }
+  return Json::parse(out);
+}
+
+Json file_fit_json(const FileFit& file, const ReportOptions& opt) {
+  std::string out;
+  write_file_fit(out, 0, file, opt);
+  return Json::parse(out);
+}
+
+Json fit_report_json(std::span<const FileFit> files, const ReportOptions& opt) {
+  Json list = Json::array();
+  for (const auto& f : files) list.push_back(file_fit_json(f, opt));
+  return Json{{"files", std::move(list)}};
+}
+
 void tag_run_json(Json& run, const RunTags& tags) {
   run["bench"]["id"] = tags.bench_id;
   if (!tags.has_seq) return;
   run["first_seq"] = tags.first_seq;
   run["last_seq"] = tags.last_seq;
-}
-
-Json tagged_run_fit_json(const RunFit& fit, const RunTags& tags, const ReportOptions& opt) {
-  Json j = run_fit_json(fit, opt);
-  tag_run_json(j, tags);
-  return j;
 }
 
 void append_run_fit_json_text(std::string& out, const RunFit& fit, const ReportOptions& opt, std::size_t indent,
