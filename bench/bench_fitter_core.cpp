@@ -29,7 +29,7 @@ std::vector<std::vector<unsigned char>> bench_messages(const std::string& bench,
     spec.t0_ms = t0_ms;
     const auto run = spindown::make_synthetic_run(spec);
     for (std::size_t i = 0; i < run.t_ms.size(); ++i) {
-      spindown::samples_t m;
+      spindown::samples_t m{};  // every field zero (lcm-gen types leave them uninitialised)
       m.bench = bench;
       m.seq = seq++;
       m.quantity = spindown::samples_t::QUANTITY_BACK_EMF_V;

@@ -105,7 +105,7 @@ std::string payload(int i, std::size_t size = 100) {
 }
 
 std::string encode_samples(const std::string& bench, std::int64_t seq, int n) {
-  samples_t s;
+  samples_t s{};  // every field zero (lcm-gen types leave them uninitialised)
   s.utime = kT0;
   s.bench = bench;
   s.seq = seq;

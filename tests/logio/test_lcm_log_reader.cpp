@@ -262,7 +262,7 @@ TEST(LcmLogReader, RepeatedMessagesNonFiniteValuesAndBackwardTimes) {
   const Recording& r = c.benches.at(0).recording;
   SCOPED_TRACE(all_diagnostics(r.diagnostics));
   EXPECT_EQ(r.size(), 12u);
-  EXPECT_TRUE(mentions(r.diagnostics, "already read"));
+  EXPECT_TRUE(mentions(r.diagnostics, "already received"));
   EXPECT_TRUE(mentions(r.diagnostics, "NaN or infinite"));
   EXPECT_TRUE(mentions(r.diagnostics, "does not advance"));
   EXPECT_TRUE(std::is_sorted(r.t_s.begin(), r.t_s.end()));

@@ -188,7 +188,7 @@ TEST(FitterCore, ARunThatNeverStopsIsClosedWithinMaxCoast) {
   o.runs.max_coast_s = 5.0;
   FitterCore core(o, sink);
   // A slow linear decline that would take minutes to stop.
-  samples_t m;
+  samples_t m{};  // every field zero (lcm-gen types leave them uninitialised)
   m.quantity = samples_t::QUANTITY_BACK_EMF_V;
   m.bench = "slow";
   std::int64_t seq = 0;

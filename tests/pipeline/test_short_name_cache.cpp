@@ -61,7 +61,7 @@ TEST(ShortNameCache, SlotsAreStableInRangeAndForgotten) {
 }
 
 std::vector<std::uint8_t> encode_samples(const std::string& bench, std::int64_t seq) {
-  samples_t m;
+  samples_t m{};  // every field zero (lcm-gen types leave them uninitialised)
   m.bench = bench;
   m.seq = seq;
   m.n = 1;
@@ -150,7 +150,7 @@ TEST(FitterCoreBenches, ManyBenchesInRandomOrderEachGetTheirOwnRuns) {
   std::vector<std::uint8_t> bytes;  // the latest message's encoding, which its view reads
   auto message = [&](const std::string& bench, std::size_t i) {
     SamplesView v;
-    samples_t m;
+    samples_t m{};  // every field zero (lcm-gen types leave them uninitialised)
     m.bench = bench;
     m.seq = static_cast<std::int64_t>(i);
     m.n = 1;

@@ -60,7 +60,7 @@ inline Stream make_stream(int runs, std::uint64_t seed, double e0 = 2.8) {
 }
 
 inline samples_t batch(const std::string& bench, const Stream& s, std::size_t from, std::size_t n, std::int64_t seq) {
-  samples_t m;
+  samples_t m{};  // every field zero (lcm-gen types leave them uninitialised)
   m.bench = bench;
   m.seq = seq;
   m.quantity = samples_t::QUANTITY_BACK_EMF_V;

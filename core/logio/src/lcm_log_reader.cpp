@@ -45,24 +45,6 @@ std::optional<SpindownChannelName> split_spindown_channel(std::string_view chann
   return SpindownChannelName{bench, kind};
 }
 
-std::optional<Quantity> quantity_from_samples_code(std::int8_t code) {
-  switch (code) {
-    case samples_t::QUANTITY_BACK_EMF_V: return Quantity::back_emf_volts;
-    case samples_t::QUANTITY_RPM: return Quantity::rpm;
-    case samples_t::QUANTITY_RAD_S: return Quantity::rad_per_s;
-    default: return std::nullopt;
-  }
-}
-
-std::int8_t samples_code_of(Quantity quantity) {
-  switch (quantity) {
-    case Quantity::back_emf_volts: return samples_t::QUANTITY_BACK_EMF_V;
-    case Quantity::rpm: return samples_t::QUANTITY_RPM;
-    case Quantity::rad_per_s: return samples_t::QUANTITY_RAD_S;
-  }
-  return samples_t::QUANTITY_BACK_EMF_V;
-}
-
 std::optional<BenchParams> bench_params_from_config(const config_t& config, std::string* why) {
   BenchParams p;
   p.inertia_kg_m2 = config.inertia_kg_m2;
@@ -400,16 +382,13 @@ struct BenchState {
   }
   BenchLog log;
   text::LineReporter reporter;
-  bool have_seq = false, have_epoch = false, quantity_known = false, bench_field_warned = false;
-  std::int64_t next_seq = 0;
-  std::int32_t epoch = 0;
-  std::int64_t last_t_us = std::numeric_limits<std::int64_t>::min();
+  SampleStream stream;
+  bool bench_field_warned = false;
   std::int64_t first_event = 0, last_event = 0;
   std::size_t skipped_messages = 0;
 };
 
 void take_samples(BenchState& st, const LcmLogEvent& ev) {
-  using Severity = Diagnostic::Severity;
   const samples_t& m = ev.samples;
   Recording& rec = st.log.recording;
   ++st.log.sample_messages;
@@ -420,72 +399,31 @@ void take_samples(BenchState& st, const LcmLogEvent& ev) {
     st.reporter.warn(ev.number, fmt::format("message names bench {} but came on {}; the channel's bench is used",
                                             printable(m.bench), ev.channel));
   }
-  const auto q = quantity_from_samples_code(m.quantity);
-  if (!q) {
-    ++st.skipped_messages;
-    st.reporter.warn(ev.number, fmt::format("unknown quantity code {} ({} samples); message skipped", int(m.quantity),
-                                            m.n));
-    return;
-  }
-  if (!st.quantity_known) {
-    rec.quantity = *q;
-    st.quantity_known = true;
-  } else if (*q != rec.quantity) {
-    ++st.skipped_messages;
-    st.reporter.warn(ev.number, fmt::format("quantity changes from {} to {}; message ({} samples) skipped",
-                                            quantity_unit(rec.quantity), quantity_unit(*q), m.n));
-    return;
-  }
-
-  bool restart = st.have_epoch && m.clock_epoch != st.epoch;
-  if (st.have_seq && m.seq != st.next_seq) {
-    if (m.seq > st.next_seq) {
-      const std::int64_t lost = m.seq - st.next_seq;
-      st.log.samples_lost += lost;
-      st.reporter.warn(ev.number, fmt::format("{} samples lost: sequence number jumps from {} to {}", lost,
-                                              st.next_seq - 1, m.seq));
-    } else if (!restart && m.n > 0 && m.device_time_us[m.n - 1] <= st.last_t_us) {
-      ++st.skipped_messages;
-      st.reporter.warn(ev.number, fmt::format("samples {} to {} were already read (repeated message); skipped",
-                                              m.seq, m.seq + m.n - 1));
-      return;
-    } else {
-      st.reporter.report(Severity::note, ev.number,
-                         fmt::format("sequence number restarts from {} at {} (bridge restarted?)", st.next_seq, m.seq));
-      if (m.n > 0 && m.device_time_us[0] <= st.last_t_us) restart = true;
+  struct Sink {
+    BenchState& st;
+    Recording& rec;
+    std::int64_t event;
+    void problem(SampleProblem kind, std::int64_t count, std::string text) {
+      switch (kind) {
+        case SampleProblem::samples_lost: st.log.samples_lost += count; break;
+        case SampleProblem::unknown_quantity:
+        case SampleProblem::quantity_change:
+        case SampleProblem::repeated: ++st.skipped_messages; break;
+        case SampleProblem::sequence_restart: st.reporter.report(Diagnostic::Severity::note, event, text); return;
+        case SampleProblem::clock_restart:
+          if (!rec.empty() && (rec.clock_restarts.empty() || rec.clock_restarts.back() != rec.size()))
+            rec.clock_restarts.push_back(rec.size());
+          st.reporter.report(Diagnostic::Severity::note, event, text);
+          return;
+        case SampleProblem::bad_value:
+        case SampleProblem::time_backwards: break;
+      }
+      st.reporter.warn(event, text);
     }
-  }
-  st.have_seq = true;
-  st.next_seq = m.seq + m.n;
-
-  if (restart) {
-    if (!rec.empty() && (rec.clock_restarts.empty() || rec.clock_restarts.back() != rec.size()))
-      rec.clock_restarts.push_back(rec.size());
-    st.reporter.report(Severity::note, ev.number,
-                       fmt::format("device clock restarted (clock epoch {} -> {}); a new timeline starts here and no "
-                                   "run spans it",
-                                   st.epoch, m.clock_epoch));
-    st.last_t_us = std::numeric_limits<std::int64_t>::min();
-  }
-  st.have_epoch = true;
-  st.epoch = m.clock_epoch;
-
-  for (std::int32_t i = 0; i < m.n; ++i) {
-    const std::int64_t t = m.device_time_us[i];
-    const double v = m.value[i];
-    if (!std::isfinite(v)) {
-      st.reporter.warn(ev.number, fmt::format("sample {}: value is NaN or infinite; skipped", m.seq + i));
-      continue;
-    }
-    if (t <= st.last_t_us) {
-      st.reporter.warn(ev.number, fmt::format("sample {}: device time {} µs does not advance (previous {} µs); "
-                                              "skipped",
-                                              m.seq + i, t, st.last_t_us));
-      continue;
-    }
-    rec.push(static_cast<double>(t) / 1e6, v);
-    st.last_t_us = t;
-  }
+    void sample(std::int64_t, std::int64_t t_us, double v) { rec.push(static_cast<double>(t_us) / 1e6, v); }
+  };
+  st.stream.take(m, static_cast<std::size_t>(std::max(m.n, 0)), Sink{st, rec, ev.number});
+  if (st.stream.quantity_known) rec.quantity = st.stream.quantity;
 }
 
 void take_config(BenchState& st, const LcmLogEvent& ev) {

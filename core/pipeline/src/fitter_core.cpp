@@ -18,14 +18,6 @@ namespace spindown {
 
 namespace {
 
-// A sample's time and value from either form of samples_t the core is given.
-std::int64_t device_time_us(const samples_t& m, std::size_t i) { return m.device_time_us[i]; }
-double value_of(const samples_t& m, std::size_t i) { return m.value[i]; }
-std::int64_t device_time_us(const SamplesView& m, std::size_t i) {
-  return m.device_time_us(static_cast<std::int32_t>(i));
-}
-double value_of(const SamplesView& m, std::size_t i) { return m.value(static_cast<std::int32_t>(i)); }
-
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -106,14 +98,7 @@ struct FitterCore::Bench {
   std::optional<BenchParams> config;
   std::string config_problem;
 
-  // The log reader's per-bench checks (lcm_log_reader.cpp take_samples), so refit == fit.
-  bool quantity_known = false;
-  Quantity quantity = Quantity::back_emf_volts;
-  std::int8_t quantity_code = 0;  // the samples_t code that gave quantity
-  bool have_seq = false, have_epoch = false;
-  std::int64_t next_seq = 0;
-  std::int32_t epoch = 0;
-  std::int64_t last_t_us = std::numeric_limits<std::int64_t>::min();
+  SampleStream stream;  // the log reader's checks too (sample_stream.hpp), so refit == fit
   bool pending_restart = false;  // the clock restarted: tell the detector before the next sample
 
   // Rate cap (token bucket on host receive time).
@@ -385,75 +370,32 @@ template <class Message>
                       text::escape_invalid_utf8(m.bench.substr(0, 40))),
           recv_utime);
   }
-  // The bench's own quantity code again (nearly always): nothing to check.
-  if (!b.quantity_known || m.quantity != b.quantity_code) {
-    const auto q = quantity_from_samples_code(m.quantity);
-    if (!q) {
-      ++counters_.quantity_errors;
-      error(fmt::format("{}: unknown quantity code {} at seq {}; message skipped", ch, int(m.quantity), m.seq),
-            recv_utime);
-      return;
+  struct Sink {
+    FitterCore& core;
+    Bench& b;
+    std::int64_t recv_utime;
+    void problem(SampleProblem kind, std::int64_t count, std::string text) {
+      FitterCounters& c = core.counters_;
+      switch (kind) {
+        case SampleProblem::unknown_quantity:
+        case SampleProblem::quantity_change: ++c.quantity_errors; break;
+        case SampleProblem::samples_lost: ++c.seq_gaps, c.samples_lost += count; break;
+        case SampleProblem::repeated: ++c.duplicates; break;
+        case SampleProblem::sequence_restart: ++c.seq_restarts; return;  // the clock's restart says it
+        case SampleProblem::clock_restart:  // the detector says it when it closes the run
+          ++c.clock_restarts;
+          b.pending_restart = true;
+          return;
+        case SampleProblem::bad_value: ++c.nan_values; break;
+        case SampleProblem::time_backwards: ++c.time_backwards; break;
+      }
+      core.error(b.channel + ": " + text, recv_utime);
     }
-    if (!b.quantity_known) {
-      b.quantity = *q;
-      b.quantity_code = m.quantity;
-      b.quantity_known = true;
-    } else if (*q != b.quantity) {
-      ++counters_.quantity_errors;
-      error(fmt::format("{}: quantity changes from {} to {} at seq {}; message skipped", ch,
-                        quantity_unit(b.quantity), quantity_unit(*q), m.seq),
-            recv_utime);
-      return;
+    [[gnu::always_inline]] void sample(std::int64_t seq, std::int64_t t_us, double v) {
+      core.push_sample(b, seq, static_cast<double>(t_us) / 1e6, v, recv_utime);
     }
-  }
-
-  bool restart = b.have_epoch && m.clock_epoch != b.epoch;
-  if (b.have_seq && m.seq != b.next_seq) {
-    if (m.seq > b.next_seq) {
-      ++counters_.seq_gaps;
-      counters_.samples_lost += m.seq - b.next_seq;
-      error(fmt::format("{}: {} samples lost: sequence number jumps from {} to {}", ch, m.seq - b.next_seq,
-                        b.next_seq - 1, m.seq),
-            recv_utime);
-    } else if (!restart && n > 0 && device_time_us(m, n - 1) <= b.last_t_us) {
-      ++counters_.duplicates;
-      error(fmt::format("{}: samples {} to {} were already received (repeated message); skipped", ch, m.seq,
-                        m.seq + std::int64_t(n) - 1),
-            recv_utime);
-      return;
-    } else {
-      ++counters_.seq_restarts;
-      if (n > 0 && device_time_us(m, 0) <= b.last_t_us) restart = true;
-    }
-  }
-  b.have_seq = true;
-  b.next_seq = m.seq + std::int64_t(n);
-  if (restart) {
-    ++counters_.clock_restarts;
-    b.pending_restart = true;
-    b.last_t_us = std::numeric_limits<std::int64_t>::min();
-  }
-  b.have_epoch = true;
-  b.epoch = m.clock_epoch;
-
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::int64_t t = device_time_us(m, i);
-    const double v = value_of(m, i);
-    if (!std::isfinite(v)) {
-      ++counters_.nan_values;
-      error(fmt::format("{}: sample {}: value is NaN or infinite; skipped", ch, m.seq + std::int64_t(i)), recv_utime);
-      continue;
-    }
-    if (t <= b.last_t_us) {
-      ++counters_.time_backwards;
-      error(fmt::format("{}: sample {}: device time {} µs does not advance (previous {} µs); skipped", ch,
-                        m.seq + std::int64_t(i), t, b.last_t_us),
-            recv_utime);
-      continue;
-    }
-    b.last_t_us = t;
-    push_sample(b, m.seq + std::int64_t(i), static_cast<double>(t) / 1e6, v, recv_utime);
-  }
+  };
+  b.stream.take(m, n, Sink{*this, b, recv_utime});
 }
 
 void FitterCore::restart_clock(Bench& b, std::int64_t recv_utime) {
@@ -603,7 +545,7 @@ void FitterCore::fit_and_publish(Bench& b, const Run& run, const std::string& wh
   }
   const auto t0 = std::chrono::steady_clock::now();
   try {
-    r.fit = fit_run(scratch_t_, scratch_v_, b.quantity, local, fo);
+    r.fit = fit_run(scratch_t_, scratch_v_, b.stream.quantity, local, fo);
   } catch (const std::exception& e) {
     ++counters_.internal_errors;
     error(fmt::format("{}: run {}: the fit failed: {}", b.channel, run.number, e.what()), recv_utime);

@@ -28,6 +28,7 @@
 #include "spindown/bench.hpp"
 #include "spindown/message_decode.hpp"
 #include "spindown/recording.hpp"
+#include "spindown/sample_stream.hpp"
 #include "spindown/short_name_cache.hpp"
 
 namespace spindown {
@@ -171,8 +172,5 @@ LcmLogContents read_lcm_log(const std::string& path, const LcmLogOptions& option
 
 // J and K_b from a config message when they are usable; otherwise nullopt and *why.
 std::optional<BenchParams> bench_params_from_config(const config_t& config, std::string* why = nullptr);
-
-std::optional<Quantity> quantity_from_samples_code(std::int8_t code);  // samples_t::QUANTITY_*
-std::int8_t samples_code_of(Quantity quantity);
 
 }  // namespace spindown
