@@ -11,6 +11,7 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <span>
 #include <sstream>
 
 #include "exit_codes.hpp"
@@ -20,6 +21,7 @@
 #include "spindown/health_baseline.hpp"
 #include "spindown/lcm_channels.hpp"
 #include "spindown/lcm_log_reader.hpp"
+#include "spindown/offline_pipeline.hpp"
 #include "spindown/read_recording.hpp"
 #include "spindown/runs.hpp"
 
@@ -122,52 +124,61 @@ int run_baseline(const BaselineCommandOptions& o) {
       bad_usage(fmt::format("--update: {}", e.what()));
     }
   }
-  const ReadOptions read = read_options_from(o.input);
-
-  std::vector<BaselineRun> good;
-  std::size_t runs_seen = 0;
-  bool all_read = true;
-  for (const auto& path : o.files) {
-    std::vector<RecordingInfo> info;
-    const auto recordings = read_recordings(path, read, &info);
-    bool bench_found = false;
-    for (std::size_t k = 0; k < recordings.size(); ++k) {
-      const Recording& rec = recordings[k];
-      const RecordingInfo* about = k < info.size() ? &info[k] : nullptr;
-      if (about && !about->bench.empty() && about->bench != o.bench) continue;  // another bench in the log
-      bench_found = true;
-      for (const auto& d : rec.diagnostics)
-        if (d.severity == Diagnostic::Severity::error) std::cerr << d.to_string() << '\n';
-      if (rec.empty()) {
-        all_read = false;
-        continue;
+  // The offline path (offline_pipeline.hpp) over the files, for this bench's recordings only.
+  struct Sink : OfflineSink {
+    const FitOptions& fit_opt;
+    std::vector<BaselineRun> good;
+    std::size_t runs_seen = 0;
+    bool all_read = true, bench_found = false;
+    explicit Sink(const FitOptions& f) : fit_opt(f) {}
+    void recording(const OfflineRecording&) override { bench_found = true; }
+    void diagnostics(const OfflineRecording&, From from, std::span<const Diagnostic> diags) override {
+      // The reader's errors and the CONFIG's problems.
+      for (const auto& d : diags)
+        if (from == From::config || (from == From::reader && d.severity == Diagnostic::Severity::error))
+          std::cerr << d.to_string() << '\n';
+    }
+    void failure(const OfflineRecording* r, std::string why) override {
+      if (!r || r->recording.empty()) {
+        all_read = false;  // the reader's error is already on stderr
+        if (!r) std::cerr << fmt::format("{}: error: {}\n", current, why);
+        return;
       }
+      std::cerr << fmt::format("{}: {}\n", r->path, why);
+    }
+    void run(const OfflineRecording& r, const Run& run) override {
+      ++runs_seen;
       FitOptions this_fit = fit_opt;
-      std::vector<Diagnostic> config_problems;
-      this_fit.bench = choose_bench_params(choice, update_file ? &*update_file : nullptr,
-                                           config_bench_params(about, rec.source, config_problems));
-      for (const auto& d : config_problems) std::cerr << d.to_string() << '\n';
-      const Segmentation seg = find_runs(rec);
-      if (seg.runs.empty()) std::cerr << fmt::format("{}: no spin-down run found\n", path);
-      for (const Run& run : seg.runs) {
-        ++runs_seen;
-        const RunFit fit = fit_run(rec, run, this_fit);
-        const std::string source = fmt::format("{} run {}", path, run.number);
-        if (auto r = baseline_run(fit, source, &why)) {
-          std::cout << fmt::format("  used     {}: c_v = {} N·m·s/rad, c_c = {} N·m\n", source,
-                                   format_value_error(r->c_viscous, r->c_viscous_stderr),
-                                   format_value_error(r->c_coulomb, r->c_coulomb_stderr));
-          good.push_back(*r);
-        } else {
-          std::cout << fmt::format("  not used {}: {}\n", source, why);
-        }
+      this_fit.bench = r.params;
+      const RunFit fit = fit_run(r.recording, run, this_fit);
+      const std::string source = fmt::format("{} run {}", r.path, run.number);
+      std::string why;
+      if (auto b = baseline_run(fit, source, &why)) {
+        std::cout << fmt::format("  used     {}: c_v = {} N·m·s/rad, c_c = {} N·m\n", source,
+                                 format_value_error(b->c_viscous, b->c_viscous_stderr),
+                                 format_value_error(b->c_coulomb, b->c_coulomb_stderr));
+        good.push_back(*b);
+      } else {
+        std::cout << fmt::format("  not used {}: {}\n", source, why);
       }
     }
-    if (!bench_found) {
+    std::string current;
+  } sink(fit_opt);
+  OfflinePlan plan{read_options_from(o.input), choice, {}, {}};
+  plan.bench_file = [&update_file](const OfflineRecording&) { return update_file ? &*update_file : nullptr; };
+  plan.wanted = [&o](const OfflineRecording& r) { return r.bench.empty() || r.bench == o.bench; };
+  for (const auto& path : o.files) {
+    sink.bench_found = false;
+    sink.current = path;
+    walk_file(path, plan, sink);
+    if (!sink.bench_found) {
       std::cerr << fmt::format("{}: error: no samples of bench '{}' in this file\n", path, o.bench);
-      all_read = false;
+      sink.all_read = false;
     }
   }
+  std::vector<BaselineRun>& good = sink.good;
+  const std::size_t runs_seen = sink.runs_seen;
+  const bool all_read = sink.all_read;
 
   std::string source = fmt::format("bench {}:", o.bench);
   for (const auto& f : o.files) source += " " + std::filesystem::path(f).filename().string();

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <span>
 #include <string>
 
 #include "exit_codes.hpp"
@@ -17,6 +18,7 @@
 #include "spindown/explain.hpp"
 #include "spindown/explain_report.hpp"
 #include "spindown/fit_report.hpp"
+#include "spindown/offline_pipeline.hpp"
 #include "spindown/read_recording.hpp"
 #include "spindown/runs.hpp"
 
@@ -43,48 +45,29 @@ ExplainPlan plan_from(const ExplainCommandOptions& o) {
   return plan;
 }
 
-// Read, segment and explain one file. Problems become diagnostics or failures, never exceptions.
+// Read, segment and explain one file (the offline path: offline_pipeline.hpp). Problems become
+// diagnostics or failures, never exceptions.
 FileExplain explain_file(const std::string& path, const ExplainPlan& plan) {
-  FileExplain out;
-  out.file = path;
-  try {
-    std::vector<RecordingInfo> info;
-    const auto recordings = read_recordings(path, plan.read, &info);
-    for (std::size_t k = 0; k < recordings.size(); ++k) {
-      const Recording& rec = recordings[k];
-      const std::string where = recordings.size() > 1 ? fmt::format("{}: ", rec.source) : std::string{};
-      out.samples += rec.size();
-      out.diagnostics.insert(out.diagnostics.end(), rec.diagnostics.begin(), rec.diagnostics.end());
-      if (rec.empty()) {
-        std::string why = "no samples";
-        for (const auto& d : rec.diagnostics)
-          if (d.severity == Diagnostic::Severity::error) {
-            why = d.message;
-            break;
-          }
-        out.failures.push_back(where + why);
-        continue;
-      }
-      ExplainOptions opt = plan.explain;
-      opt.bench = choose_bench_params(plan.bench, nullptr,
-                                      config_bench_params(k < info.size() ? &info[k] : nullptr, rec.source,
-                                                          out.diagnostics));
-      const Segmentation seg = find_runs(rec);
-      out.diagnostics.insert(out.diagnostics.end(), seg.diagnostics.begin(), seg.diagnostics.end());
-      if (seg.runs.empty()) {
-        out.failures.push_back(where + fmt::format("no spin-down run found in {} samples", rec.size()));
-        continue;
-      }
-      for (const Run& run : seg.runs) {
-        ExplainResult r = explain_run(rec, run, opt);
-        if (!r.ok) out.failures.push_back(where + fmt::format("run {}: {}", run.number, r.message));
-        out.runs.push_back(std::move(r));
-      }
+  struct Sink : OfflineSink {
+    const ExplainPlan& plan;
+    FileExplain out;
+    explicit Sink(const ExplainPlan& p) : plan(p) {}
+    void recording(const OfflineRecording& r) override { out.samples += r.recording.size(); }
+    void diagnostics(const OfflineRecording&, From, std::span<const Diagnostic> diags) override {
+      out.diagnostics.insert(out.diagnostics.end(), diags.begin(), diags.end());
     }
-  } catch (const std::exception& e) {
-    out.failures.push_back(fmt::format("could not be processed: {}", e.what()));
-  }
-  return out;
+    void failure(const OfflineRecording*, std::string why) override { out.failures.push_back(std::move(why)); }
+    void run(const OfflineRecording& r, const Run& run) override {
+      ExplainOptions opt = plan.explain;
+      opt.bench = r.params;
+      ExplainResult result = explain_run(r.recording, run, opt);
+      if (!result.ok) out.failures.push_back(r.where + fmt::format("run {}: {}", run.number, result.message));
+      out.runs.push_back(std::move(result));
+    }
+  } sink(plan);
+  sink.out.file = path;
+  walk_file(path, OfflinePlan{plan.read, plan.bench, {}, {}}, sink);
+  return std::move(sink.out);
 }
 
 }  // namespace

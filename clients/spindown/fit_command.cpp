@@ -9,6 +9,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <unistd.h>
@@ -20,6 +21,7 @@
 #include "spindown/fit.hpp"
 #include "spindown/fit_report.hpp"
 #include "spindown/motor_health.hpp"
+#include "spindown/offline_pipeline.hpp"
 #include "spindown/ordered_parallel.hpp"
 #include "spindown/read_recording.hpp"
 #include "spindown/runs.hpp"
@@ -67,69 +69,54 @@ FitPlan plan_from(const FitCommandOptions& o) {
   return plan;
 }
 
-// Read, segment and fit one file. Problems become diagnostics or failures, never exceptions.
+// Read, segment and fit one file (the offline path: offline_pipeline.hpp). Problems become
+// diagnostics or failures, never exceptions.
 FileFit fit_file(const std::string& path, const FitPlan& plan) {
-  FileFit out;
-  out.file = path;
-  try {
-    std::vector<RecordingInfo> info;
-    const auto recordings = read_recordings(path, plan.read, &info);
-    out.lcm_log = !info.empty() && info.front().format == FileFormat::lcm_log;
-    for (std::size_t k = 0; k < recordings.size(); ++k) {
-      const Recording& rec = recordings[k];
-      // An LCM log names several benches: say which one a failure is about.
-      const std::string where = recordings.size() > 1 ? fmt::format("{}: ", rec.source) : std::string{};
-      out.samples += rec.size();
-      out.lines_read += rec.lines_read;
-      out.lines_skipped += rec.lines_skipped;
-      out.diagnostics.insert(out.diagnostics.end(), rec.diagnostics.begin(), rec.diagnostics.end());
-      if (rec.empty()) {
-        std::string why = "no samples";
-        for (const auto& d : rec.diagnostics)
-          if (d.severity == Diagnostic::Severity::error) {
-            why = d.message;
-            break;
-          }
-        out.failures.push_back(where + why);
-        continue;
-      }
-      FitOptions fit_opt = plan.fit;
-      const BenchFile* bench_file = bench_file_for(plan, k < info.size() ? info[k].bench : std::string{});
-      fit_opt.bench = choose_bench_params(
-          plan.bench, bench_file, config_bench_params(k < info.size() ? &info[k] : nullptr, rec.source, out.diagnostics));
-      if (!bench_file && !plan.bench_files.files.empty()) {
-        out.diagnostics.push_back({Diagnostic::Severity::warning, rec.source, 0,
-                                   fmt::format("no --bench-config file for bench '{}': no health verdict",
-                                               k < info.size() ? info[k].bench : std::string{})});
-      }
-      const Segmentation seg = find_runs(rec);
-      out.diagnostics.insert(out.diagnostics.end(), seg.diagnostics.begin(), seg.diagnostics.end());
-      if (seg.runs.empty()) {
-        out.failures.push_back(where + fmt::format("no spin-down run found in {} samples", rec.size()));
-        continue;
-      }
-      for (const Run& run : seg.runs) {
-        RunFit fit = fit_run(rec, run, fit_opt);
-        // An LCM log of several benches: each run says whose it is (run numbers restart per bench).
-        if (recordings.size() > 1)
-          out.run_bench.push_back(k < info.size() && !info[k].bench.empty() ? info[k].bench : rec.source);
-        if (fit.best.empty()) {
-          std::string why;
-          for (const auto& m : fit.models)
-            if (!m.message.empty()) why += fmt::format("; {}: {}", model_name(m.kind), m.message);
-          out.failures.push_back(where + fmt::format("run {}: no model converged{}", run.number, why));
-        }
-        if (bench_file) {
-          out.health.resize(out.runs.size());
-          out.health.push_back(assess_health(fit, bench_file->health));
-        }
-        out.runs.push_back(std::move(fit));
-      }
+  struct Sink : OfflineSink {
+    const FitPlan& plan;
+    FileFit out;
+    explicit Sink(const FitPlan& p) : plan(p) {}
+    void file_read(std::span<const Recording>, std::span<const RecordingInfo> info, std::size_t) override {
+      out.lcm_log = !info.empty() && info.front().format == FileFormat::lcm_log;
     }
-  } catch (const std::exception& e) {
-    out.failures.push_back(fmt::format("could not be processed: {}", e.what()));
-  }
-  return out;
+    void recording(const OfflineRecording& r) override {
+      out.samples += r.recording.size();
+      out.lines_read += r.recording.lines_read;
+      out.lines_skipped += r.recording.lines_skipped;
+    }
+    void diagnostics(const OfflineRecording&, From, std::span<const Diagnostic> diags) override {
+      out.diagnostics.insert(out.diagnostics.end(), diags.begin(), diags.end());
+    }
+    void failure(const OfflineRecording*, std::string why) override { out.failures.push_back(std::move(why)); }
+    void bench_chosen(const OfflineRecording& r) override {
+      if (!r.bench_file && !plan.bench_files.files.empty())
+        out.diagnostics.push_back({Diagnostic::Severity::warning, r.recording.source, 0,
+                                   fmt::format("no --bench-config file for bench '{}': no health verdict", r.bench)});
+    }
+    void run(const OfflineRecording& r, const Run& run) override {
+      FitOptions fit_opt = plan.fit;
+      fit_opt.bench = r.params;
+      RunFit fit = fit_run(r.recording, run, fit_opt);
+      // An LCM log of several benches: each run says whose it is (run numbers restart per bench).
+      if (r.count > 1) out.run_bench.push_back(!r.bench.empty() ? r.bench : r.recording.source);
+      if (fit.best.empty()) {
+        std::string why;
+        for (const auto& m : fit.models)
+          if (!m.message.empty()) why += fmt::format("; {}: {}", model_name(m.kind), m.message);
+        out.failures.push_back(r.where + fmt::format("run {}: no model converged{}", run.number, why));
+      }
+      if (r.bench_file) {
+        out.health.resize(out.runs.size());
+        out.health.push_back(assess_health(fit, r.bench_file->health));
+      }
+      out.runs.push_back(std::move(fit));
+    }
+  } sink(plan);
+  sink.out.file = path;
+  OfflinePlan offline{plan.read, plan.bench, {}, {}};
+  offline.bench_file = [&plan](const OfflineRecording& r) { return bench_file_for(plan, r.bench); };
+  walk_file(path, offline, sink);
+  return std::move(sink.out);
 }
 
 }  // namespace

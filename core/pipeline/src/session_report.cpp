@@ -12,6 +12,7 @@
 #include <stdexcept>
 
 #include "spindown/lcm_log_reader.hpp"
+#include "spindown/offline_pipeline.hpp"
 #include "spindown/quantity.hpp"
 
 namespace spindown {
@@ -25,10 +26,11 @@ std::string file_stem(const std::string& path) {
   return name.empty() ? path : name;
 }
 
-std::string first_error(const Recording& rec) {
-  for (const auto& d : rec.diagnostics)
-    if (d.severity == Diagnostic::Severity::error) return d.message;
-  return "no samples";
+// The bench a recording is reported under: an LCM log's bench id, else --bench, else the file's
+// name without its extension.
+std::string report_bench(const OfflineRecording& r, const SessionReportOptions& options) {
+  const bool is_log = r.info && r.info->format == FileFormat::lcm_log;
+  return is_log && !r.bench.empty() ? r.bench : !options.text_bench.empty() ? options.text_bench : file_stem(r.path);
 }
 
 // The first bytes of a file (for the PuTTY header); "" when it cannot be read.
@@ -51,7 +53,7 @@ std::optional<double> lcm_log_start(const std::string& path) {
   return std::nullopt;
 }
 
-void keep_diagnostics(ReportFile& file, const std::vector<Diagnostic>& more, std::size_t cap) {
+void keep_diagnostics(ReportFile& file, std::span<const Diagnostic> more, std::size_t cap) {
   for (const auto& d : more) {
     if (file.diagnostics.size() < cap)
       file.diagnostics.push_back(d);
@@ -296,71 +298,63 @@ SessionReport build_session_report(std::span<const std::string> paths, const Ses
     ReportFile& file = report.files[fi];
     p.file = file.file;
     if (progress) progress(p);
-    try {
-      std::vector<RecordingInfo> info;
-      const auto recordings = read_recordings(file.file, options.read, &info);
-      // Runs of every recording first, so progress knows how many are coming.
-      std::vector<Segmentation> segs;
-      std::size_t runs_in_file = 0;
-      for (const Recording& rec : recordings) {
-        segs.push_back(rec.empty() ? Segmentation{} : find_runs(rec));
-        runs_in_file += segs.back().runs.size();
+    // The offline path (offline_pipeline.hpp): the report's work per recording and run.
+    struct Sink : OfflineSink {
+      SessionReport& report;
+      ReportFile& file;
+      std::size_t fi;
+      const SessionReportOptions& options;
+      const ReportProgressFn& progress;
+      ReportProgress& p;
+      std::uintmax_t bytes_before;
+      std::size_t runs_in_file = 0, runs_done_in_file = 0;
+      Sink(SessionReport& rep, ReportFile& f, std::size_t index, const SessionReportOptions& o,
+           const ReportProgressFn& pr, ReportProgress& pp, std::uintmax_t before)
+          : report(rep), file(f), fi(index), options(o), progress(pr), p(pp), bytes_before(before) {}
+
+      void file_read(std::span<const Recording>, std::span<const RecordingInfo>, std::size_t runs_found) override {
+        runs_in_file = runs_found;
+        p.runs_found += runs_found;
       }
-      p.runs_found += runs_in_file;
-      std::size_t runs_done_in_file = 0;
-      for (std::size_t k = 0; k < recordings.size(); ++k) {
-        const Recording& rec = recordings[k];
-        const RecordingInfo* ri = k < info.size() ? &info[k] : nullptr;
-        if (ri && file.format == FileFormat::automatic) file.format = ri->format;
-        const bool is_log = ri && ri->format == FileFormat::lcm_log;
-        const std::string bench = is_log && !ri->bench.empty() ? ri->bench
-                                  : !options.text_bench.empty() ? options.text_bench
-                                                                : file_stem(file.file);
-        const std::string where = recordings.size() > 1 ? fmt::format("{}: ", rec.source) : std::string{};
+      void recording(const OfflineRecording& r) override {
+        if (r.info && file.format == FileFormat::automatic) file.format = r.info->format;
+        const std::string bench = report_bench(r, options);
         if (std::find(file.benches.begin(), file.benches.end(), bench) == file.benches.end())
           file.benches.push_back(bench);
-        file.samples += rec.size();
-        keep_diagnostics(file, rec.diagnostics, options.max_diagnostics_per_file);
-        if (rec.empty()) {
-          file.failures.push_back(where + first_error(rec));
-          continue;
-        }
-        // J and K_b by the one rule (choose_bench_params): command line, else the bench's file,
-        // else the log's CONFIG, else the lab's.
-        const auto ref = options.references.find(bench);
-        if (ref != options.references.end())
-          reference_used[static_cast<std::size_t>(std::distance(options.references.begin(), ref))] = true;
-        std::vector<Diagnostic> config_problems;
-        const BenchParams params = choose_bench_params(
-            options.bench, ref != options.references.end() && ref->second.bench ? &*ref->second.bench : nullptr,
-            config_bench_params(ri, rec.source, config_problems));
-        keep_diagnostics(file, config_problems, options.max_diagnostics_per_file);
-        const Segmentation& seg = segs[k];
-        keep_diagnostics(file, seg.diagnostics, options.max_diagnostics_per_file);
-        if (seg.runs.empty()) {
-          file.failures.push_back(where + fmt::format("no spin-down run found in {} samples", rec.size()));
-          continue;
-        }
-        for (const Run& run : seg.runs) {
-          ReportRun r = make_report_run(rec, run, bench, params, options);
-          r.file_index = fi;
-          if (file.start_unix_s && !rec.t_s.empty()) r.cut_unix_s = *file.start_unix_s + (run.t_cut_s - rec.t_s.front());
-          if (r.fit.best.empty()) {
-            std::string why;
-            for (const auto& m : r.fit.models)
-              if (!m.message.empty()) why += fmt::format("; {}: {}", model_name(m.kind), m.message);
-            file.failures.push_back(where + fmt::format("run {}: no model converged{}", run.number, why));
-          }
-          report.runs.push_back(std::move(r));
-          ++p.runs_done;
-          ++runs_done_in_file;
-          p.bytes_done = bytes_before + file.bytes * runs_done_in_file / std::max<std::size_t>(runs_in_file, 1);
-          if (progress) progress(p);
-        }
+        file.samples += r.recording.size();
       }
-    } catch (const std::exception& e) {
-      file.failures.push_back(fmt::format("could not be processed: {}", e.what()));
-    }
+      void diagnostics(const OfflineRecording&, From, std::span<const Diagnostic> diags) override {
+        keep_diagnostics(file, diags, options.max_diagnostics_per_file);
+      }
+      void failure(const OfflineRecording*, std::string why) override { file.failures.push_back(std::move(why)); }
+      void run(const OfflineRecording& r, const Run& run) override {
+        ReportRun rr = make_report_run(r.recording, run, report_bench(r, options), r.params, options);
+        rr.file_index = fi;
+        if (file.start_unix_s && !r.recording.t_s.empty())
+          rr.cut_unix_s = *file.start_unix_s + (run.t_cut_s - r.recording.t_s.front());
+        if (rr.fit.best.empty()) {
+          std::string why;
+          for (const auto& m : rr.fit.models)
+            if (!m.message.empty()) why += fmt::format("; {}: {}", model_name(m.kind), m.message);
+          file.failures.push_back(r.where + fmt::format("run {}: no model converged{}", run.number, why));
+        }
+        report.runs.push_back(std::move(rr));
+        ++p.runs_done;
+        ++runs_done_in_file;
+        p.bytes_done = bytes_before + file.bytes * runs_done_in_file / std::max<std::size_t>(runs_in_file, 1);
+        if (progress) progress(p);
+      }
+    } sink(report, file, fi, options, progress, p, bytes_before);
+    // J and K_b by the one rule (choose_bench_params): command line, else the bench's file,
+    // else the log's CONFIG, else the lab's.
+    OfflinePlan plan{options.read, options.bench, {}, {}};
+    plan.bench_file = [&](const OfflineRecording& r) -> const BenchFile* {
+      const auto ref = options.references.find(report_bench(r, options));
+      if (ref == options.references.end()) return nullptr;
+      reference_used[static_cast<std::size_t>(std::distance(options.references.begin(), ref))] = true;
+      return ref->second.bench ? &*ref->second.bench : nullptr;
+    };
+    walk_file(file.file, plan, sink);
     if (file.format == FileFormat::automatic) file.format = options.read.format;
     bytes_before += file.bytes;
     p.bytes_done = bytes_before;

@@ -1,0 +1,186 @@
+// walk_file (offline_pipeline.hpp): the one offline path of fit, explain, baseline and report.
+// A two-bench LCM log (bench "a": a whole synthetic run and a CONFIG; bench "b": a CONFIG and
+// no samples) and a sample text file, walked with a sink that records every call.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <lcm/lcm-cpp.hpp>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+#include "spindown/offline_pipeline.hpp"
+#include "spindown/synthetic_run.hpp"
+
+using namespace spindown;
+
+namespace {
+
+struct Call {
+  std::string what;   // "file_read", "recording", "reader", "config", "run_finder", "failure", "bench", "run"
+  std::string bench;  // the recording's bench ("" for text or the whole file)
+  std::string text;   // failure: why; run: its number
+};
+
+struct RecordingSink : OfflineSink {
+  std::vector<Call> calls;
+  std::vector<BenchParams> params;  // per run
+  std::size_t runs_found = 0;
+  void file_read(std::span<const Recording>, std::span<const RecordingInfo>, std::size_t n) override {
+    runs_found = n;
+    calls.push_back({"file_read", "", ""});
+  }
+  void recording(const OfflineRecording& r) override { calls.push_back({"recording", r.bench, r.where}); }
+  void diagnostics(const OfflineRecording& r, From from, std::span<const Diagnostic>) override {
+    calls.push_back({from == From::reader ? "reader" : from == From::config ? "config" : "run_finder", r.bench, ""});
+  }
+  void failure(const OfflineRecording* r, std::string why) override {
+    calls.push_back({"failure", r ? r->bench : "", why});
+  }
+  void bench_chosen(const OfflineRecording& r) override {
+    EXPECT_NE(r.segmentation, nullptr);
+    calls.push_back({"bench", r.bench, ""});
+  }
+  void run(const OfflineRecording& r, const Run& run) override {
+    calls.push_back({"run", r.bench, std::to_string(run.number)});
+    params.push_back(r.params);
+  }
+  std::vector<std::string> sequence() const {
+    std::vector<std::string> out;
+    for (const auto& c : calls) out.push_back(c.what + (c.bench.empty() ? "" : ":" + c.bench));
+    return out;
+  }
+};
+
+template <class M>
+void write_event(lcm::LogFile& log, const std::string& channel, const M& m, std::int64_t utime) {
+  std::vector<std::uint8_t> buf(static_cast<std::size_t>(m.getEncodedSize()));
+  m.encode(buf.data(), 0, static_cast<int>(buf.size()));
+  lcm::LogEvent e{0, utime, channel, static_cast<std::int32_t>(buf.size()), buf.data()};
+  ASSERT_EQ(log.writeEvent(&e), 0);
+}
+
+config_t config(const std::string& bench, double j, double kb) {
+  config_t c{};
+  c.bench = bench;
+  c.inertia_kg_m2 = j;
+  c.kb_v_s_per_rad = kb;
+  return c;
+}
+
+// Bench "b" comes first (a CONFIG, then samples that are all NaN: no usable sample); bench "a"
+// has a CONFIG and a whole run.
+std::string two_bench_log() {
+  const std::string path = ::testing::TempDir() + "spindown_offline_" + std::to_string(::getpid()) + ".lcm";
+  const SyntheticRun run = make_synthetic_run(SyntheticRunSpec{});
+  lcm::LogFile log(path, "w");
+  EXPECT_TRUE(log.good());
+  write_event(log, "SPINDOWN.b.CONFIG", config("b", 3e-5, 0.02), 1);
+  write_event(log, "SPINDOWN.a.CONFIG", config("a", 2e-5, 0.01), 2);
+  for (int i = 0; i < 3; ++i) {
+    samples_t m{};
+    m.bench = "b";
+    m.seq = i;
+    m.quantity = samples_t::QUANTITY_BACK_EMF_V;
+    m.n = 1;
+    m.device_time_us = {20000 * (i + 1)};
+    m.host_time_us = {0};
+    m.value = {std::nan("")};
+    m.raw_adc = {-1};
+    write_event(log, "SPINDOWN.b.SAMPLE", m, 3 + i);
+  }
+  for (std::size_t i = 0; i < run.t_ms.size(); ++i) {
+    samples_t m{};
+    m.bench = "a";
+    m.seq = static_cast<std::int64_t>(i);
+    m.quantity = samples_t::QUANTITY_BACK_EMF_V;
+    m.n = 1;
+    m.device_time_us = {std::llround(run.t_ms[i] * 1000)};
+    m.host_time_us = {0};
+    m.value = {run.volts[i]};
+    m.raw_adc = {-1};
+    write_event(log, "SPINDOWN.a.SAMPLE", m, 10 + static_cast<std::int64_t>(i));
+  }
+  return path;
+}
+
+}  // namespace
+
+TEST(OfflinePipeline, EveryRecordingInOrderReaderConfigRunsThenTheRuns) {
+  const std::string log = two_bench_log();
+  RecordingSink sink;
+  walk_file(log, OfflinePlan{}, sink);
+  const std::vector<std::string> expected = {"file_read",  "recording:b", "reader:b",     "failure:b",
+                                             "recording:a", "reader:a",   "bench:a",      "run:a"};
+  auto seq = sink.sequence();
+  // The run finder may or may not have notes about bench a's run; nothing else may differ.
+  std::erase(seq, "run_finder:a");
+  EXPECT_EQ(seq, expected);
+  EXPECT_EQ(sink.runs_found, 1u);
+  // Several recordings in one file: each failure and recording names its source.
+  EXPECT_NE(sink.calls[1].text.find("SPINDOWN.b.SAMPLE: "), std::string::npos) << sink.calls[1].text;
+  EXPECT_NE(sink.calls[3].text.find("SPINDOWN.b.SAMPLE: "), std::string::npos) << sink.calls[3].text;
+  // J and K_b from bench a's own CONFIG, never b's.
+  ASSERT_EQ(sink.params.size(), 1u);
+  EXPECT_DOUBLE_EQ(sink.params[0].inertia_kg_m2, 2e-5);
+  EXPECT_DOUBLE_EQ(sink.params[0].kb_v_s_per_rad, 0.01);
+  std::filesystem::remove(log);
+}
+
+TEST(OfflinePipeline, TheOneRuleForJAndKb) {
+  const std::string log = two_bench_log();
+  BenchFile file;
+  file.bench = "a";
+  file.params.inertia_kg_m2 = 4e-5;
+  file.params.inertia_source = "bench file";
+  file.sets_inertia = true;  // the file gives J only: K_b still comes from the CONFIG
+  OfflinePlan plan;
+  plan.bench_file = [&](const OfflineRecording& r) { return r.bench == "a" ? &file : nullptr; };
+  RecordingSink with_file;
+  walk_file(log, plan, with_file);
+  ASSERT_EQ(with_file.params.size(), 1u);
+  EXPECT_DOUBLE_EQ(with_file.params[0].inertia_kg_m2, 4e-5);  // the bench file over the CONFIG
+  EXPECT_DOUBLE_EQ(with_file.params[0].kb_v_s_per_rad, 0.01);  // the CONFIG over the default
+
+  plan.bench.given.kb_v_s_per_rad = 0.005;  // the command line over everything
+  plan.bench.kb_given = true;
+  RecordingSink with_flag;
+  walk_file(log, plan, with_flag);
+  ASSERT_EQ(with_flag.params.size(), 1u);
+  EXPECT_DOUBLE_EQ(with_flag.params[0].inertia_kg_m2, 4e-5);
+  EXPECT_DOUBLE_EQ(with_flag.params[0].kb_v_s_per_rad, 0.005);
+  std::filesystem::remove(log);
+}
+
+TEST(OfflinePipeline, AnUnwantedBenchIsNeverSeen) {
+  const std::string log = two_bench_log();
+  OfflinePlan plan;
+  plan.wanted = [](const OfflineRecording& r) { return r.bench == "a"; };
+  RecordingSink sink;
+  walk_file(log, plan, sink);
+  for (const auto& c : sink.calls) EXPECT_NE(c.bench, "b") << c.what;
+  EXPECT_EQ(sink.params.size(), 1u);
+  std::filesystem::remove(log);
+}
+
+TEST(OfflinePipeline, ATextFileIsOneRecordingWithoutPrefix) {
+  RecordingSink sink;
+  walk_file(std::string(SPINDOWN_SAMPLE_DATA) + "/seed-3v-run1.tsv", OfflinePlan{}, sink);
+  std::vector<std::string> seq = sink.sequence();
+  std::erase(seq, "run_finder");
+  EXPECT_EQ(seq, (std::vector<std::string>{"file_read", "recording", "reader", "bench", "run"}));
+  EXPECT_EQ(sink.calls[1].text, "");  // where: no prefix for a file of one recording
+  ASSERT_EQ(sink.params.size(), 1u);
+  EXPECT_EQ(sink.params[0].inertia_source, "lab default");
+}
+
+TEST(OfflinePipeline, AMissingFileIsOneFailureNamingIt) {
+  RecordingSink sink;
+  walk_file("/nonexistent/run.tsv", OfflinePlan{}, sink);
+  std::string failures;
+  for (const auto& c : sink.calls)
+    if (c.what == "failure") failures += c.text + "\n";
+  EXPECT_NE(failures.find("/nonexistent/run.tsv"), std::string::npos) << failures;
+  EXPECT_TRUE(sink.params.empty());
+}
