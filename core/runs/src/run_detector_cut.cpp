@@ -1,0 +1,271 @@
+// Finding a coast's cut: where the lead-in ends and the decline starts, and what came before it.
+#include "spindown/run_detector.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <fmt/format.h>
+#include <string>
+
+#include "run_detector_tuning.hpp"
+
+namespace spindown {
+
+using namespace detector_tuning;
+
+RunDetector::CutSplit RunDetector::split_at_cut(std::size_t a, std::size_t b, const WindowFit& w) {
+  const std::size_t lower = std::max(lo_, base_);
+  CutSplit sp;
+  sp.a = a;
+
+  // A reading pinned at its maximum and left without a step: the converter's top.
+  double m = v(a);
+  for (std::size_t k = a; k <= b; ++k) m = std::max(m, v(k));
+  std::size_t p = b + 1;  // last pinned sample
+  for (std::size_t k = b; k >= a + 2 && k <= b; --k) {
+    if (v(k) == m && v(k - 1) == m && v(k - 2) == m) {
+      p = k;
+      break;
+    }
+  }
+  if (p < b) {
+    std::size_t q = p;  // first pinned sample
+    while (q > lower && v(q - 1) == m) --q;
+    // Quantized data plateaus too; a clipped reading is pinned much longer than the longest
+    // plateau of the coast after it.
+    std::size_t longest = 1, cur = 1;
+    for (std::size_t k = p + 2; k <= b; ++k) {
+      cur = v(k) == v(k - 1) ? cur + 1 : 1;
+      longest = std::max(longest, cur);
+    }
+    const std::size_t pinned = p - q + 1;
+    const double leave = m - v(p + 1);
+    // … and much longer than one step of the reading lasts at the coast's start: a heavy
+    // flywheel's coast holds its first printed value for a second, unclipped.
+    const double slope = w.slope(), step = std::max(reading_step(p + 1, b + 1), leave);
+    const double period = b > p + 1 ? (t(b) - t(p + 1)) / double(b - p - 1) : 0.0;
+    const double step_lasts = slope < 0 && period > 0 && step > 0 ? step / -slope / period : 0.0;
+    if (q > lower && pinned >= 5 && pinned >= 3 * longest && pinned >= 3.0 * step_lasts && leave > 0 &&
+        leave <= 0.02 * std::abs(m) + 3.0 * w.resid_sd()) {
+      sp.clipped = true;
+      sp.pin_first = q;
+      sp.pin_last = p;
+      sp.pin_level = m;
+      sp.a = std::max(lower, std::min(a, q >= back_search_min_samples ? q - back_search_min_samples : 0));
+      sp.cut_index = p + 1;
+      sp.t_cut_s = 0.5 * (t(q - 1) + t(q));
+      sp.pre_end = q;
+      sp.v0 = m;
+      sp.sd_post = w.resid_sd();
+    }
+  }
+
+  if (!sp.clipped) {
+    // Two-segment least squares over [a, b]: constant lead-in [a, c), linear coast [c, b].
+    const std::size_t n = b - a + 1;
+    double* pv = scratch(6 * (n + 1));  // prefix Σv, Σv² of [a, a+k)
+    double* pvv = pv + (n + 1);
+    double* ss = pvv + (n + 1);  // suffix Σt, Σt², Σv, Σtv of [a+k, b] (t relative to t(b))
+    double* stt_ = ss + (n + 1);
+    double* sv_ = stt_ + (n + 1);
+    double* stv_ = sv_ + (n + 1);
+    pv[0] = pvv[0] = 0.0;
+    ss[n] = stt_[n] = sv_[n] = stv_[n] = 0.0;
+    for (std::size_t k = 0; k < n; ++k) {
+      const double x = v(a + k);
+      pv[k + 1] = pv[k] + x;
+      pvv[k + 1] = pvv[k] + x * x;
+    }
+    const double tr = t(b);
+    for (std::size_t k = n; k-- > 0;) {
+      const double tt = t(a + k) - tr, x = v(a + k);
+      ss[k] = ss[k + 1] + tt;
+      stt_[k] = stt_[k + 1] + tt * tt;
+      sv_[k] = sv_[k + 1] + x;
+      stv_[k] = stv_[k + 1] + tt * x;
+    }
+    const double svv_all = pvv[n];
+    struct Line {
+      double v0 = 0, slope = 0, sd = 0;
+    };
+    auto post_line = [&](std::size_t k) {
+      const double np = double(n - k);
+      const double sxx = stt_[k] - ss[k] * ss[k] / np;
+      const double sxy = stv_[k] - ss[k] * sv_[k] / np;
+      const double syy = (svv_all - pvv[k]) - sv_[k] * sv_[k] / np;
+      Line l;
+      l.slope = sxx > 0 ? sxy / sxx : 0.0;
+      l.v0 = sv_[k] / np + l.slope * ((t(a + k) - tr) - ss[k] / np);
+      l.sd = np > 2 ? std::sqrt(std::max(syy - l.slope * sxy, 0.0) / (np - 2)) : 0.0;
+      return l;
+    };
+    // Best split with the lead-in starting at kb. The confirming window may straddle a small
+    // step (supply → back-EMF), so the split may fall anywhere that leaves a few samples for
+    // the line.
+    auto best_split = [&](std::size_t kb) {
+      double best = std::numeric_limits<double>::infinity();
+      std::size_t best_k = kb;
+      for (std::size_t k = kb; k + 3 <= n; ++k) {
+        const double m = double(k - kb);
+        const double sp_ = pv[k] - pv[kb];
+        const double sse_pre = k > kb ? (pvv[k] - pvv[kb]) - sp_ * sp_ / m : 0.0;
+        const double np = double(n - k);
+        const double sxx = stt_[k] - ss[k] * ss[k] / np;
+        const double sxy = stv_[k] - ss[k] * sv_[k] / np;
+        const double syy = (svv_all - pvv[k]) - sv_[k] * sv_[k] / np;
+        const double sse_post = sxx > 0 ? syy - sxy * sxy / sxx : syy;
+        const double sse = std::max(sse_pre, 0.0) + std::max(sse_post, 0.0);
+        if (sse < best) {
+          best = sse;
+          best_k = k;
+        }
+      }
+      return best_k;
+    };
+    std::size_t kb = 0;
+    std::size_t k = best_split(0);
+    // Two steps in reach (zeros → supply → back-EMF): the coast follows the later one, taken
+    // when it splits a flat plateau from the coast by a clear step.
+    for (int again = 0; again < 3; ++again) {
+      const std::size_t k2 = best_split(k);
+      if (k2 < k + 3) break;
+      const double m = double(k2 - k);
+      const double mean = (pv[k2] - pv[k]) / m;
+      const double sd = std::sqrt(std::max((pvv[k2] - pvv[k]) / m - mean * mean, 0.0));
+      const Line l = post_line(k2);
+      const double scale = std::abs(l.v0);
+      if (std::abs(l.v0 - mean) <= std::max(5.0 * l.sd, 0.03 * scale) || sd > std::max(3.0 * l.sd, 0.02 * scale))
+        break;
+      kb = k;
+      k = k2;
+    }
+    const Line l = post_line(k);
+    const std::size_t c = a + k;
+    sp.a = a + kb;
+    sp.v0 = l.v0;
+    sp.post_slope = l.slope;
+    sp.sd_post = l.sd;
+    sp.cut_index = c;
+    sp.pre_end = c;
+    const bool sample_before = c > base_ && c > stream_start_ && c - 1 >= lo_;
+    sp.t_cut_s = sample_before ? 0.5 * (t(c - 1) + t(c)) : t(c);
+  }
+
+  // The lead-in [a, pre_end): level, roughness, maximum and trend.
+  sp.npre = sp.pre_end - sp.a;
+  if (sp.npre >= 3) {
+    WindowFit f;
+    f.clear(sp.a, t(sp.a));
+    sp.pre_max = v(sp.a);
+    for (std::size_t k = sp.a; k < sp.pre_end; ++k) {
+      f.add(t(k), v(k));
+      sp.pre_max = std::max(sp.pre_max, v(k));
+    }
+    sp.pre_mean = f.mean();
+    sp.pre_sd = std::sqrt(std::max(f.svv() / f.n - sp.pre_mean * sp.pre_mean, 0.0));
+    // A lead-in falling at a good part of the coast's own rate is more coast: the cut lies
+    // further back.
+    const double s = f.slope(), sd = f.resid_sd();
+    const double s_err = f.sxx() > 0 ? sd / std::sqrt(f.sxx()) : 0.0;
+    const bool smooth = sd <= std::max(3.0 * sp.sd_post, 0.02 * std::abs(sp.v0));  // not a wandering pin
+    sp.pre_declining = sp.npre >= 8 && smooth && s < 0 && -s > 3.0 * s_err &&
+                       (sp.clipped || sp.post_slope >= 0 || s <= 0.3 * sp.post_slope);
+    sp.pre_flat = sp.npre >= 8 && std::abs(s) + 2.0 * s_err <= 0.3 * std::abs(sp.post_slope);
+  }
+  return sp;
+}
+
+double RunDetector::smoothed(std::size_t k, std::size_t lo, std::size_t hi) const {
+  const std::size_t from = k > lo ? k - 1 : k, to = std::min(k + 2, hi + 1);
+  double sum = 0;
+  for (std::size_t j = from; j < to; ++j) sum += v(j);
+  return sum / double(to - from);
+}
+
+bool RunDetector::at_peak(CutSplit& sp, std::size_t b) {
+  if (sp.clipped || b < sp.cut_index + 3) return false;
+  const double thr = std::max(4.0 * sp.sd_post, 0.02 * std::abs(sp.v0));
+  // The highest reading (a 3-sample mean, so one noisy sample does not make the peak) from the
+  // cut found to the newest sample.
+  std::size_t p = sp.cut_index;
+  double top3 = 3.0 * smoothed(p, sp.cut_index, b);  // three times the mean: sums compared, no division
+  for (std::size_t k = sp.cut_index + 1; k < b; ++k) {
+    const double m3 = v(k - 1) + v(k) + v(k + 1);
+    if (m3 > top3) top3 = m3, p = k;
+  }
+  const double top = top3 / 3.0;
+  if (top > smoothed(sp.cut_index, sp.cut_index, b) + thr && p < b) {
+    // A rise after the cut found: the coast starts at its peak, and what came before is the rise.
+    sp.pre_end = p;
+    sp.cut_index = p;
+    sp.t_cut_s = t(p);
+    sp.v0 = top;
+    sp.npre = p - sp.a;
+    sp.pre_declining = false;
+    WindowFit coast;  // the coast's line and noise from the peak on (the rise is not its noise)
+    coast.clear(p, t(p));
+    for (std::size_t k = p; k <= b; ++k) coast.add(t(k), v(k));
+    sp.post_slope = coast.slope();
+    sp.sd_post = coast.resid_sd();
+    return true;
+  }
+  // A lead-in that climbs into the cut: its last samples rise to the coast's start.
+  const std::size_t c = sp.cut_index;
+  if (c < sp.a + 6) return false;
+  const double before = smoothed(c - 5, sp.a, b), last = smoothed(c - 2, sp.a, b);
+  return last > before + thr && last >= sp.v0 - thr && before < sp.v0 - 2.0 * thr;
+}
+
+std::string RunDetector::start_not_seen(CutSplit& sp) {
+  const std::size_t c = sp.cut_index;
+  // The first sample after the stream's start or the last pause, whichever came last.
+  const bool after_pause = resume_index_ > stream_start_;
+  const std::size_t seen_from = after_pause ? resume_index_ : stream_start_;
+  if (c < seen_from || std::max(sp.a, base_) > seen_from) return {};
+  // From there to the cut found, a "lead-in" that lies on the coast's line is more coast.
+  const std::size_t a = seen_from;
+  if (c > a) {
+    const double tol = std::max(4.0 * sp.sd_post, 0.01 * std::abs(sp.v0));
+    double sse = 0;
+    for (std::size_t k = a; k < c; ++k) {
+      const double r = v(k) - (sp.v0 + sp.post_slope * (t(k) - t(c)));
+      sse += r * r;
+    }
+    if (sp.post_slope >= 0 || std::sqrt(sse / double(c - a)) > tol) return {};
+    // … and is not clearly flatter than the coast (a noisy plateau within the tolerance is a
+    // lead-in, its step hidden in the noise).
+    if (c - a >= 5) {
+      const WindowFit pre = window_over(ring_.get(), mask_, 1e300, a, c);
+      // A quantized reading can repeat one value over a few samples of a coast: its spread is at
+      // least the step's.
+      const double e = std::max(pre.resid_sd(), reading_step(a, c + 1) * step_sd);
+      const double s = pre.slope(), se = pre.sxx() > 0 ? e / std::sqrt(pre.sxx()) : 0.0;
+      if (s - sp.post_slope > 3.0 * se && s > 0.5 * sp.post_slope) return {};
+    }
+  }
+  sp.cut_index = a;
+  sp.pre_end = a;
+  sp.npre = 0;
+  sp.t_cut_s = t(a);
+  sp.v0 = sp.v0 + sp.post_slope * (t(a) - t(c));
+  if (after_pause)
+    return fmt::format("the recording paused for {:.3g} s (until {}) right before this coast: its cut was not "
+                       "recorded, so the coast is taken from the first sample after the pause",
+                       resume_pause_s_, fmt_s(t(a)));
+  return fmt::format("the recording starts mid-coast at {}: the cut was not recorded, so the coast is partial",
+                     fmt_s(t(a)));
+}
+
+std::string RunDetector::classify_lead_in(const CutSplit& sp) const {
+  if (sp.npre < 3) return "none";
+  const double scale = std::abs(sp.v0);
+  const double step = sp.v0 - sp.pre_mean;
+  // No step beyond the noise of either side: a powered motor whose speed is the reading.
+  if (std::abs(step) <= std::max({3.0 * sp.sd_post, 4.0 * sp.pre_sd, 0.01 * scale})) return "powered";
+  if (step < 0) return "supply";
+  if (sp.pre_sd > std::max(0.02 * scale, 3.0 * sp.sd_post)) return "floating";
+  if (std::abs(sp.pre_mean) <= 0.1 * scale) return "zeros";
+  return "floating";
+}
+
+}  // namespace spindown

@@ -1,0 +1,308 @@
+// A coast's end: the standstill (or why there is none), the tail after it, a stop retracted.
+#include "spindown/run_detector.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <fmt/format.h>
+#include <string>
+
+#include "run_detector_tuning.hpp"
+
+namespace spindown {
+
+using namespace detector_tuning;
+
+void RunDetector::coast_too_long(std::size_t i) {
+  if (buffered() > opt_.max_buffer) {
+    RunEvent e;
+    e.kind = RunEvent::Kind::ignored;
+    e.run = run_;
+    e.has_diagnostic = true;
+    e.diagnostic = {Diagnostic::Severity::warning, source_, 0,
+                    fmt::format("run cut at {}: coast longer than max_buffer ({} samples) abandoned",
+                                fmt_s(run_.t_cut_s), opt_.max_buffer)};
+    events_.push_back(std::move(e));
+    to_idle(i + 1, true);
+    return;
+  }
+  // The coast was within max_coast_s until one step jumped past it: a gap in the recording
+  // (logging paused, the device clock jumped), not a coast that went on too long. The sample
+  // after the gap is not this coast's, and the user must hear that the coast was cut short.
+  if (i > run_.cut_index && t(i - 1) - run_.t_cut_s <= opt_.max_coast_s && long_silence(t(i - 1), t(i), run_.t_cut_s)) {
+    run_note_severity_ = Diagnostic::Severity::warning;
+    close_unstopped(i,
+                    fmt::format("{}: the coast is cut short there and fitted as never stopped; the samples "
+                                "after the gap are not in this run",
+                                gap_before(i)),
+                    Run::End::gap);
+    to_idle(i, false);
+    // What follows is found afresh: a coast going on after it is partial, from its first sample.
+    resume_index_ = i;
+    resume_pause_s_ = t(i) - t(i - 1);
+    return;
+  }
+  run_note_severity_ = Diagnostic::Severity::warning;
+  close_unstopped(i + 1,
+                  fmt::format("no standstill within max_coast_s ({:g} s): closed there as never stopped; the rest of "
+                              "this coast is not a run",
+                              opt_.max_coast_s),
+                  Run::End::cap);
+  to_idle(i + 1, true);
+  // The coast goes on: no new run until the reading rises above where it was closed, or has come
+  // down to the motor's zero (stopped) first.
+  block_until_rise(v(i));
+}
+
+void RunDetector::power_back() {
+  const std::size_t at = rise_start_;
+  close_unstopped(at, fmt::format("the reading rose again at {} before standstill (power restored?)", fmt_s(t(at))),
+                  Run::End::power_back);
+  to_idle(at, false);
+}
+
+void RunDetector::standstill_checks(std::size_t i, bool at_end, double mu, double sxx, double e) {
+  // The hold window is flat and low (coast_checks has shown it: mu is its mean, sxx and e its
+  // Sxx and residual sd), and either its slope is resolved well below the coast's mean rate or
+  // a three times longer window is flat too (noisy, slow coasts).
+  bool resolved = at_end;
+  if (!at_end) {
+    const double mean_rate = (v0_ - mu) / std::max(t(i) - run_.t_cut_s, 1e-9);
+    // A quantized reading can sit on one value for the whole window (e = 0) while the motor still
+    // turns: its resolution is at best the step's uniform spread. A coast so slow that its first
+    // samples showed no step yet learns it here, once.
+    if (coast_step_ == 0) coast_step_ = reading_step(run_.cut_index, i + 1);
+    const double e_eff = std::max(e, coast_step_ * step_sd);
+    resolved = sxx > 0 && e_eff / std::sqrt(sxx) <= slope_resolution * mean_rate;
+  }
+  if (creeping_ && !at_end) resolved = false;  // an asymptotic coast ends when the long window is flat
+  if (!resolved) {
+    if (!hold_long_live_) {
+      // Three hold windows, or 3 % of the coast so far if longer: a heavy flywheel's coast falls a
+      // few mV a second near its end, which a 3 s window of noisy readings can take for level.
+      hold_long_.span_s = std::max(3.0 * opt_.stop_hold_s, long_hold_fraction * (t(i) - run_.t_cut_s));
+      reset_window(hold_long_, run_.cut_index, i + 1);
+      hold_long_live_ = true;
+    }
+    if (!flat(hold_long_)) return;
+  }
+  found_standstill(i, at_end);
+}
+
+void RunDetector::found_standstill(std::size_t i, bool at_end) {
+  const std::size_t h0 = hold_.first;
+  const double z = median_of(h0, i + 1);
+  double var = 0;
+  for (std::size_t k = h0; k <= i; ++k) var += (v(k) - z) * (v(k) - z);
+  const double sd_z = std::sqrt(var / double(i + 1 - h0));
+  const double amp = v0_ - z;
+  const double band = std::max(3.0 * sd_z, 1e-9 * std::max(std::abs(amp), 1e-300));
+
+  // First sample of the standstill that contains the hold window (an isolated sample outside
+  // the band is noise; two in a row are the coast).
+  std::size_t first_in = i + 1;
+  while (first_in > run_.cut_index + 1) {
+    if (std::abs(v(first_in - 1) - z) <= band) {
+      --first_in;
+    } else if (first_in - 1 > run_.cut_index + 1 && std::abs(v(first_in - 2) - z) <= band && first_in - 1 < i + 1) {
+      first_in -= 2;  // lone outlier
+    } else {
+      break;
+    }
+  }
+  first_in = std::min(first_in, i);
+  if (signal_lost(i, first_in, z, amp)) return;
+
+  // Where the coast crossed the last quarter of its amplitude.
+  const double quarter = z + 0.25 * amp;
+  std::size_t k = first_in;
+  while (k > run_.cut_index && v(k - 1) <= quarter) --k;
+  double t_quarter = t(k);
+  if (k > run_.cut_index) {
+    const double va = v(k - 1), vb = v(k);
+    t_quarter = va > vb ? t(k - 1) + (t(k) - t(k - 1)) * (va - quarter) / (va - vb) : t(k);
+  }
+
+  // Stop time: the approach line (the last ≤2 s above the band) meets the zero level.
+  double t_hit = t(first_in);
+  {
+    std::size_t from = first_in;
+    while (from > k && t(first_in) - t(from - 1) <= 2.0) --from;
+    if (first_in >= from + 3) {
+      WindowFit f;
+      f.clear(from, t(from));
+      for (std::size_t j = from; j < first_in; ++j) f.add(t(j), v(j));
+      const double sl = f.slope();
+      if (sl < 0) {
+        const double tb = f.st() / f.n, vb = f.mean();
+        const double th = f.t0 + tb + (z - vb) / sl;
+        if (std::isfinite(th)) t_hit = std::clamp(th, t_quarter, t(i));
+      }
+    }
+  }
+  // The first sample at or after t_hit (times never decrease within a stream), at most i.
+  std::size_t lo = run_.cut_index + 1, hi = std::max(lo, i);
+  while (lo < hi) {
+    const std::size_t mid = lo + (hi - lo) / 2;
+    if (t(mid) < t_hit) lo = mid + 1;
+    else hi = mid;
+  }
+  const std::size_t stop = lo;
+  // A stop that falls in a pause of the recording is known only to lie in it.
+  if (stop > run_.cut_index + 2) {
+    const double pause = t(stop) - t(stop - 1);
+    const double period = (t(stop - 1) - t(run_.cut_index)) / double(stop - 1 - run_.cut_index);
+    if (pause > 1.0 && pause > 25.0 * period) {
+      run_note_ = fmt::format("the stop falls in a pause of the recording ({:.3g} s, from {} to {}): it lies somewhere "
+                              "in it, and the stop time is the pause's end",
+                              pause, fmt_s(t(stop - 1)), fmt_s(t(stop)));
+      run_note_severity_ = Diagnostic::Severity::warning;
+    }
+  }
+
+  // A real stop arrives with a finite slope; an exponential creeps in.
+  const double t_stop = t(stop);
+  const double coast = t_stop - run_.t_cut_s;
+  const double last_quarter = t_stop - t_quarter;
+  const double end_rate = last_quarter > 0 ? 0.25 * coast / last_quarter : std::numeric_limits<double>::infinity();
+
+  run_.zero_level = z;
+  run_.noise_level = sd_z;
+  // … and right before it the reading still falls clearly (an exponential has flattened).
+  double approach_t = std::numeric_limits<double>::infinity();
+  {
+    std::size_t from = stop;
+    while (from > run_.cut_index && t_stop - t(from - 1) <= opt_.stop_hold_s) --from;
+    if (stop >= from + 3) {
+      WindowFit f;
+      f.clear(from, t(from));
+      for (std::size_t j = from; j < stop; ++j) f.add(t(j), v(j));
+      const double e = f.resid_sd();
+      approach_t = e > 0 ? -f.slope() * std::sqrt(f.sxx()) / e : (f.slope() < 0 ? approach_t : 0.0);
+    }
+  }
+  if (end_rate >= stop_min_end_rate || approach_t >= stop_min_approach_t || amp <= 0) {
+    run_.stopped = true;
+    run_.stop_index = stop;
+    run_.t_stop_s = t_stop;
+    depart_band_ = std::max(6.0 * sd_z, 0.05 * std::abs(amp));
+    departing_ = 0;
+    state_ = State::tail;
+    RunEvent e;
+    e.kind = RunEvent::Kind::stop;
+    e.run = run_;
+    events_.push_back(std::move(e));
+    tail_ends_by_time(i);
+  } else if (!creeping_ && !at_end) {
+    // Keep the coast until the decay is lost in the noise even over the long window: the
+    // exponential's tail still carries information for the fit.
+    creeping_ = true;
+  } else {
+    // The floor an asymptotic coast shows is where its decay was lost in the noise or the print,
+    // not where it is heading (an exponential heads for the true zero): 0.01 V on the lab's
+    // 2-decimal print long before the motor stops, and subtracting that from every reading
+    // bends the viscous curve into Coulomb friction that is not there. A floor the detector's
+    // own flatness test cannot tell from the lead-in's zero (the motor at rest, read before the
+    // run) gives way to that zero: within 3 noise sd, 1 % of the cut's reading (level()'s
+    // allowance for a flat window's drop) or one reading step. A floor clearly above it (an
+    // offset only the coasting reading has) is kept.
+    std::string floor_said;
+    const double band = std::max({3.0 * sd_z, 0.01 * std::abs(v0_), reading_step(hold_.first, i + 1)});
+    if (std::isfinite(lead_in_zero_) && std::abs(z - lead_in_zero_) <= band * (1 + 1e-9) && z != lead_in_zero_) {
+      run_.zero_level = lead_in_zero_;
+      floor_said = fmt::format(", not to be told from the lead-in's zero, so zero level {:g}", lead_in_zero_);
+    }
+    run_note_ = fmt::format(
+        "run cut at {}: the coast approaches its floor ({:g}{}) asymptotically (last quarter {:.2f}x slower than "
+        "the mean rate), as pure viscous friction does: treated as never stopped, coast closed at {}",
+        fmt_s(run_.t_cut_s), z, floor_said, end_rate > 0 ? 1.0 / end_rate : 0.0, fmt_s(t(i)));
+    run_.stopped = false;
+    run_.end = Run::End::asymptotic;
+    complete_run(i + 1);
+    to_idle(i + 1, true);
+  }
+}
+
+void RunDetector::block_until_rise(double level) {
+  need_rise_ = true;
+  block_band_ = rise_jump_;  // as far above as power coming back
+  rise_level_ = level + block_band_;
+}
+
+bool RunDetector::signal_lost(std::size_t i, std::size_t first_in, double z, double amp) {
+  if (first_in < run_.cut_index + 8 || !(amp > 0)) return false;
+  const double zero = motor_zero();
+  // The coast's last reading before the standstill, and the first sample that held it.
+  const std::size_t last = first_in - 1;
+  std::size_t held = last;
+  while (held > run_.cut_index && v(held - 1) == v(last)) --held;
+  // The most friction lets the reading fall in one sample: the coast's slope over the second
+  // before the held value, per period.
+  std::size_t from = held;  // the second before the held value, found from its end
+  while (from > run_.cut_index && t(held) - t(from - 1) <= 1.0) --from;
+  WindowFit f = window_over(ring_.get(), mask_, 1.0, from, held);
+  if (f.n < 5) return false;  // too few samples to know how fast friction lets it fall
+  // A sensor that gives up reads zero (the motor's, when the lead-in showed it) after it.
+  if (std::abs(z - zero) > 0.05 * amp) return false;
+  const double period = t(first_in) - t(last);
+  const double fall = f.n >= 5 ? std::max(-f.slope(), 0.0) * period : 0.0;
+  const double drop = v(last) - z;
+  // A collapse: a fall far beyond the coast's, from a reading held longer than the coast allows
+  // (friction would have moved it two steps), or beyond any fall the coast showed. A lab stop's
+  // last printed values (0.02, 0.01 on the 2-decimal print) are neither.
+  const double held_for = double(first_in - held);
+  const bool big_drop = drop > std::max({10.0 * fall, 6.0 * f.resid_sd(), 3.0 * coast_step_, 0.005 * amp});
+  const bool long_hold = held_for * fall > std::max(2.0 * coast_step_, 3.0 * f.resid_sd());
+  const bool collapse = big_drop && (long_hold || drop > 30.0 * fall);
+  if (!collapse) return false;
+  const double level = v(held);
+  run_note_severity_ = Diagnostic::Severity::warning;
+  close_unstopped(held + 1,
+                  fmt::format("signal lost below {:g} at {}: {} where friction lets it fall about {:.2g} a sample; a "
+                              "sensor that gives up at low speed (per-revolution pulses, an encoder, a display)? "
+                              "Fitted up to there, as never stopped",
+                              level, fmt_s(t(held)),
+                              fmt::format("the reading fell from {:g} to {:g} in one sample", v(last), z),
+                              fall > 1e-9 * amp ? fall : 0.0),
+                  Run::End::signal_lost);
+  to_idle(i + 1, true);
+  // No new run until the reading rises above what the sensor last showed (or after a standstill).
+  block_until_rise(std::max(level, z));
+  return true;
+}
+
+void RunDetector::tail_ends_by_time(std::size_t upto) {
+  const double t_end = run_.t_stop_s + opt_.tail_s;
+  for (std::size_t e = run_.stop_index + 1; e <= upto; ++e) {
+    if (t(e) >= t_end) {
+      complete_run(e);
+      to_idle(e, false);
+      return;
+    }
+  }
+}
+
+bool RunDetector::still_falling(std::size_t i) const {
+  // Over the whole tail, a slope many standard errors below zero, lower than the quantization
+  // allows a level reading, and at least a third of the approach's: the "standstill" was a slow
+  // exponential's stretch (a viscous coast at a fraction of its start), not a stop.
+  if (i < run_.stop_index + 8) return false;
+  const WindowFit w = window_over(ring_.get(), mask_, 1e300, run_.stop_index, i + 1);
+  const double sxx = w.sxx();
+  if (!(sxx > 0)) return false;
+  const double slope = w.slope();
+  const double e = std::max(w.resid_sd(), coast_step_ * step_sd);
+  const double mean_rate = (v0_ - run_.zero_level) / std::max(run_.t_stop_s - run_.t_cut_s, 1e-9);
+  return slope < 0 && -slope * std::sqrt(sxx) > 6.0 * e && -slope > 0.1 * mean_rate;
+}
+
+void RunDetector::close_unstopped(std::size_t end, const std::string& why, Run::End reason) {
+  run_.stopped = false;
+  run_.end = reason;
+  run_.zero_level = 0;
+  run_.noise_level = coast_sd_;
+  run_note_ = fmt::format("run cut at {}: {}", fmt_s(run_.t_cut_s), why);
+  complete_run(end);
+}
+
+}  // namespace spindown

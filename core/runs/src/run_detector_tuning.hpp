@@ -1,0 +1,54 @@
+#pragma once
+// The run detector's tuning, shared by its files (run_detector.cpp: the per-sample path and the
+// tests of a window; run_detector_cut.cpp: finding the cut; run_detector_stop.cpp: the stop;
+// run_detector_close.cpp: closing a run and its warnings). Private to the runs module.
+#include <cstddef>
+#include <fmt/format.h>
+#include <string>
+
+namespace spindown::detector_tuning {
+
+// Seconds of lead-in searched for the cut before the window that confirmed the coast.
+inline constexpr double back_search_s = 2.0;
+// Seconds of lead-in kept while idle.
+inline constexpr double idle_keep_s = 40.0;
+// Samples searched at least, for slow loops.
+inline constexpr std::size_t back_search_min_samples = 16;
+// A coast is confirmed by a decline this many standard errors strong …
+inline constexpr double confirm_t_stat = 6.0;
+// … whose residual roughness is at most this fraction of its level (rejects a floating pin).
+inline constexpr double confirm_max_roughness = 0.05;
+// Standstill: slope within this many standard errors of zero.
+inline constexpr double flat_t_stat = 3.0;
+// Standstill must be below this fraction of the reading at the cut.
+inline constexpr double standstill_max_fraction = 0.3;
+// A real stop arrives with a finite slope: the last quarter of the amplitude is crossed at
+// least this fast relative to the coast's mean rate (Coulomb ≈ 1, lab's combined ≈ 0.8,
+// pure viscous ≈ 0.3–0.45, depending on the noise that decides "flat").
+inline constexpr double stop_min_end_rate = 0.5;
+// … or the last stop_hold_s before the stop still falls with this t-statistic (an exponential
+// that has become "flat" shows ~3–6 there, a Coulomb stop tens).
+inline constexpr double stop_min_approach_t = 10.0;
+// A 1 s hold window decides alone when its slope error is this fraction of the mean rate.
+inline constexpr double slope_resolution = 0.05;
+// In the tail, a hold-window mean this fraction of the amplitude below the zero level retracts
+// the stop.
+inline constexpr double retract_fraction = 0.01;
+// The spread of a reading rounded to steps of 1, as uniform rounding error: 1/sqrt(12).
+inline constexpr double step_sd = 0.2886751345948129;
+// The long hold window spans at least this fraction of the coast before it.
+inline constexpr double long_hold_fraction = 0.03;
+// Recompute sliding sums from scratch this often (rounding drift).
+inline constexpr unsigned refresh_every = 4096;
+
+// A silence inside a coast (from the sample at prev to the one at t, the coast cut at t_cut) that
+// ends it: longer than half a minute and than the coast seen before it, so the samples after it
+// would be a coast the fit barely knew the way to. A shorter one is samples lost (or a clock
+// that jumped), said by warn_of_gap_in_coast, and the coast goes on.
+[[gnu::always_inline]] inline bool long_silence(double prev, double t, double t_cut) {
+  return t - prev > 30.0 && t - prev > prev - t_cut;
+}
+
+inline std::string fmt_s(double t) { return fmt::format("{:.3f} s", t); }
+
+}  // namespace spindown::detector_tuning
