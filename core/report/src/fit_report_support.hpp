@@ -1,0 +1,25 @@
+#pragma once
+// Shared by the fit report's text (fit_report.cpp) and its JSON (fit_json.cpp). Private to the
+// report module.
+#include <cstddef>
+
+#include "spindown/fit.hpp"
+#include "spindown/recording.hpp"
+
+namespace spindown {
+
+inline const char* severity_name(Diagnostic::Severity s) {
+  switch (s) {
+    case Diagnostic::Severity::error: return "error";
+    case Diagnostic::Severity::warning: return "warning";
+    case Diagnostic::Severity::note: return "note";
+  }
+  return "warning";
+}
+
+// Samples from the cut to the run's end.
+inline std::size_t samples_in(const Run& run) {
+  return run.end_index > run.cut_index ? run.end_index - run.cut_index : 0;
+}
+
+}  // namespace spindown
