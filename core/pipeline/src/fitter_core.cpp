@@ -1,11 +1,13 @@
+// FitterCore: messages in (SAMPLE, CONFIG), the bench table and its admission, the stream checks
+// and the per-sample path into the run detector.
 #include "spindown/fitter_core.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <exception>
 #include <fmt/format.h>
 #include <limits>
+#include <regex>
 
 #include "spindown/fit_message.hpp"
 #include "spindown/lcm_channels.hpp"
@@ -14,108 +16,9 @@
 #include "spindown/message_decode.hpp"
 #include "spindown/text_support.hpp"
 
+#include "fitter_bench.hpp"
+
 namespace spindown {
-
-namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-}  // namespace
-
-bool FitterOptions::is_valid(std::string* why) const {
-  auto fail = [&](std::string text) {
-    if (why) *why = std::move(text);
-    return false;
-  };
-  std::string inner;
-  if (!runs.is_valid(&inner)) return fail("run options: " + inner);
-  FitOptions fo;
-  fo.bench = default_bench;
-  fo.models = models;
-  if (!fo.is_valid(&inner)) return fail("fit options: " + inner);
-  if (max_benches < 1) return fail("max_benches must be at least 1");
-  if (!(std::isfinite(admit_rate_hz) && admit_rate_hz > 0))
-    return fail(fmt::format("admit_rate_hz must be > 0 (got {})", admit_rate_hz));
-  if (!(silent_s > 0)) return fail(fmt::format("silent_s must be > 0 (got {})", silent_s));
-  if (!(std::isfinite(max_rate_hz) && max_rate_hz >= 0))
-    return fail(fmt::format("max_rate_hz must be >= 0 (got {})", max_rate_hz));
-  if (!(std::isfinite(burst_s) && burst_s > 0)) return fail(fmt::format("burst_s must be > 0 (got {})", burst_s));
-  try {
-    std::regex re(bench_regex);
-  } catch (const std::regex_error& e) {
-    return fail(fmt::format("bench regex '{}' is not a valid regular expression ({})", bench_regex, e.what()));
-  }
-  return true;
-}
-
-// ---------------------------------------------------------------------------------------------
-
-struct FitterCore::Bench {
-  struct Sample {
-    double t_s;
-    double value;
-    std::int64_t seq;
-  };
-  // The detector's buffer again, with sequence numbers, oldest first: a ring that grows to the
-  // largest buffer seen (at most RunOptions::max_buffer + 1) and allocates no more after that.
-  class Mirror {
-   public:
-    std::size_t size() const { return count_; }
-    const Sample& operator[](std::size_t i) const { return slots_[(head_ + i) & mask_]; }
-    void push_back(const Sample& s) {
-      if (count_ == slots_.size()) grow();
-      slots_[(head_ + count_) & mask_] = s;
-      ++count_;
-    }
-    void drop_front(std::size_t n) {
-      head_ = (head_ + n) & mask_;
-      count_ -= n;
-    }
-
-   private:
-    void grow() {
-      std::vector<Sample> bigger(std::max<std::size_t>(256, 2 * slots_.size()));
-      for (std::size_t i = 0; i < count_; ++i) bigger[i] = (*this)[i];
-      slots_.swap(bigger);
-      head_ = 0;
-      mask_ = slots_.size() - 1;
-    }
-    std::vector<Sample> slots_;  // size a power of two
-    std::size_t head_ = 0, count_ = 0, mask_ = 0;
-  };
-  Bench(std::string bench_id, const RunOptions& runs)
-      : id(std::move(bench_id)), channel(fmt::format("SPINDOWN.{}.SAMPLE", id)), detector(runs, channel) {}
-
-  std::string id;
-  std::string channel;
-  RunDetector detector;
-  Mirror mirror;  // samples of a run, with the sequence numbers a published run names
-  std::uint64_t last_active = 0, arrival = 0;
-  std::int64_t last_sample_utime = 0;  // host time of its last samples (poll(): silent benches)
-
-  std::optional<BenchParams> config;
-  std::string config_problem;
-
-  SampleStream stream;  // the log reader's checks too (sample_stream.hpp), so refit == fit
-  bool pending_restart = false;  // the clock restarted: tell the detector before the next sample
-
-  // Rate cap (token bucket on host receive time).
-  double tokens = 0;
-  std::int64_t tokens_utime = 0;
-  bool bucket_started = false;
-
-  // The open run as last published: 0 none, 1 coasting, 2 stopped (provisional).
-  int open_state = 0;
-  Run open_run;
-
-  std::size_t base() const { return detector.samples_seen() - mirror.size(); }
-  const Sample* at(std::size_t index) const {
-    const std::size_t b = base();
-    return index >= b && index - b < mirror.size() ? &mirror[index - b] : nullptr;
-  }
-};
 
 FitterCore::FitterCore(FitterOptions options, FitterSink& sink)
     : opt_(std::move(options)), sink_(sink), bench_filter_(opt_.bench_regex) {}
@@ -126,12 +29,6 @@ void FitterCore::error(std::string text, std::int64_t utime) {
   sink_.problem(text);
   last_error_ = std::move(text);
   last_error_utime_ = utime;
-}
-
-std::size_t FitterCore::buffered_samples() const {
-  std::size_t n = 0;
-  for (const auto& [id, b] : benches_) n += b->detector.buffered() + b->mirror.size();
-  return n;
 }
 
 std::vector<std::string> FitterCore::benches() const {
@@ -435,222 +332,6 @@ void FitterCore::retract_stop(Bench& b, std::int64_t recv_utime) {
   b.open_run.t_stop_s = std::numeric_limits<double>::quiet_NaN();
   publish_run(b, b.open_run, run_t::STATE_COASTING, "standstill retracted: the reading kept falling", recv_utime);
   b.open_state = 1;
-}
-
-inline void FitterCore::trim_mirror(Bench& b) {
-  const std::size_t keep = b.detector.buffered();
-  if (b.mirror.size() > keep) b.mirror.drop_front(b.mirror.size() - keep);
-}
-
-void FitterCore::publish_run(Bench& b, const Run& run, std::int8_t state, std::string note, std::int64_t utime) {
-  const Bench::Sample* first = b.at(run.cut_index);
-  const std::size_t last_index = b.detector.samples_seen() > 0 ? b.detector.samples_seen() - 1 : 0;
-  std::size_t end = last_index + 1;
-  if (state == run_t::STATE_ABANDONED || (state == run_t::STATE_STOPPED && run.end_index > run.cut_index))
-    end = std::max(run.end_index, run.cut_index + 1);
-  const Bench::Sample* last = b.at(end - 1);
-  const std::int64_t samples = end > run.cut_index ? std::int64_t(end - run.cut_index) : 0;
-  sink_.run_changed(to_run_message(b.id, run, state, first ? first->seq : -1, last ? last->seq : -1,
-                                   static_cast<std::int32_t>(samples), std::move(note), utime));
-}
-
-void FitterCore::handle_events(Bench& b, std::int64_t recv_utime) {
-  for (RunEvent& e : b.detector.take_events()) {
-    if (e.has_diagnostic) sink_.diagnostic(b.id, e.diagnostic);
-    switch (e.kind) {
-      case RunEvent::Kind::cut:
-        ++counters_.runs_started;
-        b.open_state = 1;
-        b.open_run = e.run;
-        publish_run(b, e.run, run_t::STATE_COASTING,
-                    e.run.partial() ? std::string("cut not seen: joined mid-coast, a partial run from its first sample")
-                                    : fmt::format("cut (lead-in: {})", e.run.lead_in),
-                    recv_utime);
-        break;
-      case RunEvent::Kind::stop:
-        b.open_state = 2;
-        b.open_run = e.run;
-        publish_run(b, e.run, run_t::STATE_STOPPED, "standstill: collecting the tail before fitting", recv_utime);
-        break;
-      case RunEvent::Kind::complete:
-        b.open_state = 0;
-        counters_.partial_runs += e.run.partial();
-        counters_.silent_benches += e.run.end == Run::End::silent;
-        fit_and_publish(b, e.run, e.has_diagnostic && !e.run.stopped ? e.diagnostic.message : std::string(),
-                        recv_utime);
-        break;
-      case RunEvent::Kind::ignored:
-        ++counters_.runs_ignored;
-        b.open_state = 0;
-        publish_run(b, e.run, run_t::STATE_ABANDONED, e.has_diagnostic ? e.diagnostic.message : "ignored",
-                    recv_utime);
-        break;
-      case RunEvent::Kind::diagnostic: break;
-    }
-  }
-}
-
-void FitterCore::fit_and_publish(Bench& b, const Run& run, const std::string& why_unstopped, std::int64_t recv_utime) {
-  ++counters_.runs;
-  const Bench::Sample* first = b.at(run.cut_index);
-  const Bench::Sample* last = run.end_index > run.cut_index ? b.at(run.end_index - 1) : first;
-  if (!first || !last) {
-    ++counters_.internal_errors;
-    error(fmt::format("{}: run {} (samples {}..{}) is no longer buffered; not fitted", b.channel, run.number,
-                      run.cut_index, run.end_index),
-          recv_utime);
-    return;
-  }
-  const std::string note = run.stopped ? std::string("complete: fitted")
-                                       : why_unstopped.empty()
-                                           ? fmt::format("closed without a stop ({}); fitted", end_name(run.end))
-                                           : fmt::format("closed without a stop: {}; fitted", why_unstopped);
-  publish_run(b, run, run.stopped ? run_t::STATE_STOPPED : run_t::STATE_ABANDONED, note, recv_utime);
-
-  // The run's samples as contiguous arrays, indices relative to the cut.
-  const std::size_t base = b.base();
-  const std::size_t count = run.end_index > run.cut_index ? run.end_index - run.cut_index : 0;
-  scratch_t_.resize(count);
-  scratch_v_.resize(count);
-  for (std::size_t k = 0; k < count; ++k) {
-    const Bench::Sample& s = b.mirror[run.cut_index + k - base];
-    scratch_t_[k] = s.t_s;
-    scratch_v_[k] = s.value;
-  }
-  Run local = run;
-  local.cut_index = 0;
-  local.stop_index = run.stop_index - run.cut_index;
-  local.end_index = run.end_index - run.cut_index;
-  for (std::size_t& k : local.outliers) k -= run.cut_index;
-
-  FitResult r;
-  r.bench = b.id;
-  r.first_seq = first->seq;
-  r.last_seq = last->seq;
-  r.detected_utime = recv_utime;
-  FitOptions fo;
-  fo.models = opt_.models;
-  if (opt_.ignore_config) {
-    fo.bench = opt_.default_bench;
-    r.bench_source = "default (CONFIG ignored by option)";
-  } else if (b.config) {
-    fo.bench = *b.config;
-    r.bench_source = "config";
-  } else {
-    fo.bench = opt_.default_bench;
-    r.bench_source = b.config_problem.empty()
-                         ? fmt::format("default ({}): no CONFIG received from bench {}", opt_.default_bench.inertia_source,
-                                       b.id)
-                         : fmt::format("default ({}): {}", opt_.default_bench.inertia_source, b.config_problem);
-  }
-  const auto t0 = std::chrono::steady_clock::now();
-  try {
-    r.fit = fit_run(scratch_t_, scratch_v_, b.stream.quantity, local, fo);
-  } catch (const std::exception& e) {
-    ++counters_.internal_errors;
-    error(fmt::format("{}: run {}: the fit failed: {}", b.channel, run.number, e.what()), recv_utime);
-    return;
-  }
-  r.fit_seconds = seconds_since(t0);
-  r.fit.run = run;  // indices as in the bench's stream
-  if (r.fit.best.empty()) {
-    ++counters_.fit_failures;
-    error(fmt::format("{}: run {}: no model converged", b.channel, run.number), recv_utime);
-  }
-  if (auto h = opt_.health.find(b.id); h != opt_.health.end()) {
-    try {
-      r.health = assess_health(r.fit, h->second);
-    } catch (const std::exception& e) {
-      ++counters_.internal_errors;
-      error(fmt::format("{}: run {}: the health verdict failed: {}", b.channel, run.number, e.what()), recv_utime);
-    }
-  }
-  r.t_s = scratch_t_;
-  r.value = scratch_v_;
-  ++counters_.fits;
-  sink_.fit_ready(r);
-}
-
-void FitterCore::finish(std::int64_t now_utime) {
-  std::vector<Bench*> order;
-  for (auto& [id, b] : benches_) order.push_back(b.get());
-  std::sort(order.begin(), order.end(), [](const Bench* a, const Bench* b) { return a->arrival < b->arrival; });
-  for (Bench* b : order) {
-    try {
-      b->detector.finish();
-      handle_events(*b, now_utime);
-    } catch (const std::exception& e) {
-      ++counters_.internal_errors;
-      error(fmt::format("{}: internal error at the end: {}", b->channel, e.what()), now_utime);
-    }
-    trim_mirror(*b);
-  }
-}
-
-void FitterCore::poll(std::int64_t now_utime) {
-  const auto silent_us = static_cast<std::int64_t>(opt_.silent_s * 1e6);
-  for (auto& [id, b] : benches_) {
-    if (b->open_state == 0 || now_utime - b->last_sample_utime < silent_us) continue;
-    try {
-      b->detector.went_silent(opt_.silent_s);  // not the silence measured: live and refit say the same
-      handle_events(*b, now_utime);
-    } catch (const std::exception& e) {
-      ++counters_.internal_errors;
-      error(fmt::format("{}: internal error closing a silent bench's run: {}", b->channel, e.what()), now_utime);
-    }
-    trim_mirror(*b);
-  }
-}
-
-status_t FitterCore::make_status(std::int64_t now_utime, std::string_view instance, std::string_view host,
-                                 std::int32_t pid, std::string_view state, double uptime_s) const {
-  status_t s;
-  s.utime = now_utime;
-  s.service = "fitter";
-  s.instance = std::string(instance);
-  s.host = std::string(host);
-  s.pid = pid;
-  s.state = std::string(state);
-  s.uptime_s = uptime_s;
-  const FitterCounters& c = counters_;
-  const std::pair<const char*, std::int64_t> counters[] = {
-      {"messages", c.messages},           {"sample_messages", c.sample_messages},
-      {"config_messages", c.config_messages}, {"samples", c.samples},
-      {"runs_started", c.runs_started},   {"runs", c.runs},
-      {"runs_ignored", c.runs_ignored},   {"fits", c.fits},
-      {"fit_failures", c.fit_failures},   {"decode_errors", c.decode_errors},
-      {"invalid_bench", c.invalid_bench}, {"bench_mismatch", c.bench_mismatch},
-      {"filtered", c.filtered},           {"other_channels", c.other_channels},
-      {"seq_gaps", c.seq_gaps},           {"samples_lost", c.samples_lost},
-      {"duplicates", c.duplicates},       {"seq_restarts", c.seq_restarts},
-      {"clock_restarts", c.clock_restarts}, {"nan_values", c.nan_values},
-      {"time_backwards", c.time_backwards}, {"quantity_errors", c.quantity_errors},
-      {"bad_configs", c.bad_configs},     {"dropped_benches", c.dropped_benches},
-      {"benches_refused", c.benches_refused}, {"partial_runs", c.partial_runs},
-      {"silent_benches", c.silent_benches},
-      {"flood_drops", c.flood_drops},     {"flood_messages", c.flood_messages},
-      {"internal_errors", c.internal_errors},
-  };
-  for (const auto& [name, value] : counters) {
-    s.counter_name.emplace_back(name);
-    s.counter_value.push_back(value);
-  }
-  s.ncounters = static_cast<std::int32_t>(s.counter_name.size());
-  std::size_t coasting = 0;
-  for (const auto& [id, b] : benches_) coasting += b->open_state != 0;
-  const std::pair<const char*, double> gauges[] = {
-      {"benches", double(benches_.size())},
-      {"benches_coasting", double(coasting)},
-      {"buffered_samples", double(buffered_samples())},
-  };
-  for (const auto& [name, value] : gauges) {
-    s.gauge_name.emplace_back(name);
-    s.gauge_value.push_back(value);
-  }
-  s.ngauges = static_cast<std::int32_t>(s.gauge_name.size());
-  s.last_error = last_error_;
-  s.last_error_utime = last_error_utime_;
-  return s;
 }
 
 }  // namespace spindown

@@ -1,0 +1,102 @@
+// FitterCore's options checked and its STATUS heartbeat.
+#include "spindown/fitter_core.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <fmt/format.h>
+#include <limits>
+#include <regex>
+
+#include "spindown/fit_message.hpp"
+#include "spindown/lcm_channels.hpp"
+
+#include "fitter_bench.hpp"
+
+namespace spindown {
+
+bool FitterOptions::is_valid(std::string* why) const {
+  auto fail = [&](std::string text) {
+    if (why) *why = std::move(text);
+    return false;
+  };
+  std::string inner;
+  if (!runs.is_valid(&inner)) return fail("run options: " + inner);
+  FitOptions fo;
+  fo.bench = default_bench;
+  fo.models = models;
+  if (!fo.is_valid(&inner)) return fail("fit options: " + inner);
+  if (max_benches < 1) return fail("max_benches must be at least 1");
+  if (!(std::isfinite(admit_rate_hz) && admit_rate_hz > 0))
+    return fail(fmt::format("admit_rate_hz must be > 0 (got {})", admit_rate_hz));
+  if (!(silent_s > 0)) return fail(fmt::format("silent_s must be > 0 (got {})", silent_s));
+  if (!(std::isfinite(max_rate_hz) && max_rate_hz >= 0))
+    return fail(fmt::format("max_rate_hz must be >= 0 (got {})", max_rate_hz));
+  if (!(std::isfinite(burst_s) && burst_s > 0)) return fail(fmt::format("burst_s must be > 0 (got {})", burst_s));
+  try {
+    std::regex re(bench_regex);
+  } catch (const std::regex_error& e) {
+    return fail(fmt::format("bench regex '{}' is not a valid regular expression ({})", bench_regex, e.what()));
+  }
+  return true;
+}
+
+std::size_t FitterCore::buffered_samples() const {
+  std::size_t n = 0;
+  for (const auto& [id, b] : benches_) n += b->detector.buffered() + b->mirror.size();
+  return n;
+}
+
+status_t FitterCore::make_status(std::int64_t now_utime, std::string_view instance, std::string_view host,
+                                 std::int32_t pid, std::string_view state, double uptime_s) const {
+  status_t s;
+  s.utime = now_utime;
+  s.service = "fitter";
+  s.instance = std::string(instance);
+  s.host = std::string(host);
+  s.pid = pid;
+  s.state = std::string(state);
+  s.uptime_s = uptime_s;
+  const FitterCounters& c = counters_;
+  const std::pair<const char*, std::int64_t> counters[] = {
+      {"messages", c.messages},           {"sample_messages", c.sample_messages},
+      {"config_messages", c.config_messages}, {"samples", c.samples},
+      {"runs_started", c.runs_started},   {"runs", c.runs},
+      {"runs_ignored", c.runs_ignored},   {"fits", c.fits},
+      {"fit_failures", c.fit_failures},   {"decode_errors", c.decode_errors},
+      {"invalid_bench", c.invalid_bench}, {"bench_mismatch", c.bench_mismatch},
+      {"filtered", c.filtered},           {"other_channels", c.other_channels},
+      {"seq_gaps", c.seq_gaps},           {"samples_lost", c.samples_lost},
+      {"duplicates", c.duplicates},       {"seq_restarts", c.seq_restarts},
+      {"clock_restarts", c.clock_restarts}, {"nan_values", c.nan_values},
+      {"time_backwards", c.time_backwards}, {"quantity_errors", c.quantity_errors},
+      {"bad_configs", c.bad_configs},     {"dropped_benches", c.dropped_benches},
+      {"benches_refused", c.benches_refused}, {"partial_runs", c.partial_runs},
+      {"silent_benches", c.silent_benches},
+      {"flood_drops", c.flood_drops},     {"flood_messages", c.flood_messages},
+      {"internal_errors", c.internal_errors},
+  };
+  for (const auto& [name, value] : counters) {
+    s.counter_name.emplace_back(name);
+    s.counter_value.push_back(value);
+  }
+  s.ncounters = static_cast<std::int32_t>(s.counter_name.size());
+  std::size_t coasting = 0;
+  for (const auto& [id, b] : benches_) coasting += b->open_state != 0;
+  const std::pair<const char*, double> gauges[] = {
+      {"benches", double(benches_.size())},
+      {"benches_coasting", double(coasting)},
+      {"buffered_samples", double(buffered_samples())},
+  };
+  for (const auto& [name, value] : gauges) {
+    s.gauge_name.emplace_back(name);
+    s.gauge_value.push_back(value);
+  }
+  s.ngauges = static_cast<std::int32_t>(s.gauge_name.size());
+  s.last_error = last_error_;
+  s.last_error_utime = last_error_utime_;
+  return s;
+}
+
+}  // namespace spindown
