@@ -13,6 +13,8 @@
 #include "spindown/offline_pipeline.hpp"
 #include "spindown/synthetic_run.hpp"
 
+#include "lcm_log_events.hpp"
+
 using namespace spindown;
 
 namespace {
@@ -53,13 +55,7 @@ struct RecordingSink : OfflineSink {
   }
 };
 
-template <class M>
-void write_event(lcm::LogFile& log, const std::string& channel, const M& m, std::int64_t utime) {
-  std::vector<std::uint8_t> buf(static_cast<std::size_t>(m.getEncodedSize()));
-  m.encode(buf.data(), 0, static_cast<int>(buf.size()));
-  lcm::LogEvent e{0, utime, channel, static_cast<std::int32_t>(buf.size()), buf.data()};
-  ASSERT_EQ(log.writeEvent(&e), 0);
-}
+using spindown::testing::write_event;
 
 config_t config(const std::string& bench, double j, double kb) {
   config_t c{};

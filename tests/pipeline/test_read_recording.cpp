@@ -13,6 +13,8 @@
 #include "spindown/read_recording.hpp"
 #include "spindown/synthetic_run.hpp"
 
+#include "lcm_log_events.hpp"
+
 using namespace spindown;
 
 namespace {
@@ -28,13 +30,7 @@ struct TempFile {
   ~TempFile() { std::filesystem::remove(path); }
 };
 
-template <class M>
-void write_event(lcm::LogFile& log, const std::string& channel, const M& m, std::int64_t utime) {
-  std::vector<std::uint8_t> buf(static_cast<std::size_t>(m.getEncodedSize()));
-  m.encode(buf.data(), 0, static_cast<int>(buf.size()));
-  lcm::LogEvent e{0, utime, channel, static_cast<std::int32_t>(buf.size()), buf.data()};
-  ASSERT_EQ(log.writeEvent(&e), 0);
-}
+using spindown::testing::write_event;
 
 samples_t batch(const std::string& bench, std::int64_t seq, int n, std::int8_t quantity) {
   samples_t m{};
