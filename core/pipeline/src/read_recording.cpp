@@ -12,6 +12,7 @@
 
 #include "spindown/file_bytes.hpp"
 #include "spindown/lab_line.hpp"
+#include "spindown/text_repairs.hpp"
 #include "spindown/text_support.hpp"
 
 namespace spindown {
@@ -195,12 +196,23 @@ std::vector<Recording> read_recordings(const std::string& path, const ReadOption
     return out;
   }
 
-  const std::string_view bytes = text_bytes->view();
+  std::string_view bytes = text_bytes->view();
+  // What editors and terminals did to the text, undone (text_repairs.hpp); lines stay in place.
+  std::string repaired;
+  std::vector<std::string> repairs;
+  if (needs_text_repair(bytes)) {
+    repaired.assign(bytes);
+    repairs = repair_text(repaired);
+    bytes = repaired;
+  }
   const FileFormat format = detect_format(bytes, options);
   if (format == FileFormat::delimited_text)
     add(read_delimited_text(bytes, path, options.delimited), {FileFormat::delimited_text, {}, {}, 0});
   else
     add(read_arduino_text(bytes, path, options.arduino), {FileFormat::arduino_text, {}, {}, 0});
+  for (auto it = repairs.rbegin(); it != repairs.rend(); ++it)
+    out.back().diagnostics.insert(out.back().diagnostics.begin(),
+                                  Diagnostic{Diagnostic::Severity::note, path, 0, std::move(*it)});
   return out;
 }
 

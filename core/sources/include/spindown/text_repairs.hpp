@@ -1,0 +1,23 @@
+#pragma once
+// What students' editors and terminals do to the lab's text, undone before it is read. Each
+// repair keeps every line where it was (diagnostics still name the right line) and is said in a
+// note:
+//  - UTF-16 from a Windows editor ("Unicode" in Notepad), with or without a byte-order mark:
+//    decoded to UTF-8;
+//  - the Arduino IDE serial monitor's timestamps ("10:21:38.234 -> 5234<TAB>0.00"): removed, the
+//    sample's own millis stays its time;
+//  - a decimal comma in the lab's two columns ("5234<TAB>2,45", a spreadsheet with a European
+//    locale): read as a point, only when no sample line uses a point.
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace spindown {
+
+// Whether repair_text would change text (looks at its first lines only; cheap).
+bool needs_text_repair(std::string_view text);
+
+// Rewrites text in place; returns one note per repair made (empty: nothing to do).
+std::vector<std::string> repair_text(std::string& text);
+
+}  // namespace spindown

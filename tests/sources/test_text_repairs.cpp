@@ -1,0 +1,90 @@
+// repair_text (text_repairs.hpp): UTF-16, the Arduino IDE serial monitor's timestamps and a
+// decimal comma, undone line for line, each said in a note; the lab's own text left alone.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "spindown/arduino_text.hpp"
+#include "spindown/text_repairs.hpp"
+
+using namespace spindown;
+
+namespace {
+
+const std::string lab = "=~=~= PuTTY log 2023.09.14 10:21:33 =~=~=\r\n0\t0.00\r\n20\t2.45\r\n40\t2.43\r\n60\t2.41\r\n"
+                        "80\t2.40\r\n100\t2.38\r\n";
+
+std::string utf16le(const std::string& ascii, bool bom) {
+  std::string out = bom ? std::string("\xFF\xFE", 2) : std::string();
+  for (char c : ascii) {
+    out += c;
+    out += '\0';
+  }
+  return out;
+}
+
+std::string utf16be(const std::string& ascii) {
+  std::string out("\xFE\xFF", 2);
+  for (char c : ascii) {
+    out += '\0';
+    out += c;
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST(TextRepairs, TheLabsOwnTextIsLeftAlone) {
+  std::string text = lab;
+  EXPECT_FALSE(needs_text_repair(text));
+  EXPECT_TRUE(repair_text(text).empty());
+  EXPECT_EQ(text, lab);
+}
+
+TEST(TextRepairs, Utf16WithAndWithoutByteOrderMark) {
+  for (std::string text : {utf16le(lab, true), utf16le(lab, false), utf16be(lab)}) {
+    ASSERT_TRUE(needs_text_repair(text));
+    const auto notes = repair_text(text);
+    ASSERT_EQ(notes.size(), 1u);
+    EXPECT_NE(notes[0].find("UTF-16"), std::string::npos) << notes[0];
+    EXPECT_EQ(text, lab);
+  }
+}
+
+TEST(TextRepairs, Utf16BeyondAsciiBecomesUtf8) {
+  // "Ω\n" and an emoji (a surrogate pair) in UTF-16LE with a mark.
+  std::string text("\xFF\xFE\xA9\x03\x0A\x00\x3D\xD8\x00\xDE", 10);
+  repair_text(text);
+  EXPECT_EQ(text, "\xCE\xA9\n\xF0\x9F\x98\x80");
+}
+
+TEST(TextRepairs, SerialMonitorTimestampsAreRemovedLineForLine) {
+  std::string text = "10:21:38.234 -> 0\t0.00\n10:21:38.254 -> 20\t2.45\n10:21:38.274 -> 40\t2.43\n"
+                     "garbage line\n10:21:38.294 -> 60\t2.41";
+  const auto notes = repair_text(text);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("removed from 4 lines"), std::string::npos) << notes[0];
+  EXPECT_EQ(text, "0\t0.00\n20\t2.45\n40\t2.43\ngarbage line\n60\t2.41");
+  const Recording rec = read_arduino_text(text, "ide.txt");
+  EXPECT_EQ(rec.size(), 4u);
+  EXPECT_DOUBLE_EQ(rec.value.at(1), 2.45);
+}
+
+TEST(TextRepairs, DecimalCommasOnlyWhenNoLineUsesAPoint) {
+  std::string text = "0\t0,00\r\n20\t2,45\r\n40\t2,43\r\n60\t2,41\r\n80\t2,40\r\n100\t-0,01\r\n";
+  const auto notes = repair_text(text);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("6 lines"), std::string::npos) << notes[0];
+  EXPECT_EQ(text, "0\t0.00\r\n20\t2.45\r\n40\t2.43\r\n60\t2.41\r\n80\t2.40\r\n100\t-0.01\r\n");
+
+  std::string mixed = "0\t0,00\n20\t2,45\n40\t2,43\n60\t2,41\n80\t2,40\n100\t2.38\n";
+  EXPECT_FALSE(needs_text_repair(mixed));  // a point somewhere: the commas are not decimal commas
+}
+
+TEST(TextRepairs, TimestampsAndCommasTogether) {
+  std::string text;
+  for (int i = 0; i < 6; ++i) text += "10:21:38.2" + std::to_string(10 + i) + " -> " + std::to_string(20 * i) + "\t2,4" +
+                                      std::to_string(i) + "\n";
+  EXPECT_EQ(repair_text(text).size(), 2u);
+  EXPECT_EQ(text.substr(0, 14), "0\t2.40\n20\t2.41");
+}
