@@ -182,7 +182,9 @@ int run_baseline(const BaselineCommandOptions& o) {
 
   std::string source = fmt::format("bench {}:", o.bench);
   for (const auto& f : o.files) source += " " + std::filesystem::path(f).filename().string();
-  const auto baseline = make_baseline(good, o.date.empty() ? today_utc() : o.date, source, &why);
+  std::vector<SetAsideRun> set_aside;
+  const auto baseline = make_baseline(good, o.date.empty() ? today_utc() : o.date, source, &why, &set_aside);
+  for (const auto& r : set_aside) std::cout << fmt::format("  set aside {}: {}\n", r.source, r.why);
   if (!baseline) {
     std::cerr << fmt::format("spindown baseline: error: {} ({} run{} seen)\n", why, runs_seen,
                              runs_seen == 1 ? "" : "s");

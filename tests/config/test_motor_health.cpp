@@ -99,8 +99,9 @@ TEST(MotorHealth, LevelNamesRoundTrip) {
 TEST(MotorHealth, NoReferenceSaysSoInsteadOfInventingOne) {
   const HealthVerdict v = assess_health(combined_fit(cv0, 2e-9, cc0, 4e-7), MotorHealthConfig{});
   EXPECT_FALSE(v.has_reference);
-  EXPECT_EQ(v.level, HealthLevel::ok);
-  EXPECT_NE(v.reason.find("no reference"), std::string::npos) << v.reason;
+  EXPECT_EQ(v.level, HealthLevel::not_judged);  // never OK when nothing was judged
+  EXPECT_EQ(v.reason.rfind("not judged: ", 0), 0u) << v.reason;
+
   EXPECT_EQ(finding(v, "dry friction"), nullptr);
   // The lab's time rules still apply.
   ASSERT_NE(finding(v, "time to stop"), nullptr);
@@ -181,6 +182,7 @@ TEST(MotorHealth, ThresholdsComeFromTheConfig) {
   cfg.baseline = lab_baseline();
   cfg.thresholds.check_ratio = 2.0;
   cfg.thresholds.service_ratio = 3.0;
+  cfg.thresholds.stop_change_fraction = 0.9;  // the friction ratios alone decide here
   EXPECT_EQ(assess_health(combined_fit(cv0, 2e-9, 2.7 * cc0, 5e-7), cfg).level, HealthLevel::check);
   EXPECT_EQ(assess_health(combined_fit(cv0, 2e-9, 1.8 * cc0, 5e-7), cfg).level, HealthLevel::ok);
   cfg.thresholds.significance_sigma = 0;
@@ -453,4 +455,71 @@ TEST(MotorHealth, FittedRunsAgainstABaselineFromGoodRuns) {
 }
 
 }  // namespace
+
+// A worn motor whose friction ratios stay below check_ratio still stops much sooner than the
+// baseline predicts: that is a check, never OK.
+TEST(MotorHealth, StoppingMuchSoonerThanTheBaselineIsACheck) {
+  MotorHealthConfig cfg;
+  cfg.baseline = lab_baseline();
+  cfg.thresholds.significance_sigma = 1e9;  // no friction ratio is ever flagged
+  const HealthVerdict v = assess_health(combined_fit(1.3 * cv0, 2e-9, 1.45 * cc0, 5e-7), cfg);
+  const HealthFinding* stop = finding(v, "stop time vs baseline");
+  ASSERT_NE(stop, nullptr);
+  EXPECT_LT(stop->ratio, 0.75);
+  EXPECT_EQ(stop->level, HealthLevel::check);
+  EXPECT_EQ(v.level, HealthLevel::check);
+  EXPECT_NE(v.reason.find("sooner than the baseline"), std::string::npos) << v.reason;
+  // The same motor as the baseline: within a few per cent, no flag.
+  EXPECT_EQ(assess_health(combined_fit(cv0, 2e-9, cc0, 5e-7), cfg).level, HealthLevel::ok);
+}
+
+namespace {
+BaselineRun baseline_of(double cv, double cc, std::string source) {
+  return BaselineRun{std::move(source), cv, 0.006e-7, cc, 0.001e-4, J};
+}
+}  // namespace
+
+TEST(HealthBaseline, AWornRunIsSetAsideNamedAndLeftOutOfTheMean) {
+  const std::vector<BaselineRun> runs = {baseline_of(1.822e-7, 1.1389e-4, "a run 1"),
+                                         baseline_of(1.823e-7, 1.1386e-4, "b run 1"),
+                                         baseline_of(1.817e-7, 1.1396e-4, "c run 1"),
+                                         baseline_of(1.78e-7, 4.51e-4, "worn run 1")};
+  std::vector<SetAsideRun> aside;
+  std::string why;
+  const auto b = make_baseline(runs, "2026-11-26", "test", &why, &aside);
+  ASSERT_TRUE(b) << why;
+  ASSERT_EQ(aside.size(), 1u);
+  EXPECT_EQ(aside[0].source, "worn run 1");
+  EXPECT_NE(aside[0].why.find("dry friction 4"), std::string::npos) << aside[0].why;
+  EXPECT_EQ(b->runs, 3);
+  EXPECT_NEAR(b->c_coulomb, 1.139e-4, 0.001e-4);  // the worn run's 4.5e-4 is not in the mean
+  // Its error includes the run-to-run scatter: never below spread/sqrt(n).
+  EXPECT_GE(b->c_coulomb_stderr, b->c_coulomb_spread / std::sqrt(3.0) * (1 - 1e-12));
+}
+
+TEST(HealthBaseline, TwoRunsThatDisagreeAreRefusedNotAveraged) {
+  const std::vector<BaselineRun> runs = {baseline_of(1.822e-7, 1.1389e-4, "good run 1"),
+                                         baseline_of(1.78e-7, 4.51e-4, "worn run 1")};
+  std::string why;
+  EXPECT_FALSE(make_baseline(runs, "2026-11-26", "test", &why));
+  EXPECT_NE(why.find("which one is the motor's normal cannot be told"), std::string::npos) << why;
+  // Two runs of one motor a few per cent apart (far beyond their tiny errors) are its scatter.
+  const std::vector<BaselineRun> close = {baseline_of(1.822e-7, 1.1389e-4, "a"), baseline_of(1.85e-7, 1.16e-4, "b")};
+  EXPECT_TRUE(make_baseline(close, "2026-11-26", "test", &why)) << why;
+}
+
+TEST(HealthBaseline, RunsThatNeverStoppedOrWerePartialAreNotUsed) {
+  RunFit fit = combined_fit(cv0, 2e-9, cc0, 4e-7);
+  std::string why;
+  EXPECT_TRUE(baseline_run(fit, "ok", &why)) << why;
+  fit.run.stopped = false;
+  fit.run.end = Run::End::end_of_data;
+  EXPECT_FALSE(baseline_run(fit, "cut short", &why));
+  EXPECT_NE(why.find("never stopped"), std::string::npos) << why;
+  fit.run.stopped = true;
+  fit.run.lead_in = "none";
+  EXPECT_FALSE(baseline_run(fit, "partial", &why));
+  EXPECT_NE(why.find("partial"), std::string::npos) << why;
+}
+
 }  // namespace spindown

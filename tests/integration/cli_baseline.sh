@@ -102,10 +102,12 @@ EOF
 "$B/spindown" fit "$T/worn.tsv" --json >"$T/plain.json" 2>/dev/null || fail "fit without bench file"
 python3 -c 'import json,sys; r=json.load(open(sys.argv[1]))["files"][0]["runs"][0]; assert "health" not in r' \
   "$T/plain.json" || fail "health without a bench file"
-# A bench file without datasheet or baseline: the verdict says there is no reference.
+# A bench file without datasheet or baseline: nothing is judged, and the verdict never says OK.
 printf 'bench_id = "b2"\n' >"$T/b2.toml"
 "$B/spindown" fit "$T/worn.tsv" --bench-config "$T/b2.toml" >"$T/noref.out" 2>&1 || fail "fit with empty bench file"
-grep -q "(no reference) — .*no reference" "$T/noref.out" || fail "no-reference verdict"
+grep -q "health: NOT JUDGED — not judged: the bench file has no \[motor\] datasheet" "$T/noref.out" ||
+  fail "no-reference verdict"
+! grep -q "health: OK" "$T/noref.out" || fail "a run judged against nothing is called OK"
 # A bad bench file: exit 2, the message names the file and the key.
 printf '[motor]\nno_load_current_a = "45 mA"\n' >"$T/bad.toml"
 set +e
@@ -158,4 +160,15 @@ assert ok["level"] == "ok", ok
 assert worn["level"] == "service" and "dry friction" in worn["reason"], worn
 print("fitter FIT: bench000 %s; bench001 %s: %s" % (ok["level"], worn["level"], worn["reason"]))
 EOF
+
+# A worn run among good ones is set aside, named, and left out of the mean; two runs that
+# disagree are refused rather than averaged.
+"$B/spindown" baseline --bench b3 -o "$T/b3.toml" "$T/good1.tsv" "$T/good2.tsv" "$T/good3.tsv" "$T/worn.tsv" \
+  >"$T/b3.out" 2>&1 || fail "baseline with a worn run among the good ones"
+grep -q "set aside $T/worn.tsv run 1: dry friction 2.5× the others' median" "$T/b3.out" || fail "worn run not set aside"
+grep -q "baseline of bench b3 from 3 of 4 runs" "$T/b3.out" || fail "the worn run is in the mean"
+if "$B/spindown" baseline --bench b4 -o "$T/b4.toml" "$T/good1.tsv" "$T/worn.tsv" >"$T/b4.out" 2>&1; then
+  fail "two runs that disagree made a baseline"
+fi
+grep -q "which one is the motor's normal cannot be told" "$T/b4.out" || fail "two disagreeing runs: no reason given"
 echo "PASS cli_baseline"

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "spindown/fit_report.hpp"
+#include "spindown/health_report.hpp"
 
 using namespace spindown;
 
@@ -415,4 +416,16 @@ TEST(FitReportJsonText, RunTextMatchesTheTaggedDocumentsDump) {
         EXPECT_EQ(untagged, untagged_expected) << lab_units << " " << indent;
       }
     }
+}
+
+// A run judged against nothing says so in words and never reads OK.
+TEST(HealthReportText, NotJudgedIsNeverOk) {
+  HealthVerdict v;
+  v.level = HealthLevel::not_judged;
+  v.has_reference = false;
+  v.reason = "not judged: the bench file has no [motor] datasheet";
+  const std::string text = format_health_verdict(v);
+  EXPECT_EQ(text, "  health: NOT JUDGED — not judged: the bench file has no [motor] datasheet\n");
+  EXPECT_EQ(health_level_name(HealthLevel::not_judged), "not_judged");
+  EXPECT_EQ(parse_health_level("not_judged"), HealthLevel::not_judged);
 }

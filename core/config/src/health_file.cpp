@@ -82,7 +82,7 @@ MotorHealthConfig load_motor_health_config(const std::string& path) {
   r.only_keys("baseline", {"c_viscous_n_m_s", "c_viscous_stderr", "c_viscous_spread", "c_coulomb_n_m",
                            "c_coulomb_stderr", "c_coulomb_spread", "runs", "date", "inertia_kg_m2", "source"});
   r.only_keys("health", {"check_ratio", "service_ratio", "significance_sigma", "max_slowdown_s",
-                         "slowdown_fraction", "max_stop_s"});
+                         "slowdown_fraction", "max_stop_s", "stop_change_fraction"});
 
   if (r.at("motor")) {
     MotorDatasheet ds;
@@ -129,6 +129,7 @@ MotorHealthConfig load_motor_health_config(const std::string& path) {
   th.max_slowdown_s = r.number("health.max_slowdown_s").value_or(th.max_slowdown_s);
   th.slowdown_fraction = r.number("health.slowdown_fraction").value_or(th.slowdown_fraction);
   th.max_stop_s = r.number("health.max_stop_s").value_or(th.max_stop_s);
+  th.stop_change_fraction = r.number("health.stop_change_fraction").value_or(th.stop_change_fraction);
   std::string why;
   if (!th.is_valid(&why)) throw std::runtime_error(fmt::format("{}: [health]: {}", path, why));
   return cfg;

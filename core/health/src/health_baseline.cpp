@@ -1,5 +1,7 @@
 #include "spindown/health_baseline.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 #include <fmt/format.h>
 #include <regex>
@@ -41,7 +43,7 @@ Mean weighted_mean(const std::vector<double>& x, const std::vector<double>& se) 
   if (weighted) {
     const double internal = 1.0 / std::sqrt(sw);
     const double birge = n > 1 ? std::sqrt(chi2 / double(n - 1)) : 1.0;
-    m.stderr_ = internal * std::max(1.0, birge);
+    m.stderr_ = std::max(internal * std::max(1.0, birge), n > 1 ? m.spread / std::sqrt(double(n)) : 0.0);
   } else {
     m.stderr_ = n > 1 ? m.spread / std::sqrt(double(n)) : (se.empty() ? 0.0 : std::fabs(se[0]));
     if (!std::isfinite(m.stderr_)) m.stderr_ = 0;
@@ -94,6 +96,13 @@ std::optional<BaselineRun> baseline_run(const RunFit& fit, std::string source, s
   const Parameter* cc = m->param("c4");
   if (!cv || !cc || !std::isfinite(cv->value) || !std::isfinite(cc->value))
     return fail(why, "combined fit has no finite c3/c4"), std::nullopt;
+  if (fit.run.partial())
+    return fail(why, "the cut was not recorded (the coast is partial): its friction is not a whole coast's"),
+           std::nullopt;
+  if (!fit.run.stopped)
+    return fail(why, fmt::format("the run never stopped (its window ends: {}): its friction is not a whole coast's",
+                                 end_name(fit.run.end))),
+           std::nullopt;
   BaselineRun r;
   r.source = std::move(source);
   r.c_viscous = cv->value;
@@ -104,9 +113,91 @@ std::optional<BaselineRun> baseline_run(const RunFit& fit, std::string source, s
   return r;
 }
 
-std::optional<HealthBaseline> make_baseline(std::span<const BaselineRun> runs, std::string date, std::string source,
-                                            std::string* why) {
-  if (runs.empty()) return fail(why, "no good run (a combined fit that converged) to make a baseline from"), std::nullopt;
+namespace {
+
+double median_of(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// How far each run's coefficient lies from the runs' median, in standard errors that count the
+// run's own error and the runs' natural scatter (robust: 1.4826·MAD, at least a fraction of the
+// median).
+std::vector<double> robust_z(const std::vector<double>& x, const std::vector<double>& se) {
+  const double med = median_of(x);
+  std::vector<double> dev;
+  for (double v : x) dev.push_back(std::fabs(v - med));
+  const double scatter = std::max(1.4826 * median_of(dev), baseline_natural_scatter * std::fabs(med));
+  std::vector<double> z;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const double s = std::hypot(std::isfinite(se[i]) ? se[i] : 0.0, scatter);
+    z.push_back(s > 0 ? (x[i] - med) / s : 0.0);
+  }
+  return z;
+}
+
+std::string times_median(double x, double med) {
+  return med > 0 ? fmt::format("{:.2g}× the others' median", x / med) : fmt::format("{:.3g}", x);
+}
+
+}  // namespace
+
+std::optional<HealthBaseline> make_baseline(std::span<const BaselineRun> all_runs, std::string date,
+                                            std::string source, std::string* why,
+                                            std::vector<SetAsideRun>* set_aside) {
+  if (all_runs.empty())
+    return fail(why, "no good run (a combined fit that converged) to make a baseline from"), std::nullopt;
+  std::vector<BaselineRun> runs(all_runs.begin(), all_runs.end());
+  {
+    std::vector<double> cv, cv_se, cc, cc_se;
+    for (const auto& r : runs) {
+      cv.push_back(r.c_viscous);
+      cv_se.push_back(r.c_viscous_stderr);
+      cc.push_back(r.c_coulomb);
+      cc_se.push_back(r.c_coulomb_stderr);
+    }
+    if (runs.size() == 2) {
+      // Two runs: a median cannot tell which one is off; they must agree with each other.
+      const auto disagree = [&](const std::vector<double>& x, const std::vector<double>& se) {
+        const double scatter = baseline_natural_scatter * 0.5 * std::fabs(x[0] + x[1]);
+        const double s = std::sqrt(se[0] * se[0] + se[1] * se[1] + 2 * scatter * scatter);
+        return s > 0 ? std::fabs(x[0] - x[1]) / s : 0.0;
+      };
+      const double zc = disagree(cc, cc_se), zv = disagree(cv, cv_se);
+      if (std::max(zc, zv) > baseline_outlier_sigma)
+        return fail(why, fmt::format("the 2 runs disagree ({} differs by {:.0f} standard errors, counting {:.0f} % "
+                                     "run-to-run scatter): which one is the motor's normal cannot be told — "
+                                     "record a third good run",
+                                     zc >= zv ? "dry friction" : "viscous friction", std::max(zc, zv),
+                                     100 * baseline_natural_scatter)),
+               std::nullopt;
+    } else if (runs.size() >= 3) {
+      const std::vector<double> zv = robust_z(cv, cv_se), zc = robust_z(cc, cc_se);
+      const double med_v = median_of(cv), med_c = median_of(cc);
+      std::vector<BaselineRun> kept;
+      for (std::size_t i = 0; i < runs.size(); ++i) {
+        const bool off_c = std::fabs(zc[i]) > baseline_outlier_sigma, off_v = std::fabs(zv[i]) > baseline_outlier_sigma;
+        if (!off_c && !off_v) {
+          kept.push_back(runs[i]);
+          continue;
+        }
+        const bool by_c = std::fabs(zc[i]) >= std::fabs(zv[i]);
+        const std::string what =
+            by_c ? fmt::format("dry friction {} ({:.0f} standard errors)", times_median(cc[i], med_c), std::fabs(zc[i]))
+                 : fmt::format("viscous friction {} ({:.0f} standard errors)", times_median(cv[i], med_v),
+                               std::fabs(zv[i]));
+        if (set_aside)
+          set_aside->push_back({runs[i].source, what + ": worn, another motor, or a bad run — not this motor's normal"});
+      }
+      if (kept.size() * 2 < runs.size())
+        return fail(why, fmt::format("{} of {} runs disagree with the others' median: no common normal to make a "
+                                     "baseline of",
+                                     runs.size() - kept.size(), runs.size())),
+               std::nullopt;
+      runs = std::move(kept);
+    }
+  }
   std::vector<double> cv, cv_se, cc, cc_se;
   double J = 0;
   for (const auto& r : runs) {

@@ -182,7 +182,16 @@ void compare_with_baseline(const FittedFriction& fr, double J, const HealthBasel
   stop.reference = t_base;
   stop.reference_name = "baseline";
   stop.unit = "s";
-  if (std::isfinite(t_run) && std::isfinite(t_base) && t_base > 0) stop.ratio = t_run / t_base;
+  if (std::isfinite(t_run) && std::isfinite(t_base) && t_base > 0) {
+    stop.ratio = t_run / t_base;
+    if (std::fabs(stop.ratio - 1.0) > th.stop_change_fraction) {
+      stop.level = HealthLevel::check;
+      stop.reason = stop.ratio < 1 ? stop.reason + ": friction has grown since the baseline — check bearings and "
+                                                   "lubrication"
+                                   : stop.reason + ": friction has fallen since the baseline — check the bench's "
+                                                   "inertia J and that the flywheel is fixed";
+    }
+  }
   out.push_back(std::move(stop));
 }
 
@@ -288,6 +297,7 @@ const ModelFit* best_of(const RunFit& fit) {
 
 std::string_view health_level_name(HealthLevel level) {
   switch (level) {
+    case HealthLevel::not_judged: return "not_judged";
     case HealthLevel::ok: return "ok";
     case HealthLevel::check: return "check";
     case HealthLevel::service: return "service";
@@ -296,7 +306,7 @@ std::string_view health_level_name(HealthLevel level) {
 }
 
 std::optional<HealthLevel> parse_health_level(std::string_view name) {
-  for (HealthLevel l : {HealthLevel::ok, HealthLevel::check, HealthLevel::service})
+  for (HealthLevel l : {HealthLevel::not_judged, HealthLevel::ok, HealthLevel::check, HealthLevel::service})
     if (health_level_name(l) == name) return l;
   return std::nullopt;
 }
@@ -332,6 +342,8 @@ bool HealthThresholds::is_valid(std::string* why) const {
   if (!(slowdown_fraction > 0 && slowdown_fraction < 1))
     return fail(fmt::format("slowdown_fraction {} not in (0, 1)", slowdown_fraction));
   if (!(max_stop_s > 0)) return fail(fmt::format("max_stop_s {} must be positive", max_stop_s));
+  if (!(stop_change_fraction > 0 && stop_change_fraction < 1))
+    return fail(fmt::format("stop_change_fraction {} not in (0, 1)", stop_change_fraction));
   return true;
 }
 
@@ -392,9 +404,10 @@ HealthVerdict assess_health(const RunFit& fit, const MotorHealthConfig& cfg) {
   for (const auto* f : flagged) reason += (reason.empty() ? "" : "; ") + f->reason;
   if (!v.has_reference) {
     const std::string none =
-        "no reference: the bench file has no [motor] datasheet (no-load current and torque or speed constant) "
+        "not judged: the bench file has no [motor] datasheet (no-load current and torque or speed constant) "
         "and no [baseline], so friction cannot be judged — make a baseline with `spindown baseline`";
     v.reason = reason.empty() ? none : reason + "; " + none;
+    if (v.level == HealthLevel::ok) v.level = HealthLevel::not_judged;
   } else if (!reason.empty()) {
     v.reason = reason;
   } else {

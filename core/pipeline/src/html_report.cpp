@@ -40,10 +40,10 @@ td.num{text-align:right;font-variant-numeric:tabular-nums;white-space:nowrap}
 tr.best td{background:#f3f8ee}
 tr.model-first td{border-top:2px solid #999}
 .badge{display:inline-block;padding:1px 8px;border-radius:10px;font-weight:bold;font-size:12px;color:#fff}
-.badge.ok{background:#2e7d32}.badge.check{background:#e0a100;color:#222}.badge.service{background:#c62828}
+.badge.not_judged{background:#757575}.badge.ok{background:#2e7d32}.badge.check{background:#e0a100;color:#222}.badge.service{background:#c62828}
 .badge.none{background:#888}
 .verdict{border-left:6px solid #888;background:#fafafa;padding:6px 10px;margin:8px 0}
-.verdict.ok{border-color:#2e7d32}.verdict.check{border-color:#e0a100}.verdict.service{border-color:#c62828}
+.verdict.not_judged{border-color:#757575}.verdict.ok{border-color:#2e7d32}.verdict.check{border-color:#e0a100}.verdict.service{border-color:#c62828}
 .noref{color:#666;font-style:italic}
 .drift{color:#c62828;font-weight:bold}
 .steady{color:#2e7d32}
@@ -70,7 +70,7 @@ std::string anchor(std::string_view prefix, std::string_view text) {
 std::string level_badge(HealthLevel level) {
   const std::string_view name = health_level_name(level);
   std::string upper(name);
-  for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  for (char& c : upper) c = c == '_' ? ' ' : static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
   return fmt::format("<span class=\"badge {}\">{}</span>", name, upper);
 }
 

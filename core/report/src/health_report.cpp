@@ -22,9 +22,10 @@ std::string value_text(double value, double se, const std::string& unit) {
 
 std::string format_health_verdict(const HealthVerdict& v, std::string_view indent) {
   std::string level(health_level_name(v.level));
-  std::transform(level.begin(), level.end(), level.begin(), [](unsigned char c) { return char(std::toupper(c)); });
-  std::string out = fmt::format("{}health: {}{} — {}\n", indent, level, v.has_reference ? "" : " (no reference)",
-                                v.reason);
+  std::transform(level.begin(), level.end(), level.begin(),
+                 [](unsigned char c) { return c == '_' ? ' ' : char(std::toupper(c)); });
+  std::string out = fmt::format("{}health: {}{} — {}\n", indent, level,
+                                v.has_reference || v.level == HealthLevel::not_judged ? "" : " (no reference)", v.reason);
   for (const auto& f : v.findings) {
     if (!std::isfinite(f.value) && !std::isinf(f.value)) continue;  // words only: already in the reason
     std::string line = fmt::format("{}  {:<26} {}", indent, f.what, value_text(f.value, f.std_error, f.unit));

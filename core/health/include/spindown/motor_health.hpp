@@ -27,8 +27,10 @@
 
 namespace spindown {
 
-enum class HealthLevel { ok, check, service };
-std::string_view health_level_name(HealthLevel level);  // "ok" | "check" | "service"
+// not_judged: nothing to judge the run against (no datasheet, no baseline) and nothing else
+// flagged it; never shown as OK. Ordered by concern: a bench's worst run is the maximum.
+enum class HealthLevel { not_judged, ok, check, service };
+std::string_view health_level_name(HealthLevel level);  // "not_judged" | "ok" | "check" | "service"
 std::optional<HealthLevel> parse_health_level(std::string_view name);
 
 // The motor's datasheet; every value optional (SI except where the unit says rpm).
@@ -69,6 +71,9 @@ struct HealthThresholds {
   double max_slowdown_s = 30.0;
   double slowdown_fraction = 0.5;
   double max_stop_s = 60.0;
+  // A stop time this fraction sooner or later than the baseline predicts from the run's own
+  // speed at the cut is a "check", whatever the friction ratios say.
+  double stop_change_fraction = 0.25;
   bool is_valid(std::string* why) const;
 };
 

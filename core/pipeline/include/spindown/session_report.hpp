@@ -106,7 +106,7 @@ CoefficientTrend coefficient_trend(std::string name, std::string unit, std::stri
 struct BenchSummary {
   std::string bench;
   std::vector<std::size_t> runs;  // indices into SessionReport::runs, time order
-  HealthLevel worst = HealthLevel::ok;
+  HealthLevel worst = HealthLevel::not_judged;
   bool has_reference = false;
   std::string reference_file;
   CoefficientTrend viscous, coulomb;  // from the combined model
