@@ -62,6 +62,8 @@ FileExplain explain_file(const std::string& path, const ExplainPlan& plan) {
       opt.bench = r.params;
       ExplainResult result = explain_run(r.recording, run, opt);
       if (!result.ok) out.failures.push_back(r.where + fmt::format("run {}: {}", run.number, result.message));
+      // An LCM log of several benches: each run says whose it is (run numbers restart per bench).
+      if (r.count > 1) out.run_bench.push_back(!r.bench.empty() ? r.bench : r.recording.source);
       out.runs.push_back(std::move(result));
     }
   } sink(plan);

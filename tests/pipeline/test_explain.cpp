@@ -120,6 +120,30 @@ TEST(Explain, TellsTheLabStoryOnTheSeedData) {
     EXPECT_NE(svg.find(part), std::string::npos) << part;
 }
 
+// A file of several benches (an LCM log): every run names its bench in text, JSON and the SVG.
+TEST(Explain, RunsOfSeveralBenchesSayWhoseTheyAre) {
+  const auto recs = read_recordings(std::string(SPINDOWN_SAMPLE_DATA) + "/seed-3v-run1.tsv");
+  ASSERT_EQ(recs.size(), 1u);
+  const Segmentation seg = find_runs(recs[0]);
+  ASSERT_EQ(seg.runs.size(), 1u);
+  FileExplain file;
+  file.file = "lab.lcm";
+  file.runs = {explain_run(recs[0], seg.runs[0], ExplainOptions{}), explain_run(recs[0], seg.runs[0], ExplainOptions{})};
+  file.run_bench = {"bench-a", "bench-b"};
+  const std::string text = format_file_explain(file);
+  EXPECT_NE(text.find("run 1 of bench bench-a: cut at"), std::string::npos) << text;
+  EXPECT_NE(text.find("run 1 of bench bench-b: cut at"), std::string::npos) << text;
+  const ExplainJson j = explain_report_json(std::span<const FileExplain>(&file, 1));
+  EXPECT_EQ(j["files"][0]["runs"][0]["bench"], "bench-a");
+  EXPECT_EQ(j["files"][0]["runs"][1]["bench"], "bench-b");
+  const std::string svg = explain_svg(std::span<const FileExplain>(&file, 1));
+  EXPECT_NE(svg.find("lab.lcm bench bench-b - run 1"), std::string::npos);
+  // One bench, one file: no bench named.
+  file.run_bench.clear();
+  EXPECT_EQ(format_file_explain(file).find(" of bench "), std::string::npos);
+  EXPECT_FALSE(explain_report_json(std::span<const FileExplain>(&file, 1))["files"][0]["runs"][0].contains("bench"));
+}
+
 TEST(Explain, RejectsBadOptionsWithAReason) {
   ExplainOptions opt;
   opt.base = {find_effect("sensor_offset")};

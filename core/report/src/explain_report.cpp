@@ -73,9 +73,10 @@ std::string where_text(const std::vector<Disagreement>& where, const std::string
 
 }  // namespace
 
-ExplainJson explain_run_json(const ExplainResult& r) {
+ExplainJson explain_run_json(const ExplainResult& r, std::string_view bench) {
   ExplainJson j;
   j["run"] = r.run.number;
+  if (!bench.empty()) j["bench"] = bench;
   j["base"] = r.base.names();
   ExplainJson steps = ExplainJson::array();
   for (const auto& s : r.steps)
@@ -118,7 +119,8 @@ ExplainJson explain_report_json(std::span<const FileExplain> files) {
     ExplainJson fj;
     fj["file"] = f.file;
     ExplainJson runs = ExplainJson::array();
-    for (const auto& r : f.runs) runs.push_back(explain_run_json(r));
+    for (std::size_t i = 0; i < f.runs.size(); ++i)
+      runs.push_back(explain_run_json(f.runs[i], i < f.run_bench.size() ? f.run_bench[i] : std::string_view{}));
     fj["runs"] = runs;
     fj["samples"] = f.samples;
     fj["failures"] = f.failures;
@@ -128,11 +130,12 @@ ExplainJson explain_report_json(std::span<const FileExplain> files) {
   return out;
 }
 
-std::string format_explain(const ExplainResult& r) {
+std::string format_explain(const ExplainResult& r, std::string_view bench) {
   const std::string& u = r.unit;
-  std::string out = fmt::format("run {}: cut at {:.3f} s, {} samples, noise {:.2g} {} per reading ({:.2g} {} per "
+  std::string out = fmt::format("run {}{}: cut at {:.3f} s, {} samples, noise {:.2g} {} per reading ({:.2g} {} per "
                                 "{}-sample bin)\n",
-                                r.run.number, r.run.t_cut_s, r.tau.size(), r.noise_level, u, r.bin_noise, u,
+                                r.run.number, bench.empty() ? std::string() : fmt::format(" of bench {}", bench),
+                                r.run.t_cut_s, r.tau.size(), r.noise_level, u, r.bin_noise, u,
                                 r.bin_samples);
   if (!r.ok) return out + fmt::format("  could not be explained: {}\n", r.message);
   out += fmt::format("  base model: {}   RMSE {:.4g} {}\n", r.base.label(), r.base.rmse, u);
@@ -172,7 +175,8 @@ std::string format_explain(const ExplainResult& r) {
 
 std::string format_file_explain(const FileExplain& file) {
   std::string out = fmt::format("{}\n", file.file);
-  for (const auto& r : file.runs) out += format_explain(r) + "\n";
+  for (std::size_t i = 0; i < file.runs.size(); ++i)
+    out += format_explain(file.runs[i], i < file.run_bench.size() ? file.run_bench[i] : std::string_view{}) + "\n";
   return out;
 }
 
@@ -185,13 +189,13 @@ using svg::polyline;
 
 constexpr double fig_w = 960, fig_h = 700;
 
-std::string run_figure(const std::string& file, const ExplainResult& r, double top) {
+std::string run_figure(const std::string& file, std::string_view bench, const ExplainResult& r, double top) {
   const std::string& u = r.unit;
   const std::size_t n = r.tau.size();
   std::string s;
   const std::string name = file.substr(file.find_last_of('/') == std::string::npos ? 0 : file.find_last_of('/') + 1);
-  const std::string title = fmt::format("{} - run {}: base {} (RMSE {:.3g} {}) -> {} (RMSE {:.3g} {})", name,
-                                        r.run.number, r.base.label(), r.base.rmse, u, r.final_fit.label(),
+  const std::string title = fmt::format("{}{} - run {}: base {} (RMSE {:.3g} {}) -> {} (RMSE {:.3g} {})", name,
+                                        bench.empty() ? std::string() : fmt::format(" bench {}", bench), r.run.number, r.base.label(), r.base.rmse, u, r.final_fit.label(),
                                         r.final_fit.rmse, u);
   s += fmt::format("<text x=\"{}\" y=\"{:.1f}\" text-anchor=\"middle\" font-size=\"15\" font-weight=\"bold\">{}</text>\n",
                    fig_w / 2, top + 22, svg::escape(title));
@@ -261,8 +265,8 @@ std::string explain_svg(std::span<const FileExplain> files) {
                               fig_w, height, fig_w, height);
   double top = 0;
   for (const auto& f : files)
-    for (const auto& r : f.runs) {
-      s += run_figure(f.file, r, top);
+    for (std::size_t i = 0; i < f.runs.size(); ++i) {
+      s += run_figure(f.file, i < f.run_bench.size() ? f.run_bench[i] : std::string_view{}, f.runs[i], top);
       top += fig_h;
     }
   s += "</svg>\n";

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -20,6 +21,7 @@ struct FileExplain {
   std::size_t samples = 0;
   std::vector<Diagnostic> diagnostics;
   std::vector<ExplainResult> runs;
+  std::vector<std::string> run_bench;  // a log of several benches: each run's bench id (same order)
   std::vector<std::string> failures;  // non-empty means exit code 1
   bool usable() const { return failures.empty(); }
 };
@@ -29,11 +31,13 @@ using ExplainJson = nlohmann::ordered_json;
 // {"run":1,"base":[…],"steps":[{"added":…,"rmse_before":…,"rmse_after":…,"where":[{"t_from_s":…,
 // "t_to_s":…,"mean_residual":…}],"why":…}],"final":[…],"rmse_base":…,"rmse_final":…} plus extra
 // fields (units, parameters, candidates, noise, conclusion). Non-finite numbers become null.
-ExplainJson explain_run_json(const ExplainResult& r);
+// bench: the run's bench id when its file holds several ("bench": … after "run"), else "".
+ExplainJson explain_run_json(const ExplainResult& r, std::string_view bench = {});
 ExplainJson explain_report_json(std::span<const FileExplain> files);
 
 // The story, step by step, for people.
-std::string format_explain(const ExplainResult& r);
+// bench: as explain_run_json ("run 1 of bench b2: …").
+std::string format_explain(const ExplainResult& r, std::string_view bench = {});
 // The same for every run of a file, headed by the file name.
 std::string format_file_explain(const FileExplain& file);
 
