@@ -13,6 +13,7 @@
 #include "exit_codes.hpp"
 #include "spindown/clock_checks.hpp"
 #include "spindown/doctor_check.hpp"
+#include "spindown/host_name.hpp"
 #include "spindown/lcm_self_test.hpp"
 #include "spindown/lcm_url.hpp"
 #include "spindown/network_checks.hpp"
@@ -186,7 +187,7 @@ int run_doctor(const DoctorCommandOptions& o) {
     if (o.listen_s > 0 && url && lcm_works) {
       if (!o.json) std::fprintf(stderr, "spindown doctor: listening %.3g s for the lab's clocks on %s\n", o.listen_s,
                                 resolved.url.c_str());
-      for (auto& c : check_clock_skew(listen_for_clocks(resolved.url, o.listen_s), this_host_name(), o.listen_s))
+      for (auto& c : check_clock_skew(listen_for_clocks(resolved.url, o.listen_s), host_name(), o.listen_s))
         checks.push_back(std::move(c));
     } else if (o.listen_s > 0) {
       checks.push_back({"clock skew", CheckLevel::skip, "LCM does not work here: no other PC's clock to compare", ""});

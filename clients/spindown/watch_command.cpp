@@ -1,39 +1,27 @@
 #include "watch_command.hpp"
 
 #include <CLI/CLI.hpp>
-#include <algorithm>
-#include <atomic>
-#include <chrono>
-#include <csignal>
 #include <cstdint>
 #include <cstdio>
 #include <ctime>
 #include <deque>
 #include <exception>
 #include <fmt/format.h>
-#include <lcm/lcm-cpp.hpp>
-#include <limits>
 #include <memory>
 #include <regex>
 #include <sys/ioctl.h>
 #include <unistd.h>
 
 #include "exit_codes.hpp"
+#include "spindown/clock.hpp"
 #include "spindown/lab_table.hpp"
 #include "spindown/lcm_channels.hpp"
-#include "spindown/message_decode.hpp"
+#include "spindown/lcm_loop.hpp"
+#include "spindown/stop_signal.hpp"
 
 namespace spindown::cli {
 
 namespace {
-
-std::atomic<bool> g_stop{false};
-extern "C" void on_stop_signal(int) { g_stop = true; }
-
-std::int64_t wall_us() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 std::string clock_text(std::int64_t utime) {
   const std::time_t s = static_cast<std::time_t>(utime / 1000000);
@@ -48,66 +36,50 @@ std::size_t terminal_width() {
   return 0;
 }
 
-// Decodes the suite's channels into the table; never lets an exception reach LCM's C callback.
-class WatchListener {
- public:
-  WatchListener(LabTable& table, const std::string& bench_regex) : table_(table), wanted_(bench_regex) {}
-
-  // LCM's C callback (the C++ wrapper's member-function subscriptions trip UBSan inside LCM
-  // 1.3.1's header, as spindown-fitter found).
-  static void on_lcm(const lcm_recv_buf_t* rbuf, const char* channel, void* user) {
-    auto* self = static_cast<WatchListener*>(user);
-    try {
-      self->handle(rbuf, channel);
-    } catch (const std::exception& e) {
-      self->table_.on_bad_message(fmt::format("{}: {}", channel, e.what()), rbuf->recv_utime);
-    }
-  }
-
- private:
-  template <class Message>
-  bool decode(const lcm_recv_buf_t* rbuf, const std::string& channel, Message& m, const char* type) {
-    // decode_message checks the layout first: a hostile packet cannot make it allocate gigabytes.
-    const auto size = static_cast<std::int64_t>(rbuf->data_size);
-    std::string why;
-    if (decode_message(m, rbuf->data, size, &why)) return true;
-    table_.on_bad_message(fmt::format("{}: {} bytes that do not decode as {}: {}", channel, size, type, why),
-                          rbuf->recv_utime);
-    return false;
-  }
-
-  void handle(const lcm_recv_buf_t* rbuf, const std::string& channel) {
+// The table hears SPINDOWN.<bench>.<KIND> as Msg: table_call(bench id, message, receive time).
+// A channel whose name is not the suite's is ignored, and so is (before decoding) a bench the
+// --bench regex does not want, unless every bench is kept (the services' heartbeats).
+template <class Msg, class TableCall>
+bool listen(LcmLoop& loop, ChannelKind kind, const std::regex& wanted, bool every_bench, TableCall table_call) {
+  LcmSubscribeOptions options;
+  options.queue_capacity = 10000;  // LCM's default of 30 drops silently in a burst (design §7)
+  options.accept = [kind, &wanted, every_bench](std::string_view channel) {
     const auto parsed = parse_channel(channel);
-    if (!parsed) return;
-    const std::string& id = parsed->bench;
-    const std::int64_t now = rbuf->recv_utime > 0 ? rbuf->recv_utime : wall_us();
-    const bool bench_wanted = std::regex_match(id, wanted_);
-    switch (parsed->kind) {
-      case ChannelKind::sample:
-        if (samples_t m; bench_wanted && decode(rbuf, channel, m, "samples_t")) table_.on_samples(id, m, now);
-        break;
-      case ChannelKind::config:
-        if (config_t m; bench_wanted && decode(rbuf, channel, m, "config_t")) table_.on_config(id, m, now);
-        break;
-      case ChannelKind::run:
-        if (run_t m; bench_wanted && decode(rbuf, channel, m, "run_t")) table_.on_run(id, m, now);
-        break;
-      case ChannelKind::fit:
-        if (fit_t m; bench_wanted && decode(rbuf, channel, m, "fit_t")) table_.on_fit(id, m, now);
-        break;
-      case ChannelKind::status:
-        // A bridge's heartbeat belongs to its bench (filtered); services are always shown.
-        if (status_t m; decode(rbuf, channel, m, "status_t") && (m.service != "bridge" || bench_wanted))
-          table_.on_status(id, m, now);
-        break;
-      case ChannelKind::explain:
-        break;
-    }
-  }
+    return parsed && parsed->kind == kind && (every_bench || std::regex_match(parsed->bench, wanted));
+  };
+  return loop.subscribe<Msg>(
+      fmt::format("SPINDOWN\\..*\\.{}", channel_suffix(kind)),
+      [table_call](const Msg& m, const LcmMessage& r) {
+        table_call(parse_channel(r.channel)->bench, m, r.recv_utime > 0 ? r.recv_utime : wall_us());
+      },
+      std::move(options));
+}
 
-  LabTable& table_;
-  std::regex wanted_;
-};
+// The suite's channels into the table (EXPLAIN is not shown); what does not decode, or makes
+// the table throw, is one of the table's bad messages.
+bool listen_to_lab(LcmLoop& loop, LabTable& table, const std::regex& wanted) {
+  loop.on_decode_error([&table](const LcmDecodeError& e) { table.on_bad_message(e.text(), e.recv_utime); });
+  loop.on_handler_error([&table](const LcmMessage& m, const std::exception& e) {
+    table.on_bad_message(fmt::format("{}: {}", m.channel, e.what()), m.recv_utime);
+  });
+  return listen<samples_t>(loop, ChannelKind::sample, wanted, false,
+                           [&table](const std::string& id, const samples_t& m, std::int64_t now) {
+                             table.on_samples(id, m, now);
+                           }) &&
+         listen<config_t>(loop, ChannelKind::config, wanted, false,
+                          [&table](const std::string& id, const config_t& m, std::int64_t now) {
+                            table.on_config(id, m, now);
+                          }) &&
+         listen<run_t>(loop, ChannelKind::run, wanted, false,
+                       [&table](const std::string& id, const run_t& m, std::int64_t now) { table.on_run(id, m, now); }) &&
+         listen<fit_t>(loop, ChannelKind::fit, wanted, false,
+                       [&table](const std::string& id, const fit_t& m, std::int64_t now) { table.on_fit(id, m, now); }) &&
+         // A bridge's heartbeat belongs to its bench (filtered); services are always shown.
+         listen<status_t>(loop, ChannelKind::status, wanted, true,
+                          [&table, &wanted](const std::string& id, const status_t& m, std::int64_t now) {
+                            if (m.service != "bridge" || std::regex_match(id, wanted)) table.on_status(id, m, now);
+                          });
+}
 
 void print(const std::string& text) {
   std::fputs(text.c_str(), stdout);
@@ -148,8 +120,8 @@ void setup_watch(CLI::App& app) {
 }
 
 int run_watch(const WatchCommandOptions& o) {
-  lcm::LCM lcm(o.lcm_url);
-  if (!lcm.good()) {
+  LcmLoop loop(o.lcm_url);
+  if (!loop.good()) {
     std::fprintf(stderr, "spindown watch: cannot start LCM%s%s\n", o.lcm_url.empty() ? "" : " at ",
                  o.lcm_url.c_str());
     return exit_unusable;
@@ -157,50 +129,33 @@ int run_watch(const WatchCommandOptions& o) {
   LabTableOptions topt;
   topt.lab_units = o.lab_units;
   LabTable table(topt);
-  WatchListener listener(table, o.bench_regex);
-  lcm_t* raw = lcm.getUnderlyingLCM();
-  lcm_subscription_t* sub = lcm_subscribe(raw, "SPINDOWN\\..*", &WatchListener::on_lcm, &listener);
-  if (!sub) {
+  const std::regex wanted(o.bench_regex);
+  if (!listen_to_lab(loop, table, wanted)) {
     std::fprintf(stderr, "spindown watch: cannot subscribe to SPINDOWN\\..*\n");
     return exit_unusable;
   }
-  lcm_subscription_set_queue_capacity(sub, 10000);  // LCM's default of 30 drops silently in a burst (design §7)
-
-  g_stop = false;
-  struct sigaction sa{};
-  sa.sa_handler = on_stop_signal;
-  sigemptyset(&sa.sa_mask);
-  sa.sa_flags = 0;  // no SA_RESTART: a signal ends the wait at once
-  struct sigaction old_int{}, old_term{};
-  sigaction(SIGINT, &sa, &old_int);
-  sigaction(SIGTERM, &sa, &old_term);
+  StopSignals stop;
 
   const bool tty = ::isatty(STDOUT_FILENO) == 1;
   const bool redraw = tty && !o.plain && !o.once;
   const double duration = o.duration_s > 0 ? o.duration_s : (o.once ? 3.0 : 0.0);
   const double interval = o.interval_s > 0 ? o.interval_s : (redraw ? 1.0 : 10.0);
-  const std::int64_t start = wall_us();
-  const std::int64_t end = duration > 0 ? start + static_cast<std::int64_t>(duration * 1e6) : std::numeric_limits<std::int64_t>::max();
-  const auto interval_us = static_cast<std::int64_t>(interval * 1e6);
-  std::int64_t next_table = redraw ? start : start + interval_us;
   std::deque<std::string> recent;  // events shown under a redrawn table
   constexpr std::size_t recent_shown = 12;
+  const auto redraw_screen = [&](std::int64_t t) {
+    std::string screen = "\x1b[H\x1b[2J" + table.render(t, terminal_width());
+    if (!recent.empty()) {
+      screen += "\nrecent events:\n";
+      for (const auto& line : recent) screen += "  " + line + '\n';
+    }
+    print(screen);
+  };
 
   if (!redraw && !o.once)
     print(fmt::format("spindown watch: listening{}{} (benches matching '{}')\n", o.lcm_url.empty() ? "" : " on ",
                       o.lcm_url, o.bench_regex));
-  int lcm_failures = 0;
-  for (;;) {
-    const std::int64_t now = wall_us();
-    if (g_stop || now >= end) break;
-    const int wait_ms = static_cast<int>(std::clamp<std::int64_t>((std::min(next_table, end) - now) / 1000, 1, 100));
-    if (lcm.handleTimeout(wait_ms) < 0 && !g_stop) {
-      if (++lcm_failures > 50) {
-        std::fprintf(stderr, "spindown watch: LCM keeps failing to receive; stopping\n");
-        break;
-      }
-    }
-    const std::int64_t t = wall_us();
+  // After every wait: the table's events, as lines or under the redrawn table.
+  loop.every(0, [&](std::int64_t t) {
     for (auto& e : table.take_events()) {
       std::string line = clock_text(t) + "  " + e;
       if (redraw) {
@@ -210,32 +165,28 @@ int run_watch(const WatchCommandOptions& o) {
         print(line + '\n');
       }
     }
-    if (o.once || t < next_table) continue;
-    next_table = t + interval_us;
-    if (redraw) {
-      std::string screen = "\x1b[H\x1b[2J" + table.render(t, terminal_width());
-      if (!recent.empty()) {
-        screen += "\nrecent events:\n";
-        for (const auto& line : recent) screen += "  " + line + '\n';
-      }
-      print(screen);
-    } else if (table.changed()) {
-      print('\n' + table.render(t) + '\n');
-      table.clear_changed();
-    }
-  }
-  lcm_unsubscribe(raw, sub);
-  sigaction(SIGINT, &old_int, nullptr);
-  sigaction(SIGTERM, &old_term, nullptr);
+  });
+  // Every interval: the table redrawn, or (plain) printed when something changed.
+  if (!o.once)
+    loop.every(
+        interval,
+        [&](std::int64_t t) {
+          if (redraw) {
+            redraw_screen(t);
+          } else if (table.changed()) {
+            print('\n' + table.render(t) + '\n');
+            table.clear_changed();
+          }
+        },
+        redraw ? 0 : interval);
+  if (loop.run({.stop = &stop, .timeout_s = duration}) == LcmLoopEnd::failed)
+    std::fprintf(stderr, "spindown watch: LCM keeps failing to receive; stopping\n");
+  loop.unsubscribe_all();
+
   // The last state stays on screen (a redraw) or closes the log (plain, --once).
   const std::int64_t t = wall_us();
   if (redraw) {
-    std::string screen = "\x1b[H\x1b[2J" + table.render(t, terminal_width());
-    if (!recent.empty()) {
-      screen += "\nrecent events:\n";
-      for (const auto& line : recent) screen += "  " + line + '\n';
-    }
-    print(screen);
+    redraw_screen(t);
   } else {
     if (!o.once && !o.no_events)
       for (auto& e : table.take_events()) print(clock_text(t) + "  " + e + '\n');

@@ -3,27 +3,21 @@
 // resets, wrong baud rates and garbage; SIGINT/SIGTERM end it with exit code 0.
 #include <CLI/CLI.hpp>
 #include <array>
-#include <atomic>
 #include <chrono>
-#include <csignal>
 #include <fmt/format.h>
 #include <lcm/lcm-cpp.hpp>
-#include <thread>
+#include <optional>
 
 #include "spindown/bridge_settings.hpp"
+#include "spindown/clock.hpp"
 #include "spindown/lcm_channels.hpp"
 #include "spindown/serial_bridge.hpp"
 #include "spindown/serial_port.hpp"
+#include "spindown/stop_signal.hpp"
 
 namespace {
 
-std::atomic<bool> g_stop{false};
-extern "C" void on_signal(int) { g_stop = true; }
-
-std::int64_t wall_us() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
+using spindown::wall_us;
 
 class LcmSink : public spindown::BridgeSink {
  public:
@@ -46,27 +40,35 @@ class LcmSink : public spindown::BridgeSink {
   long failures_ = 0;
 };
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  CLI::App app{"spindown-bridge: a bench's serial port -> LCM SPINDOWN.<bench>.SAMPLE|CONFIG|STATUS"};
-  spindown::BridgeSettings s;
-  std::string config_file, lcm_url;
+struct BridgeOptions {
+  spindown::BridgeSettings settings;
+  std::string lcm_url;
   bool exit_on_missing = false;
   double retry_s = 0.25;
+};
+
+// The command line (and --config) into o; an exit code when the program ends here.
+std::optional<int> parse_options(int argc, char** argv, BridgeOptions& o) {
+  CLI::App app{"spindown-bridge: a bench's serial port -> LCM SPINDOWN.<bench>.SAMPLE|CONFIG|STATUS"};
+  spindown::BridgeSettings& s = o.settings;
+  std::string config_file;
   app.add_option("--device", s.device, "serial device, e.g. /dev/ttyACM0");
   app.add_option("--bench", s.bench, "bench id [A-Za-z0-9_-]{1,32}");
   auto* baud_opt = app.add_option("--baud", s.baud, "baud rate (lab sketch 9600, spindown firmware 115200)");
-  app.add_option("--lcm-url", lcm_url, "LCM URL (default: LCM_DEFAULT_URL or LCM's default)");
+  app.add_option("--lcm-url", o.lcm_url, "LCM URL (default: LCM_DEFAULT_URL or LCM's default)");
   app.add_option("--config", config_file, "TOML file: bench J, K_b, quantity, ADC, serial (see README)")
       ->check(CLI::ExistingFile);
   bool retry_flag = false;
   auto* retry = app.add_flag("--retry", retry_flag, "keep retrying a missing device every --retry-interval (default)");
-  app.add_flag("--exit-on-missing", exit_on_missing, "exit with code 1 when the device cannot be opened")
+  app.add_flag("--exit-on-missing", o.exit_on_missing, "exit with code 1 when the device cannot be opened")
       ->excludes(retry);
-  app.add_option("--retry-interval", retry_s, "seconds between attempts to open the device")
+  app.add_option("--retry-interval", o.retry_s, "seconds between attempts to open the device")
       ->check(CLI::Range(0.01, 0.5));
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
 
   // CLI beats the file: remember what the command line said before reading the file.
   const spindown::BridgeSettings cli = s;
@@ -86,29 +88,20 @@ int main(int argc, char** argv) {
     fmt::print(stderr, "spindown-bridge: {}\n", why);
     return 2;
   }
+  return std::nullopt;
+}
 
-  lcm::LCM lcm(lcm_url);
-  if (!lcm.good()) {
-    fmt::print(stderr, "spindown-bridge: cannot start LCM{}{}\n", lcm_url.empty() ? "" : " at ", lcm_url);
-    return 1;
-  }
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
-  std::signal(SIGPIPE, SIG_IGN);
-
-  LcmSink sink(lcm, s.bench);
-  spindown::SerialBridge bridge(s, sink);
-  bridge.start(wall_us());
-  fmt::print(stderr, "spindown-bridge: bench {} device {} at {} baud\n", s.bench, s.device, s.baud);
-
+// The serial loop: open the device (again after an unplug, every --retry-interval), feed what
+// it sends to the bridge, tick the bridge's heartbeat; until a stop signal. The exit code.
+int pump(const BridgeOptions& o, spindown::SerialBridge& bridge, const spindown::StopSignals& stop) {
+  const spindown::BridgeSettings& s = o.settings;
   spindown::SerialPort port;
   std::array<char, 4096> buf{};
-  const auto retry_every = std::chrono::microseconds(static_cast<long>(retry_s * 1e6));
+  const auto retry_every = std::chrono::microseconds(static_cast<long>(o.retry_s * 1e6));
   auto next_try = std::chrono::steady_clock::now();
   std::string last_open_error;
   bool said_wrong_baud = false;
-  int rc = 0;
-  while (!g_stop) {
+  while (!stop.requested()) {
     if (!port.is_open()) {
       if (std::chrono::steady_clock::now() >= next_try) {
         try {
@@ -118,13 +111,12 @@ int main(int argc, char** argv) {
           fmt::print(stderr, "spindown-bridge: connected to {}\n", s.device);
         } catch (const std::exception& e) {
           bridge.open_failed(wall_us(), e.what());
-          if (exit_on_missing) {
+          if (o.exit_on_missing) {
             fmt::print(stderr, "spindown-bridge: {} (exiting: --exit-on-missing)\n", e.what());
-            rc = 1;
-            break;
+            return 1;
           }
           if (last_open_error != e.what()) {
-            fmt::print(stderr, "spindown-bridge: {} (retrying every {:.2f} s)\n", e.what(), retry_s);
+            fmt::print(stderr, "spindown-bridge: {} (retrying every {:.2f} s)\n", e.what(), o.retry_s);
             last_open_error = e.what();
           }
           next_try = std::chrono::steady_clock::now() + retry_every;
@@ -132,7 +124,7 @@ int main(int argc, char** argv) {
       }
       if (!port.is_open()) {
         bridge.tick(wall_us());
-        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        stop.sleep_for(std::chrono::milliseconds(20));
         continue;
       }
     }
@@ -155,6 +147,28 @@ int main(int argc, char** argv) {
     }
     bridge.tick(wall_us());
   }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  BridgeOptions o;
+  if (const auto exit_code = parse_options(argc, argv, o)) return *exit_code;
+  const spindown::BridgeSettings& s = o.settings;
+
+  lcm::LCM lcm(o.lcm_url);
+  if (!lcm.good()) {
+    fmt::print(stderr, "spindown-bridge: cannot start LCM{}{}\n", o.lcm_url.empty() ? "" : " at ", o.lcm_url);
+    return 1;
+  }
+  spindown::StopSignals stop({.ignore_sigpipe = true});
+
+  LcmSink sink(lcm, s.bench);
+  spindown::SerialBridge bridge(s, sink);
+  bridge.start(wall_us());
+  fmt::print(stderr, "spindown-bridge: bench {} device {} at {} baud\n", s.bench, s.device, s.baud);
+  const int rc = pump(o, bridge, stop);
   bridge.stop(wall_us());
   const auto& c = bridge.counters();
   fmt::print(stderr,

@@ -1,31 +1,23 @@
 #include "fitter_service.hpp"
 
 #include <chrono>
+#include <deque>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <unistd.h>
 
 #include <spindown/status_t.hpp>
 
+#include "spindown/clock.hpp"
 #include "spindown/explain_message.hpp"
 #include "spindown/fit_message.hpp"
+#include "spindown/host_name.hpp"
 #include "spindown/lcm_channels.hpp"
 #include "spindown/network_checks.hpp"
 
 namespace spindown {
 
 namespace {
-
-std::int64_t wall_us() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
-std::string host_name() {
-  char buf[256] = {};
-  if (::gethostname(buf, sizeof buf - 1) != 0) return "unknown";
-  return buf;
-}
 
 // SPINDOWN\.(<bench regex>)\.(SAMPLE|CONFIG): LCM anchors the channel regex at both ends.
 std::string subscription_regex(const std::string& bench_regex) {
@@ -35,53 +27,22 @@ std::string subscription_regex(const std::string& bench_regex) {
 }  // namespace
 
 FitterService::FitterService(FitterServiceOptions options)
-    : opt_(std::move(options)), lcm_(opt_.lcm_url), core_(opt_.core, *this), host_(host_name()) {}
+    : opt_(std::move(options)),
+      loop_(opt_.lcm_url),
+      core_(opt_.core, *this),
+      host_(host_name()),
+      queue_({.max_messages = opt_.max_queue_messages,
+              .max_bytes = opt_.max_queue_bytes,
+              .max_message_bytes = opt_.max_queue_bytes}) {}
 
 FitterService::~FitterService() {
-  {
-    std::lock_guard lock(mu_);
-    stopping_ = true;
-  }
-  cv_.notify_all();
+  queue_.close();
   if (worker_.joinable()) worker_.join();
-}
-
-void FitterService::on_lcm(const lcm_recv_buf_t* rbuf, const char* channel, void* self) {
-  static_cast<FitterService*>(self)->enqueue(rbuf, channel);
-}
-
-void FitterService::enqueue(const lcm_recv_buf_t* rbuf, const char* channel) {
-  const std::size_t size = rbuf->data_size;
-  {
-    std::lock_guard lock(mu_);
-    // A message larger than the whole queue may hold is no sign of a full queue: LCM 1.3.1
-    // assembles a fragmented message of whatever size its first fragment claims (up to 256 MB),
-    // and a first fragment that also claims to be the only one is delivered at once, the rest
-    // of the claimed size left zero — one forged 1 kB datagram becomes a 100 MB message.
-    if (size > opt_.max_queue_bytes) {
-      ++oversize_drops_;
-      oversize_last_ = fmt::format("{} bytes on {}", size, channel);
-      return;
-    }
-    if (queue_.size() >= opt_.max_queue_messages || queue_bytes_ + size > opt_.max_queue_bytes) {
-      ++queue_drops_;
-      return;
-    }
-    Message m;
-    m.channel = channel;
-    const auto* d = static_cast<const unsigned char*>(rbuf->data);
-    m.data.assign(d, d + size);
-    m.recv_utime = rbuf->recv_utime;
-    queue_bytes_ += size;
-    queue_.push_back(std::move(m));
-    queue_high_water_ = std::max(queue_high_water_, queue_.size());
-  }
-  cv_.notify_one();
 }
 
 void FitterService::run_changed(const run_t& run) {
   const std::string channel = channel_name(run.bench, ChannelKind::run);
-  if (lcm_.publish(channel, &run) != 0) ++publish_failures_;
+  if (loop_.publish(channel, run) != 0) ++publish_failures_;
   if (opt_.verbose)
     fmt::print(stderr, "spindown-fitter: {} run {} {}: {}\n", run.bench, run.run, run_state_name(run.state), run.note);
 }
@@ -96,7 +57,7 @@ void FitterService::fit_ready(const FitResult& r) {
   about.latency_s = 1e-6 * double(now - r.detected_utime);
   about.health = r.health;
   const fit_t msg = to_fit_message(r.fit, about, now);
-  if (lcm_.publish(channel_name(r.bench, ChannelKind::fit), &msg) != 0) ++publish_failures_;
+  if (loop_.publish(channel_name(r.bench, ChannelKind::fit), msg) != 0) ++publish_failures_;
   last_latency_s_ = about.latency_s;
   max_latency_s_ = std::max(max_latency_s_, about.latency_s);
   last_fit_s_ = r.fit_seconds;
@@ -126,7 +87,7 @@ void FitterService::publish_explain(const FitResult& r) {
   const ExplainResult ex = explain_run(r.t_s, r.value, r.fit.quantity, run, eo);
   if (!ex.ok) ++explain_failures_;
   const explain_t msg = to_explain_message(ex, r.bench, wall_us());
-  if (lcm_.publish(channel_name(r.bench, ChannelKind::explain), &msg) != 0) ++publish_failures_;
+  if (loop_.publish(channel_name(r.bench, ChannelKind::explain), msg) != 0) ++publish_failures_;
   ++explains_;
   if (opt_.verbose)
     fmt::print(stderr, "spindown-fitter: {} run {} explained: {} -> {} (RMSE {:.4g} -> {:.4g})\n", r.bench,
@@ -142,26 +103,16 @@ void FitterService::diagnostic(const std::string& bench, const Diagnostic& d) {
 void FitterService::publish_status(std::int64_t now_us, const char* state) {
   status_t s = core_.make_status(now_us, opt_.instance, host_, static_cast<std::int32_t>(::getpid()), state,
                                  1e-6 * double(now_us - start_us_));
-  std::size_t depth = 0, high = 0;
-  std::int64_t drops = 0, oversize = 0;
-  std::string oversize_last;
-  {
-    std::lock_guard lock(mu_);
-    depth = queue_.size();
-    high = queue_high_water_;
-    drops = queue_drops_;
-    oversize = oversize_drops_;
-    oversize_last = oversize_last_;
-  }
+  const MessageQueueCounts q = queue_.counts();
   const std::int64_t samples = core_.counters().samples;
   if (last_rate_us_ > 0 && now_us > last_rate_us_)
     rate_hz_ = double(samples - last_samples_) / (1e-6 * double(now_us - last_rate_us_));
   last_rate_us_ = now_us;
   last_samples_ = samples;
   s.counter_name.emplace_back("queue_drops");
-  s.counter_value.push_back(drops);
+  s.counter_value.push_back(q.full_drops);
   s.counter_name.emplace_back("oversize_drops");
-  s.counter_value.push_back(oversize);
+  s.counter_value.push_back(q.oversize_drops);
   s.counter_name.emplace_back("publish_failures");
   s.counter_value.push_back(publish_failures_);
   s.counter_name.emplace_back("explains");
@@ -170,14 +121,14 @@ void FitterService::publish_status(std::int64_t now_us, const char* state) {
   s.counter_value.push_back(explain_failures_);
   // Datagrams the kernel dropped on the fitter's own sockets (a full receive buffer): lost
   // before LCM read them, so only sequence gaps would show them otherwise.
-  if (const auto kernel = own_udp_socket_drops()) {
+  if (const std::int64_t kernel = own_udp_drop_count(); kernel >= 0) {
     s.counter_name.emplace_back("udp_drops");
-    s.counter_value.push_back(kernel->drops);
+    s.counter_value.push_back(kernel);
   }
   s.ncounters = static_cast<std::int32_t>(s.counter_name.size());
   const std::pair<const char*, double> gauges[] = {
-      {"sample_rate_hz", rate_hz_},           {"queue_depth", double(depth)},
-      {"queue_high_water", double(high)},     {"last_latency_s", last_latency_s_},
+      {"sample_rate_hz", rate_hz_},               {"queue_depth", double(q.depth)},
+      {"queue_high_water", double(q.high_water)}, {"last_latency_s", last_latency_s_},
       {"max_latency_s", max_latency_s_},      {"last_fit_s", last_fit_s_},
   };
   for (const auto& [name, value] : gauges) {
@@ -185,31 +136,25 @@ void FitterService::publish_status(std::int64_t now_us, const char* state) {
     s.gauge_value.push_back(value);
   }
   s.ngauges = static_cast<std::int32_t>(s.gauge_name.size());
-  if (s.last_error.empty() && oversize > 0)
-    s.last_error = fmt::format("{} messages dropped: larger than the receive queue's limit of {} bytes (last: {}; "
-                               "a forged LCM fragment header claims any size)",
-                               oversize, opt_.max_queue_bytes, oversize_last);
-  if (s.last_error.empty() && drops > 0) s.last_error = fmt::format("{} messages dropped: receive queue full", drops);
-  if (lcm_.publish(channel_name(opt_.instance, ChannelKind::status), &s) != 0) ++publish_failures_;
+  if (s.last_error.empty() && q.oversize_drops > 0)
+    s.last_error = fmt::format("{} messages dropped: larger than the receive queue's limit of {} bytes (last: {} "
+                               "bytes on {}; a forged LCM fragment header claims any size)",
+                               q.oversize_drops, opt_.max_queue_bytes, q.last_oversize_bytes, q.last_oversize_channel);
+  if (s.last_error.empty() && q.full_drops > 0)
+    s.last_error = fmt::format("{} messages dropped: receive queue full", q.full_drops);
+  if (loop_.publish(channel_name(opt_.instance, ChannelKind::status), s) != 0) ++publish_failures_;
 }
 
 void FitterService::worker() {
   const auto period = std::chrono::microseconds(static_cast<std::int64_t>(opt_.status_period_s * 1e6));
   auto next_status = std::chrono::steady_clock::now();
   constexpr auto poll_wait = std::chrono::microseconds(FitterCore::poll_period_us);
-  std::deque<Message> batch;
+  std::deque<QueuedMessage> batch;
   std::int64_t next_poll = 0;
   for (;;) {
-    bool stop = false;
-    {
-      std::unique_lock lock(mu_);
-      cv_.wait_until(lock, std::min(next_status, std::chrono::steady_clock::now() + poll_wait),
-                     [&] { return stopping_ || !queue_.empty(); });
-      batch.swap(queue_);
-      queue_bytes_ = 0;
-      stop = stopping_;
-    }
-    for (const Message& m : batch)
+    // Closed (the service stops): this batch is the last.
+    const bool open = queue_.take_all(batch, std::min(next_status, std::chrono::steady_clock::now() + poll_wait));
+    for (const QueuedMessage& m : batch)
       core_.on_message(m.channel, m.data.data(), static_cast<std::int64_t>(m.data.size()), m.recv_utime);
     // Benches gone silent mid-coast, by the time of the traffic just handled (as refit does with
     // a log), so a backlog in the queue is never taken for silence; the clock when none came.
@@ -224,47 +169,33 @@ void FitterService::worker() {
       next_status += period;
       if (next_status < std::chrono::steady_clock::now()) next_status = std::chrono::steady_clock::now() + period;
     }
-    if (stop) break;
+    if (!open) break;
   }
 }
 
-int FitterService::run(const std::atomic<bool>& stop_flag) {
+int FitterService::run(const StopSignals& stop) {
   start_us_ = wall_us();
-  lcm_t* raw = lcm_.getUnderlyingLCM();
-  lcm_subscription_t* sub =
-      lcm_subscribe(raw, subscription_regex(opt_.core.bench_regex).c_str(), &FitterService::on_lcm, this);
-  if (!sub) {
+  // The handler only copies into the service's queue, but LCM's own default of 30 queued
+  // messages drops silently in a burst (design §7).
+  const bool subscribed = loop_.subscribe_raw(
+      subscription_regex(opt_.core.bench_regex),
+      [this](const LcmMessage& m) { queue_.offer(m.recv_utime, m.channel, m.data, static_cast<std::size_t>(m.size)); },
+      {.queue_capacity = 100000});
+  if (!subscribed) {
     fmt::print(stderr, "spindown-fitter: cannot subscribe (bad --bench regex?)\n");
     return 2;
   }
-  // Our handler only copies into the service's queue, but LCM's own default of 30 queued
-  // messages drops silently in a burst (design §7).
-  lcm_subscription_set_queue_capacity(sub, 100000);
   worker_ = std::thread([this] { worker(); });
-  int failures = 0;
-  while (!stop_flag) {
-    if (lcm_.handleTimeout(100) >= 0) {
-      failures = 0;
-      continue;
-    }
-    if (stop_flag) break;  // a signal interrupted the wait
-    if (++failures > 50) {
-      fmt::print(stderr, "spindown-fitter: LCM keeps failing to receive; stopping\n");
-      break;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(10));
-  }
-  lcm_unsubscribe(raw, sub);
-  {
-    std::lock_guard lock(mu_);
-    stopping_ = true;
-  }
-  cv_.notify_all();
+  if (loop_.run({.stop = &stop}) == LcmLoopEnd::failed)
+    fmt::print(stderr, "spindown-fitter: LCM keeps failing to receive; stopping\n");
+  loop_.unsubscribe_all();
+  queue_.close();
   worker_.join();
   // Runs still open are left open (a restarted fitter finds them again from new samples);
   // only the counters go out.
   publish_status(wall_us(), "stopping");
   const FitterCounters& c = core_.counters();
+  const MessageQueueCounts q = queue_.counts();
   fmt::print(stderr,
              "spindown-fitter: stopped: {} benches, {} samples, {} runs, {} fits, {} decode errors, {} sequence gaps, "
              "{} duplicates, {} NaN values, {} time backwards, {} benches evicted, {} benches refused, {} partial runs, "
@@ -272,7 +203,7 @@ int FitterService::run(const std::atomic<bool>& stop_flag) {
              "on the fitter's socket\n",
              core_.bench_count(), c.samples, c.runs, c.fits, c.decode_errors, c.seq_gaps, c.duplicates, c.nan_values,
              c.time_backwards, c.dropped_benches, c.benches_refused, c.partial_runs, c.silent_benches, c.flood_drops,
-             queue_drops_, oversize_drops_, own_udp_socket_drops().value_or(UdpSocketDrops{0, -1}).drops);
+             q.full_drops, q.oversize_drops, own_udp_drop_count());
   return 0;
 }
 

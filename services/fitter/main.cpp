@@ -2,10 +2,9 @@
 // SPINDOWN.<bench>.RUN, the friction fits on SPINDOWN.<bench>.FIT and its own heartbeat on
 // SPINDOWN.<instance>.STATUS. SIGINT/SIGTERM end it with exit code 0.
 #include <CLI/CLI.hpp>
-#include <atomic>
-#include <csignal>
 #include <cstdlib>
 #include <fmt/format.h>
+#include <optional>
 
 #include "fitter_service.hpp"
 #include "spindown/bench.hpp"
@@ -14,15 +13,13 @@
 #include "spindown/fit.hpp"
 #include "spindown/lcm_channels.hpp"
 #include "spindown/lcm_url.hpp"
+#include "spindown/stop_signal.hpp"
 
 namespace {
-std::atomic<bool> g_stop{false};
-extern "C" void on_signal(int) { g_stop = true; }
-}  // namespace
 
-int main(int argc, char** argv) {
+// The command line into o; an exit code when the program ends here (--help 0, bad usage 2).
+std::optional<int> parse_options(int argc, char** argv, spindown::FitterServiceOptions& o) {
   CLI::App app{"spindown-fitter: SPINDOWN.<bench>.SAMPLE|CONFIG -> RUN, FIT and STATUS, live"};
-  spindown::FitterServiceOptions o;
   std::vector<std::string> models;
   double kv = 0;
   long recv_buf = spindown::services_recv_buf_bytes;
@@ -69,7 +66,11 @@ int main(int argc, char** argv) {
                  "per-bench TOML file(s) or a directory of them (/etc/spindown/benches): [motor], [baseline], "
                  "[health] give each fit of that bench a motor health verdict");
   app.add_flag("-v,--verbose", o.verbose, "one line per run event and fit on stderr");
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
 
   if (j->count()) o.core.default_bench.inertia_source = "--inertia";
   if (kb->count()) o.core.default_bench.kb_source = "--kb";
@@ -110,13 +111,21 @@ int main(int argc, char** argv) {
   }
 
   o.lcm_url = spindown::with_receive_buffer(o.lcm_url, recv_buf);
+  return std::nullopt;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  spindown::FitterServiceOptions o;
+  if (const auto exit_code = parse_options(argc, argv, o)) return *exit_code;
+
   spindown::FitterService service(o);
   if (!service.good()) {
     fmt::print(stderr, "spindown-fitter: cannot start LCM{}{}\n", o.lcm_url.empty() ? "" : " at ", o.lcm_url);
     return 1;
   }
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
+  spindown::StopSignals stop;
   fmt::print(stderr, "spindown-fitter: fitting benches matching '{}'{}; heartbeat on SPINDOWN.{}.STATUS\n",
              o.core.bench_regex, o.lcm_url.empty() ? "" : " on " + o.lcm_url, o.instance);
   if (!o.core.health.empty()) {
@@ -124,5 +133,5 @@ int main(int argc, char** argv) {
     for (const auto& [bench, cfg] : o.core.health) benches += (benches.empty() ? "" : ", ") + bench;
     fmt::print(stderr, "spindown-fitter: motor health verdicts for {}\n", benches);
   }
-  return service.run(g_stop);
+  return service.run(stop);
 }

@@ -2,33 +2,19 @@
 // links it with --link), waits for a reader (as an Arduino boots when its port opens), then
 // writes the runs at the baud rate's pace, --speed times faster. Exits when all runs are sent.
 #include <CLI/CLI.hpp>
-#include <atomic>
 #include <chrono>
-#include <csignal>
 #include <filesystem>
 #include <fmt/format.h>
 #include <fstream>
-#include <thread>
 
 #include "spindown/pseudo_terminal.hpp"
+#include "spindown/stop_signal.hpp"
 #include "spindown/virtual_bench.hpp"
 #include "spindown/virtual_bench_cli.hpp"
 
 namespace {
 
-std::atomic<bool> g_stop{false};
-extern "C" void on_signal(int) { g_stop = true; }
-
 using Clock = std::chrono::steady_clock;
-
-// Sleeps until t (or a signal), in short steps.
-void sleep_until(Clock::time_point t) {
-  for (int guard = 0; guard < 100'000'000 && !g_stop; ++guard) {
-    const auto now = Clock::now();
-    if (now >= t) return;
-    std::this_thread::sleep_for(std::min<Clock::duration>(t - now, std::chrono::milliseconds(50)));
-  }
-}
 
 void relink(const std::string& link, const std::string& target) {
   if (link.empty()) return;
@@ -74,9 +60,7 @@ int main(int argc, char** argv) {
       out << fmt::format("{}\t{}\t{:.17g}\t{}\t{}\n", s.epoch, s.device_time_us, s.value, s.raw_adc, s.device_seq);
   }
 
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
-  std::signal(SIGPIPE, SIG_IGN);
+  spindown::StopSignals stop({.ignore_sigpipe = true});
   auto pty = std::make_unique<spindown::PseudoTerminal>();
   relink(link, pty->slave_path());
   fmt::print("{}\n", pty->slave_path());
@@ -85,7 +69,7 @@ int main(int argc, char** argv) {
   const auto wait_reader = [&]() {
     if (wait_reader_s <= 0) return true;
     const auto deadline = Clock::now() + std::chrono::milliseconds(long(wait_reader_s * 1000));
-    while (!g_stop && Clock::now() < deadline)
+    while (!stop.requested() && Clock::now() < deadline)
       if (pty->wait_for_reader(std::chrono::milliseconds(100))) return true;
     return false;
   };
@@ -96,7 +80,7 @@ int main(int argc, char** argv) {
   if (!wait_reader()) {
     fmt::print(stderr, "spindown-virtual-bench: nobody opened {} within {} s\n", pty->slave_path(), wait_reader_s);
     unlink();
-    return g_stop ? 0 : 1;
+    return stop.requested() ? 0 : 1;
   }
 
   const int baud = o.effective_baud();
@@ -107,17 +91,17 @@ int main(int argc, char** argv) {
   };
   long written = 0, dropped = 0, garbled = 0;
   for (const auto& e : bench->emissions()) {
-    if (g_stop) break;
+    if (stop.requested()) break;
     if (e.kind == spindown::BenchEmission::Kind::unplug) {
-      sleep_until(at(e.wire_s));
+      stop.sleep_until(at(e.wire_s));
       // What was sent before the pull reached the host (the reader may be a little behind):
       // let it drain, so "sent" means "delivered" and tests can compare sample for sample.
-      sleep_until(Clock::now() + std::chrono::milliseconds(200));
+      stop.sleep_until(Clock::now() + std::chrono::milliseconds(200));
       fmt::print(stderr, "spindown-virtual-bench: cable pulled for {} s\n", e.unplug_for_s);
       pty.reset();
       if (!link.empty()) std::filesystem::remove(link);
       const auto back = Clock::now() + std::chrono::milliseconds(long(e.unplug_for_s * 1000 / (speed > 0 ? speed : 1e9)));
-      sleep_until(back);
+      stop.sleep_until(back);
       pty = std::make_unique<spindown::PseudoTerminal>();
       relink(link, pty->slave_path());
       fmt::print("{}\n", pty->slave_path());
@@ -126,12 +110,12 @@ int main(int argc, char** argv) {
       if (!wait_reader()) {
         fmt::print(stderr, "spindown-virtual-bench: nobody reopened {} within {} s\n", pty->slave_path(), wait_reader_s);
         unlink();
-        return g_stop ? 0 : 1;
+        return stop.requested() ? 0 : 1;
       }
       anchor += Clock::now() - waited_from;  // the board boots when the port opens
       continue;
     }
-    sleep_until(at(e.wire_s));
+    stop.sleep_until(at(e.wire_s));
     std::string_view bytes = e.bytes;
     std::string garbage;
     const int reader = pty->reader_baud();
@@ -146,7 +130,7 @@ int main(int argc, char** argv) {
     if (put < bytes.size()) ++dropped;
     else ++written;
   }
-  if (!g_stop) sleep_until(Clock::now() + std::chrono::milliseconds(long(linger_s * 1000)));
+  if (!stop.requested()) stop.sleep_until(Clock::now() + std::chrono::milliseconds(long(linger_s * 1000)));
   fmt::print(stderr, "spindown-virtual-bench: {} lines written, {} dropped (no reader), {} garbled (baud mismatch)\n",
              written, dropped, garbled);
   unlink();

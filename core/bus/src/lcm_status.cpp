@@ -6,12 +6,6 @@
 
 namespace spindown {
 
-std::string host_name() {
-  char buf[256] = {};
-  if (gethostname(buf, sizeof buf - 1) != 0 || buf[0] == '\0') return "unknown";
-  return buf;
-}
-
 StatusHeartbeat::StatusHeartbeat(std::string service, std::string instance, std::int64_t start_us,
                                  double interval_s, std::string host, int pid)
     : service_(std::move(service)),

@@ -4,51 +4,13 @@
 #include <chrono>
 #include <cstring>
 #include <fmt/format.h>
-#include <lcm/lcm.h>
 #include <random>
-#include <fcntl.h>
 #include <unistd.h>
 
+#include "spindown/lcm_loop.hpp"
+#include "spindown/quiet_stderr.hpp"
+
 namespace spindown {
-
-namespace {
-
-struct Receipt {
-  std::string nonce;
-  bool received = false;
-};
-
-// A plain C callback (LCM 1.3.1's C++ subscription templates trip UBSan in its own header).
-extern "C" void on_self_test_message(const lcm_recv_buf_t* rbuf, const char*, void* user) {
-  auto* r = static_cast<Receipt*>(user);
-  const auto size = static_cast<std::size_t>(rbuf->data_size);
-  if (size == r->nonce.size() && std::memcmp(rbuf->data, r->nonce.data(), size) == 0) r->received = true;
-}
-
-// LCM 1.3.1 prints its own advice to stderr when multicast does not work ("LCM self test
-// failed!!", a route hint with ifconfig); the doctor says it with the fix, so LCM's text is held
-// back while the test runs.
-class QuietStderr {
- public:
-  QuietStderr() : saved_(::dup(2)) {
-    const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
-    if (saved_ >= 0 && null >= 0) ::dup2(null, 2);
-    if (null >= 0) ::close(null);
-  }
-  ~QuietStderr() {
-    if (saved_ >= 0) {
-      ::dup2(saved_, 2);
-      ::close(saved_);
-    }
-  }
-  QuietStderr(const QuietStderr&) = delete;
-  QuietStderr& operator=(const QuietStderr&) = delete;
-
- private:
-  int saved_;
-};
-
-}  // namespace
 
 LcmSelfTest run_lcm_self_test(const std::string& url, double timeout_s) {
   using clock = std::chrono::steady_clock;
@@ -58,37 +20,35 @@ LcmSelfTest run_lcm_self_test(const std::string& url, double timeout_s) {
   std::random_device rd;
   const auto nonce = fmt::format("{:08x}{:08x}", rd(), rd());
   t.channel = fmt::format("SPINDOWN_DOCTOR.{}.{}", ::getpid(), nonce.substr(0, 8));
+  // LCM 1.3.1 prints its own advice to stderr when multicast does not work ("LCM self test
+  // failed!!", a route hint with ifconfig); the doctor says it with the fix, so LCM's text is
+  // held back while the test runs.
   QuietStderr quiet;
-  lcm_t* lcm = lcm_create(url.empty() ? nullptr : url.c_str());
-  if (!lcm) return t;
+  LcmLoop loop(url);
+  if (!loop.good()) return t;
   t.started = true;
-  Receipt receipt{"spindown doctor self-test " + nonce, false};
-  lcm_subscription_t* sub = lcm_subscribe(lcm, t.channel.c_str(), on_self_test_message, &receipt);
-  // LCM 1.3.1 returns fd -1 when its receive setup failed, and lcm_handle_timeout would then
-  // FD_SET(-1) and abort: never wait on it.
-  t.receiving = sub && lcm_get_fileno(lcm) >= 0;
-  if (!t.receiving) {
-    if (sub) lcm_unsubscribe(lcm, sub);
-    lcm_destroy(lcm);
-    return t;
-  }
-  const auto start = clock::now();
-  const auto deadline = start + std::chrono::duration_cast<clock::duration>(std::chrono::duration<double>(t.timeout_s));
-  auto next_publish = start;
-  // Bounded in count as well as time: one publish per 100 ms, one wait per 20 ms at most.
-  for (int i = 0; i < 2000 && !receipt.received && clock::now() < deadline; ++i) {
-    if (clock::now() >= next_publish) {
-      if (lcm_publish(lcm, t.channel.c_str(), receipt.nonce.data(), static_cast<unsigned>(receipt.nonce.size())) != 0)
-        ++t.publish_errors;
-      ++t.published;
-      next_publish += std::chrono::milliseconds(100);
+  const std::string payload = "spindown doctor self-test " + nonce;
+  const bool subscribed = loop.subscribe_raw(t.channel, [&](const LcmMessage& m) {
+    if (static_cast<std::size_t>(m.size) == payload.size() && std::memcmp(m.data, payload.data(), payload.size()) == 0) {
+      t.received = true;
+      loop.stop();
     }
-    if (lcm_handle_timeout(lcm, 20) < 0) break;
-  }
-  t.received = receipt.received;
+  });
+  // LCM 1.3.1 has no socket to wait on when its own loopback self-test failed.
+  t.receiving = subscribed && loop.can_receive();
+  if (!t.receiving) return t;
+  const auto start = clock::now();
+  // One publish per 100 ms until one comes back or the time is up.
+  loop.every(
+      0.1,
+      [&](std::int64_t) {
+        if (loop.lcm().publish(t.channel, payload.data(), static_cast<unsigned>(payload.size())) != 0)
+          ++t.publish_errors;
+        ++t.published;
+      },
+      0);
+  loop.run({.timeout_s = t.timeout_s, .max_wait_ms = 20, .max_failures = 0});
   t.round_trip_s = std::chrono::duration<double>(clock::now() - start).count();
-  if (sub) lcm_unsubscribe(lcm, sub);
-  lcm_destroy(lcm);
   return t;
 }
 

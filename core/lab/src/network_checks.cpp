@@ -295,6 +295,11 @@ std::optional<UdpSocketDrops> own_udp_socket_drops() {
   return total;
 }
 
+std::int64_t own_udp_drop_count() {
+  const auto d = own_udp_socket_drops();
+  return d ? d->drops : -1;
+}
+
 DoctorCheck check_receive_buffer(std::optional<long> rmem_max, std::optional<long> rcvbuf_errors) {
   DoctorCheck c{"receive buffer", CheckLevel::ok, "", ""};
   const std::string errors =

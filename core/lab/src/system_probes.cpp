@@ -1,14 +1,11 @@
 #include "spindown/system_probes.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <fcntl.h>
 #include <fmt/format.h>
 #include <fstream>
 #include <ifaddrs.h>
-#include <lcm/lcm.h>
 #include <sstream>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -16,8 +13,10 @@
 #include <spindown/config_t.hpp>
 #include <spindown/status_t.hpp>
 
+#include "spindown/clock.hpp"
 #include "spindown/lcm_channels.hpp"
-#include "spindown/message_decode.hpp"
+#include "spindown/lcm_loop.hpp"
+#include "spindown/quiet_stderr.hpp"
 
 namespace spindown {
 
@@ -131,70 +130,31 @@ std::string running_ntp_client() {
   return {};
 }
 
-std::string this_host_name() {
-  char name[256] = {};
-  if (::gethostname(name, sizeof name - 1) != 0) return {};
-  return name;
-}
-
-namespace {
-
-std::int64_t wall_us() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-
-// Listens to the lab's STATUS and CONFIG messages and feeds their utime into the tracker.
-struct SkewListener {
-  ClockSkewTracker tracker;
-  static void on_lcm(const lcm_recv_buf_t* rbuf, const char* channel, void* user) {
-    auto* self = static_cast<SkewListener*>(user);
-    const auto parsed = parse_channel(channel);
-    if (!parsed) return;
-    const std::int64_t received = rbuf->recv_utime > 0 ? rbuf->recv_utime : wall_us();
-    const auto size = static_cast<std::int64_t>(rbuf->data_size);
-    if (parsed->kind == ChannelKind::status) {
-      status_t m;
-      if (decode_message(m, rbuf->data, size)) self->tracker.add(m.host, m.service + " " + m.instance, m.utime, received);
-    } else if (parsed->kind == ChannelKind::config) {
-      config_t m;
-      if (decode_message(m, rbuf->data, size)) self->tracker.add(m.host, "bridge " + m.bench, m.utime, received);
-    }
-  }
-};
-
-}  // namespace
-
 std::vector<HostSkew> listen_for_clocks(const std::string& url, double seconds) {
-  SkewListener listener;
+  ClockSkewTracker tracker;
   // LCM 1.3.1 prints its own multicast advice on stderr; the self-test above has reported it.
-  std::fflush(stderr);
-  const int saved = ::dup(2);
-  if (const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC); null >= 0) {
-    ::dup2(null, 2);
-    ::close(null);
-  }
-  lcm_t* lcm = lcm_create(url.c_str());
-  if (saved >= 0) {
-    ::dup2(saved, 2);
-    ::close(saved);
-  }
-  if (!lcm) return {};
-  lcm_subscription_t* sub = lcm_subscribe(lcm, "SPINDOWN\\..*\\.(STATUS|CONFIG)", &SkewListener::on_lcm, &listener);
-  if (sub) lcm_subscription_set_queue_capacity(sub, 10000);
-  // LCM 1.3.1: fd -1 after a failed receive setup; lcm_handle_timeout would abort on it.
-  if (!sub || lcm_get_fileno(lcm) < 0) {
-    if (sub) lcm_unsubscribe(lcm, sub);
-    lcm_destroy(lcm);
-    return {};
-  }
-  const auto end = std::chrono::steady_clock::now() + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
-                                                          std::chrono::duration<double>(seconds));
-  for (int i = 0; i < 100000 && std::chrono::steady_clock::now() < end; ++i)
-    if (lcm_handle_timeout(lcm, 50) < 0) break;
-  if (sub) lcm_unsubscribe(lcm, sub);
-  lcm_destroy(lcm);
-  return listener.tracker.hosts();
+  QuietStderr quiet;
+  LcmLoop loop(url);
+  if (!loop.good()) return {};
+  const auto received = [](const LcmMessage& r) { return r.recv_utime > 0 ? r.recv_utime : wall_us(); };
+  const LcmSubscribeOptions lab_channels{.queue_capacity = 10000,
+                                         .accept = [](std::string_view ch) { return parse_channel(ch).has_value(); }};
+  const bool subscribed =
+      loop.subscribe<status_t>(
+          "SPINDOWN\\..*\\.STATUS",
+          [&](const status_t& m, const LcmMessage& r) {
+            tracker.add(m.host, m.service + " " + m.instance, m.utime, received(r));
+          },
+          lab_channels) &&
+      loop.subscribe<config_t>(
+          "SPINDOWN\\..*\\.CONFIG",
+          [&](const config_t& m, const LcmMessage& r) { tracker.add(m.host, "bridge " + m.bench, m.utime, received(r)); },
+          lab_channels);
+  // LCM 1.3.1: no receive socket after its own loopback self-test failed.
+  if (!subscribed || !loop.can_receive()) return {};
+  quiet.restore();
+  loop.run({.timeout_s = seconds, .max_wait_ms = 50, .max_failures = 0});
+  return tracker.hosts();
 }
 
 }  // namespace spindown

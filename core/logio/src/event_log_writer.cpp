@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <fcntl.h>
@@ -14,6 +13,7 @@
 
 #include <spindown/samples_t.hpp>
 
+#include "spindown/clock.hpp"
 #include "spindown/lcm_channels.hpp"
 #include "spindown/message_decode.hpp"
 
@@ -76,12 +76,7 @@ EventLogWriter::EventLogWriter(EventLogWriterOptions options, std::int64_t start
 }
 
 EventLogWriter::~EventLogWriter() {
-  if (log_) {
-    const auto now = std::chrono::duration_cast<std::chrono::microseconds>(
-                         std::chrono::system_clock::now().time_since_epoch())
-                         .count();
-    close(now, "stopped");
-  }
+  if (log_) close(wall_us(), "stopped");
 }
 
 void EventLogWriter::open(std::int64_t now_us) {

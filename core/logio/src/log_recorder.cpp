@@ -2,17 +2,13 @@
 
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <fmt/format.h>
 #include <stdexcept>
 
-namespace spindown {
+#include "spindown/clock.hpp"
 
-namespace {
-std::int64_t wall_us() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
-}  // namespace
+namespace spindown {
 
 bool LogRecorderOptions::is_valid(std::string* why) const {
   auto fail = [&](std::string reason) {
@@ -29,9 +25,19 @@ bool LogRecorderOptions::is_valid(std::string* why) const {
   return true;
 }
 
-LogRecorder::LogRecorder(EventLogWriter& writer, LogRecorderOptions options) : writer_(writer), o_(options) {
+namespace {
+// Checked before the queue is made of them.
+const LogRecorderOptions& valid(const LogRecorderOptions& o) {
   std::string why;
-  if (!o_.is_valid(&why)) throw std::invalid_argument(why);
+  if (!o.is_valid(&why)) throw std::invalid_argument(why);
+  return o;
+}
+}  // namespace
+
+LogRecorder::LogRecorder(EventLogWriter& writer, LogRecorderOptions options)
+    : writer_(writer),
+      o_(valid(options)),
+      queue_({.max_messages = o_.queue_capacity, .max_bytes = o_.queue_max_bytes, .max_message_bytes = o_.max_event_bytes}) {
   status_ = writer_.make_status(wall_us());
 }
 
@@ -45,44 +51,17 @@ void LogRecorder::start() {
 bool LogRecorder::offer(std::int64_t recv_utime, std::string_view channel, const void* data,
                         std::int32_t size) {
   const std::size_t n = size > 0 ? static_cast<std::size_t>(size) : 0;
-  if (n > o_.max_event_bytes) {
-    std::lock_guard lock(queue_mutex_);
-    ++oversize_;
-    last_oversize_ = fmt::format("message of {} bytes on {} not recorded: larger than the largest event kept ({} "
-                                 "bytes; a fragment header claiming more than was sent?)",
-                                 n, channel.substr(0, 80), o_.max_event_bytes);
-    return false;
-  }
-  Event ev{recv_utime, std::string(channel), {}};
-  ev.data.assign(static_cast<const std::uint8_t*>(data), static_cast<const std::uint8_t*>(data) + n);
-  bool was_empty = false;
-  {
-    std::lock_guard lock(queue_mutex_);
-    if (queue_.size() >= o_.queue_capacity || queue_bytes_ + n > o_.queue_max_bytes) {
-      dropped_.fetch_add(1);
-      return false;
-    }
-    was_empty = queue_.empty();
-    queue_bytes_ += n;
-    queue_.push_back(std::move(ev));
-  }
-  if (was_empty) wake_.notify_one();
-  return true;
-}
-
-std::size_t LogRecorder::queue_depth() const {
-  std::lock_guard lock(queue_mutex_);
-  return queue_.size();
+  return queue_.offer(recv_utime, channel, data, n) == MessageQueue::Offer::queued;
 }
 
 void LogRecorder::stop(std::string_view why) {
   {
-    std::lock_guard lock(queue_mutex_);
+    std::lock_guard lock(stop_mutex_);
     if (stopping_ && !thread_.joinable()) return;
     stopping_ = true;
     stop_why_ = std::string(why);
   }
-  wake_.notify_one();
+  queue_.close();
   if (thread_.joinable()) thread_.join();
 }
 
@@ -95,21 +74,17 @@ status_t LogRecorder::status(std::int64_t now_us) const {
 }
 
 void LogRecorder::refresh_status(std::int64_t now_us) {
-  const std::int64_t dropped = dropped_.load();
-  writer_.add_queue_drops(dropped - dropped_reported_);
-  dropped_reported_ = dropped;
-  {
-    std::string what;
-    std::int64_t oversize = 0;
-    {
-      std::lock_guard lock(queue_mutex_);
-      oversize = oversize_;
-      what = last_oversize_;
-    }
-    writer_.add_oversize_drops(oversize - oversize_reported_, now_us, std::move(what));
-    oversize_reported_ = oversize;
-  }
-  writer_.set_queue_depth(double(queue_depth()));
+  const MessageQueueCounts q = queue_.counts();
+  writer_.add_queue_drops(q.full_drops - dropped_reported_);
+  dropped_reported_ = q.full_drops;
+  if (q.oversize_drops > oversize_reported_)
+    writer_.add_oversize_drops(q.oversize_drops - oversize_reported_, now_us,
+                               fmt::format("message of {} bytes on {} not recorded: larger than the largest event "
+                                           "kept ({} bytes; a fragment header claiming more than was sent?)",
+                                           q.last_oversize_bytes, q.last_oversize_channel.substr(0, 80),
+                                           o_.max_event_bytes));
+  oversize_reported_ = q.oversize_drops;
+  writer_.set_queue_depth(double(q.depth));
   status_t st = writer_.make_status(now_us);
   std::lock_guard lock(status_mutex_);
   status_ = std::move(st);
@@ -119,18 +94,12 @@ void LogRecorder::run() {
   using clock = std::chrono::steady_clock;
   const auto flush_every = std::chrono::microseconds(static_cast<std::int64_t>(o_.flush_interval_s * 1e6));
   auto next_flush = clock::now() + flush_every;
-  std::deque<Event> batch;
+  std::deque<QueuedMessage> batch;
   for (;;) {
-    bool stopping = false;
-    {
-      std::unique_lock lock(queue_mutex_);
-      wake_.wait_until(lock, next_flush, [&] { return !queue_.empty() || stopping_; });
-      batch.swap(queue_);
-      queue_bytes_ = 0;
-      stopping = stopping_;
-    }
-    for (const Event& ev : batch)
-      writer_.write(ev.utime, ev.channel, ev.data.data(), static_cast<std::int32_t>(ev.data.size()), wall_us());
+    // After stop() the queue is closed: this batch holds everything offered, and is the last.
+    const bool open = queue_.take_all(batch, next_flush);
+    for (const QueuedMessage& ev : batch)
+      writer_.write(ev.recv_utime, ev.channel, ev.data.data(), static_cast<std::int32_t>(ev.data.size()), wall_us());
     batch.clear();
 
     const std::int64_t now = wall_us();
@@ -141,11 +110,7 @@ void LogRecorder::run() {
       next_flush = clock::now() + flush_every;
     }
     writer_.tick(now);
-    if (stopping) {
-      std::unique_lock lock(queue_mutex_);
-      if (queue_.empty()) break;  // else: events offered during the last batch, write them too
-      continue;
-    }
+    if (!open) break;
     if (now >= next_status_us_) {
       refresh_status(now);
       next_status_us_ = now + static_cast<std::int64_t>(o_.status_interval_s * 1e6);
@@ -155,7 +120,7 @@ void LogRecorder::run() {
   refresh_status(now);  // counts the last drops into the closing status event
   std::string why;
   {
-    std::lock_guard lock(queue_mutex_);
+    std::lock_guard lock(stop_mutex_);
     why = stop_why_;
   }
   writer_.close(now, why);

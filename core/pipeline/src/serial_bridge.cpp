@@ -1,20 +1,16 @@
 #include "spindown/serial_bridge.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include "spindown/clock.hpp"
+#include "spindown/host_name.hpp"
 #include "spindown/lab_line.hpp"
 
 namespace spindown {
 
 namespace {
-
-std::int64_t steady_ns() {
-  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
-      .count();
-}
 
 // A line as it can be shown in a status message: at most max bytes, non-printables escaped.
 std::string printable(std::string_view text, std::size_t max = 60) {
@@ -29,12 +25,6 @@ std::string printable(std::string_view text, std::size_t max = 60) {
   }
   if (text.size() > max) out += "...";
   return out;
-}
-
-std::string host_name() {
-  char buf[256] = {};
-  if (::gethostname(buf, sizeof buf - 1) != 0) return "unknown";
-  return buf;
 }
 
 std::int8_t to_lcm_quantity(Quantity q) {
@@ -112,7 +102,7 @@ void SerialBridge::error(std::string text, std::int64_t now_us) {
 }
 
 void SerialBridge::feed(std::string_view bytes, std::int64_t now_us) {
-  feed_start_ns_ = steady_ns();
+  feed_start_ns_ = monotonic_ns();
   counters_.bytes += static_cast<std::int64_t>(bytes.size());
   bytes_since_good_ += static_cast<std::int64_t>(bytes.size());
   for (const char ch : bytes) {
@@ -262,7 +252,7 @@ void SerialBridge::add_sample(const DeviceClock::Reading& r, std::int64_t host_u
 void SerialBridge::flush() {
   if (batch_.n == 0) return;
   sink_.publish(batch_);
-  const std::int64_t took_ns = steady_ns() - feed_start_ns_;
+  const std::int64_t took_ns = monotonic_ns() - feed_start_ns_;
   latency_us_[latency_count_ % latency_us_.size()] = static_cast<float>(took_ns / 1000.0);
   ++latency_count_;
   counters_.samples += batch_.n;

@@ -255,10 +255,13 @@ Json fit_report_json(std::span<const FileFit> files, const ReportOptions& opt) {
 }
 
 void tag_run_json(Json& run, const RunTags& tags) {
+  // As tagged_run_fit_json's text reads back (a non-negative integer parses as unsigned), so the
+  // two documents of one run compare equal member for member (refit --compare).
+  const auto as_read_back = [](std::int64_t v) { return v >= 0 ? Json(static_cast<std::uint64_t>(v)) : Json(v); };
   run["bench"]["id"] = tags.bench_id;
   if (!tags.has_seq) return;
-  run["first_seq"] = tags.first_seq;
-  run["last_seq"] = tags.last_seq;
+  run["first_seq"] = as_read_back(tags.first_seq);
+  run["last_seq"] = as_read_back(tags.last_seq);
 }
 
 void append_run_fit_json_text(std::string& out, const RunFit& fit, const ReportOptions& opt, std::size_t indent,

@@ -4,7 +4,6 @@
 // For integration tests and the fitter benchmark; only ever point it at a private LCM URL.
 #include <CLI/CLI.hpp>
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <fmt/format.h>
@@ -22,17 +21,15 @@
 #include <spindown/fit_t.hpp>
 #include <spindown/samples_t.hpp>
 
+#include "spindown/clock.hpp"
 #include "spindown/lcm_channels.hpp"
+#include "spindown/lcm_loop.hpp"
 #include "spindown/synthetic_run.hpp"
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-std::int64_t wall_us() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
+using spindown::wall_us;
 
 struct Options {
   std::string lcm_url;
@@ -111,21 +108,21 @@ struct FitSeen {
   int samples = 0;
 };
 
+// Every FIT on the URL, collected by an LCM loop on its own thread.
 class FitListener {
  public:
-  // LCM's C API: the C++ wrapper's member-function subscription trips UBSan inside LCM 1.3.1's
-  // own header.
-  explicit FitListener(const std::string& url) : lcm_(url) {
-    if (lcm_.good()) lcm_subscribe(lcm_.getUnderlyingLCM(), "SPINDOWN\\..*\\.FIT", &FitListener::on_raw, this);
+  explicit FitListener(const std::string& url) : loop_(url) {
+    if (loop_.good())
+      loop_.subscribe<spindown::fit_t>("SPINDOWN\\..*\\.FIT", [this](const spindown::fit_t& m, const spindown::LcmMessage& r) {
+        on_fit(r.recv_utime, m);
+      });
   }
-  bool good() { return lcm_.good(); }
+  bool good() const { return loop_.good(); }
   void start() {
-    thread_ = std::thread([this] {
-      while (!stop_) lcm_.handleTimeout(50);
-    });
+    thread_ = std::thread([this] { loop_.run({.max_wait_ms = 50, .max_failures = -1}); });
   }
   void stop() {
-    stop_ = true;
+    loop_.stop();
     if (thread_.joinable()) thread_.join();
   }
   std::vector<FitSeen> fits() {
@@ -138,21 +135,14 @@ class FitListener {
   }
 
  private:
-  static void on_raw(const lcm_recv_buf_t* rbuf, const char*, void* self) {
-    spindown::fit_t m;
-    if (m.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) < 0) return;
-    static_cast<FitListener*>(self)->on_fit(rbuf->recv_utime, m);
-  }
-  void on_fit(std::int64_t recv_utime, const spindown::fit_t& msg) {
-    const spindown::fit_t* m = &msg;
-    FitSeen f{m->bench, m->run, m->t_cut_s, m->t_stop_s, m->latency_s, recv_utime, Clock::now(),
-              m->best, m->bench_source, m->samples};
+  void on_fit(std::int64_t recv_utime, const spindown::fit_t& m) {
+    FitSeen f{m.bench, m.run, m.t_cut_s, m.t_stop_s, m.latency_s, recv_utime, Clock::now(),
+              m.best, m.bench_source, m.samples};
     std::lock_guard lock(mu_);
     fits_.push_back(std::move(f));
   }
-  lcm::LCM lcm_;
+  spindown::LcmLoop loop_;
   std::thread thread_;
-  std::atomic<bool> stop_{false};
   std::mutex mu_;
   std::vector<FitSeen> fits_;
 };

@@ -3,13 +3,10 @@
 // with --all-types also config_t, run_t, fit_t, explain_t and status_t on every bench's
 // channels. Prints one JSON line with what it published.
 #include <CLI/CLI.hpp>
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <csignal>
 #include <fmt/format.h>
 #include <lcm/lcm-cpp.hpp>
-#include <thread>
 
 #include <spindown/config_t.hpp>
 #include <spindown/explain_t.hpp>
@@ -18,18 +15,15 @@
 #include <spindown/samples_t.hpp>
 #include <spindown/status_t.hpp>
 
+#include "spindown/clock.hpp"
+#include "spindown/host_name.hpp"
 #include "spindown/lcm_channels.hpp"
 #include "spindown/lcm_status.hpp"
+#include "spindown/stop_signal.hpp"
 
 namespace {
 
-std::atomic<bool> g_stop{false};
-extern "C" void on_signal(int) { g_stop = true; }
-
-std::int64_t wall_us() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
+using spindown::wall_us;
 
 spindown::config_t make_config(const std::string& bench, std::int64_t now) {
   spindown::config_t c;
@@ -186,8 +180,7 @@ int main(int argc, char** argv) {
     fmt::print(stderr, "spindown-lcm-publish: cannot start LCM{}{}\n", lcm_url.empty() ? "" : " at ", lcm_url);
     return 1;
   }
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
+  spindown::StopSignals stop;
 
   const auto start = std::chrono::steady_clock::now();
   const std::int64_t start_us = wall_us();
@@ -203,7 +196,7 @@ int main(int argc, char** argv) {
   long published = 0, failures = 0, extras = 0;
   std::int64_t first_utime = 0, last_utime = 0;
   auto next_extras = start;
-  for (long k = 0; !g_stop && (count == 0 || k < count); ++k) {
+  for (long k = 0; !stop.requested() && (count == 0 || k < count); ++k) {
     const auto now_steady = std::chrono::steady_clock::now();
     if (duration_s > 0 && now_steady - start >= std::chrono::duration<double>(duration_s)) break;
     if (all_types && now_steady >= next_extras) {
@@ -247,7 +240,9 @@ int main(int argc, char** argv) {
       if (first_utime == 0) first_utime = now;
       last_utime = now;
     }
-    if (rate_hz > 0) std::this_thread::sleep_until(start + std::chrono::duration<double>(double(k + 1) / rate_hz));
+    if (rate_hz > 0)
+      stop.sleep_until(start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                   std::chrono::duration<double>(double(k + 1) / rate_hz)));
   }
   fmt::print("{{\"sample_messages\":{},\"other_messages\":{},\"failures\":{},\"first_utime\":{},\"last_utime\":{}}}\n",
              published, extras, failures, first_utime, last_utime);

@@ -12,14 +12,13 @@
 
 #include <spindown/status_t.hpp>
 
+#include "spindown/host_name.hpp"
+
 namespace lcm {
 class LCM;
 }
 
 namespace spindown {
-
-// This host's name ("unknown" when gethostname fails).
-std::string host_name();
 
 class StatusHeartbeat {
  public:

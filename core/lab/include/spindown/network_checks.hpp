@@ -78,6 +78,9 @@ UdpSocketDrops parse_udp_socket_drops(std::string_view proc_net_udp, const std::
 // This process's own UDP sockets: the inodes of /proc/self/fd's "socket:[N]" links, looked up
 // in /proc/self/net/udp and udp6. Nullopt when /proc cannot be read.
 std::optional<UdpSocketDrops> own_udp_socket_drops();
+// Their drops alone, -1 when /proc cannot be read: what the services' heartbeats and their last
+// line on stderr report as udp_drops.
+std::int64_t own_udp_drop_count();
 
 // The firewall as `nft list ruleset` and/or `iptables-save` print it (nullopt: not available;
 // unreadable is the caller's skip). fail: a rule that drops or rejects the LCM port, the group,

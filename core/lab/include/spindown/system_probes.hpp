@@ -26,7 +26,6 @@ std::optional<std::string> capture(const std::vector<std::string>& argv, std::st
 std::vector<NetInterface> read_interfaces();
 // The NTP client running here ("chrony", "systemd-timesyncd", "ntpd", "openntpd"), "" if none.
 std::string running_ntp_client();
-std::string this_host_name();
 // Listens on url for `seconds` to the lab's STATUS and CONFIG messages and returns each host's
 // clock skew against this one; empty when LCM cannot listen.
 std::vector<HostSkew> listen_for_clocks(const std::string& url, double seconds);

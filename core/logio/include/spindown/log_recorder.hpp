@@ -6,19 +6,16 @@
 //
 // Events beyond the queue's capacity are dropped and counted (never silently): they show in
 // the writer's status as queue_drops/drops.
-#include <atomic>
-#include <condition_variable>
 #include <cstdint>
-#include <deque>
 #include <mutex>
 #include <string>
 #include <string_view>
 #include <thread>
-#include <vector>
 
 #include <spindown/status_t.hpp>
 
 #include "spindown/event_log_writer.hpp"
+#include "spindown/message_queue.hpp"
 
 namespace spindown {
 
@@ -54,30 +51,20 @@ class LogRecorder {
   // The writer's latest status (refreshed by the writer thread), with utime set to now_us.
   status_t status(std::int64_t now_us) const;
 
-  std::size_t queue_depth() const;
-  std::int64_t dropped() const { return dropped_.load(); }
+  std::size_t queue_depth() const { return queue_.depth(); }
+  std::int64_t dropped() const { return queue_.counts().full_drops; }
 
  private:
-  struct Event {
-    std::int64_t utime;
-    std::string channel;
-    std::vector<std::uint8_t> data;
-  };
   void run();
   void refresh_status(std::int64_t now_us);
 
   EventLogWriter& writer_;
   LogRecorderOptions o_;
-  mutable std::mutex queue_mutex_;
-  std::condition_variable wake_;
-  std::deque<Event> queue_;
-  std::size_t queue_bytes_ = 0;
-  bool stopping_ = false;
-  std::string stop_why_ = "stopped";
-  std::atomic<std::int64_t> dropped_{0};
-  std::int64_t dropped_reported_ = 0;
-  std::int64_t oversize_ = 0, oversize_reported_ = 0;  // under queue_mutex_ / writer thread
-  std::string last_oversize_;                          // under queue_mutex_
+  MessageQueue queue_;
+  std::mutex stop_mutex_;
+  bool stopping_ = false;                              // under stop_mutex_
+  std::string stop_why_ = "stopped";                   // under stop_mutex_
+  std::int64_t dropped_reported_ = 0, oversize_reported_ = 0;  // writer thread
 
   mutable std::mutex status_mutex_;
   status_t status_;
