@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "spindown/effect_simulator.hpp"
+#include "spindown/levenberg_marquardt.hpp"
 
 namespace spindown {
 namespace {
@@ -220,45 +221,51 @@ void normal_equations(const double* jac, const double* r, std::size_t n, int p, 
   }
 }
 
-// Levenberg–Marquardt on the simulator's exact sensitivities, bounds by projection. The
-// result keeps the simulation and Jacobian at its optimum (for the SSE and the covariance).
-struct LmResult {
-  std::vector<double> theta;
-  std::vector<double> model, jac;  // at theta
-  double sse = 0;
-  int evals = 0;
-  bool converged = false;
+// What one evaluation leaves: the simulation and its Jacobian (kept at the optimum for the SSE
+// and the covariance), and the normal equations from them.
+struct Evaluation {
+  std::vector<double> model, jac;
+  Eigen::MatrixXd jtj;
+  Eigen::VectorXd jtr;
 };
 
 // Simulates t with its sensitivities into model/jac; JᵀJ, Jᵀr and the SSE from them.
-double assemble_normal(const Setup& s, const std::vector<double>& t, std::vector<double>& model,
-                       std::vector<double>& jac, Eigen::MatrixXd& jtj, Eigen::VectorXd& jtr) {
+double assemble_normal(const Setup& s, const std::vector<double>& t, Evaluation& ev) {
   const std::size_t n = s.data.tau.size();
   const int P = s.sim.size();
-  model.resize(n);
-  jac.resize(n * P);
-  s.sim.simulate(t, s.data.tau, model, jac);
+  ev.model.resize(n);
+  ev.jac.resize(n * P);
+  s.sim.simulate(t, s.data.tau, ev.model, ev.jac);
   thread_local std::vector<double> r;  // residual scratch, reused across evaluations
   r.resize(n);
   double sse = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    r[i] = s.data.y[i] - model[i];
+    r[i] = s.data.y[i] - ev.model[i];
     sse += r[i] * r[i];
   }
-  normal_equations(jac.data(), r.data(), n, P, jtj, jtr);
-  return std::isfinite(sse) && jtj.allFinite() && jtr.allFinite() ? sse : std::numeric_limits<double>::infinity();
+  normal_equations(ev.jac.data(), r.data(), n, P, ev.jtj, ev.jtr);
+  return std::isfinite(sse) && ev.jtj.allFinite() && ev.jtr.allFinite() ? sse : std::numeric_limits<double>::infinity();
 }
 
-LmResult levenberg_marquardt(const Setup& s, std::vector<double> th) {
-  const int P = s.sim.size();
-  LmResult out;
-  std::vector<double> model_try, jac_try;
-  Eigen::MatrixXd jtj, jtj_try;
-  Eigen::VectorXd jtr, jtr_try;
-  double sse = assemble_normal(s, th, out.model, out.jac, jtj, jtr);
-  out.evals = 1;
-  double lambda = 1e-3;
-  for (int it = 0; it < 60 && out.evals < 80; ++it) {
+// The combination's least squares for the shared Levenberg–Marquardt (levenberg_marquardt.hpp):
+// the simulator's exact sensitivities, bounds by projection. Its policy: the damping has a floor
+// of 10⁻¹² of JᵀJ's largest diagonal entry; an active set at the bounds; only a step that lowers
+// the SSE is taken; converged when every parameter moves less than 10⁻⁷ of itself (or of 10⁻⁶ of
+// its typical size) or the SSE gains under 10⁻¹⁰ of itself; at most 60 iterations and 80
+// evaluations.
+class EffectLeastSquares {
+ public:
+  using Point = std::vector<double>;
+  using State = Evaluation;
+  explicit EffectLeastSquares(const Setup& s) : s_(s) {}
+
+  LmPolicy policy() const { return {.max_iterations = 60, .max_evaluations = 80, .take_equal = false, .relative_gain = 1e-10}; }
+  double evaluate(const Point& th, State& ev) const { return assemble_normal(s_, th, ev); }
+  bool at_minimum(const Point&, const State&, double) const { return false; }
+  bool step(const Point& th, const State& ev, double lambda, Point& trial) const {
+    const int P = s_.sim.size();
+    const Eigen::MatrixXd& jtj = ev.jtj;
+    const Eigen::VectorXd& jtr = ev.jtr;
     Eigen::MatrixXd a = jtj;
     Eigen::VectorXd rhs = jtr;
     const double floor = 1e-12 * (jtj.diagonal().maxCoeff() + 1e-300);
@@ -266,8 +273,8 @@ LmResult levenberg_marquardt(const Setup& s, std::vector<double> th) {
       a(j, j) = jtj(j, j) * (1.0 + lambda) + lambda * floor;
       // A parameter on its bound that the descent direction pushes outward stays there
       // (active set); otherwise projection would make LM stall on rejected steps.
-      const bool at_lo = th[j] <= s.lo[j] && jtr[j] <= 0;
-      const bool at_hi = th[j] >= s.hi[j] && jtr[j] >= 0;
+      const bool at_lo = th[j] <= s_.lo[j] && jtr[j] <= 0;
+      const bool at_hi = th[j] >= s_.hi[j] && jtr[j] >= 0;
       if (at_lo || at_hi) {
         a.row(j).setZero();
         a.col(j).setZero();
@@ -276,41 +283,29 @@ LmResult levenberg_marquardt(const Setup& s, std::vector<double> th) {
       }
     }
     const Eigen::LDLT<Eigen::MatrixXd> ldlt(a);
-    if (ldlt.info() != Eigen::Success) break;
+    if (ldlt.info() != Eigen::Success) return false;
     const Eigen::VectorXd step = ldlt.solve(rhs);
-    if (!step.allFinite()) break;
-    std::vector<double> trial(th);
+    if (!step.allFinite()) return false;
+    trial = th;
     for (int j = 0; j < P; ++j) trial[j] += step[j];
-    s.clamp(trial);
-    const double sse_try = assemble_normal(s, trial, model_try, jac_try, jtj_try, jtr_try);
-    ++out.evals;
-    if (sse_try < sse) {
-      const double gain = sse - sse_try;
-      bool small = true;
-      for (int j = 0; j < P; ++j)
-        if (std::abs(trial[j] - th[j]) > 1e-7 * std::max(std::abs(th[j]), 1e-6 * s.typical[j])) small = false;
-      th = trial;
-      std::swap(jtj, jtj_try);
-      std::swap(jtr, jtr_try);
-      std::swap(out.model, model_try);
-      std::swap(out.jac, jac_try);
-      sse = sse_try;
-      lambda = std::max(lambda / 10, 1e-12);
-      if (small || gain <= 1e-10 * sse) {
-        out.converged = true;
-        break;
-      }
-    } else {
-      lambda *= 10;
-      if (lambda > 1e10) {
-        out.converged = true;  // no step improves: at a (bounded) minimum
-        break;
-      }
-    }
+    s_.clamp(trial);
+    return true;
   }
-  out.theta = th;
-  out.sse = sse;
-  return out;
+  bool negligible(const Point& th, const Point& trial) const {
+    for (std::size_t j = 0; j < th.size(); ++j)
+      if (std::abs(trial[j] - th[j]) > 1e-7 * std::max(std::abs(th[j]), 1e-6 * s_.typical[j])) return false;
+    return true;
+  }
+
+ private:
+  const Setup& s_;
+};
+
+using EffectLm = LmResult<std::vector<double>, Evaluation>;
+
+EffectLm fit_by_lm(const Setup& s, std::vector<double> th) {
+  EffectLeastSquares problem(s);
+  return levenberg_marquardt(problem, std::move(th));
 }
 
 // NLopt: bounded L-BFGS on θ_j / scale_j with the sensitivity gradient. Never lets an
@@ -550,14 +545,14 @@ EffectFit fit_effects(const std::vector<const Effect*>& effects, const EffectFit
     }
   }
 
-  LmResult lm = levenberg_marquardt(s, th);
+  EffectLm lm = fit_by_lm(s, th);
   out.evaluations = lm.evals;
   bool warm_is_subset = warm != nullptr;
   if (warm)
     for (const Effect* we : warm->effects) warm_is_subset = warm_is_subset && std::find(effects.begin(), effects.end(), we) != effects.end();
   if (!th_nested.empty() && warm_is_subset && lm.sse > warm->sse * (1 + 1e-9)) {
     // Nested models can only fit better: restart from the smaller model's optimum.
-    LmResult again = levenberg_marquardt(s, th_nested);
+    EffectLm again = fit_by_lm(s, th_nested);
     out.evaluations += again.evals;
     if (again.sse < lm.sse) lm = again;
   }
@@ -568,16 +563,14 @@ EffectFit fit_effects(const std::vector<const Effect*>& effects, const EffectFit
   if (!lm.converged) {
     why = refine_with_nlopt(s, th, 300, out.evaluations);
     if (th != lm.theta) {
-      Eigen::MatrixXd jtj;
-      Eigen::VectorXd jtr;
-      lm.sse = assemble_normal(s, th, lm.model, lm.jac, jtj, jtr);
+      lm.sse = assemble_normal(s, th, lm.state);
     }
   }
   const bool solved = lm.converged || why.empty();
 
   out.theta = th;
   out.sse = lm.sse;
-  out.simulated = std::move(lm.model);
+  out.simulated = std::move(lm.state.model);
   const double dn = static_cast<double>(n);
   out.rmse = std::sqrt(out.sse / dn);
   const double ll = dn * std::log(std::max(out.sse / dn, 1e-300));
@@ -587,7 +580,7 @@ EffectFit fit_effects(const std::vector<const Effect*>& effects, const EffectFit
   out.t_stop_pred_s = s.sim.stop_time(th);
 
   bool cov_ok = false;
-  const Eigen::MatrixXd cov = covariance(s, out.simulated, lm.jac, cov_ok);
+  const Eigen::MatrixXd cov = covariance(s, out.simulated, lm.state.jac, cov_ok);
   out.converged = solved;
   if (!solved)
     out.message = why;

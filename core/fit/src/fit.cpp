@@ -1,5 +1,6 @@
 #include "spindown/fit.hpp"
 
+#include "spindown/levenberg_marquardt.hpp"
 #include "spindown/reading_noise.hpp"
 #include "vector_clones.hpp"
 
@@ -576,16 +577,6 @@ Theta integral_start(const Family& f, const IntegralForm& form) {
   return unpack(f, sol.data());
 }
 
-// Levenberg–Marquardt in Eigen with the bounds α, β ≥ 0, u0 > 0 enforced by projection. The
-// closed-form Jacobian makes each iteration one pass over the data; from the integral start
-// it converges in a handful of iterations.
-struct LmResult {
-  Theta theta;
-  double sse = 0;
-  int evals = 0;
-  bool converged = false;
-};
-
 // Converged once the Gauss–Newton step from the current point is a tiny fraction of each
 // parameter's own statistical uncertainty s²·(JᵀJ)⁻¹ (both from the same JᵀJ, so the test
 // costs no evaluation): iterating further only moves digits nobody can use. A step that a
@@ -614,58 +605,52 @@ bool at_minimum(const Family& f, const Theta& th, const Eigen::Matrix3d& jtj, co
   return true;
 }
 
-LmResult levenberg_marquardt(const Family& f, Theta th, Evaluator& eval) {
-  const int p = f.size();
-  const double dof = static_cast<double>(std::max<std::size_t>(eval.size() - p, 1));
-  LmResult out;
-  Eigen::Matrix3d jtj, jtj_try;
-  Eigen::Vector3d jtr, jtr_try;
-  double sse = eval(f, th, &jtj, &jtr);
-  out.evals = 1;
-  double lambda = 1e-3;
-  for (int it = 0; it < 100 && out.evals < 200; ++it) {
-    if (at_minimum(f, th, jtj, jtr, sse, dof)) {
-      out.converged = true;
-      break;
-    }
-    Eigen::Matrix3d a = jtj;
+// One family's least squares for the shared Levenberg–Marquardt (levenberg_marquardt.hpp), with
+// the bounds α, β ≥ 0, u0 > 0 enforced by projection. The closed-form Jacobian makes each
+// iteration one pass over the data; from the integral start it converges in a handful of
+// iterations. Its policy: a step that leaves the SSE equal is taken, converged when the step is
+// negligible beside the standard errors (at_minimum) or gains under 10⁻¹⁴ of the SSE, at most 100
+// iterations and 200 evaluations; 3×3 systems for every family (a smaller one padded with the
+// identity).
+class FamilyLeastSquares {
+ public:
+  using Point = Theta;
+  struct State {
+    Eigen::Matrix3d jtj;
+    Eigen::Vector3d jtr;
+  };
+  FamilyLeastSquares(const Family& f, Evaluator& eval)
+      : f_(f), eval_(eval), dof_(static_cast<double>(std::max<std::size_t>(eval.size() - f.size(), 1))) {}
+
+  LmPolicy policy() const { return {.max_iterations = 100, .max_evaluations = 200, .take_equal = true, .relative_gain = 1e-14}; }
+  double evaluate(const Theta& th, State& s) { return eval_(f_, th, &s.jtj, &s.jtr); }
+  bool at_minimum(const Theta& th, const State& s, double sse) const {
+    return spindown::at_minimum(f_, th, s.jtj, s.jtr, sse, dof_);
+  }
+  bool step(const Theta& th, const State& s, double lambda, Theta& out) const {
+    const int p = f_.size();
+    Eigen::Matrix3d a = s.jtj;
     a.diagonal().head(p) *= 1.0 + lambda;
     const Eigen::LDLT<Eigen::Matrix3d> ldlt(a);
-    if (ldlt.info() != Eigen::Success) break;
-    const Eigen::Vector3d step = ldlt.solve(jtr);
-    if (!step.allFinite()) break;
+    if (ldlt.info() != Eigen::Success) return false;
+    const Eigen::Vector3d step = ldlt.solve(s.jtr);
+    if (!step.allFinite()) return false;
     double x[3];
     int j = 0;
     x[j++] = th.u0;
-    if (f.alpha_free) x[j++] = th.alpha;
-    if (f.beta_free) x[j++] = th.beta;
+    if (f_.alpha_free) x[j++] = th.alpha;
+    if (f_.beta_free) x[j++] = th.beta;
     for (j = 0; j < p; ++j) x[j] = std::max(x[j] + step[j], j == 0 ? 1e-12 : 0.0);
-    const Theta trial = unpack(f, x);
-    const double sse_try = eval(f, trial, &jtj_try, &jtr_try);
-    ++out.evals;
-    if (sse_try <= sse) {
-      const double gain = sse - sse_try;
-      th = trial;
-      jtj = jtj_try;
-      jtr = jtr_try;
-      sse = sse_try;
-      lambda = std::max(lambda / 10, 1e-12);
-      if (gain <= 1e-14 * sse) {
-        out.converged = true;
-        break;
-      }
-    } else {
-      lambda *= 10;
-      if (lambda > 1e10) {
-        out.converged = true;  // no step improves: at a (bounded) minimum
-        break;
-      }
-    }
+    out = unpack(f_, x);
+    return true;
   }
-  out.theta = th;
-  out.sse = sse;
-  return out;
-}
+  bool negligible(const Theta&, const Theta&) const { return false; }
+
+ private:
+  Family f_;
+  Evaluator& eval_;
+  double dof_;
+};
 
 // The viscous model by variable projection: Newton's method on the one-dimensional projected
 // SSE F(α) = Σw·y² − (Σw·y·e)²/Σw·e², u0 following in closed form. The same minimum as LM over
@@ -975,7 +960,8 @@ ModelFit fit_model(ModelKind kind, std::span<const double> tau, std::span<const 
   if (direct) {
     th = *direct;
   } else {
-    const LmResult lm = levenberg_marquardt(fam, th, eval);
+    FamilyLeastSquares problem(fam, eval);
+    const auto lm = levenberg_marquardt(problem, th);
     out.evaluations += lm.evals;
     th = lm.theta;
     solved = lm.converged;
