@@ -11,6 +11,7 @@
 
 #include "spindown/effect_simulator.hpp"
 #include "spindown/levenberg_marquardt.hpp"
+#include "spindown/parameter_covariance.hpp"
 
 namespace spindown {
 namespace {
@@ -395,8 +396,8 @@ std::string refine_with_nlopt(const Setup& s, std::vector<double>& th, int max_e
   return why;
 }
 
-// Covariance of θ from the Jacobian: classic s²(JᵀJ)⁻¹ widened per parameter to the
-// Newey–West (HAC) variance when residuals are correlated (ripple, quantization), as fit.cpp.
+// Covariance of θ from the Jacobian (parameter_covariance.hpp): classic s²(JᵀJ)⁻¹ widened per
+// parameter to the Newey–West (HAC) variance when residuals are correlated (ripple, quantization).
 // Parameters with no influence (a shape parameter whose amplitude is 0) get NaN.
 Eigen::MatrixXd covariance(const Setup& s, const std::vector<double>& model, const std::vector<double>& jacv,
                            bool& ok) {
@@ -428,37 +429,22 @@ Eigen::MatrixXd covariance(const Setup& s, const std::vector<double>& model, con
   Eigen::MatrixXd jtj;
   Eigen::VectorXd unused;
   normal_equations(js.data(), nullptr, n, p, jtj, unused);
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(jtj);
-  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return cov;
-  Eigen::MatrixXd inv = ldlt.solve(Eigen::MatrixXd::Identity(p, p));
-  if (!inv.allFinite() || inv.diagonal().maxCoeff() > 1e12) return cov;
-  const double s2 = rss / static_cast<double>(N - p);
-  const Eigen::MatrixXd classic = s2 * inv;
-  // Newey–West: only the diagonal of inv·meat·inv is used, and eᵀ_j inv·Γ_l·inv e_j is the lag-l
-  // autocovariance of the series u_j(i) = (inv·score_i)_j, score_i = js_i·r_i.
-  const int lags = static_cast<int>(std::ceil(4.0 * std::pow(static_cast<double>(N) / 100.0, 2.0 / 9.0)));
-  std::vector<double> u(n * static_cast<std::size_t>(p));
-  for (std::size_t i = 0; i < n; ++i)
-    for (int j = 0; j < p; ++j) {
+  // Newey–West: parameter j's long-run variance is that of the series u_j(i) = (inv·score_i)_j,
+  // score_i = js_i·r_i.
+  const int lags = newey_west_lags(n);
+  std::vector<double> u(n);
+  const auto long_run = [&](const Eigen::MatrixXd& inv, int j) {
+    for (std::size_t i = 0; i < n; ++i) {
       double v = 0;
       for (int c = 0; c < p; ++c) v += inv(j, c) * js[i * p + c];
-      u[i * p + j] = v * res[i];
+      u[i] = v * res[i];
     }
-  Eigen::VectorXd widen(p);
-  for (int j = 0; j < p; ++j) {
-    double hac = 0;
-    for (std::size_t i = 0; i < n; ++i) hac += u[i * p + j] * u[i * p + j];
-    for (int l = 1; l <= lags && l < N; ++l) {
-      const double wgt = 1.0 - l / (lags + 1.0);
-      double g = 0;
-      for (std::size_t i = 0; i + static_cast<std::size_t>(l) < n; ++i) g += u[i * p + j] * u[(i + l) * p + j];
-      hac += 2.0 * wgt * g;
-    }
-    hac *= static_cast<double>(N) / static_cast<double>(N - p);
-    widen[j] = std::sqrt(std::max(1.0, hac / classic(j, j)));
-  }
-  Eigen::MatrixXd c = widen.asDiagonal() * classic * widen.asDiagonal();
-  c = cs.cwiseInverse().asDiagonal() * c * cs.cwiseInverse().asDiagonal();
+    return newey_west_sum(u, lags);
+  };
+  // An inverse's diagonal past 10¹² (in the scaled columns): a direction the run does not identify.
+  const std::optional<Eigen::MatrixXd> widened = hac_covariance(jtj, rss, n, p, long_run, 1e12);
+  if (!widened) return cov;
+  Eigen::MatrixXd c = cs.cwiseInverse().asDiagonal() * *widened * cs.cwiseInverse().asDiagonal();
   for (int a = 0; a < p; ++a)
     for (int b = 0; b < p; ++b) cov(keep[a], keep[b]) = c(a, b);
   ok = c.allFinite() && p == P;

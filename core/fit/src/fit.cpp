@@ -1,6 +1,7 @@
 #include "spindown/fit.hpp"
 
 #include "spindown/levenberg_marquardt.hpp"
+#include "spindown/parameter_covariance.hpp"
 #include "spindown/reading_noise.hpp"
 #include "vector_clones.hpp"
 
@@ -235,11 +236,6 @@ class Evaluator {
     double tail = 0;
     for (std::size_t i = tau_.size(); i-- > m_;) tail += y_[i] * y_[i];
     return last_plain_moving_ + tail;
-  }
-
-  // Newey–West's bandwidth for n samples: L = ⌈4·(n/100)^(2/9)⌉.
-  static int newey_west_lags(std::size_t n) {
-    return static_cast<int>(std::ceil(4.0 * std::pow(static_cast<double>(n) / 100.0, 2.0 / 9.0)));
   }
 
  private:
@@ -831,35 +827,22 @@ struct Covariance {
   bool ok = false;
 };
 
-// Parameter covariance from the Jacobian at the optimum. The classic s²(JᵀJ)⁻¹ assumes white
-// residuals; commutator ripple and quantization make them correlated, so the Newey–West
-// (HAC) sandwich is computed too and each parameter's variance is widened to the larger of
-// the two. Only its diagonal is needed: var_j = v_jᵀ·Ω·v_j with v_j = column j of (JᵀJ)⁻¹,
-// which is the long-run variance of the scalar series z_i = (g_i·v_j)·r_i.
+// Parameter covariance from the Jacobian at the optimum (parameter_covariance.hpp): classic,
+// widened per parameter to the Newey–West variance, whose Ω comes from the evaluation's moving
+// sums of the scores (Evaluator::operator()).
 Covariance covariance(const Family& f, const Theta& th, Evaluator& eval) {
   const int p = f.size();
   Eigen::Matrix3d jtj, omega;
   Eigen::Vector3d jtr;
   const double sse = eval(f, th, &jtj, &jtr, &omega);
-  const auto n = static_cast<Eigen::Index>(eval.size());
   Covariance out;
-  const Eigen::LDLT<Eigen::Matrix3d> ldlt(jtj);
-  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return out;
-  const Eigen::Matrix3d inv = ldlt.solve(Eigen::Matrix3d::Identity());
-  if (!inv.allFinite()) return out;
-  const double s2 = sse / static_cast<double>(std::max<Eigen::Index>(1, n - p));
-  const Eigen::Matrix3d classic = s2 * inv;
-  // Ω from the evaluation's moving sums of the scores (Evaluator::operator()).
-  const double dof = static_cast<double>(n) / static_cast<double>(std::max<Eigen::Index>(1, n - p));
-  Eigen::Vector3d widen = Eigen::Vector3d::Ones();
-  for (int j = 0; j < p; ++j) {
+  const auto long_run = [&](const Eigen::Matrix3d& inv, int j) {
     const auto v = inv.col(j).head(p);
-    const double long_run = v.dot(omega.topLeftCorner(p, p) * v) / (eval.lags() + 1.0);
-    widen[j] = std::sqrt(std::max(1.0, dof * long_run / classic(j, j)));
-  }
-  // Keep the correlation structure of the classic estimate, widened per parameter.
-  out.cov = widen.asDiagonal() * classic * widen.asDiagonal();
-  for (int j = p; j < 3; ++j) out.cov.row(j).setZero(), out.cov.col(j).setZero();
+    return v.dot(omega.topLeftCorner(p, p) * v) / (eval.lags() + 1.0);
+  };
+  const std::optional<Eigen::Matrix3d> cov = hac_covariance(jtj, sse, eval.size(), p, long_run);
+  if (!cov) return out;
+  out.cov = *cov;
   out.ok = out.cov.allFinite();
   return out;
 }
