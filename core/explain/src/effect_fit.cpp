@@ -3,12 +3,11 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <exception>
 #include <fmt/format.h>
 #include <limits>
-#include <nlopt.hpp>
 #include <utility>
 
+#include "spindown/bounded_refinement.hpp"
 #include "spindown/effect_simulator.hpp"
 #include "spindown/levenberg_marquardt.hpp"
 #include "spindown/parameter_covariance.hpp"
@@ -309,87 +308,48 @@ EffectLm fit_by_lm(const Setup& s, std::vector<double> th) {
   return levenberg_marquardt(problem, std::move(th));
 }
 
-// NLopt: bounded L-BFGS on θ_j / scale_j with the sensitivity gradient. Never lets an
-// exception cross the C callback (design §7).
-struct NloptProblem {
-  const Setup* s;
-  std::vector<double> scale;
-  double sse0 = 1;
-  int evals = 0;
-  std::vector<double> model, jac, th;
-  std::exception_ptr error;
-};
-
-double nlopt_objective(unsigned n, const double* x, double* grad, void* data) {
-  auto* pb = static_cast<NloptProblem*>(data);
-  try {
-    ++pb->evals;
-    const Setup& s = *pb->s;
-    const std::size_t m = s.data.tau.size();
-    for (unsigned j = 0; j < n; ++j) pb->th[j] = x[j] * pb->scale[j];
-    pb->model.resize(m);
-    pb->jac.resize(grad ? m * n : 0);
-    s.sim.simulate(pb->th, s.data.tau, pb->model, grad ? std::span<double>(pb->jac) : std::span<double>());
-    double sse = 0;
-    if (grad) std::fill(grad, grad + n, 0.0);
-    for (std::size_t i = 0; i < m; ++i) {
-      const double r = s.data.y[i] - pb->model[i];
-      sse += r * r;
-      if (grad)
-        for (unsigned j = 0; j < n; ++j) grad[j] -= 2 * r * pb->jac[i * n + j];
-    }
-    if (grad)
-      for (unsigned j = 0; j < n; ++j) grad[j] *= pb->scale[j] / pb->sse0;
-    return sse / pb->sse0;
-  } catch (...) {
-    pb->error = std::current_exception();
-    throw nlopt::forced_stop();
-  }
-}
-
-// Returns "" on success or why it failed; th becomes the best point found.
+// Bounded L-BFGS (bounded_refinement.hpp) on θ_j / scale_j with the sensitivity gradient, the
+// SSE normalised by its value at the start. Returns "" on success or why it failed; th becomes
+// the best point found, if it is no worse than th.
 std::string refine_with_nlopt(const Setup& s, std::vector<double>& th, int max_evals, int& evals) {
   const int P = s.sim.size();
-  NloptProblem pb{&s, std::vector<double>(P), 1.0, 0, {}, {}, th, nullptr};
-  std::vector<double> x(P), lb(P), ub(P);
+  std::vector<double> scale(P), x(P);
+  RefinementOptions options{.lower = std::vector<double>(P),
+                            .upper = std::vector<double>(P),
+                            .ftol_rel = 1e-12,
+                            .xtol_rel = 1e-10,
+                            .max_evaluations = max_evals};
+  std::vector<double>&lb = options.lower, &ub = options.upper;
   for (int j = 0; j < P; ++j) {
-    pb.scale[j] = std::max(std::abs(th[j]), std::abs(s.typical[j]) * 1e-3) + 1e-300;
-    x[j] = th[j] / pb.scale[j];
-    lb[j] = s.lo[j] / pb.scale[j];
-    ub[j] = s.hi[j] / pb.scale[j];
+    scale[j] = std::max(std::abs(th[j]), std::abs(s.typical[j]) * 1e-3) + 1e-300;
+    x[j] = th[j] / scale[j];
+    lb[j] = s.lo[j] / scale[j];
+    ub[j] = s.hi[j] / scale[j];
     x[j] = std::clamp(x[j], lb[j], ub[j]);
   }
   std::vector<double> model;
-  pb.sse0 = std::max(sse_of(s, th, model), 1e-300);
-  std::string why;
-  double fmin = 0;
-  try {
-    nlopt::opt opt(nlopt::LD_LBFGS, static_cast<unsigned>(P));
-    opt.set_lower_bounds(lb);
-    opt.set_upper_bounds(ub);
-    opt.set_min_objective(nlopt_objective, &pb);
-    opt.set_ftol_rel(1e-12);
-    opt.set_xtol_rel(1e-10);
-    opt.set_maxeval(max_evals);
-    const nlopt::result res = opt.optimize(x, fmin);
-    if (res == nlopt::MAXEVAL_REACHED) why = fmt::format("no convergence within {} evaluations", max_evals);
-  } catch (const nlopt::roundoff_limited&) {
-    // at the optimum to machine precision: accept
-  } catch (const nlopt::forced_stop&) {
-    why = "the objective failed";
-    if (pb.error) {
-      try {
-        std::rethrow_exception(pb.error);
-      } catch (const std::exception& e) {
-        why = fmt::format("the objective failed: {}", e.what());
-      }
+  const double sse0 = std::max(sse_of(s, th, model), 1e-300);
+  // Scratch for the objective: the point, its simulation and sensitivities.
+  std::vector<double> point(th), simulated, jac;
+  const auto objective = [&](std::span<const double> xs, std::span<double> grad) {
+    const std::size_t n = xs.size(), m = s.data.tau.size();
+    for (std::size_t j = 0; j < n; ++j) point[j] = xs[j] * scale[j];
+    simulated.resize(m);
+    jac.resize(grad.empty() ? 0 : m * n);
+    s.sim.simulate(point, s.data.tau, simulated, grad.empty() ? std::span<double>() : std::span<double>(jac));
+    double sse = 0;
+    std::fill(grad.begin(), grad.end(), 0.0);
+    for (std::size_t i = 0; i < m; ++i) {
+      const double r = s.data.y[i] - simulated[i];
+      sse += r * r;
+      for (std::size_t j = 0; j < grad.size(); ++j) grad[j] -= 2 * r * jac[i * n + j];
     }
-  } catch (const std::exception& e) {
-    why = fmt::format("NLopt: {}", e.what());
-  }
-  evals += pb.evals;
+    for (std::size_t j = 0; j < grad.size(); ++j) grad[j] *= scale[j] / sse0;
+    return sse / sse0;
+  };
+  const std::string why = refine_bounded(x, options, objective, evals);
   std::vector<double> cand(P);
-  for (int j = 0; j < P; ++j) cand[j] = x[j] * pb.scale[j];
+  for (int j = 0; j < P; ++j) cand[j] = x[j] * scale[j];
   s.clamp(cand);
   // NLopt returns its best point; keep it only when it is no worse.
   if (sse_of(s, cand, model) <= sse_of(s, th, model)) th = cand;

@@ -1,5 +1,6 @@
 #include "spindown/fit.hpp"
 
+#include "spindown/bounded_refinement.hpp"
 #include "spindown/levenberg_marquardt.hpp"
 #include "spindown/parameter_covariance.hpp"
 #include "spindown/reading_noise.hpp"
@@ -12,11 +13,9 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <exception>
 #include <fmt/format.h>
 #include <limits>
 #include <memory>
-#include <nlopt.hpp>
 
 namespace spindown {
 namespace {
@@ -472,35 +471,6 @@ class Evaluator {
   Eigen::Vector3d last_jtr_;
 };
 
-struct Problem {
-  Family fam;
-  Evaluator* eval;
-  Eigen::Vector3d scale;  // parameters are optimised as x_j = θ_j / scale_j (conditioning)
-  double sse0 = 1;        // objective normalisation
-  int evals = 0;
-  std::exception_ptr error;
-};
-
-// NLopt's C++ objective: never let an exception cross it (design §7).
-double nlopt_objective(unsigned n, const double* xs, double* grad, void* data) {
-  auto* pb = static_cast<Problem*>(data);
-  try {
-    ++pb->evals;
-    double x[3];
-    for (unsigned j = 0; j < n; ++j) x[j] = xs[j] * pb->scale[j];
-    const Theta th = unpack(pb->fam, x);
-    Eigen::Matrix3d jtj;
-    Eigen::Vector3d jtr;
-    const double sse = grad ? (*pb->eval)(pb->fam, th, &jtj, &jtr) : (*pb->eval)(pb->fam, th);
-    if (grad)  // d(Σr²)/dθ = −2·Jᵀr
-      for (unsigned j = 0; j < n; ++j) grad[j] = -2 * jtr[j] * pb->scale[j] / pb->sse0;
-    return sse / pb->sse0;
-  } catch (...) {
-    pb->error = std::current_exception();
-    throw nlopt::forced_stop();
-  }
-}
-
 // Starting point from the integral form of the ODE, linear in the unknowns:
 //   r(τ) = u0 − α·∫₀^τ r dt − β·τ     (while moving)
 // one least-squares solve over the samples before the stop: no derivatives of noisy data,
@@ -863,51 +833,41 @@ double delta_se(const Family& f, const Eigen::Matrix3d& cov, double d_u0, double
   return var > 0 ? std::sqrt(var) : 0.0;
 }
 
-// Bounded quasi-Newton refinement with NLopt (the fallback when LM does not converge).
+// Bounded quasi-Newton refinement (bounded_refinement.hpp, the fallback when LM does not
+// converge) on the parameters scaled by their size, the SSE by its value at the start.
 // Returns "" on success or why it failed; th is updated to the best point found.
 std::string refine_with_nlopt(const Family& fam, std::span<const double> tau, Evaluator& eval, Theta& th,
                               int& evals) {
   const int p = fam.size();
   const double span_s = std::max(tau.back(), 1e-3);
-  Problem pb{fam, &eval, {}, 1.0, 0, nullptr};
+  Eigen::Vector3d scale;  // parameters are optimised as x_j = θ_j / scale_j (conditioning)
   std::vector<double> x(p);
   {
     int j = 0;
-    pb.scale[j] = std::max(th.u0, 1e-9), x[j] = th.u0 / pb.scale[j], ++j;
-    if (fam.alpha_free) pb.scale[j] = std::max(th.alpha, 1e-6 / span_s), x[j] = th.alpha / pb.scale[j], ++j;
-    if (fam.beta_free) pb.scale[j] = std::max(th.beta, 1e-6 * th.u0 / span_s), x[j] = th.beta / pb.scale[j], ++j;
+    scale[j] = std::max(th.u0, 1e-9), x[j] = th.u0 / scale[j], ++j;
+    if (fam.alpha_free) scale[j] = std::max(th.alpha, 1e-6 / span_s), x[j] = th.alpha / scale[j], ++j;
+    if (fam.beta_free) scale[j] = std::max(th.beta, 1e-6 * th.u0 / span_s), x[j] = th.beta / scale[j], ++j;
   }
-  pb.sse0 = std::max(eval(fam, th), 1e-300);
-  nlopt::opt opt(nlopt::LD_LBFGS, static_cast<unsigned>(p));
-  std::vector<double> lb(p, 0.0), ub(p, 1e6);
-  lb[0] = 1e-9;
-  opt.set_lower_bounds(lb);
-  opt.set_upper_bounds(ub);
-  opt.set_min_objective(nlopt_objective, &pb);
-  opt.set_ftol_rel(1e-13);
-  opt.set_xtol_rel(1e-10);
-  opt.set_maxeval(400);
-  double fmin = 0;
-  std::string why;
-  try {
-    const nlopt::result res = opt.optimize(x, fmin);
-    if (res == nlopt::MAXEVAL_REACHED) why = "no convergence within 400 evaluations";
-  } catch (const nlopt::roundoff_limited&) {
-    // at the optimum to machine precision: accept
-  } catch (const nlopt::forced_stop&) {
-    why = "the objective failed";
-    if (pb.error) {
-      try {
-        std::rethrow_exception(pb.error);
-      } catch (const std::exception& e) {
-        why = fmt::format("the objective failed: {}", e.what());
-      }
-    }
-  } catch (const std::exception& e) {
-    why = fmt::format("NLopt: {}", e.what());
-  }
-  evals += pb.evals;
-  for (int j = 0; j < p; ++j) x[j] *= pb.scale[j];
+  const double sse0 = std::max(eval(fam, th), 1e-300);  // objective normalisation
+  RefinementOptions options{.lower = std::vector<double>(p, 0.0),
+                            .upper = std::vector<double>(p, 1e6),
+                            .ftol_rel = 1e-13,
+                            .xtol_rel = 1e-10,
+                            .max_evaluations = 400};
+  options.lower[0] = 1e-9;
+  const auto objective = [&](std::span<const double> xs, std::span<double> grad) {
+    double xt[3];
+    for (int j = 0; j < p; ++j) xt[j] = xs[j] * scale[j];
+    const Theta t = unpack(fam, xt);
+    Eigen::Matrix3d jtj;
+    Eigen::Vector3d jtr;
+    const double sse = grad.empty() ? eval(fam, t) : eval(fam, t, &jtj, &jtr);
+    // d(Σr²)/dθ = −2·Jᵀr
+    for (std::size_t j = 0; j < grad.size(); ++j) grad[j] = -2 * jtr[j] * scale[j] / sse0;
+    return sse / sse0;
+  };
+  const std::string why = refine_bounded(x, options, objective, evals);
+  for (int j = 0; j < p; ++j) x[j] *= scale[j];
   th = unpack(fam, x.data());
   return why;
 }
