@@ -259,7 +259,9 @@ class EffectLeastSquares {
   using State = Evaluation;
   explicit EffectLeastSquares(const Setup& s) : s_(s) {}
 
-  LmPolicy policy() const { return {.max_iterations = 60, .max_evaluations = 80, .take_equal = false, .relative_gain = 1e-10}; }
+  LmPolicy policy() const {
+    return {.max_iterations = 60, .max_evaluations = 80, .take_equal = false, .relative_gain = 1e-10};
+  }
   double evaluate(const Point& th, State& ev) const { return assemble_normal(s_, th, ev); }
   bool at_minimum(const Point&, const State&, double) const { return false; }
   bool step(const Point& th, const State& ev, double lambda, Point& trial) const {
