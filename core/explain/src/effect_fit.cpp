@@ -321,7 +321,8 @@ std::string refine_with_nlopt(const Setup& s, std::vector<double>& th, int max_e
                             .ftol_rel = 1e-12,
                             .xtol_rel = 1e-10,
                             .max_evaluations = max_evals};
-  std::vector<double>&lb = options.lower, &ub = options.upper;
+  std::vector<double>& lb = options.lower;
+  std::vector<double>& ub = options.upper;
   for (int j = 0; j < P; ++j) {
     scale[j] = std::max(std::abs(th[j]), std::abs(s.typical[j]) * 1e-3) + 1e-300;
     x[j] = th[j] / scale[j];
