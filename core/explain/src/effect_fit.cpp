@@ -3,13 +3,14 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
-#include <exception>
 #include <fmt/format.h>
 #include <limits>
-#include <nlopt.hpp>
 #include <utility>
 
+#include "spindown/bounded_refinement.hpp"
 #include "spindown/effect_simulator.hpp"
+#include "spindown/levenberg_marquardt.hpp"
+#include "spindown/parameter_covariance.hpp"
 
 namespace spindown {
 namespace {
@@ -220,45 +221,53 @@ void normal_equations(const double* jac, const double* r, std::size_t n, int p, 
   }
 }
 
-// Levenberg–Marquardt on the simulator's exact sensitivities, bounds by projection. The
-// result keeps the simulation and Jacobian at its optimum (for the SSE and the covariance).
-struct LmResult {
-  std::vector<double> theta;
-  std::vector<double> model, jac;  // at theta
-  double sse = 0;
-  int evals = 0;
-  bool converged = false;
+// What one evaluation leaves: the simulation and its Jacobian (kept at the optimum for the SSE
+// and the covariance), and the normal equations from them.
+struct Evaluation {
+  std::vector<double> model, jac;
+  Eigen::MatrixXd jtj;
+  Eigen::VectorXd jtr;
 };
 
 // Simulates t with its sensitivities into model/jac; JᵀJ, Jᵀr and the SSE from them.
-double assemble_normal(const Setup& s, const std::vector<double>& t, std::vector<double>& model,
-                       std::vector<double>& jac, Eigen::MatrixXd& jtj, Eigen::VectorXd& jtr) {
+double assemble_normal(const Setup& s, const std::vector<double>& t, Evaluation& ev) {
   const std::size_t n = s.data.tau.size();
   const int P = s.sim.size();
-  model.resize(n);
-  jac.resize(n * P);
-  s.sim.simulate(t, s.data.tau, model, jac);
+  ev.model.resize(n);
+  ev.jac.resize(n * P);
+  s.sim.simulate(t, s.data.tau, ev.model, ev.jac);
   thread_local std::vector<double> r;  // residual scratch, reused across evaluations
   r.resize(n);
   double sse = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    r[i] = s.data.y[i] - model[i];
+    r[i] = s.data.y[i] - ev.model[i];
     sse += r[i] * r[i];
   }
-  normal_equations(jac.data(), r.data(), n, P, jtj, jtr);
-  return std::isfinite(sse) && jtj.allFinite() && jtr.allFinite() ? sse : std::numeric_limits<double>::infinity();
+  normal_equations(ev.jac.data(), r.data(), n, P, ev.jtj, ev.jtr);
+  return std::isfinite(sse) && ev.jtj.allFinite() && ev.jtr.allFinite() ? sse : std::numeric_limits<double>::infinity();
 }
 
-LmResult levenberg_marquardt(const Setup& s, std::vector<double> th) {
-  const int P = s.sim.size();
-  LmResult out;
-  std::vector<double> model_try, jac_try;
-  Eigen::MatrixXd jtj, jtj_try;
-  Eigen::VectorXd jtr, jtr_try;
-  double sse = assemble_normal(s, th, out.model, out.jac, jtj, jtr);
-  out.evals = 1;
-  double lambda = 1e-3;
-  for (int it = 0; it < 60 && out.evals < 80; ++it) {
+// The combination's least squares for the shared Levenberg–Marquardt (levenberg_marquardt.hpp):
+// the simulator's exact sensitivities, bounds by projection. Its policy: the damping has a floor
+// of 10⁻¹² of JᵀJ's largest diagonal entry; an active set at the bounds; only a step that lowers
+// the SSE is taken; converged when every parameter moves less than 10⁻⁷ of itself (or of 10⁻⁶ of
+// its typical size) or the SSE gains under 10⁻¹⁰ of itself; at most 60 iterations and 80
+// evaluations.
+class EffectLeastSquares {
+ public:
+  using Point = std::vector<double>;
+  using State = Evaluation;
+  explicit EffectLeastSquares(const Setup& s) : s_(s) {}
+
+  LmPolicy policy() const {
+    return {.max_iterations = 60, .max_evaluations = 80, .take_equal = false, .relative_gain = 1e-10};
+  }
+  double evaluate(const Point& th, State& ev) const { return assemble_normal(s_, th, ev); }
+  bool at_minimum(const Point&, const State&, double) const { return false; }
+  bool step(const Point& th, const State& ev, double lambda, Point& trial) const {
+    const int P = s_.sim.size();
+    const Eigen::MatrixXd& jtj = ev.jtj;
+    const Eigen::VectorXd& jtr = ev.jtr;
     Eigen::MatrixXd a = jtj;
     Eigen::VectorXd rhs = jtr;
     const double floor = 1e-12 * (jtj.diagonal().maxCoeff() + 1e-300);
@@ -266,8 +275,8 @@ LmResult levenberg_marquardt(const Setup& s, std::vector<double> th) {
       a(j, j) = jtj(j, j) * (1.0 + lambda) + lambda * floor;
       // A parameter on its bound that the descent direction pushes outward stays there
       // (active set); otherwise projection would make LM stall on rejected steps.
-      const bool at_lo = th[j] <= s.lo[j] && jtr[j] <= 0;
-      const bool at_hi = th[j] >= s.hi[j] && jtr[j] >= 0;
+      const bool at_lo = th[j] <= s_.lo[j] && jtr[j] <= 0;
+      const bool at_hi = th[j] >= s_.hi[j] && jtr[j] >= 0;
       if (at_lo || at_hi) {
         a.row(j).setZero();
         a.col(j).setZero();
@@ -276,132 +285,82 @@ LmResult levenberg_marquardt(const Setup& s, std::vector<double> th) {
       }
     }
     const Eigen::LDLT<Eigen::MatrixXd> ldlt(a);
-    if (ldlt.info() != Eigen::Success) break;
+    if (ldlt.info() != Eigen::Success) return false;
     const Eigen::VectorXd step = ldlt.solve(rhs);
-    if (!step.allFinite()) break;
-    std::vector<double> trial(th);
+    if (!step.allFinite()) return false;
+    trial = th;
     for (int j = 0; j < P; ++j) trial[j] += step[j];
-    s.clamp(trial);
-    const double sse_try = assemble_normal(s, trial, model_try, jac_try, jtj_try, jtr_try);
-    ++out.evals;
-    if (sse_try < sse) {
-      const double gain = sse - sse_try;
-      bool small = true;
-      for (int j = 0; j < P; ++j)
-        if (std::abs(trial[j] - th[j]) > 1e-7 * std::max(std::abs(th[j]), 1e-6 * s.typical[j])) small = false;
-      th = trial;
-      std::swap(jtj, jtj_try);
-      std::swap(jtr, jtr_try);
-      std::swap(out.model, model_try);
-      std::swap(out.jac, jac_try);
-      sse = sse_try;
-      lambda = std::max(lambda / 10, 1e-12);
-      if (small || gain <= 1e-10 * sse) {
-        out.converged = true;
-        break;
-      }
-    } else {
-      lambda *= 10;
-      if (lambda > 1e10) {
-        out.converged = true;  // no step improves: at a (bounded) minimum
-        break;
-      }
-    }
+    s_.clamp(trial);
+    return true;
   }
-  out.theta = th;
-  out.sse = sse;
-  return out;
-}
+  bool negligible(const Point& th, const Point& trial) const {
+    for (std::size_t j = 0; j < th.size(); ++j)
+      if (std::abs(trial[j] - th[j]) > 1e-7 * std::max(std::abs(th[j]), 1e-6 * s_.typical[j])) return false;
+    return true;
+  }
 
-// NLopt: bounded L-BFGS on θ_j / scale_j with the sensitivity gradient. Never lets an
-// exception cross the C callback (design §7).
-struct NloptProblem {
-  const Setup* s;
-  std::vector<double> scale;
-  double sse0 = 1;
-  int evals = 0;
-  std::vector<double> model, jac, th;
-  std::exception_ptr error;
+ private:
+  const Setup& s_;
 };
 
-double nlopt_objective(unsigned n, const double* x, double* grad, void* data) {
-  auto* pb = static_cast<NloptProblem*>(data);
-  try {
-    ++pb->evals;
-    const Setup& s = *pb->s;
-    const std::size_t m = s.data.tau.size();
-    for (unsigned j = 0; j < n; ++j) pb->th[j] = x[j] * pb->scale[j];
-    pb->model.resize(m);
-    pb->jac.resize(grad ? m * n : 0);
-    s.sim.simulate(pb->th, s.data.tau, pb->model, grad ? std::span<double>(pb->jac) : std::span<double>());
-    double sse = 0;
-    if (grad) std::fill(grad, grad + n, 0.0);
-    for (std::size_t i = 0; i < m; ++i) {
-      const double r = s.data.y[i] - pb->model[i];
-      sse += r * r;
-      if (grad)
-        for (unsigned j = 0; j < n; ++j) grad[j] -= 2 * r * pb->jac[i * n + j];
-    }
-    if (grad)
-      for (unsigned j = 0; j < n; ++j) grad[j] *= pb->scale[j] / pb->sse0;
-    return sse / pb->sse0;
-  } catch (...) {
-    pb->error = std::current_exception();
-    throw nlopt::forced_stop();
-  }
+using EffectLm = LmResult<std::vector<double>, Evaluation>;
+
+EffectLm fit_by_lm(const Setup& s, std::vector<double> th) {
+  EffectLeastSquares problem(s);
+  return levenberg_marquardt(problem, std::move(th));
 }
 
-// Returns "" on success or why it failed; th becomes the best point found.
+// Bounded L-BFGS (bounded_refinement.hpp) on θ_j / scale_j with the sensitivity gradient, the
+// SSE normalised by its value at the start. Returns "" on success or why it failed; th becomes
+// the best point found, if it is no worse than th.
 std::string refine_with_nlopt(const Setup& s, std::vector<double>& th, int max_evals, int& evals) {
   const int P = s.sim.size();
-  NloptProblem pb{&s, std::vector<double>(P), 1.0, 0, {}, {}, th, nullptr};
-  std::vector<double> x(P), lb(P), ub(P);
+  std::vector<double> scale(P), x(P);
+  RefinementOptions options{.lower = std::vector<double>(P),
+                            .upper = std::vector<double>(P),
+                            .ftol_rel = 1e-12,
+                            .xtol_rel = 1e-10,
+                            .max_evaluations = max_evals};
+  std::vector<double>& lb = options.lower;
+  std::vector<double>& ub = options.upper;
   for (int j = 0; j < P; ++j) {
-    pb.scale[j] = std::max(std::abs(th[j]), std::abs(s.typical[j]) * 1e-3) + 1e-300;
-    x[j] = th[j] / pb.scale[j];
-    lb[j] = s.lo[j] / pb.scale[j];
-    ub[j] = s.hi[j] / pb.scale[j];
+    scale[j] = std::max(std::abs(th[j]), std::abs(s.typical[j]) * 1e-3) + 1e-300;
+    x[j] = th[j] / scale[j];
+    lb[j] = s.lo[j] / scale[j];
+    ub[j] = s.hi[j] / scale[j];
     x[j] = std::clamp(x[j], lb[j], ub[j]);
   }
   std::vector<double> model;
-  pb.sse0 = std::max(sse_of(s, th, model), 1e-300);
-  std::string why;
-  double fmin = 0;
-  try {
-    nlopt::opt opt(nlopt::LD_LBFGS, static_cast<unsigned>(P));
-    opt.set_lower_bounds(lb);
-    opt.set_upper_bounds(ub);
-    opt.set_min_objective(nlopt_objective, &pb);
-    opt.set_ftol_rel(1e-12);
-    opt.set_xtol_rel(1e-10);
-    opt.set_maxeval(max_evals);
-    const nlopt::result res = opt.optimize(x, fmin);
-    if (res == nlopt::MAXEVAL_REACHED) why = fmt::format("no convergence within {} evaluations", max_evals);
-  } catch (const nlopt::roundoff_limited&) {
-    // at the optimum to machine precision: accept
-  } catch (const nlopt::forced_stop&) {
-    why = "the objective failed";
-    if (pb.error) {
-      try {
-        std::rethrow_exception(pb.error);
-      } catch (const std::exception& e) {
-        why = fmt::format("the objective failed: {}", e.what());
-      }
+  const double sse0 = std::max(sse_of(s, th, model), 1e-300);
+  // Scratch for the objective: the point, its simulation and sensitivities.
+  std::vector<double> point(th), simulated, jac;
+  const auto objective = [&](std::span<const double> xs, std::span<double> grad) {
+    const std::size_t n = xs.size(), m = s.data.tau.size();
+    for (std::size_t j = 0; j < n; ++j) point[j] = xs[j] * scale[j];
+    simulated.resize(m);
+    jac.resize(grad.empty() ? 0 : m * n);
+    s.sim.simulate(point, s.data.tau, simulated, grad.empty() ? std::span<double>() : std::span<double>(jac));
+    double sse = 0;
+    std::fill(grad.begin(), grad.end(), 0.0);
+    for (std::size_t i = 0; i < m; ++i) {
+      const double r = s.data.y[i] - simulated[i];
+      sse += r * r;
+      for (std::size_t j = 0; j < grad.size(); ++j) grad[j] -= 2 * r * jac[i * n + j];
     }
-  } catch (const std::exception& e) {
-    why = fmt::format("NLopt: {}", e.what());
-  }
-  evals += pb.evals;
+    for (std::size_t j = 0; j < grad.size(); ++j) grad[j] *= scale[j] / sse0;
+    return sse / sse0;
+  };
+  const std::string why = refine_bounded(x, options, objective, evals);
   std::vector<double> cand(P);
-  for (int j = 0; j < P; ++j) cand[j] = x[j] * pb.scale[j];
+  for (int j = 0; j < P; ++j) cand[j] = x[j] * scale[j];
   s.clamp(cand);
   // NLopt returns its best point; keep it only when it is no worse.
   if (sse_of(s, cand, model) <= sse_of(s, th, model)) th = cand;
   return why;
 }
 
-// Covariance of θ from the Jacobian: classic s²(JᵀJ)⁻¹ widened per parameter to the
-// Newey–West (HAC) variance when residuals are correlated (ripple, quantization), as fit.cpp.
+// Covariance of θ from the Jacobian (parameter_covariance.hpp): classic s²(JᵀJ)⁻¹ widened per
+// parameter to the Newey–West (HAC) variance when residuals are correlated (ripple, quantization).
 // Parameters with no influence (a shape parameter whose amplitude is 0) get NaN.
 Eigen::MatrixXd covariance(const Setup& s, const std::vector<double>& model, const std::vector<double>& jacv,
                            bool& ok) {
@@ -433,37 +392,22 @@ Eigen::MatrixXd covariance(const Setup& s, const std::vector<double>& model, con
   Eigen::MatrixXd jtj;
   Eigen::VectorXd unused;
   normal_equations(js.data(), nullptr, n, p, jtj, unused);
-  const Eigen::LDLT<Eigen::MatrixXd> ldlt(jtj);
-  if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return cov;
-  Eigen::MatrixXd inv = ldlt.solve(Eigen::MatrixXd::Identity(p, p));
-  if (!inv.allFinite() || inv.diagonal().maxCoeff() > 1e12) return cov;
-  const double s2 = rss / static_cast<double>(N - p);
-  const Eigen::MatrixXd classic = s2 * inv;
-  // Newey–West: only the diagonal of inv·meat·inv is used, and eᵀ_j inv·Γ_l·inv e_j is the lag-l
-  // autocovariance of the series u_j(i) = (inv·score_i)_j, score_i = js_i·r_i.
-  const int lags = static_cast<int>(std::ceil(4.0 * std::pow(static_cast<double>(N) / 100.0, 2.0 / 9.0)));
-  std::vector<double> u(n * static_cast<std::size_t>(p));
-  for (std::size_t i = 0; i < n; ++i)
-    for (int j = 0; j < p; ++j) {
+  // Newey–West: parameter j's long-run variance is that of the series u_j(i) = (inv·score_i)_j,
+  // score_i = js_i·r_i.
+  const int lags = newey_west_lags(n);
+  std::vector<double> u(n);
+  const auto long_run = [&](const Eigen::MatrixXd& inv, int j) {
+    for (std::size_t i = 0; i < n; ++i) {
       double v = 0;
       for (int c = 0; c < p; ++c) v += inv(j, c) * js[i * p + c];
-      u[i * p + j] = v * res[i];
+      u[i] = v * res[i];
     }
-  Eigen::VectorXd widen(p);
-  for (int j = 0; j < p; ++j) {
-    double hac = 0;
-    for (std::size_t i = 0; i < n; ++i) hac += u[i * p + j] * u[i * p + j];
-    for (int l = 1; l <= lags && l < N; ++l) {
-      const double wgt = 1.0 - l / (lags + 1.0);
-      double g = 0;
-      for (std::size_t i = 0; i + static_cast<std::size_t>(l) < n; ++i) g += u[i * p + j] * u[(i + l) * p + j];
-      hac += 2.0 * wgt * g;
-    }
-    hac *= static_cast<double>(N) / static_cast<double>(N - p);
-    widen[j] = std::sqrt(std::max(1.0, hac / classic(j, j)));
-  }
-  Eigen::MatrixXd c = widen.asDiagonal() * classic * widen.asDiagonal();
-  c = cs.cwiseInverse().asDiagonal() * c * cs.cwiseInverse().asDiagonal();
+    return newey_west_sum(u, lags);
+  };
+  // An inverse's diagonal past 10¹² (in the scaled columns): a direction the run does not identify.
+  const std::optional<Eigen::MatrixXd> widened = hac_covariance(jtj, rss, n, p, long_run, 1e12);
+  if (!widened) return cov;
+  Eigen::MatrixXd c = cs.cwiseInverse().asDiagonal() * *widened * cs.cwiseInverse().asDiagonal();
   for (int a = 0; a < p; ++a)
     for (int b = 0; b < p; ++b) cov(keep[a], keep[b]) = c(a, b);
   ok = c.allFinite() && p == P;
@@ -550,14 +494,14 @@ EffectFit fit_effects(const std::vector<const Effect*>& effects, const EffectFit
     }
   }
 
-  LmResult lm = levenberg_marquardt(s, th);
+  EffectLm lm = fit_by_lm(s, th);
   out.evaluations = lm.evals;
   bool warm_is_subset = warm != nullptr;
   if (warm)
     for (const Effect* we : warm->effects) warm_is_subset = warm_is_subset && std::find(effects.begin(), effects.end(), we) != effects.end();
   if (!th_nested.empty() && warm_is_subset && lm.sse > warm->sse * (1 + 1e-9)) {
     // Nested models can only fit better: restart from the smaller model's optimum.
-    LmResult again = levenberg_marquardt(s, th_nested);
+    EffectLm again = fit_by_lm(s, th_nested);
     out.evaluations += again.evals;
     if (again.sse < lm.sse) lm = again;
   }
@@ -568,16 +512,14 @@ EffectFit fit_effects(const std::vector<const Effect*>& effects, const EffectFit
   if (!lm.converged) {
     why = refine_with_nlopt(s, th, 300, out.evaluations);
     if (th != lm.theta) {
-      Eigen::MatrixXd jtj;
-      Eigen::VectorXd jtr;
-      lm.sse = assemble_normal(s, th, lm.model, lm.jac, jtj, jtr);
+      lm.sse = assemble_normal(s, th, lm.state);
     }
   }
   const bool solved = lm.converged || why.empty();
 
   out.theta = th;
   out.sse = lm.sse;
-  out.simulated = std::move(lm.model);
+  out.simulated = std::move(lm.state.model);
   const double dn = static_cast<double>(n);
   out.rmse = std::sqrt(out.sse / dn);
   const double ll = dn * std::log(std::max(out.sse / dn, 1e-300));
@@ -587,7 +529,7 @@ EffectFit fit_effects(const std::vector<const Effect*>& effects, const EffectFit
   out.t_stop_pred_s = s.sim.stop_time(th);
 
   bool cov_ok = false;
-  const Eigen::MatrixXd cov = covariance(s, out.simulated, lm.jac, cov_ok);
+  const Eigen::MatrixXd cov = covariance(s, out.simulated, lm.state.jac, cov_ok);
   out.converged = solved;
   if (!solved)
     out.message = why;
