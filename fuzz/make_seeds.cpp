@@ -135,6 +135,10 @@ fit_t fit_message() {
   f.period_s = 0.02;
   f.first_seq = 20;
   f.last_seq = 140;
+  f.ndoubts = 0;
+  f.reading_step = 0.01;
+  f.model_reduced_chi2.assign(static_cast<std::size_t>(f.nmodels), 1.0);
+  f.ncorrelations = 0;
   return f;
 }
 

@@ -64,6 +64,7 @@ FitPlan plan_from(const FitCommandOptions& o) {
   }
 
   plan.report.lab_units = o.lab_units;
+  plan.report.details = o.details;
   plan.report.max_diagnostics = o.verbose ? 0 : 8;
   plan.report.diagnostics_in_text = false;  // they go to stderr, with the failures
   return plan;
@@ -131,6 +132,8 @@ void setup_fit(CLI::App& app) {
       ->delimiter(',')
       ->allow_extra_args(false);  // one value per flag: `--models combined a.tsv b.tsv` leaves the files alone
   sub->add_flag("--lab-units", opt->lab_units, "Also give the lab's units (g·cm², g·cm²·s⁻¹, g·cm²·rad·s⁻²)");
+  sub->add_flag("--details", opt->details,
+                "Also give each model's 95 % intervals, parameter correlations and reduced χ² (JSON always has them)");
   sub->add_flag("-v,--verbose", opt->verbose, "Show every diagnostic, notes included");
 
   sub->add_option("--bench-config", opt->bench_configs,

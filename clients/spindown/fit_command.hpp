@@ -16,6 +16,7 @@ struct FitCommandOptions {
   std::vector<std::string> files;
   bool json = false;
   bool lab_units = false;
+  bool details = false;  // 95 % intervals, correlations, reduced χ² in the text
   bool verbose = false;  // every diagnostic, notes included
   std::vector<std::string> models;  // names; empty = all
   InputOptions input;  // the bench and delimited-text columns

@@ -160,6 +160,17 @@ fit_t make_fit() {
     m.finding_ratio_stderr = {0.012};
     m.finding_unit = {"N*m"};
   }
+  if constexpr (requires { m.ndoubts; }) {  // what the numbers cannot say by themselves
+    m.ndoubts = 1;
+    m.doubts = {"the combined model misses"};
+    m.reading_step = 0.01;
+    m.model_reduced_chi2 = {2200, 106, std::numeric_limits<double>::quiet_NaN()};
+    m.ncorrelations = 2;
+    m.corr_model = {0, 1};
+    m.corr_a = {"omega0", "omega0"};
+    m.corr_b = {"c1", "c2"};
+    m.corr_value = {0.74, 0.88};
+  }
   return m;
 }
 

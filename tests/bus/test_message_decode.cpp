@@ -116,6 +116,15 @@ fit_t make_fit() {
   f.finding_ratio = {1, 2};
   f.finding_ratio_stderr = {1, 2};
   f.finding_unit = {"N*m", "s"};
+  f.ndoubts = 2;
+  f.doubts = {"d1", "d2"};
+  f.reading_step = 0.01;
+  f.model_reduced_chi2 = {1, 2};
+  f.ncorrelations = 3;
+  f.corr_model = {0, 1, 1};
+  f.corr_a = {"omega0", "omega0", "c3"};
+  f.corr_b = {"c1", "c3", "c4"};
+  f.corr_value = {0.5, 0.6, -0.9};
   return f;
 }
 explain_t make_explain() {

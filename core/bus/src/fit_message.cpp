@@ -1,5 +1,6 @@
 #include "spindown/fit_message.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
 #include <limits>
@@ -92,6 +93,24 @@ fit_t to_fit_message(const RunFit& fit, const FitProvenance& about, std::int64_t
   m.t_end_s = fit.run.t_end_s;
   m.end = end_name(fit.run.end);
   m.last_seq = about.last_seq;
+  m.ndoubts = static_cast<std::int32_t>(fit.doubts.size());
+  m.doubts = fit.doubts;
+  m.reading_step = fit.reading_step;
+  m.ncorrelations = 0;
+  for (std::size_t i = 0; i < fit.models.size(); ++i) {
+    const ModelFit& f = fit.models[i];
+    m.model_reduced_chi2.push_back(f.reduced_chi2);
+    const std::size_t k = f.correlated.size();
+    if (f.correlation.size() != k * k) continue;
+    for (std::size_t a = 0; a < k; ++a)
+      for (std::size_t b = a + 1; b < k; ++b) {
+        m.corr_model.push_back(static_cast<std::int32_t>(i));
+        m.corr_a.push_back(f.correlated[a]);
+        m.corr_b.push_back(f.correlated[b]);
+        m.corr_value.push_back(f.correlation[a * k + b]);
+        ++m.ncorrelations;
+      }
+  }
   return m;
 }
 
@@ -162,6 +181,43 @@ std::optional<RunFit> from_fit_message(const fit_t& m, std::string* why) {
   }
   fit.best = m.best;
   fit.best_reason = m.best_reason;
+  const auto nd = static_cast<std::size_t>(std::max(m.ndoubts, 0));
+  const auto nc = static_cast<std::size_t>(std::max(m.ncorrelations, 0));
+  if (m.doubts.size() != nd || m.model_reduced_chi2.size() != nm || m.corr_model.size() != nc ||
+      m.corr_a.size() != nc || m.corr_b.size() != nc || m.corr_value.size() != nc) {
+    fail(why, fmt::format("FIT of bench {} run {}: array sizes do not match ndoubts {} / ncorrelations {}", m.bench,
+                          m.run, m.ndoubts, m.ncorrelations));
+    return std::nullopt;
+  }
+  fit.doubts = m.doubts;
+  fit.reading_step = m.reading_step;
+  for (std::size_t i = 0; i < nm; ++i) fit.models[i].reduced_chi2 = m.model_reduced_chi2[i];
+  // Each model's correlation matrix again, from its pairs (omega0 first, as fit_run orders them).
+  for (std::size_t c = 0; c < nc; ++c) {
+    const std::int32_t i = m.corr_model[c];
+    if (i < 0 || static_cast<std::size_t>(i) >= nm) {
+      fail(why, fmt::format("FIT of bench {} run {}: correlation {} belongs to model {} of {}", m.bench, m.run, c, i,
+                            nm));
+      return std::nullopt;
+    }
+    auto& names = fit.models[static_cast<std::size_t>(i)].correlated;
+    for (const std::string* n : {&m.corr_a[c], &m.corr_b[c]})
+      if (std::find(names.begin(), names.end(), *n) == names.end()) names.push_back(*n);
+  }
+  for (std::size_t i = 0; i < nm; ++i) {
+    ModelFit& f = fit.models[i];
+    const std::size_t k = f.correlated.size();
+    f.correlation.assign(k * k, std::numeric_limits<double>::quiet_NaN());
+    for (std::size_t a = 0; a < k; ++a) f.correlation[a * k + a] = 1.0;
+  }
+  for (std::size_t c = 0; c < nc; ++c) {
+    ModelFit& f = fit.models[static_cast<std::size_t>(m.corr_model[c])];
+    const auto index = [&](const std::string& n) {
+      return static_cast<std::size_t>(std::find(f.correlated.begin(), f.correlated.end(), n) - f.correlated.begin());
+    };
+    const std::size_t k = f.correlated.size(), a = index(m.corr_a[c]), b = index(m.corr_b[c]);
+    f.correlation[a * k + b] = f.correlation[b * k + a] = m.corr_value[c];
+  }
   return fit;
 }
 

@@ -204,6 +204,15 @@ constexpr WireField fit_fields[] = {
     {"finding_unit", Wire::string, 40},             // 51
     {"t_end_s", Wire::f64},                         // 52
     {"end", Wire::string},                          // 53
+    {"ndoubts", Wire::i32},                         // 54
+    {"doubts", Wire::string, 54},                   // 55
+    {"reading_step", Wire::f64},                    // 56
+    {"model_reduced_chi2", Wire::f64, 11},          // 57
+    {"ncorrelations", Wire::i32},                   // 58
+    {"corr_model", Wire::i32, 58},                  // 59
+    {"corr_a", Wire::string, 58},                   // 60
+    {"corr_b", Wire::string, 58},                   // 61
+    {"corr_value", Wire::f64, 58},                  // 62
 };
 
 constexpr WireField explain_fields[] = {

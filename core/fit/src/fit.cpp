@@ -7,6 +7,7 @@
 
 #include "coulomb_scan.hpp"
 #include "fit_covariance.hpp"
+#include "spindown/fit_checks.hpp"
 #include "fit_evaluator.hpp"
 #include "fit_family.hpp"
 #include "fit_lm.hpp"
@@ -84,6 +85,20 @@ ModelFit fit_model(ModelKind kind, std::span<const double> tau, std::span<const 
   out.rate = th.alpha;
   out.decel = th.beta / k;
 
+  out.wsse = wsse;
+  if (cv.ok) {
+    // Correlations of (omega0, the friction coefficients): each is a positive multiple of one of
+    // the free parameters (u0, α, β), so their correlations are those of θ.
+    out.correlated = {"omega0"};
+    if (fam.alpha_free) out.correlated.emplace_back(kind == ModelKind::combined ? "c3" : "c1");
+    if (fam.beta_free) out.correlated.emplace_back(kind == ModelKind::combined ? "c4" : "c2");
+    for (int i = 0; i < p; ++i)
+      for (int j = 0; j < p; ++j) {  // from the upper triangle, so the matrix is exactly symmetric
+        const int a = std::min(i, j), b = std::max(i, j);
+        const double d = std::sqrt(cv.cov(a, a) * cv.cov(b, b));
+        out.correlation.push_back(a == b ? 1.0 : d > 0 ? cv.cov(a, b) / d : nan);
+      }
+  }
   out.converged = solved && cv.ok;
   if (!solved) out.message = why;
   else if (!cv.ok) out.message = "parameters are not identifiable from this run (singular Jacobian)";
@@ -206,7 +221,8 @@ RunFit fit_run(std::span<const double> t_s, std::span<const double> value, Quant
       moving_end - begin - std::size_t(std::lower_bound(out_lo, out_hi, moving_end) - out_lo);
   const std::string_view runit = quantity_unit(q);
   // Weights from the run's own noise (σ² growing with the reading), shared by every model.
-  if (opt.weighted) weigh_by_noise_into(y, weight);
+  ReadingNoise noise;
+  if (opt.weighted) noise = weigh_by_noise_into(y, weight);
   else std::fill(weight.begin(), weight.end(), 1.0);
   Evaluator eval(tau, y, weight);  // one workspace for every model of the run
   const IntegralForm form = integral_form(tau, y, moving);
@@ -229,6 +245,18 @@ RunFit fit_run(std::span<const double> t_s, std::span<const double> value, Quant
     ModelFit again = fit_model(ModelKind::combined, tau, y, moving, k, opt.bench, runit, &eval, form, &restart);
     again.evaluations += m.evaluations;
     if (again.converged && again.aic < m.aic) m = std::move(again);
+  }
+
+  // χ² per degree of freedom against the run's noise model: the weights are 1/σ²(u) scaled to
+  // average 1, so Σ r²/σ² = wsse · mean(1/σ²).
+  if (noise.known) {
+    double inv = 0;
+    for (double v : y) inv += 1.0 / std::max(noise.variance(v), 1e-300);
+    inv /= static_cast<double>(n);
+    for (auto& m : out.models) {
+      const double dof = static_cast<double>(n) - static_cast<double>(family_of(m.kind).size());
+      if (m.converged && dof > 0) m.reduced_chi2 = m.wsse * inv / dof;
+    }
   }
 
   // Best model: lowest BIC among converged fits (BIC penalises the extra parameter).
@@ -254,6 +282,7 @@ RunFit fit_run(std::span<const double> t_s, std::span<const double> value, Quant
       out.best_reason = out.models.size() == 1 ? "the only model asked for" : "the only model that converged";
     }
   }
+  check_fit(out, tau, y, moving, std::span<const double>(value.data() + begin, end - begin), k);
   return out;
 }
 

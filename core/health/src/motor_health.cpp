@@ -394,6 +394,8 @@ HealthVerdict assess_health(const RunFit& fit, const MotorHealthConfig& cfg) {
     v.findings.push_back(std::move(f));
   }
   lab_rules(fit, best, th, v.findings);
+  // A doubt about the numbers themselves (units, a model that misses): nothing is judged OK on them.
+  for (const auto& d : fit.doubts) v.findings.push_back(note_finding("fit", HealthLevel::check, "doubtful fit: " + d));
 
   for (const auto& f : v.findings) v.level = std::max(v.level, f.level);
   std::vector<const HealthFinding*> flagged;

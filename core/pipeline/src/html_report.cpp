@@ -430,6 +430,7 @@ std::string coefficient_table(const RunFit& fit) {
   }
   s += "</table>\n";
   if (!fit.best_reason.empty()) s += fmt::format("<p class=\"meta\">best: {}</p>\n", esc(fit.best_reason));
+  for (const auto& d : fit.doubts) s += fmt::format("<p class=\"fail\">doubtful: {}</p>\n", esc(d));
   return s;
 }
 

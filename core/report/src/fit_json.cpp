@@ -59,6 +59,13 @@ void write_run_fit(PrettyJsonWriter& w, const RunFit& fit, const ReportOptions& 
       w.member_number("value", p.value);
       w.member_number("stderr", p.std_error);
       w.member("unit", p.unit);
+      w.key("ci95");
+      w.begin_array();
+      w.element();
+      w.number(p.value - 1.96 * p.std_error);
+      w.element();
+      w.number(p.value + 1.96 * p.std_error);
+      w.end_array();
       if (opt.lab_units)
         if (auto lab = lab_unit_for(p.unit)) {
           w.key("lab");
@@ -79,6 +86,29 @@ void write_run_fit(PrettyJsonWriter& w, const RunFit& fit, const ReportOptions& 
     w.member_number("t_stop_pred_s", m.t_stop_pred_s);
     w.key("n"); w.unsigned_integer(m.n);
     w.member("converged", m.converged);
+    w.member_number("reduced_chi2", m.reduced_chi2);
+    w.key("correlation");
+    w.begin_object();
+    w.key("params");
+    w.begin_array();
+    for (const auto& name : m.correlated) {
+      w.element();
+      w.string(name);
+    }
+    w.end_array();
+    w.key("matrix");
+    w.begin_array();
+    for (std::size_t i = 0; i < m.correlated.size(); ++i) {
+      w.element();
+      w.begin_array();
+      for (std::size_t j = 0; j < m.correlated.size(); ++j) {
+        w.element();
+        w.number(m.correlation[i * m.correlated.size() + j]);
+      }
+      w.end_array();
+    }
+    w.end_array();
+    w.end_object();
     if (!m.message.empty()) w.member("message", m.message);
     w.end_object();
   }
@@ -87,6 +117,14 @@ void write_run_fit(PrettyJsonWriter& w, const RunFit& fit, const ReportOptions& 
   if (fit.best.empty()) w.null();
   else w.string(fit.best);
   w.member("best_reason", explain_best(fit));
+  w.key("doubts");
+  w.begin_array();
+  for (const auto& d : fit.doubts) {
+    w.element();
+    w.string(d);
+  }
+  w.end_array();
+  w.member_number("reading_step", fit.reading_step);
   w.member("stopped", run.stopped);
   w.member("end", end_name(run.end));
   w.member_number("t_end_s", run.t_end_s);

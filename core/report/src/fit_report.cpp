@@ -195,6 +195,34 @@ std::vector<std::string> summarize_diagnostics(std::span<const Diagnostic> diagn
   return lines;
 }
 
+namespace {
+
+// What lmfit's and SciPy's reports hold beside the values: 95 % intervals, the correlation of the
+// parameters and the reduced χ² of the weighted fit (against the run's own noise model).
+std::string fit_details(const RunFit& fit, const std::string& unit) {
+  std::string out = "\n  details (95 % interval = value ± 1.96 standard errors):\n";
+  if (fit.reading_step > 0) out += fmt::format("    reading step {:.3g} {}\n", fit.reading_step, unit);
+  for (const auto& m : fit.models) {
+    if (!m.converged) continue;
+    out += fmt::format("    {}: reduced χ² {}\n", model_name(m.kind),
+                       std::isfinite(m.reduced_chi2) ? fmt::format("{:.3g}", m.reduced_chi2) : std::string("-"));
+    for (const auto& name : m.correlated) {
+      const Parameter* p = m.param(name);
+      if (!p) continue;
+      out += fmt::format("      {:<7} 95 %: [{:.6g}, {:.6g}] {}\n", p->name, p->value - 1.96 * p->std_error,
+                         p->value + 1.96 * p->std_error, p->unit);
+    }
+    const std::size_t k = m.correlated.size();
+    for (std::size_t i = 0; i < k; ++i)
+      for (std::size_t j = i + 1; j < k; ++j)
+        out += fmt::format("      correlation {}–{}: {:+.3f}\n", m.correlated[i], m.correlated[j],
+                           m.correlation[i * k + j]);
+  }
+  return out;
+}
+
+}  // namespace
+
 std::string format_run_fit(const RunFit& fit, const ReportOptions& opt) {
   const Run& run = fit.run;
   const std::string unit(quantity_unit(fit.quantity));
@@ -230,8 +258,10 @@ std::string format_run_fit(const RunFit& fit, const ReportOptions& opt) {
   out += render_table(rows, "  ");
   out += fit.best.empty() ? fmt::format("\n  best: none ({})\n", explain_best(fit))
                           : fmt::format("\n  best: {} — {}\n", fit.best, explain_best(fit));
+  for (const auto& d : fit.doubts) out += fmt::format("  doubtful: {}\n", d);
   for (const auto& m : fit.models)
     if (!m.message.empty()) out += fmt::format("  {}: {}\n", model_name(m.kind), m.message);
+  if (opt.details) out += fit_details(fit, unit);
   return out;
 }
 

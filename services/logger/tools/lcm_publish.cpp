@@ -100,8 +100,16 @@ spindown::fit_t make_fit(const std::string& bench, std::int64_t now) {
   // Every per-model array must have nmodels entries or the encoder reads past the end.
   f.model_samples.assign(f.nmodels, f.samples);
   f.model_message.assign(f.nmodels, "");
+  f.model_reduced_chi2.assign(f.nmodels, 1.0);
   f.first_seq = 0;
   f.last_seq = 1861;
+  f.ndoubts = 0;
+  f.reading_step = 0.01;
+  f.ncorrelations = 1;
+  f.corr_model = {2};
+  f.corr_a = {"c3"};
+  f.corr_b = {"c4"};
+  f.corr_value = {-0.96};
   return f;
 }
 

@@ -8,6 +8,7 @@
 // projected out, combined by Levenberg–Marquardt from the integral form's linear solution (NLopt
 // under bounds as the fallback); standard errors from the Jacobian at the optimum (widened when
 // residuals are correlated).
+#include <limits>
 #include <optional>
 #include <span>
 #include <string>
@@ -43,6 +44,14 @@ struct ModelFit {
   std::size_t n = 0;              // samples fitted
   int evaluations = 0;
   bool converged = false;
+  double wsse = 0;                // weighted sum of squared residuals (the weights average 1)
+  // χ² of the weighted fit against the run's own noise model (reading_noise.hpp), per degree of
+  // freedom: about 1 when the model and the noise model hold; NaN when the noise is not known.
+  double reduced_chi2 = std::numeric_limits<double>::quiet_NaN();
+  // Correlation of the fitted parameters (omega0, then the model's friction coefficients), row
+  // by row; empty when the covariance is not known.
+  std::vector<std::string> correlated;
+  std::vector<double> correlation;
   std::string message;            // why it did not converge, etc.
 
   const Parameter* param(std::string_view name) const;
@@ -63,8 +72,13 @@ struct RunFit {
   BenchParams bench;
   Quantity quantity = Quantity::back_emf_volts;
   std::vector<ModelFit> models;
-  std::string best;         // model name with the lowest BIC among converged fits
+  std::string best;         // model name with the lowest BIC among converged fits, unless the
+                            // reading's step cannot resolve what the extra term adds (fit_checks.hpp)
   std::string best_reason;  // why, in words (ΔBIC, RMSE)
+  double reading_step = 0;  // the readings' quantization step (0: not quantized)
+  // Why the numbers should not be trusted as they stand (units, a model that misses), in words for
+  // the default output; empty when nothing is doubted (fit_checks.hpp).
+  std::vector<std::string> doubts;
   const ModelFit* model(ModelKind k) const;
 };
 

@@ -41,6 +41,7 @@ struct ReportOptions {
   bool lab_units = false;          // add g·cm², g·cm²·s⁻¹, g·cm²·rad·s⁻² beside SI
   std::size_t max_diagnostics = 8; // shown per file before the rest is summarised; 0 = all
   bool diagnostics_in_text = true; // false when the caller prints them elsewhere (stderr)
+  bool details = false;            // text: 95 % intervals, correlations, reduced χ² (JSON has them always)
 };
 
 // JSON keeps insertion order so the object reads like the contract.

@@ -1,0 +1,60 @@
+#pragma once
+// What a fit's numbers cannot say by themselves: whether the assumptions that make them right
+// held. Each check gives words for the default output (never only with -v), the JSON's
+// "doubts" and the health verdict, which is never OK while a doubt stands.
+//  - units: readings no bench of this kind can produce (a back-EMF far beyond the Arduino's 5 V,
+//    a speed no flywheel reaches) mean the unit is wrong; the likely fix is named;
+//  - resolution: an extra friction term that changes the fitted curve by less than half the
+//    reading's printed step cannot be told from the simpler model, whatever the likelihood of
+//    continuous noise says (the print and the ADC quantize);
+//  - model miss: the best model's residuals, in bins, lie further from zero than the run's own
+//    noise allows: a physical effect is missing (spindown explain names it).
+#include <cstddef>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "spindown/fit.hpp"
+
+namespace spindown {
+
+// The largest back-EMF reading a lab bench produces (V) and the fastest shaft (rad/s, ~28,600
+// rpm) a teaching flywheel reaches; beyond them the unit is doubted.
+inline constexpr double plausible_max_volts = 30.0;
+inline constexpr double plausible_max_omega = 3000.0;
+
+// The readings' quantization step (the smallest gap between distinct values, when most gaps are
+// whole multiples of it), 0 when the readings are not quantized.
+double reading_step(std::span<const double> values);
+
+// Doubts about the units of a fit's readings (empty when plausible). peak: the largest reading
+// of the run.
+std::vector<std::string> unit_doubts(const RunFit& fit, double peak);
+
+// The largest difference, over the times tau (s after the cut), between two fitted models'
+// curves in the reading's unit (k: reading per rad/s).
+double largest_curve_difference(const ModelFit& a, const ModelFit& b, std::span<const double> tau, double k);
+
+// How far the best model's residuals lie from zero in bins of residual_bin samples over the
+// moving part of the coast, against the run's own noise (from the residuals' first differences,
+// which the smooth part cancels) and the reading's step (a bin's mean is known no better than
+// step/√12): the bins' z-scores.
+inline constexpr std::size_t residual_bin = 25;
+struct ResidualStructure {
+  std::size_t bins = 0;
+  std::size_t beyond = 0;     // bins further than 4 standard errors from zero
+  double mean_z2 = 0;         // mean squared z of the bins (about 1 for a model that holds)
+  double worst_tau_s = 0;     // where the worst bin lies (s after the cut)
+  double worst_mean = 0;      // its mean residual (reading unit)
+};
+ResidualStructure residual_structure(const ModelFit& m, std::span<const double> tau, std::span<const double> y,
+                                     std::size_t moving, double k, double step);
+
+// All of the above for one fitted run (fit_run calls it last): sets reading_step and doubts,
+// and keeps the simpler model as best when the print cannot resolve what the extra term adds.
+// tau, y: the fitted samples (y less the zero level), the first `moving` of them before the
+// stop; raw: the run's readings as read.
+void check_fit(RunFit& fit, std::span<const double> tau, std::span<const double> y, std::size_t moving,
+               std::span<const double> raw, double k);
+
+}  // namespace spindown

@@ -1,0 +1,176 @@
+#include "spindown/fit_checks.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fmt/format.h>
+#include <limits>
+
+namespace spindown {
+
+double reading_step(std::span<const double> values) {
+  std::vector<double> v(values.begin(), values.end());
+  std::sort(v.begin(), v.end());
+  v.erase(std::unique(v.begin(), v.end()), v.end());
+  if (v.size() < 8) return 0;
+  double step = INFINITY;
+  for (std::size_t i = 1; i < v.size(); ++i) step = std::min(step, v[i] - v[i - 1]);
+  if (!(step > 0) || !std::isfinite(step)) return 0;
+  // Quantized: (nearly) every gap is a whole number of steps.
+  std::size_t whole = 0;
+  for (std::size_t i = 1; i < v.size(); ++i) {
+    const double k = (v[i] - v[i - 1]) / step;
+    whole += std::fabs(k - std::round(k)) < 0.05;
+  }
+  return whole * 10 >= (v.size() - 1) * 9 ? step : 0.0;
+}
+
+std::vector<std::string> unit_doubts(const RunFit& fit, double peak) {
+  std::vector<std::string> out;
+  const ModelFit* best = nullptr;
+  for (const auto& m : fit.models)
+    if (model_name(m.kind) == fit.best) best = &m;
+  const double omega0 = best ? best->omega0 : std::numeric_limits<double>::quiet_NaN();
+  const double rpm_per_volt = 60.0 / (2 * M_PI) / fit.bench.kb_v_s_per_rad;
+  switch (fit.quantity) {
+    case Quantity::back_emf_volts:
+      if (peak > plausible_max_volts) {
+        const bool looks_rpm = std::fabs(peak / rpm_per_volt) <= 12.0;
+        out.push_back(fmt::format(
+            "readings up to {:.6g} V: far beyond any back-EMF a lab bench makes or an Arduino pin reads (0–5 V){} — "
+            "the numbers below are not the motor's friction",
+            peak,
+            looks_rpm ? fmt::format("; they look like a speed in rpm ({:.3g} V at {:.0f} rpm/V): try --value-unit rpm",
+                                    peak / rpm_per_volt, rpm_per_volt)
+                      : std::string("; check the value's unit (--value-unit V, rpm or rad/s)")));
+        return out;
+      }
+      break;
+    case Quantity::rpm:
+      if (peak < 20.0 && peak > 0) {
+        out.push_back(fmt::format("readings of at most {:.3g} rpm: a motor that barely turns, or volts read as rpm "
+                                  "— try --value-unit V",
+                                  peak));
+        return out;
+      }
+      break;
+    case Quantity::rad_per_s:
+      break;
+  }
+  if (std::isfinite(omega0) && omega0 > plausible_max_omega)
+    out.push_back(fmt::format("a speed at the cut of {:.6g} rad/s ({:.0f} rpm): faster than a teaching flywheel "
+                              "turns — check the value's unit (--value-unit) and K_b",
+                              omega0, omega0 * 60 / (2 * M_PI)));
+  return out;
+}
+
+double largest_curve_difference(const ModelFit& a, const ModelFit& b, std::span<const double> tau, double k) {
+  double most = 0;
+  for (double t : tau) most = std::max(most, std::fabs(k * (a.omega_at(t) - b.omega_at(t))));
+  return most;
+}
+
+namespace {
+
+double median_in_place(std::vector<double>& v) {
+  if (v.empty()) return 0;
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+const ModelFit* model_named(const RunFit& fit, std::string_view name) {
+  for (const auto& m : fit.models)
+    if (model_name(m.kind) == name) return &m;
+  return nullptr;
+}
+
+int free_parameters(ModelKind k) { return k == ModelKind::combined ? 3 : 2; }
+
+}  // namespace
+
+ResidualStructure residual_structure(const ModelFit& m, std::span<const double> tau, std::span<const double> y,
+                                     std::size_t moving, double k, double step) {
+  ResidualStructure out;
+  const std::size_t n = std::min({moving, tau.size(), y.size()});
+  if (n < 4 * residual_bin) return out;
+  std::vector<double> r(n);
+  for (std::size_t i = 0; i < n; ++i) r[i] = y[i] - k * m.omega_at(tau[i]);
+  // The noise of one reading from first differences: the smooth misfit cancels in them.
+  std::vector<double> d(n - 1);
+  for (std::size_t i = 1; i < n; ++i) d[i - 1] = std::fabs(r[i] - r[i - 1]);
+  double sigma = 1.4826 * median_in_place(d) / std::sqrt(2.0);
+  if (!(sigma > 0)) {  // mostly equal readings (a fine step): the rms of the differences instead
+    double ss = 0;
+    for (std::size_t i = 1; i < n; ++i) ss += (r[i] - r[i - 1]) * (r[i] - r[i - 1]);
+    sigma = std::sqrt(ss / (2.0 * static_cast<double>(n - 1)));
+  }
+  if (!(sigma > 0)) return out;
+  // A slow reading sits on one printed step for many samples: its rounding does not average out
+  // within a bin, so a bin's mean is known no better than the step's own spread, step/√12.
+  const double se = std::hypot(sigma / std::sqrt(static_cast<double>(residual_bin)), step / std::sqrt(12.0));
+  double worst = 0;
+  for (std::size_t b = 0; b + residual_bin <= n; b += residual_bin) {
+    double mean = 0;
+    for (std::size_t i = b; i < b + residual_bin; ++i) mean += r[i];
+    mean /= static_cast<double>(residual_bin);
+    const double z = mean / se;
+    ++out.bins;
+    out.beyond += std::fabs(z) > 4;
+    out.mean_z2 += z * z;
+    if (std::fabs(z) > worst) {
+      worst = std::fabs(z);
+      out.worst_tau_s = tau[b + residual_bin / 2];
+      out.worst_mean = mean;
+    }
+  }
+  if (out.bins) out.mean_z2 /= static_cast<double>(out.bins);
+  return out;
+}
+
+void check_fit(RunFit& fit, std::span<const double> tau, std::span<const double> y, std::size_t moving,
+               std::span<const double> raw, double k) {
+  fit.reading_step = reading_step(raw);
+  double peak = 0;
+  for (double v : raw) peak = std::max(peak, v);
+  fit.doubts = unit_doubts(fit, peak);
+
+  // What the print can resolve: a model with more friction terms whose curve stays within half a
+  // step of a simpler one's is not told apart from it by the readings, whatever ΔBIC says.
+  const ModelFit* best = model_named(fit, fit.best);
+  if (best && fit.reading_step > 0) {
+    const ModelFit* simpler = nullptr;
+    double gap = 0;
+    for (const auto& m : fit.models) {
+      if (!m.converged || free_parameters(m.kind) >= free_parameters(best->kind)) continue;
+      const double diff = largest_curve_difference(*best, m, tau, k);
+      if (diff < 0.5 * fit.reading_step && (!simpler || m.bic < simpler->bic)) simpler = &m, gap = diff;
+    }
+    if (simpler) {
+      const std::string unit(quantity_unit(fit.quantity));
+      fit.best_reason = fmt::format(
+          "{} kept: {} changes the curve by at most {:.2g} {}, under half the reading's step of {:.3g} {} — the "
+          "readings cannot tell them apart (by BIC alone {} would win, ΔBIC {:.1f})",
+          model_name(simpler->kind), model_name(best->kind), gap, unit, fit.reading_step, unit,
+          model_name(best->kind), simpler->bic - best->bic);
+      fit.best = std::string(model_name(simpler->kind));
+      best = simpler;
+    }
+  }
+
+  // A best model that misses: its residuals, binned, stand further from zero than the run's noise.
+  if (best && fit.doubts.empty()) {
+    const ResidualStructure rs = residual_structure(*best, tau, y, moving, k, fit.reading_step);
+    if (std::getenv("SPINDOWN_DEBUG_CHECKS"))
+      fmt::print(stderr, "check: best {} bins {} beyond {} mean_z2 {:.2f} chi2 {:.2f} step {}\n", fit.best, rs.bins,
+                 rs.beyond, rs.mean_z2, best->reduced_chi2, fit.reading_step);
+    if (rs.bins >= 8 && rs.beyond * 4 >= rs.bins && rs.mean_z2 > 9)
+      fit.doubts.push_back(fmt::format(
+          "the {} model misses: its residuals stand out of the run's noise in {} of {} stretches of {} samples "
+          "(worst {:.2g} {} at {:.1f} s after the cut) — friction the model lacks; run `spindown explain` on this "
+          "file to name it",
+          fit.best, rs.beyond, rs.bins, residual_bin, rs.worst_mean, quantity_unit(fit.quantity), rs.worst_tau_s));
+  }
+}
+
+}  // namespace spindown
