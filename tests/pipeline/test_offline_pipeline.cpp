@@ -65,6 +65,19 @@ config_t config(const std::string& bench, double j, double kb) {
   return c;
 }
 
+samples_t one_sample(const std::string& bench, std::int64_t seq, std::int64_t t_us, double value) {
+  samples_t m{};
+  m.bench = bench;
+  m.seq = seq;
+  m.quantity = samples_t::QUANTITY_BACK_EMF_V;
+  m.n = 1;
+  m.device_time_us = {t_us};
+  m.host_time_us = {0};
+  m.value = {value};
+  m.raw_adc = {-1};
+  return m;
+}
+
 // Bench "b" comes first (a CONFIG, then samples that are all NaN: no usable sample); bench "a"
 // has a CONFIG and a whole run.
 std::string two_bench_log() {
@@ -74,29 +87,12 @@ std::string two_bench_log() {
   EXPECT_TRUE(log.good());
   write_event(log, "SPINDOWN.b.CONFIG", config("b", 3e-5, 0.02), 1);
   write_event(log, "SPINDOWN.a.CONFIG", config("a", 2e-5, 0.01), 2);
-  for (int i = 0; i < 3; ++i) {
-    samples_t m{};
-    m.bench = "b";
-    m.seq = i;
-    m.quantity = samples_t::QUANTITY_BACK_EMF_V;
-    m.n = 1;
-    m.device_time_us = {20000 * (i + 1)};
-    m.host_time_us = {0};
-    m.value = {std::nan("")};
-    m.raw_adc = {-1};
-    write_event(log, "SPINDOWN.b.SAMPLE", m, 3 + i);
-  }
+  for (int i = 0; i < 3; ++i)
+    write_event(log, "SPINDOWN.b.SAMPLE", one_sample("b", i, 20000 * (i + 1), std::nan("")), 3 + i);
   for (std::size_t i = 0; i < run.t_ms.size(); ++i) {
-    samples_t m{};
-    m.bench = "a";
-    m.seq = static_cast<std::int64_t>(i);
-    m.quantity = samples_t::QUANTITY_BACK_EMF_V;
-    m.n = 1;
-    m.device_time_us = {std::llround(run.t_ms[i] * 1000)};
-    m.host_time_us = {0};
-    m.value = {run.volts[i]};
-    m.raw_adc = {-1};
-    write_event(log, "SPINDOWN.a.SAMPLE", m, 10 + static_cast<std::int64_t>(i));
+    const auto seq = static_cast<std::int64_t>(i);
+    write_event(log, "SPINDOWN.a.SAMPLE", one_sample("a", seq, std::llround(run.t_ms[i] * 1000), run.volts[i]),
+                10 + seq);
   }
   return path;
 }
