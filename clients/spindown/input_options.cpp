@@ -70,6 +70,16 @@ std::function<void()> add_input_options(CLI::App* sub, InputOptions& opt) {
                  ->check(positive)
                  ->group("Bench");
   kb->excludes(kv);
+  sub->add_option("--inertia-error", opt.inertia_error_pct,
+                  "Standard uncertainty of J in % (geometry, density): carried into c1…c4 beside their statistical "
+                  "error (default 0: J taken as exact)")
+      ->check(CLI::Range(0.0, 100.0))
+      ->group("Bench");
+  sub->add_option("--kb-error", opt.kb_error_pct,
+                  "Standard uncertainty of K_b in % (datasheet tolerance): carried into c2, c4 and omega0 of a "
+                  "back-EMF reading (default 0)")
+      ->check(CLI::Range(0.0, 100.0))
+      ->group("Bench");
 
   const char* text = "Delimited text";
   sub->add_option("--time-column", opt.time_column, "Time column: header name or 1-based index")->group(text);
@@ -110,6 +120,8 @@ BenchParams bench_from(const InputOptions& o) {
   }
   std::string why;
   if (!bench.is_valid(&why)) bad_usage(why);
+  bench.inertia_rel_error = o.inertia_error_pct / 100;
+  bench.kb_rel_error = o.kb_error_pct / 100;
   return bench;
 }
 

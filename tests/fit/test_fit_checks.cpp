@@ -102,3 +102,28 @@ TEST(FitChecks, ReadingStep) {
   EXPECT_NEAR(reading_step(std::vector<double>{0, 0.01, 0.03, 0.04, 0.07, 0.1, 0.12, 0.2, 0.21}), 0.01, 1e-12);
   EXPECT_EQ(reading_step(std::vector<double>{0.1234, 0.52, 0.9871, 1.3, 1.77, 2.01, 2.333, 2.9, 3.1}), 0.0);
 }
+
+// J (geometry) and K_b (datasheet) are not exact: their uncertainty goes into each coefficient as
+// c scales with them, beside the statistical error.
+TEST(FitChecks, UncertaintyOfJAndKbIsCarriedIntoTheCoefficients) {
+  SyntheticRunSpec spec;
+  spec.bench.inertia_rel_error = 0.02;
+  spec.bench.kb_rel_error = 0.01;
+  const Case c = make_case(spec);
+  const RunFit f = fit_of(c, c.run.volts);
+  const ModelFit* m = f.model(ModelKind::combined);
+  ASSERT_NE(m, nullptr);
+  EXPECT_DOUBLE_EQ(m->param("c3")->bench_error, 0.02 * m->param("c3")->value);              // c3 = α·J
+  EXPECT_DOUBLE_EQ(m->param("c4")->bench_error, std::hypot(0.02, 0.01) * m->param("c4")->value);  // β·J/K_b
+  EXPECT_DOUBLE_EQ(m->param("omega0")->bench_error, 0.01 * m->param("omega0")->value);      // u0/K_b
+  EXPECT_EQ(m->param("A")->bench_error, 0.0);
+  // A speed reading needs no K_b: only J's part remains.
+  std::vector<double> rad_s;
+  for (double v : c.run.volts) rad_s.push_back(v / spec.bench.kb_v_s_per_rad);
+  const ModelFit* s = fit_of(c, rad_s, Quantity::rad_per_s).model(ModelKind::combined);
+  ASSERT_NE(s, nullptr);
+  EXPECT_DOUBLE_EQ(s->param("c4")->bench_error, 0.02 * s->param("c4")->value);
+  EXPECT_EQ(s->param("omega0")->bench_error, 0.0);
+  // Exact J and K_b (the default): nothing added.
+  EXPECT_EQ(fit_of(make_case(SyntheticRunSpec{}), c.run.volts).model(ModelKind::combined)->param("c3")->bench_error, 0.0);
+}

@@ -247,6 +247,20 @@ RunFit fit_run(std::span<const double> t_s, std::span<const double> value, Quant
     if (again.converged && again.aic < m.aic) m = std::move(again);
   }
 
+  // J and K_b's own uncertainty in each coefficient: c = α·J (c1, c3) or β·J/k (c2, c4) and
+  // ω0 = u0/k, where k is K_b for a back-EMF reading and a constant for a speed.
+  {
+    const double rj = opt.bench.inertia_rel_error, rk = q == Quantity::back_emf_volts ? opt.bench.kb_rel_error : 0.0;
+    for (auto& m : out.models)
+      for (auto& p : m.params) {
+        const double rel = p.name == "c1" || p.name == "c3"   ? rj
+                           : p.name == "c2" || p.name == "c4" ? std::hypot(rj, rk)
+                           : p.name == "omega0"               ? rk
+                                                              : 0.0;
+        p.bench_error = std::fabs(p.value) * rel;
+      }
+  }
+
   // χ² per degree of freedom against the run's noise model: the weights are 1/σ²(u) scaled to
   // average 1, so Σ r²/σ² = wsse · mean(1/σ²).
   if (noise.known) {

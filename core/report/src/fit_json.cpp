@@ -59,6 +59,8 @@ void write_run_fit(PrettyJsonWriter& w, const RunFit& fit, const ReportOptions& 
       w.member_number("value", p.value);
       w.member_number("stderr", p.std_error);
       w.member("unit", p.unit);
+      w.member_number("bench_stderr", p.bench_error);
+      w.member_number("total_stderr", std::hypot(p.std_error, p.bench_error));
       w.key("ci95");
       w.begin_array();
       w.element();

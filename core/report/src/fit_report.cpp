@@ -91,6 +91,8 @@ std::string coefficient_cell(const ModelFit& m, const ReportOptions& opt) {
     if (is_curve_constant(p)) continue;
     if (!cell.empty()) cell += '\n';
     cell += display_name(p) + " = " + with_unit(format_value_error(p.value, p.std_error), p.unit);
+    if (p.bench_error > 0)  // J and K_b's own uncertainty beside the statistical one
+      cell += "\n  with J, K_b: " + format_value_error(p.value, std::hypot(p.std_error, p.bench_error));
     if (opt.lab_units)
       if (auto lab = lab_unit_for(p.unit))
         cell += fmt::format(" = {} {}", format_value_error(p.value * lab->per_si, p.std_error * lab->per_si),
@@ -244,6 +246,9 @@ std::string format_run_fit(const RunFit& fit, const ReportOptions& opt) {
                      run.stopped ? "standstill" : "coast", run.noise_level, unit, run.period_s * 1e3);
   out += fmt::format("  bench: J = {:.6g} kg·m² ({}), K_b = {:.6g} V·s/rad ({})", fit.bench.inertia_kg_m2,
                      fit.bench.inertia_source, fit.bench.kb_v_s_per_rad, fit.bench.kb_source);
+  if (fit.bench.inertia_rel_error > 0 || fit.bench.kb_rel_error > 0)
+    out += fmt::format("; uncertain by {:.3g} % (J), {:.3g} % (K_b)", 100 * fit.bench.inertia_rel_error,
+                       100 * fit.bench.kb_rel_error);
   if (opt.lab_units) out += fmt::format("; J = {:.6g} g·cm²", inertia_to_g_cm2(fit.bench.inertia_kg_m2));
   out += "\n\n";
 

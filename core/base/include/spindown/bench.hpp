@@ -11,6 +11,11 @@ struct BenchParams {
   double kb_v_s_per_rad = 1.0 / 123.569311;        // the lab's motor: 1180 rpm/V
   std::string inertia_source = "lab default";      // how J was obtained, for reports
   std::string kb_source = "lab default";
+  // Relative standard uncertainty of J and of K_b (0.02 = 2 %; 0: taken as exact). c1…c4 scale
+  // with J and, for a back-EMF reading, c2 and c4 with 1/K_b too: fit_run carries these into each
+  // coefficient's bench_error, beside its statistical standard error.
+  double inertia_rel_error = 0;
+  double kb_rel_error = 0;
 
   static BenchParams lab_default() { return {}; }
   bool is_valid(std::string* why) const;  // positive, finite, plausible

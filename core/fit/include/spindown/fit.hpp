@@ -30,6 +30,7 @@ struct Parameter {
   double value = 0;   // SI (curve constants in the reading's unit and seconds)
   double std_error = 0;  // one standard error, same unit ("stderr" in JSON)
   std::string unit;   // "N*m*s/rad", "N*m", "rad/s", "V", "1/s", …
+  double bench_error = 0;  // standard uncertainty from J's and K_b's own (BenchParams::*_rel_error)
 };
 
 struct ModelFit {
