@@ -325,4 +325,24 @@ TEST(LabTable, ChangedFlagFollowsInput) {
 }
 
 }  // namespace
+// An 80-column terminal: short columns, and the last fit's model, RMSE and verdict come before
+// its coefficients, so what matters is never cut off.
+TEST(LabTable, UsableInEightyColumns) {
+  LabTable table;
+  fit_t m = fit_msg("bench-a", 2);
+  m.verdict = "service";
+  table.on_fit("bench-a", m, t0);
+  const std::string text = table.render(t0, 80);
+  std::istringstream lines(text);
+  std::string line, row;
+  while (std::getline(lines, line)) {
+    EXPECT_LE(display_width(line), 80u) << line;
+    if (line.starts_with("bench-a")) row = line;
+  }
+  EXPECT_TRUE(contains(row, "2 combined 0.0123 V; service")) << text;
+  EXPECT_TRUE(contains(text, "BRIDGE")) << text;
+  EXPECT_FALSE(contains(text, "lines ok/bad")) << text;  // the wide header would leave no room for the fit
+}
+
 }  // namespace spindown
+

@@ -71,6 +71,25 @@ std::string gaps_text(const LabBenchRow& r) {
   return fmt::format("{} ({} lost)", r.seq_gaps, r.samples_missing);
 }
 
+// An 80-column terminal: the same facts, the verdict before the coefficients.
+constexpr std::size_t compact_width = 110;
+
+std::string bridge_short(const LabBenchRow& r) {
+  if (!r.has_bridge) return "-";
+  return r.lines_bad ? fmt::format("{} {:.0f} Hz, {} bad", r.bridge_state, r.rate_hz, r.lines_bad)
+                     : fmt::format("{} {:.0f} Hz", r.bridge_state, r.rate_hz);
+}
+
+std::string fit_short(const LabBenchRow& r) {
+  if (!r.has_fit) return "-";
+  if (r.best.empty()) return fmt::format("run {}: no model converged", r.fit_run);
+  std::string s = fmt::format("{}{} {}", r.fit_run, r.fit_partial ? " (partial)" : "", r.best);
+  if (const std::string rmse = rmse_text(r); rmse != "-") s += " " + rmse;
+  if (!r.health.empty()) s += "; " + r.health;
+  if (!r.coefficients.empty()) s += "; " + r.coefficients;
+  return s;
+}
+
 std::string counters_text(const LabServiceRow& s) {
   std::string out;
   for (const auto& [name, value] : s.counters) {
@@ -356,10 +375,19 @@ std::string LabTable::render(std::int64_t now_us, std::size_t width) const {
          '\n';
   std::vector<std::vector<std::string>> rows;
   // Health first, the long fit last: a narrow terminal cuts only the end of the coefficients.
-  rows.push_back({"BENCH", "RUN", "AGE", "BRIDGE (lines ok/bad, rate)", "SEQ GAPS", "RMSE", "LAST FIT (best model)"});
-  for (const auto& [id, r] : benches_)
-    rows.push_back({id, run_state_text(r), age_text(r.last_message_us, now_us, opt_.stale_s), bridge_text(r),
-                    gaps_text(r), rmse_text(r), fit_text(r)});
+  // Below compact_width columns (an 80-column terminal) the columns are short and the last fit
+  // gives its model, RMSE and verdict before the coefficients.
+  if (width > 0 && width < compact_width) {
+    rows.push_back({"BENCH", "RUN", "AGE", "BRIDGE", "GAPS", "LAST FIT"});
+    for (const auto& [id, r] : benches_)
+      rows.push_back({id, run_state_text(r), age_text(r.last_message_us, now_us, opt_.stale_s), bridge_short(r),
+                      r.has_samples ? fmt::format("{}", r.seq_gaps) : "-", fit_short(r)});
+  } else {
+    rows.push_back({"BENCH", "RUN", "AGE", "BRIDGE (lines ok/bad, rate)", "SEQ GAPS", "RMSE", "LAST FIT (best model)"});
+    for (const auto& [id, r] : benches_)
+      rows.push_back({id, run_state_text(r), age_text(r.last_message_us, now_us, opt_.stale_s), bridge_text(r),
+                      gaps_text(r), rmse_text(r), fit_text(r)});
+  }
   out += format_columns(rows, width);
   if (benches_.empty()) out += "(no bench heard yet)\n";
   if (!benches_.empty())
