@@ -9,6 +9,7 @@
 //    continuous noise says (the print and the ADC quantize);
 //  - model miss: the best model's residuals, in bins, lie further from zero than the run's own
 //    noise allows: a physical effect is missing (spindown explain names it).
+#include <cmath>
 #include <cstddef>
 #include <span>
 #include <string>
@@ -23,8 +24,8 @@ namespace spindown {
 inline constexpr double plausible_max_volts = 30.0;
 inline constexpr double plausible_max_omega = 3000.0;
 
-// The readings' quantization step (the smallest gap between distinct values, when most gaps are
-// whole multiples of it), 0 when the readings are not quantized.
+// The readings' quantization step (the smallest change between neighbouring readings, when nearly
+// every reading is a whole number of it from the first), 0 when the readings are not quantized.
 double reading_step(std::span<const double> values);
 
 // Doubts about the units of a fit's readings (empty when plausible). peak: the largest reading
@@ -32,8 +33,13 @@ double reading_step(std::span<const double> values);
 std::vector<std::string> unit_doubts(const RunFit& fit, double peak);
 
 // The largest difference, over the times tau (s after the cut), between two fitted models'
-// curves in the reading's unit (k: reading per rad/s).
-double largest_curve_difference(const ModelFit& a, const ModelFit& b, std::span<const double> tau, double k);
+// curves in the reading's unit (k: reading per rad/s), or a value at least `enough` as soon as one
+// is found.
+double largest_curve_difference(const ModelFit& a, const ModelFit& b, std::span<const double> tau, double k,
+                                double enough = INFINITY);
+
+// The binned residual test runs only when the best model's reduced χ² is above this (or unknown).
+inline constexpr double suspicious_chi2 = 2.0;
 
 // How far the best model's residuals lie from zero in bins of residual_bin samples over the
 // moving part of the coast, against the run's own noise (from the residuals' first differences,
