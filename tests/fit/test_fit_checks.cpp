@@ -120,7 +120,8 @@ TEST(FitChecks, UncertaintyOfJAndKbIsCarriedIntoTheCoefficients) {
   // A speed reading needs no K_b: only J's part remains.
   std::vector<double> rad_s;
   for (double v : c.run.volts) rad_s.push_back(v / spec.bench.kb_v_s_per_rad);
-  const ModelFit* s = fit_of(c, rad_s, Quantity::rad_per_s).model(ModelKind::combined);
+  const RunFit speed = fit_of(c, rad_s, Quantity::rad_per_s);
+  const ModelFit* s = speed.model(ModelKind::combined);
   ASSERT_NE(s, nullptr);
   EXPECT_DOUBLE_EQ(s->param("c4")->bench_error, 0.02 * s->param("c4")->value);
   EXPECT_EQ(s->param("omega0")->bench_error, 0.0);

@@ -4,6 +4,7 @@
 #include <cerrno>
 #include <fmt/format.h>
 #include <poll.h>
+#include <regex.h>
 #include <thread>
 
 #include "spindown/clock.hpp"
@@ -31,6 +32,13 @@ LcmLoop::~LcmLoop() { unsubscribe_all(); }
 bool LcmLoop::subscribe_raw(const std::string& channel_regex, std::function<void(const LcmMessage&)> handler,
                             LcmSubscribeOptions options) {
   if (!lcm_.good()) return false;
+  // LCM 1.3.1 leaks its copy of a pattern that does not compile: the pattern is checked here first,
+  // as LCM compiles it (POSIX extended, anchored at both ends).
+  {
+    regex_t re;
+    if (::regcomp(&re, ("^" + channel_regex + "$").c_str(), REG_NOSUB | REG_EXTENDED) != 0) return false;
+    ::regfree(&re);
+  }
   auto sub = std::make_unique<Subscription>();
   sub->loop = this;
   sub->handle = std::move(handler);
