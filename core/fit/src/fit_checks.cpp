@@ -2,11 +2,22 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <fmt/format.h>
 #include <limits>
 
+#include "fit_family.hpp"
+
 namespace spindown {
+
+namespace {
+
+// The fit's best model (nullptr when none converged).
+const ModelFit* best_model(const RunFit& fit) {
+  const auto kind = parse_model(fit.best);
+  return kind ? fit.model(*kind) : nullptr;
+}
+
+}  // namespace
 
 double reading_step(std::span<const double> values) {
   // The smallest change between neighbouring readings is the step when the readings are quantized:
@@ -32,9 +43,7 @@ double reading_step(std::span<const double> values) {
 
 std::vector<std::string> unit_doubts(const RunFit& fit, double peak) {
   std::vector<std::string> out;
-  const ModelFit* best = nullptr;
-  for (const auto& m : fit.models)
-    if (model_name(m.kind) == fit.best) best = &m;
+  const ModelFit* best = best_model(fit);
   const double omega0 = best ? best->omega0 : std::numeric_limits<double>::quiet_NaN();
   const double rpm_per_volt = 60.0 / (2 * M_PI) / fit.bench.kb_v_s_per_rad;
   switch (fit.quantity) {
@@ -90,13 +99,7 @@ double median_in_place(std::vector<double>& v) {
   return *mid;
 }
 
-const ModelFit* model_named(const RunFit& fit, std::string_view name) {
-  for (const auto& m : fit.models)
-    if (model_name(m.kind) == name) return &m;
-  return nullptr;
-}
 
-int free_parameters(ModelKind k) { return k == ModelKind::combined ? 3 : 2; }
 
 }  // namespace
 
@@ -148,12 +151,12 @@ void check_fit(RunFit& fit, std::span<const double> tau, std::span<const double>
 
   // What the print can resolve: a model with more friction terms whose curve stays within half a
   // step of a simpler one's is not told apart from it by the readings, whatever ΔBIC says.
-  const ModelFit* best = model_named(fit, fit.best);
+  const ModelFit* best = best_model(fit);
   if (best && fit.reading_step > 0) {
     const ModelFit* simpler = nullptr;
     double gap = 0;
     for (const auto& m : fit.models) {
-      if (!m.converged || free_parameters(m.kind) >= free_parameters(best->kind)) continue;
+      if (!m.converged || friction::family_of(m.kind).size() >= friction::family_of(best->kind).size()) continue;
       const double diff = largest_curve_difference(*best, m, tau, k, 0.5 * fit.reading_step);
       if (diff < 0.5 * fit.reading_step && (!simpler || m.bic < simpler->bic)) simpler = &m, gap = diff;
     }
@@ -175,9 +178,6 @@ void check_fit(RunFit& fit, std::span<const double> tau, std::span<const double>
   // the binned test then decides, and a run that fits pays nothing for it.
   if (best && fit.doubts.empty() && !(best->reduced_chi2 <= suspicious_chi2)) {
     const ResidualStructure rs = residual_structure(*best, tau, y, moving, k, fit.reading_step);
-    if (std::getenv("SPINDOWN_DEBUG_CHECKS"))
-      fmt::print(stderr, "check: best {} bins {} beyond {} mean_z2 {:.2f} chi2 {:.2f} step {}\n", fit.best, rs.bins,
-                 rs.beyond, rs.mean_z2, best->reduced_chi2, fit.reading_step);
     if (rs.bins >= 8 && rs.beyond * 4 >= rs.bins && rs.mean_z2 > 9)
       fit.doubts.push_back(fmt::format(
           "the {} model misses: its residuals stand out of the run's noise in {} of {} stretches of {} samples "
