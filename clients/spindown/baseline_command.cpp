@@ -164,10 +164,21 @@ int run_baseline(const BaselineCommandOptions& o) {
     }
     std::string current;
   } sink(fit_opt);
-  OfflinePlan plan{read_options_from(o.input), choice, {}, {}};
+  OfflinePlan plan{read_options_from(o.input), choice, {}, {}, {}};
+  const BenchNaming naming = naming_from(o.input);
+  plan.naming = &naming;
   plan.bench_file = [&update_file](const OfflineRecording&) { return update_file ? &*update_file : nullptr; };
   plan.wanted = [&o](const OfflineRecording& r) { return r.bench.empty() || r.bench == o.bench; };
   for (const auto& path : o.files) {
+    // A class's files: those the roster or --bench-pattern gives to another bench are not this one's.
+    if (naming.active()) {
+      const BenchName name = naming.name(path, file_stem(path));
+      if (name.bench != o.bench) {
+        std::cout << fmt::format("  skipped  {}: bench {} ({})\n", path, name.bench,
+                                 name.problem.empty() ? name.from : name.problem);
+        continue;
+      }
+    }
     sink.bench_found = false;
     sink.current = path;
     walk_file(path, plan, sink);

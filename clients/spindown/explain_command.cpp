@@ -30,6 +30,7 @@ struct ExplainPlan {
   ReadOptions read;
   ExplainOptions explain;
   BenchChoice bench;             // the command line's J and K_b (choose_bench_params)
+  BenchNaming naming;            // --roster, --bench-pattern: a text file's bench
 };
 
 ExplainPlan plan_from(const ExplainCommandOptions& o) {
@@ -42,6 +43,7 @@ ExplainPlan plan_from(const ExplainCommandOptions& o) {
   if (!plan.explain.is_valid(&why)) bad_usage(fmt::format("--base: {}", why));
 
   plan.read = read_options_from(o.input);
+  plan.naming = naming_from(o.input);
   return plan;
 }
 
@@ -63,12 +65,16 @@ FileExplain explain_file(const std::string& path, const ExplainPlan& plan) {
       ExplainResult result = explain_run(r.recording, run, opt);
       if (!result.ok) out.failures.push_back(r.where + fmt::format("run {}: {}", run.number, result.message));
       // An LCM log of several benches: each run says whose it is (run numbers restart per bench).
-      if (r.count > 1) out.run_bench.push_back(!r.bench.empty() ? r.bench : r.recording.source);
+      // A text file named by the roster or --bench-pattern too.
+      const bool lcm_log = r.info && r.info->format == FileFormat::lcm_log;
+      if (r.count > 1 || (!lcm_log && !r.bench.empty())) out.run_bench.push_back(!r.bench.empty() ? r.bench : r.recording.source);
       out.runs.push_back(std::move(result));
     }
   } sink(plan);
   sink.out.file = path;
-  walk_file(path, OfflinePlan{plan.read, plan.bench, {}, {}}, sink);
+  OfflinePlan offline{plan.read, plan.bench, {}, {}, {}};
+  offline.naming = &plan.naming;
+  walk_file(path, offline, sink);
   return std::move(sink.out);
 }
 

@@ -1,18 +1,24 @@
 #include "export_command.hpp"
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fmt/format.h>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <regex>
 
 #include "exit_codes.hpp"
 #include "refit_command.hpp"
+#include "spindown/csv_cells.hpp"
 #include "spindown/quantity.hpp"
+#include "spindown/bench_naming.hpp"
+#include "spindown/read_recording.hpp"
+#include "spindown/offline_pipeline.hpp"
 
 namespace spindown::cli {
 
@@ -55,23 +61,6 @@ struct Output {
   }
 };
 
-// MATLAB's readtable and pandas read NaN, Inf and -Inf.
-std::string number(double x) {
-  if (std::isnan(x)) return "NaN";
-  if (std::isinf(x)) return x > 0 ? "Inf" : "-Inf";
-  return fmt::format("{:.10g}", x);
-}
-
-// Quote a CSV field only when it needs it.
-std::string field(const std::string& s) {
-  if (s.find_first_of(",\"\r\n") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char c : s) {
-    if (c == '"') q += '"';
-    q += c;
-  }
-  return q + '"';
-}
 
 std::string fits_path_for(const std::string& out) {
   if (out.size() > 4 && out.ends_with(".csv")) return out.substr(0, out.size() - 4) + ".fits.csv";
@@ -90,44 +79,138 @@ void write_fits(std::FILE* f, const LogRefit& r) {
     const Run& rn = fit.run;
     for (const ModelFit& m : fit.models) {
       const std::string name(model_name(m.kind));
-      fmt::print(f, "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}", field(run.bench), rn.number, name,
-                 name == fit.best ? 1 : 0, m.converged ? 1 : 0, number(rn.t_cut_s),
-                 rn.stopped ? number(rn.t_stop_s) : std::string("NaN"), rn.stopped ? 1 : 0,
-                 rn.end_index - rn.cut_index, number(m.rmse), quantity_unit(fit.quantity), number(m.r2),
-                 number(m.aic), number(m.bic), number(m.t_stop_pred_s));
+      fmt::print(f, "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}", csv_field(run.bench), rn.number, name,
+                 name == fit.best ? 1 : 0, m.converged ? 1 : 0, csv_number(rn.t_cut_s),
+                 rn.stopped ? csv_number(rn.t_stop_s) : std::string("NaN"), rn.stopped ? 1 : 0,
+                 rn.end_index - rn.cut_index, csv_number(m.rmse), quantity_unit(fit.quantity), csv_number(m.r2),
+                 csv_number(m.aic), csv_number(m.bic), csv_number(m.t_stop_pred_s));
       for (const char* p : param_names) {
         if (const Parameter* q = m.param(p))
-          fmt::print(f, ",{},{}", number(q->value), number(q->std_error));
+          fmt::print(f, ",{},{}", csv_number(q->value), csv_number(q->std_error));
         else
           std::fputs(",,", f);
       }
-      fmt::print(f, ",{},{},{},{}\n", number(fit.bench.inertia_kg_m2), number(fit.bench.kb_v_s_per_rad),
-                 field(run.bench_source), number(rn.zero_level));
+      fmt::print(f, ",{},{},{},{}\n", csv_number(fit.bench.inertia_kg_m2), csv_number(fit.bench.kb_v_s_per_rad),
+                 csv_field(run.bench_source), csv_number(rn.zero_level));
     }
   }
+}
+
+
+// What the file's first bytes say it is (a missing file: not a log; the text path says why).
+bool is_lcm_log(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string start(4096, '\0');
+  in.read(start.data(), static_cast<std::streamsize>(start.size()));
+  start.resize(static_cast<std::size_t>(std::max<std::streamsize>(in.gcount(), 0)));
+  return detect_format(start) == FileFormat::lcm_log;
+}
+
+// An LCM log: every SAMPLE message as recorded, and the log refitted as spindown-fitter fits live.
+LogRefit export_log(const ExportCommandOptions& o, const std::regex& wanted, std::FILE* f, std::size_t& rows) {
+  auto each = [&](const LcmLogEvent& ev) {
+    if (ev.kind != LcmLogEvent::Kind::samples || !std::regex_match(ev.bench.begin(), ev.bench.end(), wanted)) return;
+    const samples_t& m = ev.samples;
+    const auto q = quantity_from_samples_code(m.quantity);
+    const std::string unit = q ? std::string(quantity_unit(*q)) : fmt::format("code {}", int(m.quantity));
+    for (std::int32_t i = 0; i < m.n; ++i) {
+      const std::int32_t adc = i < std::int32_t(m.raw_adc.size()) ? m.raw_adc[i] : -1;
+      const double host = i < std::int32_t(m.host_time_us.size()) ? 1e-6 * double(m.host_time_us[i]) : NAN;
+      fmt::print(f, "{},{},{:.6f},{},{},{},{},{}\n", csv_field(std::string(ev.bench)), m.seq + i,
+                 1e-6 * double(m.device_time_us[i]), std::isfinite(host) ? fmt::format("{:.6f}", host) : std::string("NaN"),
+                 csv_number(m.value[i]), csv_field(unit), adc >= 0 ? std::to_string(adc) : std::string(), m.clock_epoch);
+      ++rows;
+    }
+  };
+  FitterOptions fopt;
+  fopt.bench_regex = o.bench_regex;
+  fopt.max_rate_hz = 0;
+  return refit_log(o.log, fopt, false, each);
+}
+
+// A text recording's bench in the CSV: the roster's or --bench-pattern's, else the file's name.
+std::string csv_bench(const OfflineRecording& r) { return r.bench.empty() ? file_stem(r.path) : r.bench; }
+
+// A text recording (Arduino/PuTTY, CSV/TSV): its samples as read (seq: the sample's index; host
+// time and raw ADC unknown; clock_epoch: Arduino resets before it), and its runs fitted as
+// `spindown fit` fits them (J and K_b by the same rule). Its bench: --roster, --bench-pattern, else
+// the file's name.
+LogRefit export_text(const ExportCommandOptions& o, OfflinePlan plan, const std::regex& wanted, std::FILE* f,
+                     std::size_t& rows, bool& ok) {
+  struct Sink : OfflineSink {
+    const std::regex& wanted;
+    std::FILE* f;
+    std::size_t& rows;
+    LogRefit out;
+    FitOptions fit_opt;
+    bool export_fits = true;
+    Sink(const std::regex& w, std::FILE* file, std::size_t& n) : wanted(w), f(file), rows(n) {}
+    void recording(const OfflineRecording& r) override {
+      const Recording& rec = r.recording;
+      out.file.samples += rec.size();
+      out.file.lines_read += rec.lines_read;
+      out.file.lines_skipped += rec.lines_skipped;
+      const std::string bench = csv_field(csv_bench(r)), unit = csv_field(quantity_unit(rec.quantity));
+      std::size_t epoch = 0;
+      for (std::size_t i = 0; i < rec.size(); ++i) {
+        while (epoch < rec.clock_restarts.size() && rec.clock_restarts[epoch] <= i) ++epoch;
+        fmt::print(f, "{},{},{:.6f},NaN,{},{},,{}\n", bench, i, rec.t_s[i], csv_number(rec.value[i]), unit, epoch);
+      }
+      rows += rec.size();
+    }
+    void diagnostics(const OfflineRecording&, From, std::span<const Diagnostic> diags) override {
+      out.file.diagnostics.insert(out.file.diagnostics.end(), diags.begin(), diags.end());
+    }
+    void failure(const OfflineRecording*, std::string why) override { out.file.failures.push_back(std::move(why)); }
+    void run(const OfflineRecording& r, const Run& run) override {
+      if (!export_fits) return;
+      FitOptions opt = fit_opt;
+      opt.bench = r.params;
+      RunFit fit = fit_run(r.recording, run, opt);
+      out.runs.push_back({csv_bench(r), fit, fmt::format("J: {}; K_b: {}", r.params.inertia_source, r.params.kb_source),
+                          0, 0});
+      out.file.runs.push_back(std::move(fit));
+    }
+  } sink(wanted, f, rows);
+  sink.export_fits = !o.no_fits;
+  sink.fit_opt.bench = plan.bench.given;
+  plan.wanted = [&wanted](const OfflineRecording& r) { return std::regex_match(csv_bench(r), wanted); };
+  sink.out.file.file = o.log;
+  walk_file(o.log, plan, sink);
+  if (rows == 0 && sink.out.file.failures.empty()) {
+    std::cerr << fmt::format("{}: error: no samples of a bench matching --bench '{}'\n", o.log, o.bench_regex);
+    ok = false;
+  }
+  return std::move(sink.out);
 }
 
 }  // namespace
 
 void setup_export(CLI::App& app) {
   auto opt = std::make_shared<ExportCommandOptions>();
-  CLI::App* sub = app.add_subcommand("export", "Write an LCM log's samples (and its runs' fits) as CSV");
+  CLI::App* sub =
+      app.add_subcommand("export", "Write a recording's samples (and its runs' fits) as CSV: an LCM log or a text file");
   sub->footer(
       "Samples CSV: bench,seq,device_time_s,host_time_s,value,unit,raw_adc,clock_epoch — one row per recorded "
-      "sample, log order (repeats and NaN kept; raw_adc empty when unknown).\n"
-      "Fits CSV (-o OUT.csv writes OUT.fits.csv too, or --fits FILE): the log refitted as spindown-fitter does, "
+      "sample, log order (repeats and NaN kept; raw_adc empty when unknown). A text recording: seq is the "
+      "sample's index, host_time_s NaN, raw_adc empty, clock_epoch the Arduino resets before it; its bench the "
+      "--roster's or --bench-pattern's, else the file's name.\n"
+      "Fits CSV (-o OUT.csv writes OUT.fits.csv too, or --fits FILE): a log refitted as spindown-fitter does (a "
+      "text recording fitted as spindown fit does), "
       "one row per run and model: bench,run,model,best,converged,t_cut_s,t_stop_s,stopped,samples,rmse,"
       "residual_unit,r2,aic,bic,t_stop_pred_s, then value and _stderr of c1,c2,c3,c4,omega0,A,B,C, then "
       "J_kg_m2,Kb_V_s_per_rad,bench_source,zero_level. SI: c1,c3 N*m*s/rad; c2,c4 N*m; omega0 rad/s.\n"
       "MATLAB: readtable('OUT.csv'); Python: pandas.read_csv('OUT.csv').\n"
       "Exit codes: 0 ok, 1 the log could not be read or written, 2 bad usage.");
-  sub->add_option("LOG", opt->log, "LCM event log")->required();
+  sub->add_option("FILE", opt->log, "LCM event log, or a text recording (Arduino/PuTTY log, CSV/TSV)")->required();
   sub->add_flag("--csv", opt->csv, "CSV output (the only format; the default)");
   sub->add_option("-o,--output", opt->out, "samples CSV file (default stdout)");
   auto* fits = sub->add_option("--fits", opt->fits, "fits CSV file (default: OUT with .fits.csv when -o is given)");
   sub->add_flag("--no-fits", opt->no_fits, "do not refit, samples only")->excludes(fits);
   sub->add_option("--bench", opt->bench_regex, "only benches whose id matches this regex");
-  sub->callback([opt]() {
+  auto note_given = add_input_options(sub, opt->input);  // a text recording's columns, units, bench, J and K_b
+  sub->callback([opt, note_given]() {
+    note_given();
     const int code = run_export(*opt);
     if (code != exit_ok) throw CLI::RuntimeError(code);
   });
@@ -145,6 +228,12 @@ int run_export(const ExportCommandOptions& o) {
   if (!fits_path.empty() && fits_path == o.out)
     throw CLI::ValidationError("--fits and -o name the same file");
 
+  // A text recording's options, checked before anything is written (bad usage: exit 2).
+  const bool lcm_log = is_lcm_log(o.log);
+  const BenchNaming naming = lcm_log ? BenchNaming() : naming_from(o.input);
+  OfflinePlan text_plan{read_options_from(o.input), bench_choice_from(o.input), {}, {}, {}};
+  text_plan.naming = &naming;
+
   Output samples;
   if (!samples.open(o.out)) {
     std::cerr << "spindown export: cannot write " << o.out << ": " << std::strerror(errno) << '\n';
@@ -153,31 +242,22 @@ int run_export(const ExportCommandOptions& o) {
   std::FILE* f = samples.f;
   std::fputs("bench,seq,device_time_s,host_time_s,value,unit,raw_adc,clock_epoch\n", f);
   std::size_t rows = 0;
-  auto each = [&](const LcmLogEvent& ev) {
-    if (ev.kind != LcmLogEvent::Kind::samples || !std::regex_match(ev.bench.begin(), ev.bench.end(), wanted)) return;
-    const samples_t& m = ev.samples;
-    const auto q = quantity_from_samples_code(m.quantity);
-    const std::string unit = q ? std::string(quantity_unit(*q)) : fmt::format("code {}", int(m.quantity));
-    for (std::int32_t i = 0; i < m.n; ++i) {
-      const std::int32_t adc = i < std::int32_t(m.raw_adc.size()) ? m.raw_adc[i] : -1;
-      const double host = i < std::int32_t(m.host_time_us.size()) ? 1e-6 * double(m.host_time_us[i]) : NAN;
-      fmt::print(f, "{},{},{:.6f},{},{},{},{},{}\n", field(std::string(ev.bench)), m.seq + i, 1e-6 * double(m.device_time_us[i]),
-                 std::isfinite(host) ? fmt::format("{:.6f}", host) : std::string("NaN"), number(m.value[i]),
-                 field(unit), adc >= 0 ? std::to_string(adc) : std::string(), m.clock_epoch);
-      ++rows;
-    }
-  };
-  FitterOptions fopt;
-  fopt.bench_regex = o.bench_regex;
-  fopt.max_rate_hz = 0;
-  const LogRefit r = refit_log(o.log, fopt, false, each);
+  bool ok = true;
   std::string why;
-  bool ok = samples.close(&why);
-  if (!ok) std::cerr << "spindown export: " << why << '\n';
+  const LogRefit r = lcm_log ? export_log(o, wanted, f, rows) : export_text(o, text_plan, wanted, f, rows, ok);
+  if (!samples.close(&why)) {
+    std::cerr << "spindown export: " << why << '\n';
+    ok = false;
+  }
   for (const auto& d : r.file.diagnostics)
     if (d.severity != Diagnostic::Severity::note) std::cerr << d.to_string() << '\n';
   if (!r.file.failures.empty() && r.file.samples == 0) {
-    for (const auto& w : r.file.failures) std::cerr << o.log << ": error: " << w << '\n';
+    for (const auto& w : r.file.failures) {
+      const bool said = std::any_of(r.file.diagnostics.begin(), r.file.diagnostics.end(), [&](const Diagnostic& d) {
+        return d.severity == Diagnostic::Severity::error && d.message == w;  // the reader's error, already shown
+      });
+      if (!said) std::cerr << o.log << ": error: " << w << '\n';
+    }
     ok = false;
   }
   if (!fits_path.empty()) {

@@ -24,6 +24,7 @@
 #include "spindown/offline_pipeline.hpp"
 #include "spindown/ordered_parallel.hpp"
 #include "spindown/read_recording.hpp"
+#include "spindown/run_table.hpp"
 #include "spindown/runs.hpp"
 
 namespace spindown::cli {
@@ -37,6 +38,7 @@ struct FitPlan {
   BenchChoice bench;             // the command line's J and K_b (choose_bench_params)
   ReportOptions report;
   BenchFiles bench_files;        // --bench-config, by bench id
+  BenchNaming naming;            // --roster, --bench-pattern: a text file's bench
 };
 
 // The bench file for a recording: its bench id's (LCM logs), or the only one given (text files).
@@ -52,6 +54,7 @@ FitPlan plan_from(const FitCommandOptions& o) {
   FitPlan plan;
   plan.bench = bench_choice_from(o.input);
   plan.fit.bench = plan.bench.given;
+  plan.naming = naming_from(o.input);
   std::string why;
   if (!o.models.empty()) plan.fit.models = models_from(o.models);
   if (!plan.fit.is_valid(&why)) bad_usage(why);
@@ -81,6 +84,10 @@ FileFit fit_file(const std::string& path, const FitPlan& plan) {
       out.lcm_log = !info.empty() && info.front().format == FileFormat::lcm_log;
     }
     void recording(const OfflineRecording& r) override {
+      if (!out.lcm_log) {
+        out.bench = r.bench;
+        out.student = r.student;
+      }
       out.samples += r.recording.size();
       out.lines_read += r.recording.lines_read;
       out.lines_skipped += r.recording.lines_skipped;
@@ -100,6 +107,8 @@ FileFit fit_file(const std::string& path, const FitPlan& plan) {
       RunFit fit = fit_run(r.recording, run, fit_opt);
       // An LCM log of several benches: each run says whose it is (run numbers restart per bench).
       if (r.count > 1) out.run_bench.push_back(!r.bench.empty() ? r.bench : r.recording.source);
+      // A text file named by the roster or --bench-pattern: its runs carry that bench id too.
+      else if (!out.lcm_log && !r.bench.empty()) out.run_bench.push_back(r.bench);
       if (fit.best.empty()) {
         std::string why;
         for (const auto& m : fit.models)
@@ -114,7 +123,8 @@ FileFit fit_file(const std::string& path, const FitPlan& plan) {
     }
   } sink(plan);
   sink.out.file = path;
-  OfflinePlan offline{plan.read, plan.bench, {}, {}};
+  OfflinePlan offline{plan.read, plan.bench, {}, {}, {}};
+  offline.naming = &plan.naming;
   offline.bench_file = [&plan](const OfflineRecording& r) { return bench_file_for(plan, r.bench); };
   walk_file(path, offline, sink);
   return std::move(sink.out);
@@ -127,7 +137,13 @@ void setup_fit(CLI::App& app) {
   CLI::App* sub = app.add_subcommand("fit", "Fit viscous, Coulomb and combined friction to each spin-down run");
   sub->footer("Exit codes: 0 ok, 1 a file or run could not be used (the others are still reported), 2 bad usage.");
   sub->add_option("FILE", opt->files, "Arduino/PuTTY log, delimited text (CSV/TSV) or LCM log")->required();
-  sub->add_flag("--json", opt->json, "Print one JSON object {\"files\":[{\"runs\":[{\"models\":…}]}]} instead of tables");
+  auto* json = sub->add_flag("--json", opt->json,
+                             "Print one JSON object {\"files\":[{\"runs\":[{\"models\":…}]}]} instead of tables");
+  sub->add_option("--table", opt->table,
+                  "A class's table instead: one row per run across all files (file, bench, student, best model, "
+                  "c1…c4 ± errors, doubts, health), as csv or json (an array of the same rows)")
+      ->check(CLI::IsMember({"csv", "json"}))
+      ->excludes(json);
   sub->add_option("--models", opt->models, "Models to fit, comma-separated: viscous,coulomb,combined (default all)")
       ->delimiter(',')
       ->allow_extra_args(false);  // one value per flag: `--models combined a.tsv b.tsv` leaves the files alone
@@ -164,9 +180,14 @@ int run_fit(const FitCommandOptions& options) {
   FitReportJsonText json_files;
   const bool json_in_pieces = options.json && !isatty(STDOUT_FILENO);
   constexpr std::size_t json_piece_bytes = 256 * 1024;
+  // --table: one row per run across the files, in the order given.
+  const bool csv_table = options.table == "csv", json_table = options.table == "json";
+  bool first_row = true;
+  if (csv_table) std::cout << run_table_csv_header();
+  if (json_table) std::cout << '[';
   struct Done {
     FileFit file;
-    std::string text;  // the file's tables or JSON entry, formatted by the worker too
+    std::string text;  // the file's tables, JSON entry or table rows, formatted by the worker too
   };
   // Files are independent: fit them on every core, report them in the order given.
   for_each_ordered(
@@ -174,24 +195,32 @@ int run_fit(const FitCommandOptions& options) {
       [&](std::size_t i) {
         Done d{fit_file(options.files[i], plan), {}};
         // Bytes that are not UTF-8 (a Latin-1 file name or config string) are replaced, never abort the output.
-        d.text = options.json ? file_fit_json_text(d.file, plan.report) : format_file_fit(d.file, plan.report);
+        if (csv_table)
+          d.text = run_table_csv_rows(d.file);
+        else if (!json_table)
+          d.text = options.json ? file_fit_json_text(d.file, plan.report) : format_file_fit(d.file, plan.report);
         return d;
       },
       [&](std::size_t, Done d) {
         report_file_problems(std::cerr, d.file.file, d.file.diagnostics, d.file.failures, options.verbose,
                              plan.report.max_diagnostics);
         all_usable = all_usable && d.file.usable();
-        if (options.json) {
+        if (json_table) {
+          std::string rows;
+          append_run_table_json_rows(d.file, rows, first_row);
+          std::cout << rows;
+        } else if (options.json) {
           json_files.add(d.text, json);
           if (json_in_pieces && json.size() >= json_piece_bytes) {
             std::cout << json;
             json.clear();
           }
         } else {
-          std::cout << d.text << '\n';
+          std::cout << d.text << (csv_table ? "" : "\n");
           std::cout.flush();
         }
       });
+  if (json_table) std::cout << (first_row ? "]" : "\n]") << std::endl;
   if (options.json) {
     json_files.finish(json);
     std::cout << json << std::endl;

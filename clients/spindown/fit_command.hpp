@@ -1,6 +1,7 @@
 #pragma once
 // `spindown fit FILE...`: read each file, find its spin-down runs, fit the friction models,
-// report per run a table like the lab report's (or design §5's JSON with --json).
+// report per run a table like the lab report's (or design §5's JSON with --json), or a class's
+// table of one row per run across every file (--table csv|json).
 #include <string>
 #include <vector>
 
@@ -15,6 +16,7 @@ namespace spindown::cli {
 struct FitCommandOptions {
   std::vector<std::string> files;
   bool json = false;
+  std::string table;     // "csv" | "json": one row per run across all files (run_table.hpp)
   bool lab_units = false;
   bool details = false;  // 95 % intervals, correlations, reduced χ² in the text
   bool verbose = false;  // every diagnostic, notes included

@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <exception>
+#include <stdexcept>
 #include <fmt/format.h>
 
 namespace spindown::cli {
@@ -88,12 +89,32 @@ std::function<void()> add_input_options(CLI::App* sub, InputOptions& opt) {
   sub->add_option("--value-unit", opt.value_unit, "Value unit: V, rpm or rad/s")->group(text);
   sub->add_option("--delimiter", opt.delimiter, "Column delimiter: , ; tab space")->group(text);
 
+  const char* klass = "A class's files";
+  sub->add_option("--roster", opt.roster,
+                  "CSV/TSV with columns file,bench[,student]: which bench (and student) each text file is from")
+      ->check(CLI::ExistingFile)
+      ->group(klass);
+  sub->add_option("--bench-pattern", opt.bench_pattern,
+                  "Regex on a text file's name: group 1 is its bench, group 2 its student, "
+                  "e.g. '(bench[0-9]+)_([a-z]+)'")
+      ->group(klass);
+
   return [&opt, inertia, radius, kb, kv]() {
     opt.inertia_given = inertia->count() > 0;
     opt.flywheel_given = radius->count() > 0;
     opt.kb_given = kb->count() > 0;
     opt.speed_constant_given = kv->count() > 0;
   };
+}
+
+BenchNaming naming_from(const InputOptions& o, const std::string& fixed_bench) {
+  try {
+    return BenchNaming(o.roster, o.bench_pattern, fixed_bench);
+  } catch (const std::invalid_argument& e) {
+    bad_usage(e.what());
+  } catch (const std::exception& e) {
+    bad_usage(fmt::format("--roster: {}", e.what()));
+  }
 }
 
 BenchChoice bench_choice_from(const InputOptions& o) {

@@ -1,13 +1,14 @@
 #pragma once
-// The options `spindown fit` and `spindown explain` share: the bench (J directly or from
-// flywheel geometry + rotor inertia; K_b directly or from a speed constant) and the columns
-// and units of delimited text. One definition, so both commands accept and check them alike.
+// The options the commands that read recordings share: the bench (J directly or from flywheel
+// geometry + rotor inertia; K_b directly or from a speed constant), the columns and units of
+// delimited text, and which bench a class's text file is from (a roster or a file-name pattern). One definition, so both commands accept and check them alike.
 #include <functional>
 #include <string>
 #include <vector>
 
 #include "spindown/bench.hpp"
 #include "spindown/bench_file.hpp"
+#include "spindown/bench_naming.hpp"
 #include "spindown/fit.hpp"
 #include "spindown/read_recording.hpp"
 
@@ -29,6 +30,8 @@ struct InputOptions {
   // Delimited text: columns and units when they are not obvious from the header.
   std::string time_column, value_column, time_unit, value_unit, delimiter;
 
+  // A class's text files: which bench (and student) each is from.
+  std::string roster, bench_pattern;
 };
 
 // Adds the bench ("Bench" group) and delimited-text options to sub, bound to opt. Call the
@@ -40,6 +43,9 @@ std::function<void()> add_input_options(CLI::App* sub, InputOptions& opt);
 BenchParams bench_from(const InputOptions& opt);
 // The command line's part of the J/K_b rule (choose_bench_params): its values and which it gave.
 BenchChoice bench_choice_from(const InputOptions& opt);
+// Which bench a text file is from (--roster, --bench-pattern; fixed_bench: a command's --bench).
+// A roster that cannot be read or a bad pattern is bad usage (CLI::ValidationError).
+BenchNaming naming_from(const InputOptions& opt, const std::string& fixed_bench = {});
 // Reading options for the delimited-text columns and units. Bad usage throws CLI::ValidationError.
 ReadOptions read_options_from(const InputOptions& opt);
 

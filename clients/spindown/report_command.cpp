@@ -32,7 +32,7 @@ SessionReportOptions plan_from(const ReportCommandOptions& o) {
   plan.explain.base = parse_effect_list(o.base, &why);
   if (plan.explain.base.empty()) bad_usage(fmt::format("--base: {}", why));
   if (!plan.explain.is_valid(&why)) bad_usage(fmt::format("--base: {}", why));
-  plan.text_bench = o.text_bench;
+  plan.naming = naming_from(o.input, o.text_bench);
   try {  // one loader for fit, report and the fitter: files or directories, duplicate benches refused
     for (const auto& [bench, file] : load_bench_files(o.bench_configs).files)
       plan.references.emplace(bench, bench_reference(file));
@@ -57,8 +57,8 @@ void setup_report(CLI::App& app) {
   auto opt = std::make_shared<ReportCommandOptions>();
   CLI::App* sub = app.add_subcommand(
       "report", "Write one self-contained HTML page for a session: fits, residuals, explain story, health, drift");
-  sub->footer("Text files belong to the bench named by --bench (default: the file name); LCM logs name their "
-              "benches. A --bench-config file (the bench's TOML: bench_id, [bench], [motor], [baseline], [health]) "
+  sub->footer("Text files belong to the bench the --roster or --bench-pattern names, else --bench, else their "
+              "file name; LCM logs name their benches. A --bench-config file (the bench's TOML: bench_id, [bench], [motor], [baseline], [health]) "
               "gives that bench's health verdicts a datasheet or baseline; without one the page says "
               "\"no reference configured\".\n"
               "Exit codes: 0 ok, 1 a file or run could not be used (the page is still written), 2 bad usage.");

@@ -88,14 +88,20 @@ grep -q 'Missing effect: <strong>coulomb</strong>' "$T/data.html" || fail "no ex
 grep -q 'Summary across benches and runs' "$T/data.html" || fail "no summary"
 echo "sample files: $(cat "$T/data.out")"
 
-# --- 2. text from files is escaped ---------------------------------------------------------
+# --- 2. text from files is escaped (a file name, a roster's student name) -------------------
 cp "$D/seed-3v-run1.tsv" "$T/<b>bold & \"q\".tsv"
-"$B/spindown" report "$T/<b>bold & \"q\".tsv" --bench '<script>alert(1)</script>' -o "$T/evil.html" \
+printf 'file,bench,student\n"<b>bold & ""q"".tsv",b1,<script>alert(1)</script>\n' >"$T/roster.csv"
+"$B/spindown" report "$T/<b>bold & \"q\".tsv" --roster "$T/roster.csv" -o "$T/evil.html" \
   >"$T/evil.out" 2>"$T/evil.err" || fail "report of a strangely named file exited $?"
 check_page "$T/evil.html" || fail "escaped page"
-grep -q '<script>' "$T/evil.html" && fail "a bench id reached the page unescaped"
+grep -q '<script>' "$T/evil.html" && fail "a student's name reached the page unescaped"
 grep -q '<b>bold' "$T/evil.html" && fail "a file name reached the page unescaped"
-grep -q '&lt;script&gt;alert(1)&lt;/script&gt;' "$T/evil.html" || fail "escaped bench id missing"
+grep -q '&lt;script&gt;alert(1)&lt;/script&gt;' "$T/evil.html" || fail "escaped student name missing"
+# A bench id is one rule everywhere ([A-Za-z0-9_-], as channel names): --bench refuses markup.
+"$B/spindown" report "$T/<b>bold & \"q\".tsv" --bench '<script>' -o "$T/never.html" 2>"$T/never.err" &&
+  fail "report accepted --bench '<script>'"
+grep -q "bench '<script>'" "$T/never.err" || fail "the refused --bench is not named: $(cat "$T/never.err")"
+[ ! -e "$T/never.html" ] || fail "a refused report wrote its page"
 grep -q '&lt;b&gt;bold &amp; &quot;q&quot;.tsv' "$T/evil.html" || fail "escaped file name missing"
 
 # --- 3. a generated LCM log with two benches ----------------------------------------------

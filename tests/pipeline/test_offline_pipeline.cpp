@@ -28,14 +28,25 @@ struct Call {
 struct RecordingSink : OfflineSink {
   std::vector<Call> calls;
   std::vector<BenchParams> params;  // per run
+  std::vector<std::string> students;  // per recording
+  std::vector<Diagnostic> naming_problems;
   std::size_t runs_found = 0;
   void file_read(std::span<const Recording>, std::span<const RecordingInfo>, std::size_t n) override {
     runs_found = n;
     calls.push_back({"file_read", "", ""});
   }
-  void recording(const OfflineRecording& r) override { calls.push_back({"recording", r.bench, r.where}); }
-  void diagnostics(const OfflineRecording& r, From from, std::span<const Diagnostic>) override {
-    calls.push_back({from == From::reader ? "reader" : from == From::config ? "config" : "run_finder", r.bench, ""});
+  void recording(const OfflineRecording& r) override {
+    calls.push_back({"recording", r.bench, r.where});
+    students.push_back(r.student);
+  }
+  void diagnostics(const OfflineRecording& r, From from, std::span<const Diagnostic> diags) override {
+    calls.push_back({from == From::reader   ? "reader"
+                     : from == From::naming ? "naming"
+                     : from == From::config ? "config"
+                                            : "run_finder",
+                     r.bench, ""});
+    if (from == From::naming)
+      for (const auto& d : diags) naming_problems.push_back(d);
   }
   void failure(const OfflineRecording* r, std::string why) override {
     calls.push_back({"failure", r ? r->bench : "", why});
@@ -165,6 +176,31 @@ TEST(OfflinePipeline, ATextFileIsOneRecordingWithoutPrefix) {
   EXPECT_EQ(sink.calls[1].text, "");  // where: no prefix for a file of one recording
   ASSERT_EQ(sink.params.size(), 1u);
   EXPECT_EQ(sink.params[0].inertia_source, "lab default");
+}
+
+TEST(OfflinePipeline, AClassNamingGivesATextFileItsBenchAndStudent) {
+  const std::string file = std::string(SPINDOWN_SAMPLE_DATA) + "/seed-3v-run1.tsv";
+  const BenchNaming naming("", "(seed)-(3v)");
+  OfflinePlan plan;
+  plan.naming = &naming;
+  RecordingSink sink;
+  walk_file(file, plan, sink);
+  std::vector<std::string> seq = sink.sequence();
+  std::erase(seq, "run_finder:seed");
+  EXPECT_EQ(seq, (std::vector<std::string>{"file_read", "recording:seed", "reader:seed", "bench:seed", "run:seed"}));
+  EXPECT_EQ(sink.students, (std::vector<std::string>{"3v"}));
+  EXPECT_TRUE(sink.naming_problems.empty());
+
+  // A name the pattern does not match: the file's own name, and a warning naming the file.
+  const BenchNaming other("", "(bench[0-9]+)");
+  plan.naming = &other;
+  RecordingSink missed;
+  walk_file(file, plan, missed);
+  EXPECT_EQ(missed.calls.at(1).bench, "seed-3v-run1");
+  ASSERT_EQ(missed.naming_problems.size(), 1u);
+  EXPECT_EQ(missed.naming_problems[0].severity, Diagnostic::Severity::warning);
+  EXPECT_EQ(missed.naming_problems[0].source, file);
+  EXPECT_NE(missed.naming_problems[0].message.find("does not match --bench-pattern"), std::string::npos);
 }
 
 TEST(OfflinePipeline, AMissingFileIsOneFailureNamingIt) {

@@ -341,8 +341,12 @@ std::string summary_section(const SessionReport& report) {
 }
 
 std::string files_section(const SessionReport& report) {
-  std::string s = "<section id=\"files\">\n<h2>Files</h2>\n<table>\n<tr><th>file</th><th>format</th><th>benches</th>"
-                  "<th>samples</th><th>recorded</th><th>problems</th></tr>\n";
+  // A class's files (a roster or --bench-pattern named their students): whose each file is.
+  const bool students =
+      std::any_of(report.files.begin(), report.files.end(), [](const ReportFile& f) { return !f.student.empty(); });
+  std::string s = fmt::format("<section id=\"files\">\n<h2>Files</h2>\n<table>\n<tr><th>file</th>{}<th>format</th>"
+                              "<th>benches</th><th>samples</th><th>recorded</th><th>problems</th></tr>\n",
+                              students ? "<th>student</th>" : "");
   for (const auto& f : report.files) {
     std::string benches;
     for (const auto& b : f.benches) benches += (benches.empty() ? "" : ", ") + esc(b);
@@ -350,8 +354,9 @@ std::string files_section(const SessionReport& report) {
     for (const auto& d : f.diagnostics) warnings += d.severity != Diagnostic::Severity::note;
     std::string problems = fmt::format("{} warning{}", warnings, warnings == 1 ? "" : "s");
     for (const auto& why : f.failures) problems += fmt::format("<br><span class=\"fail\">not used: {}</span>", esc(why));
-    s += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td class=\"num\">{}</td><td>{}</td><td>{}</td></tr>\n",
-                     esc(f.file), esc(file_format_name(f.format)), benches, f.samples,
+    s += fmt::format("<tr><td>{}</td>{}<td>{}</td><td>{}</td><td class=\"num\">{}</td><td>{}</td><td>{}</td></tr>\n",
+                     esc(f.file), students ? fmt::format("<td>{}</td>", esc(f.student)) : "",
+                     esc(file_format_name(f.format)), benches, f.samples,
                      f.start_unix_s ? utc_text(*f.start_unix_s) : "–", problems);
   }
   s += "</table>\n";

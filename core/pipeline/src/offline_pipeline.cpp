@@ -36,10 +36,20 @@ void walk_file(const std::string& path, const OfflinePlan& plan, OfflineSink& si
       r.index = k;
       r.count = recordings.size();
       if (about) r.bench = about->bench;
+      Diagnostic naming_problem;
+      if (r.bench.empty() && plan.naming && plan.naming->active() &&
+          !(about && about->format == FileFormat::lcm_log)) {
+        const BenchName name = plan.naming->name(path, file_stem(path));
+        r.bench = name.bench;
+        r.student = name.student;
+        if (!name.problem.empty())
+          naming_problem = {Diagnostic::Severity::warning, path, 0, fmt::format("bench: {}", name.problem)};
+      }
       if (recordings.size() > 1) r.where = fmt::format("{}: ", rec.source);
       if (plan.wanted && !plan.wanted(r)) continue;
       sink.recording(r);
       sink.diagnostics(r, OfflineSink::From::reader, rec.diagnostics);
+      if (!naming_problem.message.empty()) sink.diagnostics(r, OfflineSink::From::naming, {&naming_problem, 1});
       if (rec.empty()) {
         sink.failure(&r, r.where + first_error(rec));
         continue;

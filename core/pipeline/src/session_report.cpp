@@ -19,19 +19,9 @@ namespace spindown {
 
 namespace {
 
-std::string file_stem(const std::string& path) {
-  std::string name = std::filesystem::path(path).filename().string();
-  const auto dot = name.find_last_of('.');
-  if (dot != std::string::npos && dot > 0) name.resize(dot);
-  return name.empty() ? path : name;
-}
-
-// The bench a recording is reported under: an LCM log's bench id, else --bench, else the file's
-// name without its extension.
-std::string report_bench(const OfflineRecording& r, const SessionReportOptions& options) {
-  const bool is_log = r.info && r.info->format == FileFormat::lcm_log;
-  return is_log && !r.bench.empty() ? r.bench : !options.text_bench.empty() ? options.text_bench : file_stem(r.path);
-}
+// The bench a recording is reported under: an LCM log's bench id, else the plan's naming (roster,
+// --bench-pattern, --bench), else the file's name without its extension.
+std::string report_bench(const OfflineRecording& r) { return !r.bench.empty() ? r.bench : file_stem(r.path); }
 
 // The first bytes of a file (for the PuTTY header); "" when it cannot be read.
 std::string file_head(const std::string& path, std::size_t n) {
@@ -318,9 +308,10 @@ SessionReport build_session_report(std::span<const std::string> paths, const Ses
       }
       void recording(const OfflineRecording& r) override {
         if (r.info && file.format == FileFormat::automatic) file.format = r.info->format;
-        const std::string bench = report_bench(r, options);
+        const std::string bench = report_bench(r);
         if (std::find(file.benches.begin(), file.benches.end(), bench) == file.benches.end())
           file.benches.push_back(bench);
+        if (!r.student.empty()) file.student = r.student;
         file.samples += r.recording.size();
       }
       void diagnostics(const OfflineRecording&, From, std::span<const Diagnostic> diags) override {
@@ -328,7 +319,7 @@ SessionReport build_session_report(std::span<const std::string> paths, const Ses
       }
       void failure(const OfflineRecording*, std::string why) override { file.failures.push_back(std::move(why)); }
       void run(const OfflineRecording& r, const Run& run) override {
-        ReportRun rr = make_report_run(r.recording, run, report_bench(r, options), r.params, options);
+        ReportRun rr = make_report_run(r.recording, run, report_bench(r), r.params, options);
         rr.file_index = fi;
         if (file.start_unix_s && !r.recording.t_s.empty())
           rr.cut_unix_s = *file.start_unix_s + (run.t_cut_s - r.recording.t_s.front());
@@ -347,9 +338,10 @@ SessionReport build_session_report(std::span<const std::string> paths, const Ses
     } sink(report, file, fi, options, progress, p, bytes_before);
     // J and K_b by the one rule (choose_bench_params): command line, else the bench's file,
     // else the log's CONFIG, else the lab's.
-    OfflinePlan plan{options.read, options.bench, {}, {}};
+    OfflinePlan plan{options.read, options.bench, {}, {}, {}};
+    plan.naming = &options.naming;
     plan.bench_file = [&](const OfflineRecording& r) -> const BenchFile* {
-      const auto ref = options.references.find(report_bench(r, options));
+      const auto ref = options.references.find(report_bench(r));
       if (ref == options.references.end()) return nullptr;
       reference_used[static_cast<std::size_t>(std::distance(options.references.begin(), ref))] = true;
       return ref->second.bench ? &*ref->second.bench : nullptr;

@@ -191,6 +191,8 @@ void write_file_fit(std::string& out, std::size_t indent, const FileFit& file, c
   PrettyJsonWriter w(out, indent);
   w.begin_object();
   w.member("file", file.file);
+  if (!file.bench.empty()) w.member("bench_id", file.bench);
+  if (!file.student.empty()) w.member("student", file.student);
   w.key("runs");
   w.begin_array();
   for (std::size_t i = 0; i < file.runs.size(); ++i) {

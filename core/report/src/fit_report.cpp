@@ -276,7 +276,12 @@ std::string format_file_fit(const FileFit& file, const ReportOptions& opt) {
     if (d.severity == Diagnostic::Severity::error) ++errors;
     if (d.severity == Diagnostic::Severity::warning) ++warnings;
   }
-  std::string out = fmt::format("== {}: {} samples from {} {} ({} skipped), {} run{} fitted", file.file,
+  std::string who;
+  if (!file.bench.empty() || !file.student.empty())
+    who = fmt::format(" ({}{}{})", file.bench.empty() ? "" : "bench " + file.bench,
+                      !file.bench.empty() && !file.student.empty() ? ", " : "",
+                      file.student.empty() ? "" : "student " + file.student);
+  std::string out = fmt::format("== {}{}: {} samples from {} {} ({} skipped), {} run{} fitted", file.file, who,
                                 file.samples, file.lines_read, file.lcm_log ? "messages" : "lines",
                                 file.lines_skipped, file.runs.size(), file.runs.size() == 1 ? "" : "s");
   auto count = [](std::size_t n, std::string_view what) { return fmt::format("{} {}{}", n, what, n == 1 ? "" : "s"); };

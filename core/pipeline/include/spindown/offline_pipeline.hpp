@@ -13,6 +13,7 @@
 
 #include "spindown/bench.hpp"
 #include "spindown/bench_file.hpp"
+#include "spindown/bench_naming.hpp"
 #include "spindown/read_recording.hpp"
 #include "spindown/recording.hpp"
 #include "spindown/runs.hpp"
@@ -27,7 +28,8 @@ struct OfflineRecording {
   const Recording& recording;
   const RecordingInfo* info;       // what read_recordings found beside it (nullptr: nothing)
   std::size_t index = 0, count = 1;  // its place among the file's recordings
-  std::string bench;               // an LCM log's bench id; "" for text
+  std::string bench;               // an LCM log's bench id; a text file's by the plan's naming, else ""
+  std::string student;             // a text file's student, when the roster or pattern names one
   std::string where;               // "SOURCE: " when the file holds several recordings, else ""
   // Set once the recording has samples, before its runs:
   const BenchFile* bench_file = nullptr;  // the plan's bench file for it (nullptr: none)
@@ -40,13 +42,16 @@ struct OfflinePlan {
   BenchChoice bench;  // the command line's J and K_b
   // The bench file of a recording (nullptr: none). Unset: none for any.
   std::function<const BenchFile*(const OfflineRecording&)> bench_file;
+  // Which bench a text file is from (roster, file-name pattern, --bench). nullptr or inactive: text
+  // files name no bench. A file it cannot name is reported under its file name, with a warning.
+  const BenchNaming* naming = nullptr;
   // Whether a recording is wanted at all (baseline: one bench of a log). Unset: all.
   std::function<bool(const OfflineRecording&)> wanted;
 };
 
 // What a command does along the path. Calls come in file order: file_read once, then per
-// recording: recording, its diagnostics (the reader's, then the CONFIG's problems, then the
-// run finder's), and either one failure or bench_chosen and its runs.
+// recording: recording, its diagnostics (the reader's, then the bench naming's, then the CONFIG's
+// problems, then the run finder's), and either one failure or bench_chosen and its runs.
 class OfflineSink {
  public:
   virtual ~OfflineSink() = default;
@@ -57,7 +62,7 @@ class OfflineSink {
     (void)recordings, (void)info, (void)runs_found;
   }
   virtual void recording(const OfflineRecording& r) { (void)r; }
-  enum class From { reader, config, run_finder };
+  enum class From { reader, naming, config, run_finder };
   virtual void diagnostics(const OfflineRecording& r, From from, std::span<const Diagnostic> diags) = 0;
   // Why a recording (r) or the whole file (r == nullptr) gave no runs, prefixed by r->where:
   // "no samples" or the reader's first error, "no spin-down run found in N samples",

@@ -16,8 +16,11 @@
 #include <vector>
 
 #include "spindown/bench.hpp"
+#include "spindown/bench_naming.hpp"
 #include "spindown/bench_file.hpp"
+#include "spindown/bench_naming.hpp"
 #include "spindown/bench_file.hpp"
+#include "spindown/bench_naming.hpp"
 #include "spindown/explain.hpp"
 #include "spindown/fit.hpp"
 #include "spindown/motor_health.hpp"
@@ -44,7 +47,7 @@ struct SessionReportOptions {
   ExplainOptions explain;       // base model and workflow settings (bench set per run)
   bool explain_runs = true;
   BenchChoice bench;            // the command line's J and K_b (choose_bench_params; fit.bench is its given)
-  std::string text_bench;       // bench id for text files; empty: the file name without its extension
+  BenchNaming naming;           // which bench a text file is from (roster, pattern, --bench); else its file name
   std::map<std::string, BenchReference, std::less<>> references;  // by bench id
   std::size_t max_diagnostics_per_file = 200;  // kept per file; the rest are counted
 };
@@ -69,6 +72,7 @@ struct ReportFile {
   std::uintmax_t bytes = 0;
   std::size_t samples = 0;
   std::vector<std::string> benches;
+  std::string student;                  // a text file's, when the roster or --bench-pattern names one
   std::optional<double> start_unix_s;   // PuTTY header or the log's first event
   std::vector<Diagnostic> diagnostics;  // at most max_diagnostics_per_file
   std::size_t diagnostics_dropped = 0;

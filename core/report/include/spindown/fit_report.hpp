@@ -21,6 +21,9 @@ namespace spindown {
 // Everything `spindown fit` learnt about one input file.
 struct FileFit {
   std::string file;                     // as named by the user
+  // A text file's bench and student when a roster or --bench-pattern named them ("" otherwise).
+  // Text: "(bench B, student S)" in the file's line; JSON: "bench_id", "student" beside "file".
+  std::string bench, student;
   std::size_t samples = 0;              // samples read
   std::size_t lines_read = 0, lines_skipped = 0;
   std::vector<Diagnostic> diagnostics;  // reading, segmentation and fitting problems

@@ -1,0 +1,192 @@
+#include "spindown/bench_naming.hpp"
+
+#include <algorithm>
+#include <filesystem>
+#include <fmt/format.h>
+#include <stdexcept>
+
+#include "spindown/file_bytes.hpp"
+#include "spindown/lcm_channels.hpp"
+#include "spindown/text_repairs.hpp"
+#include "spindown/text_support.hpp"
+
+namespace spindown {
+
+namespace {
+
+std::string trim(std::string_view s) {
+  const auto b = s.find_first_not_of(" \t");
+  if (b == std::string_view::npos) return {};
+  const auto e = s.find_last_not_of(" \t");
+  return std::string(s.substr(b, e - b + 1));
+}
+
+// One row's fields; a field in double quotes may hold the delimiter ("Smith, Anna") and "" for a quote.
+std::vector<std::string> split_row(std::string_view line, char delim) {
+  std::vector<std::string> out;
+  std::string field;
+  bool quoted = false;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
+        field += '"';
+        ++i;
+      } else if (c == '"') {
+        quoted = false;
+      } else {
+        field += c;
+      }
+    } else if (c == '"' && trim(field).empty()) {
+      field.clear();
+      quoted = true;
+    } else if (c == delim) {
+      out.push_back(trim(field));
+      field.clear();
+    } else {
+      field += c;
+    }
+  }
+  out.push_back(trim(field));
+  return out;
+}
+
+char header_delimiter(std::string_view header) {
+  for (const char d : {'\t', ';', ','})
+    if (header.find(d) != std::string_view::npos) return d;
+  return ',';
+}
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+}  // namespace
+
+std::string file_stem(const std::string& path) {
+  std::string name = std::filesystem::path(path).filename().string();
+  const auto dot = name.find_last_of('.');
+  if (dot != std::string::npos && dot > 0) name.resize(dot);
+  return name.empty() ? path : name;
+}
+
+ClassRoster load_class_roster(const std::string& path) {
+  std::string why;
+  std::optional<std::string> bytes = read_file_bytes(path, &why, std::size_t{16} << 20);
+  if (!bytes) throw std::runtime_error(why);
+  if (bytes->starts_with("\xEF\xBB\xBF")) bytes->erase(0, 3);  // a spreadsheet's byte-order mark
+  if (needs_text_repair(*bytes)) repair_text(*bytes);        // UTF-16 from a Windows editor
+  ClassRoster roster;
+  roster.path = path;
+  char delim = ',';
+  std::optional<std::size_t> col_file, col_bench, col_student;
+  std::size_t columns = 0;
+  text::for_each_line(*bytes, [&](std::int64_t number, std::string_view raw) {
+    const std::string line = trim(raw);
+    if (line.empty() || line.front() == '#') return;
+    const auto at = [&](std::string_view what) {
+      return std::runtime_error(fmt::format("{}:{}: {}", path, number, what));
+    };
+    if (columns == 0) {  // the header
+      delim = header_delimiter(line);
+      const std::vector<std::string> names = split_row(line, delim);
+      columns = names.size();
+      for (std::size_t i = 0; i < names.size(); ++i) {
+        const std::string n = lower(names[i]);
+        if (n == "file" || n == "filename" || n == "file name") col_file = i;
+        if (n == "bench" || n == "bench_id" || n == "bench id") col_bench = i;
+        if (n == "student" || n == "name" || n == "students") col_student = i;
+      }
+      if (!col_file || !col_bench)
+        throw at(fmt::format("the header '{}' needs a 'file' and a 'bench' column (e.g. file,bench,student)", line));
+      return;
+    }
+    const std::vector<std::string> f = split_row(line, delim);
+    if (f.size() <= std::max(*col_file, *col_bench))
+      throw at(fmt::format("{} field{} where the header has {}: '{}'", f.size(), f.size() == 1 ? "" : "s", columns, line));
+    RosterEntry e{f[*col_file], f[*col_bench], col_student && *col_student < f.size() ? f[*col_student] : "",
+                  static_cast<std::size_t>(number)};
+    if (e.file.empty()) throw at("no file named");
+    std::string bad;
+    if (!is_valid_bench_id(e.bench, &bad)) throw at(fmt::format("bench '{}': {}", e.bench, bad));
+    for (const auto& other : roster.entries)
+      if (other.file == e.file && other.bench != e.bench)
+        throw at(fmt::format("'{}' is bench '{}' here but bench '{}' on line {}", e.file, e.bench, other.bench,
+                             other.line));
+    roster.entries.push_back(std::move(e));
+  });
+  if (columns == 0) throw std::runtime_error(fmt::format("{}: empty: a roster needs a header 'file,bench[,student]'", path));
+  if (roster.entries.empty()) throw std::runtime_error(fmt::format("{}: the roster lists no file", path));
+  return roster;
+}
+
+BenchNaming::BenchNaming(const std::string& roster_path, const std::string& pattern, const std::string& fixed_bench)
+    : pattern_text_(pattern), fixed_(fixed_bench) {
+  if (!roster_path.empty()) roster_ = load_class_roster(roster_path);
+  if (!pattern.empty()) {
+    try {
+      pattern_.emplace(pattern, std::regex::ECMAScript);
+    } catch (const std::regex_error& e) {
+      throw std::invalid_argument(fmt::format("--bench-pattern '{}' is not a regular expression: {}", pattern, e.what()));
+    }
+    if (pattern_->mark_count() < 1)
+      throw std::invalid_argument(
+          fmt::format("--bench-pattern '{}' has no group: put the bench id in parentheses, e.g. '(bench[0-9]+)'",
+                      pattern));
+  }
+  std::string why;
+  if (!fixed_.empty() && !is_valid_bench_id(fixed_, &why))
+    throw std::invalid_argument(fmt::format("--bench '{}': {}", fixed_, why));
+}
+
+BenchName BenchNaming::name(const std::string& path, const std::string& fallback) const {
+  namespace fs = std::filesystem;
+  std::vector<std::string> problems;
+  if (roster_) {
+    const fs::path given = fs::path(path).lexically_normal();
+    const std::string base = given.filename().string();
+    const fs::path roster_dir = fs::path(roster_->path).parent_path();
+    std::error_code ec;
+    const fs::path real = fs::weakly_canonical(given, ec);
+    const RosterEntry* by_path = nullptr;
+    std::vector<const RosterEntry*> by_name;
+    for (const auto& e : roster_->entries) {
+      const fs::path listed = fs::path(e.file).lexically_normal();
+      if (listed == given) by_path = &e;
+      if (!by_path && !real.empty()) {
+        const fs::path there = fs::weakly_canonical(roster_dir / listed, ec);
+        if (!ec && there == real) by_path = &e;
+      }
+      if (listed.filename().string() == base) by_name.push_back(&e);
+      if (by_path) break;
+    }
+    const RosterEntry* hit = by_path ? by_path : by_name.size() == 1 ? by_name.front() : nullptr;
+    if (hit) return {hit->bench, hit->student, fmt::format("roster {}:{}", roster_->path, hit->line), {}};
+    problems.push_back(by_name.size() > 1
+                           ? fmt::format("the roster {} lists several files named '{}' (lines {} and {}): give its "
+                                         "folder too",
+                                         roster_->path, base, by_name[0]->line, by_name[1]->line)
+                           : fmt::format("not in the roster {}", roster_->path));
+  }
+  if (pattern_) {
+    const std::string name = fs::path(path).filename().string();
+    std::smatch m;
+    if (std::regex_search(name, m, *pattern_) && m[1].matched && m[1].length() > 0) {
+      std::string why;
+      if (is_valid_bench_id(m[1].str(), &why))
+        return {m[1].str(), pattern_->mark_count() >= 2 && m[2].matched ? m[2].str() : "", "--bench-pattern", {}};
+      problems.push_back(fmt::format("--bench-pattern took '{}' from the file name, not a bench id: {}", m[1].str(), why));
+    } else {
+      problems.push_back(fmt::format("its name does not match --bench-pattern '{}'", pattern_text_));
+    }
+  }
+  if (!fixed_.empty()) return {fixed_, "", "--bench", {}};
+  std::string problem;
+  for (const auto& p : problems) problem += (problem.empty() ? "" : "; ") + p;
+  if (!problem.empty())
+    problem += fallback.empty() ? "" : fmt::format("; reported as bench '{}' (its file name)", fallback);
+  return {fallback, "", "", problem};
+}
+
+}  // namespace spindown
