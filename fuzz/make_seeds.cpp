@@ -76,6 +76,8 @@ config_t bench_config() {
   c.baud = 9600;
   c.device = "/dev/ttyACM0";
   c.host = "lab-pc-3";
+  c.inertia_rel_error = 0.02;
+  c.kb_rel_error = 0.05;
   return c;
 }
 
@@ -139,6 +141,9 @@ fit_t fit_message() {
   f.reading_step = 0.01;
   f.model_reduced_chi2.assign(static_cast<std::size_t>(f.nmodels), 1.0);
   f.ncorrelations = 0;
+  f.inertia_rel_error = 0.02;
+  f.kb_rel_error = 0.05;
+  f.param_bench_error = {8e-9, 1e-5, 9e-6, 2e-9};
   return f;
 }
 

@@ -71,14 +71,14 @@ std::function<void()> add_input_options(CLI::App* sub, InputOptions& opt) {
                  ->check(positive)
                  ->group("Bench");
   kb->excludes(kv);
-  sub->add_option("--inertia-error", opt.inertia_error_pct,
+  auto* j_error = sub->add_option("--inertia-error", opt.inertia_error_pct,
                   "Standard uncertainty of J in % (geometry, density): carried into c1…c4 beside their statistical "
-                  "error (default 0: J taken as exact)")
+                  "error (default: the bench file's inertia_error_pct, the CONFIG's, else 0: J taken as exact)")
       ->check(CLI::Range(0.0, 100.0))
       ->group("Bench");
-  sub->add_option("--kb-error", opt.kb_error_pct,
+  auto* kb_error = sub->add_option("--kb-error", opt.kb_error_pct,
                   "Standard uncertainty of K_b in % (datasheet tolerance): carried into c2, c4 and omega0 of a "
-                  "back-EMF reading (default 0)")
+                  "back-EMF reading (default: the bench file's kb_error_pct, the CONFIG's, else 0)")
       ->check(CLI::Range(0.0, 100.0))
       ->group("Bench");
 
@@ -99,7 +99,9 @@ std::function<void()> add_input_options(CLI::App* sub, InputOptions& opt) {
                   "e.g. '(bench[0-9]+)_([a-z]+)'")
       ->group(klass);
 
-  return [&opt, inertia, radius, kb, kv]() {
+  return [&opt, inertia, radius, kb, kv, j_error, kb_error]() {
+    opt.inertia_error_given = j_error->count() > 0;
+    opt.kb_error_given = kb_error->count() > 0;
     opt.inertia_given = inertia->count() > 0;
     opt.flywheel_given = radius->count() > 0;
     opt.kb_given = kb->count() > 0;
@@ -118,7 +120,8 @@ BenchNaming naming_from(const InputOptions& o, const std::string& fixed_bench) {
 }
 
 BenchChoice bench_choice_from(const InputOptions& o) {
-  return {bench_from(o), o.inertia_given || o.flywheel_given, o.kb_given || o.speed_constant_given};
+  return {bench_from(o), o.inertia_given || o.flywheel_given, o.kb_given || o.speed_constant_given,
+          o.inertia_error_given, o.kb_error_given};
 }
 
 BenchParams bench_from(const InputOptions& o) {

@@ -26,6 +26,7 @@ struct InputOptions {
   double speed_constant_rpm_per_v = 0;
   bool inertia_given = false, flywheel_given = false, kb_given = false, speed_constant_given = false;
   double inertia_error_pct = 0, kb_error_pct = 0;  // their standard uncertainties, % (0: exact)
+  bool inertia_error_given = false, kb_error_given = false;
 
   // Delimited text: columns and units when they are not obvious from the header.
   std::string time_column, value_column, time_unit, value_unit, delimiter;

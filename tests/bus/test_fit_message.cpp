@@ -55,6 +55,32 @@ TEST(FitMessage, RoundTripKeepsTheReport) {
   EXPECT_EQ((*j)["bench"]["J_source"], "geometry");
 }
 
+TEST(FitMessage, TheUncertaintyOfJAndKbTravelsWithEachParameter) {
+  SyntheticRunSpec spec;
+  spec.seed = 42;
+  const SyntheticRun run = make_synthetic_run(spec);
+  Recording rec;
+  for (std::size_t i = 0; i < run.t_ms.size(); ++i) rec.push(run.t_ms[i] / 1000.0, run.volts[i]);
+  FitOptions fo;
+  fo.bench.inertia_rel_error = 0.02;
+  fo.bench.kb_rel_error = 0.05;
+  const RunFit fit = fit_run(rec, find_runs(rec).runs.at(0), fo);
+  const fit_t msg = to_fit_message(fit, FitProvenance{"b", "config", 0, 0, 0, std::nullopt}, 1);
+  EXPECT_DOUBLE_EQ(msg.inertia_rel_error, 0.02);
+  EXPECT_DOUBLE_EQ(msg.kb_rel_error, 0.05);
+  ASSERT_EQ(msg.param_bench_error.size(), msg.param_name.size());
+  for (std::size_t k = 0; k < msg.param_name.size(); ++k) {
+    if (msg.param_name[k] == "c4") {
+      EXPECT_GT(msg.param_bench_error[k], 0.04 * msg.param_value[k]);  // J's 2 % and 1/K_b's 5 %
+    }
+  }
+  std::string why;
+  const auto back = from_fit_message(msg, &why);
+  ASSERT_TRUE(back) << why;
+  EXPECT_EQ(run_fit_json(*back).dump(), run_fit_json(fit).dump());  // bench_stderr, total_stderr included
+  EXPECT_NE(run_fit_json(fit).dump().find("\"total_stderr\""), std::string::npos);
+}
+
 TEST(FitMessage, InconsistentArraysAreRefused) {
   fit_t msg = to_fit_message(sample_fit(), {"b", "config", 0, 0, 0, std::nullopt}, 0);
   fit_t bad = msg;

@@ -90,6 +90,10 @@ config_t make_config() {
   m.baud = 9600;
   m.device = "/dev/ttyACM0";
   m.host = "lab-pc-07";
+  if constexpr (requires { m.inertia_rel_error; }) {  // J's and K_b's own uncertainty
+    m.inertia_rel_error = 0.02;
+    m.kb_rel_error = 0.05;
+  }
   return m;
 }
 
@@ -170,6 +174,11 @@ fit_t make_fit() {
     m.corr_a = {"omega0", "omega0"};
     m.corr_b = {"c1", "c2"};
     m.corr_value = {0.74, 0.88};
+  }
+  if constexpr (requires { m.param_bench_error; }) {  // J's and K_b's uncertainty in each parameter
+    m.inertia_rel_error = 0.02;
+    m.kb_rel_error = 0.05;
+    m.param_bench_error = {2.8e-8, 7e-6, 3.6e-9, 6.6e-6};
   }
   return m;
 }

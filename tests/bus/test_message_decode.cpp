@@ -60,6 +60,8 @@ config_t make_config() {
   c.baud = 9600;
   c.device = "/dev/ttyACM0";
   c.host = "h";
+  c.inertia_rel_error = 0.02;
+  c.kb_rel_error = 0.05;
   return c;
 }
 run_t make_run() {
@@ -125,6 +127,9 @@ fit_t make_fit() {
   f.corr_a = {"omega0", "omega0", "c3"};
   f.corr_b = {"c1", "c3", "c4"};
   f.corr_value = {0.5, 0.6, -0.9};
+  f.inertia_rel_error = 0.02;
+  f.kb_rel_error = 0.05;
+  f.param_bench_error = {0.01, 0.02, 0.03};
   return f;
 }
 explain_t make_explain() {

@@ -59,5 +59,23 @@ TEST(BenchChoice, TheCommandLineOverEverythingOneParameterAtATime) {
   EXPECT_EQ(p.kb_source, "datasheet (benches/b1.toml)");
 }
 
+TEST(BenchChoice, TheUncertaintiesFollowTheSameRuleEachOnItsOwn) {
+  BenchFile f = file_with(true, true);
+  f.params.inertia_rel_error = 0.03;
+  f.sets_inertia_error = true;  // the file gives J's uncertainty, not K_b's
+  BenchParams config = config_params();
+  config.inertia_rel_error = 0.01;
+  config.kb_rel_error = 0.04;
+  BenchChoice cli;
+  BenchParams p = choose_bench_params(cli, &f, config);
+  EXPECT_DOUBLE_EQ(p.inertia_rel_error, 0.03);  // the file's
+  EXPECT_DOUBLE_EQ(p.kb_rel_error, 0.04);       // the CONFIG's
+  cli.given.inertia_rel_error = 0.0;
+  cli.inertia_error_given = true;  // --inertia-error 0: the user says J is exact
+  p = choose_bench_params(cli, &f, config);
+  EXPECT_DOUBLE_EQ(p.inertia_rel_error, 0.0);
+  EXPECT_DOUBLE_EQ(choose_bench_params(BenchChoice{}, nullptr, std::nullopt).kb_rel_error, 0.0);  // none: exact
+}
+
 }  // namespace
 }  // namespace spindown

@@ -161,6 +161,16 @@ TEST(LabTable, FitShowsBestModelCoefficientsAndRmse) {
   EXPECT_TRUE(contains(events[0], "RMSE 0.0123 V")) << events[0];
 }
 
+TEST(LabTable, TheTotalErrorWhenJAndKbAreUncertain) {
+  fit_t m = fit_msg("b", 1);
+  m.param_bench_error.assign(m.param_stderr.size(), 0.0);
+  for (std::size_t k = 0; k < m.param_name.size(); ++k)
+    if (m.param_name[k] == "c3") m.param_bench_error[k] = 0.02 * m.param_value[k];  // J known to 2 %
+  // c3's statistical 1.1e-9 and J's 3.644e-9 (2 %): √(1.1² + 3.644²) = 3.8e-9.
+  EXPECT_EQ(fit_coefficients_text(m, false, false).rfind("c3 = (1.822 ± 0.038)e-07,", 0), 0u)
+      << fit_coefficients_text(m, false, false);
+}
+
 TEST(LabTable, LabUnitsMatchTheLabReport) {
   const std::string text = fit_coefficients_text(fit_msg("b", 1), true);
   EXPECT_EQ(text, "c3 = 1.822 ± 0.011 g·cm²·s⁻¹, c4 = 1139.0 ± 2.0 g·cm²·rad·s⁻²");

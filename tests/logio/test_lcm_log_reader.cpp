@@ -87,6 +87,8 @@ config_t config(const std::string& bench, double j = 1.12687602e-5) {
   c.baud = 9600;
   c.device = "/dev/ttyACM0";
   c.host = "test";
+  c.inertia_rel_error = 0;
+  c.kb_rel_error = 0;
   return c;
 }
 
@@ -170,6 +172,14 @@ TEST(LcmLogReader, TwoBenchesWithConfigAndOtherChannels) {
   auto params = bench_params_from_config(*a->config);
   ASSERT_TRUE(params);
   EXPECT_DOUBLE_EQ(params->inertia_kg_m2, 2e-5);
+  EXPECT_DOUBLE_EQ(params->inertia_rel_error, 0.0);
+  config_t uncertain = *a->config;  // the bench file's inertia_error_pct / kb_error_pct, via the bridge
+  uncertain.inertia_rel_error = 0.02;
+  uncertain.kb_rel_error = 0.05;
+  EXPECT_DOUBLE_EQ(bench_params_from_config(uncertain)->inertia_rel_error, 0.02);
+  EXPECT_DOUBLE_EQ(bench_params_from_config(uncertain)->kb_rel_error, 0.05);
+  uncertain.kb_rel_error = std::nan("");  // nonsense is not used: K_b taken as exact
+  EXPECT_DOUBLE_EQ(bench_params_from_config(uncertain)->kb_rel_error, 0.0);
   config_t bad = *a->config;
   bad.inertia_kg_m2 = -1;
   std::string why;

@@ -87,6 +87,19 @@ TEST(BridgeLogic, LabLinesBecomeSamplesWithGaplessSeq) {
   EXPECT_EQ(sink.configs.back().firmware, "lab sketch");
   EXPECT_DOUBLE_EQ(sink.configs.back().inertia_kg_m2, 1.12687602e-5);
   EXPECT_DOUBLE_EQ(sink.configs.back().sample_period_s, 0.020);
+  EXPECT_DOUBLE_EQ(sink.configs.back().inertia_rel_error, 0.0);  // none given: J taken as exact
+}
+
+TEST(BridgeLogic, ConfigCarriesTheUncertaintyOfJAndKb) {
+  CaptureSink sink;
+  BridgeSettings s = settings();
+  s.params.inertia_rel_error = 0.02;
+  s.params.kb_rel_error = 0.05;
+  SerialBridge b(s, sink);
+  b.tick(T0);
+  ASSERT_FALSE(sink.configs.empty());
+  EXPECT_DOUBLE_EQ(sink.configs.back().inertia_rel_error, 0.02);
+  EXPECT_DOUBLE_EQ(sink.configs.back().kb_rel_error, 0.05);
 }
 
 TEST(BridgeLogic, SpindownV1SamplesCarryRawCountsAndDetectLoss) {
@@ -321,9 +334,12 @@ TEST(BridgeSettings, TomlFileSetsTheBench) {
   std::ofstream(path) << "bench_id = \"bench-7\"\n[serial]\ndevice = \"/dev/ttyACM3\"\nbaud = 115200\n"
                          "[bench]\nflywheel_radius_m = 0.02\nflywheel_height_m = 0.015\n"
                          "flywheel_density_kg_m3 = 2700\nrotor_inertia_kg_m2 = 1.09e-6\n"
-                         "speed_constant_rpm_per_v = 1180\nquantity = \"rpm\"\n[lab]\nperiod_s = 0.01\n";
+                         "speed_constant_rpm_per_v = 1180\nquantity = \"rpm\"\ninertia_error_pct = 2\n"
+                         "kb_error_pct = 5\n[lab]\nperiod_s = 0.01\n";
   BridgeSettings s;
   load_bridge_settings(path, s);
+  EXPECT_DOUBLE_EQ(s.params.inertia_rel_error, 0.02);  // their uncertainties, carried to the CONFIG
+  EXPECT_DOUBLE_EQ(s.params.kb_rel_error, 0.05);
   EXPECT_EQ(s.bench, "bench-7");
   EXPECT_EQ(s.device, "/dev/ttyACM3");
   EXPECT_EQ(s.baud, 115200);
@@ -347,6 +363,13 @@ TEST(BridgeSettings, BadFileNamesFileKeyAndProblem) {
   }
   std::ofstream(path) << "[serial]\nbaud = \"fast\"\n";
   EXPECT_THROW(load_bridge_settings(path, s), std::runtime_error);
+  std::ofstream(path) << "[bench]\ninertia_error_pct = 150\n";
+  try {
+    load_bridge_settings(path, s);
+    FAIL() << "an uncertainty of 150 % was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": key 'bench.inertia_error_pct': 150 is not a percentage in 0-100");
+  }
   std::ofstream(path) << "[serial\n";
   try {
     load_bridge_settings(path, s);

@@ -31,6 +31,8 @@ fit_t to_fit_message(const RunFit& fit, const FitProvenance& about, std::int64_t
                                                                                : 0);
   m.inertia_kg_m2 = fit.bench.inertia_kg_m2;
   m.kb_v_s_per_rad = fit.bench.kb_v_s_per_rad;
+  m.inertia_rel_error = fit.bench.inertia_rel_error;
+  m.kb_rel_error = fit.bench.kb_rel_error;
   m.bench_source = about.bench_source;
   m.zero_level = fit.run.zero_level;
   m.residual_unit = std::string(quantity_unit(fit.quantity));
@@ -54,6 +56,7 @@ fit_t to_fit_message(const RunFit& fit, const FitProvenance& about, std::int64_t
       m.param_value.push_back(p.value);
       m.param_stderr.push_back(p.std_error);
       m.param_unit.push_back(p.unit);
+      m.param_bench_error.push_back(p.bench_error);
       ++m.nparams;
     }
   }
@@ -121,7 +124,7 @@ std::optional<RunFit> from_fit_message(const fit_t& m, std::string* why) {
       m.aic.size() != nm || m.bic.size() != nm || m.t_stop_pred_s.size() != nm || m.converged.size() != nm ||
       m.model_samples.size() != nm || m.model_message.size() != nm || m.param_model.size() != np ||
       m.param_name.size() != np || m.param_value.size() != np || m.param_stderr.size() != np ||
-      m.param_unit.size() != np) {
+      m.param_unit.size() != np || m.param_bench_error.size() != np) {
     fail(why, fmt::format("FIT of bench {} run {}: array sizes do not match nmodels {} / nparams {}", m.bench, m.run,
                           m.nmodels, m.nparams));
     return std::nullopt;
@@ -144,6 +147,8 @@ std::optional<RunFit> from_fit_message(const fit_t& m, std::string* why) {
   fit.bench.kb_v_s_per_rad = m.kb_v_s_per_rad;
   fit.bench.inertia_source = m.inertia_source;
   fit.bench.kb_source = m.kb_source;
+  fit.bench.inertia_rel_error = m.inertia_rel_error;
+  fit.bench.kb_rel_error = m.kb_rel_error;
   const auto q = parse_quantity(m.residual_unit);
   if (!q) {
     fail(why, fmt::format("FIT of bench {} run {}: unknown residual unit '{}'", m.bench, m.run, m.residual_unit));
@@ -176,7 +181,7 @@ std::optional<RunFit> from_fit_message(const fit_t& m, std::string* why) {
       return std::nullopt;
     }
     ModelFit& f = fit.models[static_cast<std::size_t>(i)];
-    f.params.push_back({m.param_name[k], m.param_value[k], m.param_stderr[k], m.param_unit[k]});
+    f.params.push_back({m.param_name[k], m.param_value[k], m.param_stderr[k], m.param_unit[k], m.param_bench_error[k]});
     if (m.param_name[k] == "omega0") f.omega0 = m.param_value[k];
   }
   fit.best = m.best;

@@ -123,6 +123,7 @@ constexpr WireField config_fields[] = {
     {"quantity", Wire::i8},         {"adc_volts_per_count", Wire::f64}, {"adc_bits", Wire::i32},
     {"firmware", Wire::string},     {"protocol", Wire::string},     {"sample_period_s", Wire::f64},
     {"baud", Wire::i32},            {"device", Wire::string},       {"host", Wire::string},
+    {"inertia_rel_error", Wire::f64}, {"kb_rel_error", Wire::f64},
 };
 
 constexpr WireField run_fields[] = {
@@ -213,6 +214,9 @@ constexpr WireField fit_fields[] = {
     {"corr_a", Wire::string, 58},                   // 60
     {"corr_b", Wire::string, 58},                   // 61
     {"corr_value", Wire::f64, 58},                  // 62
+    {"inertia_rel_error", Wire::f64},               // 63
+    {"kb_rel_error", Wire::f64},                    // 64
+    {"param_bench_error", Wire::f64, 19},           // 65
 };
 
 constexpr WireField explain_fields[] = {

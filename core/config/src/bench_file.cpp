@@ -16,15 +16,16 @@ namespace spindown {
 namespace {
 
 // One parameter by the rule: the command line's (already in p), else the file's, else the CONFIG's.
+// source: where the value came from, for reports (nullptr: an uncertainty, which has none of its own).
 void choose_one(bool given, bool file_sets, const BenchFile* file, const std::optional<BenchParams>& config,
                 double BenchParams::*value, std::string BenchParams::*source, BenchParams& p) {
   if (given) return;
   if (file && file_sets) {
     p.*value = file->params.*value;
-    p.*source = file->params.*source + " (" + file->path + ")";
+    if (source) p.*source = file->params.*source + " (" + file->path + ")";
   } else if (config) {
     p.*value = (*config).*value;
-    p.*source = (*config).*source;
+    if (source) p.*source = (*config).*source;
   }
 }
 
@@ -36,6 +37,9 @@ BenchParams choose_bench_params(const BenchChoice& cli, const BenchFile* file, c
              &BenchParams::inertia_source, p);
   choose_one(cli.kb_given, file && file->sets_kb, file, config, &BenchParams::kb_v_s_per_rad, &BenchParams::kb_source,
              p);
+  choose_one(cli.inertia_error_given, file && file->sets_inertia_error, file, config, &BenchParams::inertia_rel_error,
+             nullptr, p);
+  choose_one(cli.kb_error_given, file && file->sets_kb_error, file, config, &BenchParams::kb_rel_error, nullptr, p);
   return p;
 }
 
@@ -53,6 +57,8 @@ BenchFile load_bench_file(const std::string& path) {
   const toml::table root = parse_toml_file(path);
   f.sets_inertia = root.at_path("bench.inertia_kg_m2").node() || root.at_path("bench.flywheel_radius_m").node();
   f.sets_kb = root.at_path("bench.kb_v_s_per_rad").node() || root.at_path("bench.speed_constant_rpm_per_v").node();
+  f.sets_inertia_error = root.at_path("bench.inertia_error_pct").node() != nullptr;
+  f.sets_kb_error = root.at_path("bench.kb_error_pct").node() != nullptr;
   return f;
 }
 

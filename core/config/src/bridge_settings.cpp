@@ -111,6 +111,13 @@ void load_bridge_settings(const std::string& path, BridgeSettings& s) {
     s.params.kb_source = fmt::format("speed constant {} rpm/V", d);
   }
   r.text("bench.kb_source", s.params.kb_source);
+  // Their standard uncertainties in percent (geometry and density; the datasheet's tolerance).
+  for (const auto& [key, field] : {std::pair{"bench.inertia_error_pct", &BenchParams::inertia_rel_error},
+                                   std::pair{"bench.kb_error_pct", &BenchParams::kb_rel_error}}) {
+    if (!r.number(key, d)) continue;
+    if (!(d >= 0 && d < 100)) r.fail(key, fmt::format("{} is not a percentage in 0-100", d));
+    s.params.*field = d / 100;
+  }
   if (r.text("bench.quantity", t)) {
     const auto q = parse_quantity(t);
     if (!q) r.fail("bench.quantity", fmt::format("unknown quantity '{}' (want V, rpm or rad/s)", t));

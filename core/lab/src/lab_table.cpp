@@ -153,6 +153,8 @@ std::string fit_coefficients_text(const fit_t& msg, bool lab_units, bool with_un
        ++k) {
     if (msg.param_model[k] != static_cast<std::int32_t>(best) || !is_friction_coefficient(msg.param_name[k])) continue;
     double value = msg.param_value[k], err = msg.param_stderr[k];
+    // With J's and K_b's own uncertainty given, the total (what a lab report quotes).
+    if (k < msg.param_bench_error.size() && msg.param_bench_error[k] > 0) err = std::hypot(err, msg.param_bench_error[k]);
     std::string_view unit = pretty_unit(msg.param_unit[k]);
     if (lab_units)
       if (auto lab = lab_unit_for(msg.param_unit[k])) {

@@ -51,6 +51,10 @@ std::optional<BenchParams> bench_params_from_config(const config_t& config, std:
   p.kb_v_s_per_rad = config.kb_v_s_per_rad;
   p.inertia_source = config.inertia_source.empty() ? "config" : config.inertia_source;
   p.kb_source = config.kb_source.empty() ? "config" : config.kb_source;
+  // A CONFIG's own uncertainties; a nonsense one (NaN, negative, ≥ 100 %) is not used.
+  const auto rel = [](double x) { return std::isfinite(x) && x >= 0 && x < 1 ? x : 0.0; };
+  p.inertia_rel_error = rel(config.inertia_rel_error);
+  p.kb_rel_error = rel(config.kb_rel_error);
   std::string bad;
   if (!p.is_valid(&bad)) {
     if (why) *why = fmt::format("config of bench '{}': {}", text::escape_invalid_utf8(config.bench), bad);

@@ -306,6 +306,8 @@ config_t SerialBridge::make_config(std::int64_t now_us) const {
   c.inertia_source = s_.params.inertia_source;
   c.kb_v_s_per_rad = s_.params.kb_v_s_per_rad;
   c.kb_source = s_.params.kb_source;
+  c.inertia_rel_error = s_.params.inertia_rel_error;
+  c.kb_rel_error = s_.params.kb_rel_error;
   c.protocol = std::string(wire_protocol_name(protocol_));
   c.baud = s_.baud;
   c.device = s_.device;

@@ -220,6 +220,8 @@ int main(int argc, char** argv) {
     c.baud = 9600;
     c.device = "generated";
     c.host = "localhost";
+    c.inertia_rel_error = 0;
+    c.kb_rel_error = 0;
     lcm.publish(spindown::channel_name(p.id, spindown::ChannelKind::config), &c);
   };
 

@@ -42,6 +42,8 @@ spindown::config_t make_config(const std::string& bench, std::int64_t now) {
   c.baud = 9600;
   c.device = "/dev/ttyACM0";
   c.host = spindown::host_name();
+  c.inertia_rel_error = 0.02;
+  c.kb_rel_error = 0.05;
   return c;
 }
 
@@ -110,6 +112,9 @@ spindown::fit_t make_fit(const std::string& bench, std::int64_t now) {
   f.corr_a = {"c3"};
   f.corr_b = {"c4"};
   f.corr_value = {-0.96};
+  f.inertia_rel_error = 0.02;
+  f.kb_rel_error = 0.05;
+  f.param_bench_error = {3e-8, 9e-6, 4e-9, 6e-6};
   return f;
 }
 

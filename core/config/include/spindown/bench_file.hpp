@@ -19,6 +19,7 @@ struct BenchFile {
   BenchParams params;          // [bench] J and K_b (lab defaults where the file sets none)
   bool sets_inertia = false;   // the file gives J (inertia_kg_m2 or flywheel geometry)
   bool sets_kb = false;        // the file gives K_b (kb_v_s_per_rad or speed_constant_rpm_per_v)
+  bool sets_inertia_error = false, sets_kb_error = false;  // [bench] inertia_error_pct, kb_error_pct
   MotorHealthConfig health;    // [motor], [baseline], [health]
 };
 
@@ -30,10 +31,12 @@ struct BenchFiles {
 // baseline, report), each parameter on its own: the command line (--inertia or --flywheel…,
 // --kb or --speed-constant), else the bench's file ([bench] of its --bench-config TOML), else
 // the log's CONFIG, else the lab's defaults. inertia_source and kb_source name where each came
-// from. (refit and export reproduce the live fitter, which takes CONFIG, else its defaults.)
+// from. Their uncertainties follow the same rule, each on its own (--inertia-error/--kb-error,
+// [bench] inertia_error_pct/kb_error_pct, the CONFIG's; else 0: taken as exact). (refit and export reproduce the live fitter, which takes CONFIG, else its defaults.)
 struct BenchChoice {
   BenchParams given;  // the lab's defaults with the command line's values applied
   bool inertia_given = false, kb_given = false;
+  bool inertia_error_given = false, kb_error_given = false;
 };
 BenchParams choose_bench_params(const BenchChoice& cli, const BenchFile* file, const std::optional<BenchParams>& config);
 
