@@ -297,6 +297,7 @@ int main(int argc, char** argv) {
   const auto drain_until = Clock::now() + std::chrono::seconds(5);
   while (!pending.empty() && Clock::now() < drain_until && !stop.requested() && pty->reader_attached())
     pending.erase(0, pty->write(pending, std::chrono::milliseconds(50)));
+  counter.drop();  // the pty closes after the linger: a reader drops the line the end cut short
   const double wall_s = std::chrono::duration<double>(Clock::now() - started).count() - waited_s;
   write_truth(wall_s);
   if (!stop.requested()) stop.sleep_for(std::chrono::milliseconds(long(linger_s * 1000)));

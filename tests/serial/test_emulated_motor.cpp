@@ -43,11 +43,12 @@ TEST(EmulatedMotor, VoltsFollowTheCoastSimulator) {
   const auto r1 = m.runs()[0];
   EXPECT_EQ(m.volts_at(0.2), 0.0);   // at rest
   EXPECT_EQ(m.volts_at(1.0), 0.0);   // powered, the pin reads 0 (lead-in zeros)
+  EXPECT_NEAR(m.volts_at(r1.cut_s), o.e0_v, 1e-9);
   const std::vector<double> tau = {0.0, 0.5, 1.0, 2.0, 3.0};
   const auto omega = simulate_coast(o.friction, o.bench.inertia_kg_m2, r1.omega0, tau);
   for (std::size_t i = 0; i < tau.size(); ++i)
     EXPECT_NEAR(m.volts_at(r1.cut_s + tau[i]), o.bench.kb_v_s_per_rad * omega[i], 1e-9) << "tau " << tau[i];
-  EXPECT_NEAR(m.volts_at(r1.cut_s), o.e0_v, 1e-9);
+  EXPECT_NEAR(m.volts_at(r1.cut_s), m.volts_at(r1.cut_s + 3.0), 1e-12);  // time never goes back
   EXPECT_EQ(m.volts_at(r1.stop_s + 0.01), 0.0);  // stopped
   // The second run starts at its own e0.
   EXPECT_NEAR(m.volts_at(m.runs()[1].cut_s + 1e-9), o.e0_v, 1e-3);
