@@ -96,23 +96,38 @@ LAB_PROFILE_TEXT=(
   "lab sketch 9600 baud, 1000 rpm/V motor, oily bearing (mostly viscous)"
 )
 
-# lab_profile INDEX NAME: sets LAB_BENCH_ARGS (virtual bench options) and writes the bridge's
-# config file $LAB_WORK/NAME.toml with the same J and K_b (what the bridge says in CONFIG).
+# The same benches with the real firmware on an emulated Arduino Uno (deploy/run-lab --firmware):
+# the sketch's own bytes; the pin reads 0 V before the cut where the virtual bench floats it.
+LAB_AVR_PROFILE_TEXT=(
+  ""
+  "lab_sketch.elf on an emulated Uno, 9600 baud, aluminium flywheel, friction as in the students' report"
+  "spindown_coast.elf on an emulated Uno, 115200 baud, brass flywheel J=2.0e-5 kg·m², worn bearings (Coulomb ×1.8)"
+  "lab_sketch.elf on an emulated Uno, 9600 baud, 1000 rpm/V motor, oily bearing (mostly viscous)"
+)
+
+# lab_profile INDEX NAME: sets LAB_BENCH_ARGS (virtual bench options), LAB_AVR_ARGS (the emulated
+# Arduino's: sketch and motor) and writes the bridge's config file $LAB_WORK/NAME.toml with the
+# same J and K_b (what the bridge says in CONFIG).
 lab_profile() {
   local toml="$LAB_WORK/$2.toml"
   case $1 in
     1)
       LAB_BENCH_ARGS=(--protocol lab --lead-in zeros --e0 2.8 --e0-step 0.4 --seed 11)
+      LAB_AVR_ARGS=(lab_sketch --lead-in zeros --e0 2.8 --e0-step 0.4 --noise 0.003 --seed 11)
       printf '[bench]\ninertia_source = "aluminium flywheel r=2 cm h=1.5 cm + rotor"\n' >"$toml"
       ;;
     2)
       LAB_BENCH_ARGS=(--protocol spindown-v1 --period-ms 10 --jitter-ms 0.2 --lead-in floating --inertia 2.0e-5
                       --coulomb 2.05e-4 --viscous 1.5e-7 --e0 3.0 --e0-step 0.3 --seed 22)
+      LAB_AVR_ARGS=(spindown_coast --lead-in zeros --inertia 2.0e-5 --coulomb 2.05e-4 --viscous 1.5e-7 --e0 3.0
+                    --e0-step 0.3 --noise 0.003 --seed 22)
       printf '[bench]\ninertia_kg_m2 = 2.0e-5\ninertia_source = "brass flywheel"\n[serial]\nbaud = 115200\n' >"$toml"
       ;;
     3)
       LAB_BENCH_ARGS=(--protocol lab --lead-in supply --supply 3.2 --kb 0.009549296585513721 --viscous 1.2e-6
                       --coulomb 3.0e-5 --e0 2.5 --e0-step 0.3 --seed 33)
+      LAB_AVR_ARGS=(lab_sketch --lead-in supply --supply 3.2 --kb 0.009549296585513721 --viscous 1.2e-6
+                    --coulomb 3.0e-5 --e0 2.5 --e0-step 0.3 --noise 0.003 --seed 33)
       printf '[bench]\nspeed_constant_rpm_per_v = 1000\nkb_source = "motor datasheet 1000 rpm/V"\n' >"$toml"
       ;;
     *) echo "lab_profile: no profile $1 (1..3)" >&2; return 2 ;;
@@ -132,6 +147,27 @@ lab_start_bench() {
     --wait-reader 30 --linger 1 "$@"
   if ! lab_wait "[[ -L '$LAB_WORK/$name.tty' ]]" 15; then
     echo "lab: the virtual bench $name did not make its pty: $(tail -3 "$LAB_WORK/$name.bench.err")" >&2
+    return 1
+  fi
+  lab_start "$ns" "$name.bridge" "$LAB_BIN/spindown-bridge" --device "$LAB_WORK/$name.tty" --bench "$name" \
+    --lcm-url "$url" --config "$LAB_WORK/$name.toml"
+}
+
+# lab_start_avr NS NAME PROFILE URL RUNS SPEED FIRMWARE_DIR: the profile's sketch (FIRMWARE_DIR/
+# SKETCH.elf, built by make -C deploy/firmware) on an emulated Arduino Uno (spindown-avr-bench,
+# SPEED: at most that many emulated seconds per wall second, 0: as fast as it runs) on a pty
+# ($LAB_WORK/NAME.tty), and a bridge reading it. Processes NAME.bench and NAME.bridge; the truth
+# in $LAB_WORK/NAME.truth.json as with lab_start_bench.
+lab_start_avr() {
+  local ns=$1 name=$2 profile=$3 url=$4 runs=$5 speed=$6 fw=$7
+  lab_profile "$profile" "$name" || return 2
+  local sketch=${LAB_AVR_ARGS[0]}
+  rm -f "$LAB_WORK/$name.tty"
+  lab_start "$ns" "$name.bench" "$LAB_BIN/spindown-avr-bench" --firmware "$fw/$sketch.elf" "${LAB_AVR_ARGS[@]:1}" \
+    --runs "$runs" --speed "$speed" --idle 1.0 --link "$LAB_WORK/$name.tty" --truth "$LAB_WORK/$name.truth.json" \
+    --wait-reader 30 --linger 1
+  if ! lab_wait "[[ -L '$LAB_WORK/$name.tty' ]]" 15; then
+    echo "lab: the emulated Arduino $name did not make its pty: $(tail -3 "$LAB_WORK/$name.bench.err")" >&2
     return 1
   fi
   lab_start "$ns" "$name.bridge" "$LAB_BIN/spindown-bridge" --device "$LAB_WORK/$name.tty" --bench "$name" \
