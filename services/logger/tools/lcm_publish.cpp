@@ -112,6 +112,12 @@ spindown::fit_t make_fit(const std::string& bench, std::int64_t now) {
   f.corr_a = {"c3"};
   f.corr_b = {"c4"};
   f.corr_value = {-0.96};
+  // lcm-gen's C++ structs leave numbers uninitialized: an unset count made the encoder walk a
+  // garbage number of findings (a crash now and then, seen under the lcm-spy GUI test).
+  f.health_reference = false;
+  f.nfindings = 0;
+  f.t_end_s = 38.5;
+  f.end = "stopped";
   f.inertia_rel_error = 0.02;
   f.kb_rel_error = 0.05;
   f.param_bench_error = {3e-8, 9e-6, 4e-9, 6e-6};
