@@ -1,8 +1,9 @@
 // spindown-logger: records LCM traffic (SPINDOWN.* by default) into standard LCM event logs,
 // with rotation by size and time, a flush on a timer, nothing lost on SIGINT/SIGTERM, and its
 // counters (events, bytes, files, drops, write errors, flushes) on SPINDOWN.logger.STATUS and
-// in the logs themselves; retention (--keep-files, --keep-mb) deletes its oldest files. The
-// logic lives in spindown::EventLogWriter, spindown::LogRecorder and spindown::LogRetentionOptions.
+// in the logs themselves; retention (--keep-files, --keep-mb) deletes its oldest files; under
+// systemd Type=notify with a watchdog. The logic lives in spindown::EventLogWriter,
+// spindown::LogRecorder, spindown::LogRetentionOptions and spindown::ServiceNotifier.
 #include <CLI/CLI.hpp>
 #include <cstdint>
 #include <fmt/format.h>
@@ -16,7 +17,9 @@
 #include "spindown/lcm_status.hpp"
 #include "spindown/lcm_url.hpp"
 #include "spindown/log_recorder.hpp"
+#include "spindown/loop_watchdog.hpp"
 #include "spindown/network_checks.hpp"
+#include "spindown/service_notifier.hpp"
 #include "spindown/stop_signal.hpp"
 
 namespace {
@@ -202,7 +205,13 @@ int main(int argc, char** argv) {
 
   Heartbeat heartbeat(loop, recorder, w.status_channel);
   loop.every(1.0, [&](std::int64_t now) { heartbeat.beat(now); }, 0);
+  spindown::ServiceNotifier notify;
+  spindown::feed_watchdog_from_loop(loop, notify, [&](std::int64_t now_ns) {
+    return now_ns - recorder.writer_alive_ns() < notify.stuck_after_ns();
+  });
+  notify.ready(fmt::format("recording '{}' into {}", o.channels, w.dir));
   loop.run({.stop = &stop, .max_failures = -1});
+  notify.stopping("stopping: draining LCM and closing the log");
 
   // Drain what has reached this host: LCM's receive thread may still hold packets from the
   // socket, so dispatch until 50 ms pass with nothing new (at most 2 s under continuous

@@ -2,8 +2,9 @@
 # deploy/systemd/*.service pass `systemd-analyze verify` with no complaint at all (an unknown key
 # or a bad value is only a warning there, so any output fails the test), with the ExecStart paths
 # pointed at this build's programs through a temporary copy; the bridge template is verified as
-# an instance. Also checks what the units promise: the logger's retention, the unprivileged
-# user, the hardening, only the bench's serial device, the bench file and the LCM env file. Skips (exit 77) only when
+# an instance. Also checks what the units promise: Type=notify with a watchdog, the logger's
+# retention, the unprivileged user, the hardening, only the bench's serial device, the bench file
+# and the LCM env file. Skips (exit 77) only when
 # systemd-analyze is not installed (Debian: apt-get install systemd).
 set -euo pipefail
 src="${SPINDOWN_SOURCE_DIR:?}"
@@ -63,7 +64,8 @@ expect() {  # UNIT LINE
 for u in spindown-bridge@.service spindown-fitter.service spindown-logger.service; do
   for line in User=spindown NoNewPrivileges=yes ProtectSystem=strict ProtectHome=yes PrivateTmp=yes \
     DevicePolicy=closed "RestrictAddressFamilies=AF_INET AF_UNIX" CapabilityBoundingSet= \
-    SystemCallFilter=@system-service Restart=on-failure EnvironmentFile=/etc/spindown/lcm.env; do
+    SystemCallFilter=@system-service Restart=on-failure EnvironmentFile=/etc/spindown/lcm.env \
+    Type=notify NotifyAccess=main WatchdogSec=30; do
     expect "$u" "$line"
   done
 done
