@@ -173,5 +173,28 @@ TEST_F(RetentionDir, WriterPrunesAtEachRotationAndKeepsTheCurrentFile) {
   w.close(now);
 }
 
+TEST_F(RetentionDir, ANameRetentionFreedIsNotTakenAgain) {
+  // Many files within one second, the oldest deleted as they go: the suffixes only go up, so the
+  // names keep the order the files were written in (no second "lab-….lcm" after ".3").
+  EventLogWriterOptions o;
+  o.dir = dir_.string();
+  o.prefix = "lab";
+  o.rotate_size_mb = 0.002;
+  o.retention.keep_files = 2;
+  const std::int64_t now = 1'700'000'000'000'000;  // one second for every file
+  EventLogWriter w(o, now);
+  w.open(now);
+  const std::string payload(500, 'p');
+  for (int i = 0; i < 30; ++i) {
+    ASSERT_TRUE(w.write(now, "SPINDOWN.x.OTHER", payload.data(), static_cast<std::int32_t>(payload.size()), now));
+    w.flush(now);
+  }
+  ASSERT_GE(w.files().size(), 5u);
+  std::set<std::string> unique(w.files().begin(), w.files().end());
+  EXPECT_EQ(unique.size(), w.files().size()) << "a file name used twice";
+  EXPECT_EQ(fs::path(w.files()[3]).filename().string(), event_log_file_name("lab", "", now / 1000000, 3));
+  w.close(now);
+}
+
 }  // namespace
 }  // namespace spindown

@@ -89,12 +89,16 @@ void EventLogWriter::open(std::int64_t now_us) {
 void EventLogWriter::open_new_file(std::int64_t now_us) {
   const std::time_t t = static_cast<std::time_t>(now_us / 1000000);
   std::string name;
-  // O_EXCL: never overwrite a log (a restart or a rotation within the same second).
-  for (int suffix = 0;; ++suffix) {
+  int suffix_used = 0;
+  // O_EXCL: never overwrite a log (a restart or a rotation within the same second). Within a
+  // second the suffix only goes up, so a name that retention freed is not taken again and the
+  // names keep the order the files were written in.
+  for (int suffix = t == last_name_time_ ? last_suffix_ + 1 : 0;; ++suffix) {
     name = o_.dir + "/" + event_log_file_name(o_.prefix, o_.bench, t, suffix);
     const int fd = ::open(name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
     if (fd >= 0) {
       ::close(fd);
+      suffix_used = suffix;
       break;
     }
     if (errno != EEXIST || suffix >= 999)
@@ -105,6 +109,8 @@ void EventLogWriter::open_new_file(std::int64_t now_us) {
   // Our own buffer, flushed only between events (see raw_write), so the kernel only ever sees
   // whole events and a SIGKILL cannot leave half an event behind.
   std::setvbuf(log_->f, stdio_buffer_.data(), _IOFBF, stdio_buffer_.size());
+  last_name_time_ = t;
+  last_suffix_ = suffix_used;
   path_ = name;
   files_.push_back(name);
   ++counters_.files;

@@ -165,6 +165,8 @@ class EventLogWriter {
   std::int64_t unflushed_events_ = 0;   // received events among them
   std::int64_t next_reopen_us_ = 0;
   std::int64_t next_prune_us_ = 0;
+  std::time_t last_name_time_ = -1;  // the second of the latest file's name, and its suffix
+  int last_suffix_ = 0;
   std::int64_t kept_files_ = 0, kept_bytes_ = 0;  // the logger's files after the last prune
   std::vector<std::string> deleted_;
   // The file as it was after the last successful flush: whole events only.
