@@ -13,6 +13,7 @@
 #include <regex>
 
 #include "exit_codes.hpp"
+#include "export_mcap.hpp"
 #include "refit_command.hpp"
 #include "spindown/csv_cells.hpp"
 #include "spindown/quantity.hpp"
@@ -203,11 +204,15 @@ void setup_export(CLI::App& app) {
       "MATLAB: readtable('OUT.csv'); Python: pandas.read_csv('OUT.csv').\n"
       "Exit codes: 0 ok, 1 the log could not be read or written, 2 bad usage.");
   sub->add_option("FILE", opt->log, "LCM event log, or a text recording (Arduino/PuTTY log, CSV/TSV)")->required();
-  sub->add_flag("--csv", opt->csv, "CSV output (the only format; the default)");
+  sub->add_flag("--csv", opt->csv, "CSV output (the default; see --mcap)");
   sub->add_option("-o,--output", opt->out, "samples CSV file (default stdout)");
   auto* fits = sub->add_option("--fits", opt->fits, "fits CSV file (default: OUT with .fits.csv when -o is given)");
   sub->add_flag("--no-fits", opt->no_fits, "do not refit, samples only")->excludes(fits);
   sub->add_option("--bench", opt->bench_regex, "only benches whose id matches this regex");
+  sub->add_option("--mcap", opt->mcap,
+                  "write MCAP (Foxglove, PlotJuggler) to this file instead of CSV: every sample, and the log's RUN "
+                  "and FIT messages, as JSON (LCM logs only)")
+      ->excludes("--csv")->excludes("--output")->excludes("--fits")->excludes("--no-fits");
   auto note_given = add_input_options(sub, opt->input);  // a text recording's columns, units, bench, J and K_b
   sub->callback([opt, note_given]() {
     note_given();
@@ -223,6 +228,7 @@ int run_export(const ExportCommandOptions& o) {
   } catch (const std::regex_error& e) {
     throw CLI::ValidationError(fmt::format("--bench '{}' is not a valid regex ({})", o.bench_regex, e.what()));
   }
+  if (!o.mcap.empty()) return run_export_mcap(o);
   std::string fits_path = o.fits;
   if (fits_path.empty() && !o.no_fits && !o.out.empty() && o.out != "-") fits_path = fits_path_for(o.out);
   if (!fits_path.empty() && fits_path == o.out)

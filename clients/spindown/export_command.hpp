@@ -20,6 +20,9 @@
 // in SI: c1, c3 in N·m·s/rad, c2, c4 in N·m, omega0 in rad/s; A, B, C are the lab's curve
 // constants (viscous y = A·e^(−B·t): A in V, B in 1/s; Coulomb y = A·t + B: A in V/s, B in V;
 // combined y = A + B·e^(C·t): A, B in V, C in 1/s). Empty cells: not part of that model.
+//
+// `spindown export LOG --mcap FILE`: the same samples, with the log's RUN and FIT messages, as
+// MCAP for Foxglove and PlotJuggler instead (export_mcap.hpp).
 #include <string>
 
 #include "input_options.hpp"
@@ -38,6 +41,7 @@ struct ExportCommandOptions {
   bool no_fits = false;
   std::string bench_regex = ".*";
   InputOptions input;  // a text recording: columns, units, --roster/--bench-pattern, J and K_b
+  std::string mcap;      // MCAP file instead of CSV (export_mcap.hpp)
 };
 
 void setup_export(CLI::App& app);

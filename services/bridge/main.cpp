@@ -1,6 +1,7 @@
 // spindown-bridge: reads a bench's Arduino over a serial port and publishes its samples,
 // config and heartbeat on LCM (SPINDOWN.<bench>.SAMPLE|CONFIG|STATUS). Survives unplugging,
-// resets, wrong baud rates and garbage; SIGINT/SIGTERM end it with exit code 0.
+// resets, wrong baud rates and garbage; SIGINT/SIGTERM end it with exit code 0. Under systemd
+// (Type=notify): READY=1 when its serial loop starts, WATCHDOG=1 from that loop, STOPPING=1.
 #include <CLI/CLI.hpp>
 #include <array>
 #include <chrono>
@@ -13,6 +14,7 @@
 #include "spindown/lcm_channels.hpp"
 #include "spindown/serial_bridge.hpp"
 #include "spindown/serial_port.hpp"
+#include "spindown/service_notifier.hpp"
 #include "spindown/stop_signal.hpp"
 
 namespace {
@@ -93,7 +95,8 @@ std::optional<int> parse_options(int argc, char** argv, BridgeOptions& o) {
 
 // The serial loop: open the device (again after an unplug, every --retry-interval), feed what
 // it sends to the bridge, tick the bridge's heartbeat; until a stop signal. The exit code.
-int pump(const BridgeOptions& o, spindown::SerialBridge& bridge, const spindown::StopSignals& stop) {
+int pump(const BridgeOptions& o, spindown::SerialBridge& bridge, const spindown::StopSignals& stop,
+         spindown::ServiceNotifier& notify) {
   const spindown::BridgeSettings& s = o.settings;
   spindown::SerialPort port;
   std::array<char, 4096> buf{};
@@ -101,7 +104,12 @@ int pump(const BridgeOptions& o, spindown::SerialBridge& bridge, const spindown:
   auto next_try = std::chrono::steady_clock::now();
   std::string last_open_error;
   bool said_wrong_baud = false;
+  notify.ready(fmt::format("bench {}: reading {}", s.bench, s.device));
   while (!stop.requested()) {
+    // Each round of this loop is progress (a read returns within 100 ms, a retry within 20 ms),
+    // so the watchdog is fed here and nowhere else: a hung read or publish stops the pings.
+    notify.stall_point();
+    notify.watchdog();
     if (!port.is_open()) {
       if (std::chrono::steady_clock::now() >= next_try) {
         try {
@@ -168,7 +176,9 @@ int main(int argc, char** argv) {
   spindown::SerialBridge bridge(s, sink);
   bridge.start(wall_us());
   fmt::print(stderr, "spindown-bridge: bench {} device {} at {} baud\n", s.bench, s.device, s.baud);
-  const int rc = pump(o, bridge, stop);
+  spindown::ServiceNotifier notify;
+  const int rc = pump(o, bridge, stop, notify);
+  notify.stopping();
   bridge.stop(wall_us());
   const auto& c = bridge.counters();
   fmt::print(stderr,

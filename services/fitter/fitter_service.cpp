@@ -13,6 +13,7 @@
 #include "spindown/fit_message.hpp"
 #include "spindown/host_name.hpp"
 #include "spindown/lcm_channels.hpp"
+#include "spindown/loop_watchdog.hpp"
 #include "spindown/network_checks.hpp"
 
 namespace spindown {
@@ -152,6 +153,7 @@ void FitterService::worker() {
   std::deque<QueuedMessage> batch;
   std::int64_t next_poll = 0;
   for (;;) {
+    worker_alive_ns_.store(monotonic_ns(), std::memory_order_relaxed);
     // Closed (the service stops): this batch is the last.
     const bool open = queue_.take_all(batch, std::min(next_status, std::chrono::steady_clock::now() + poll_wait));
     for (const QueuedMessage& m : batch)
@@ -185,9 +187,15 @@ int FitterService::run(const StopSignals& stop) {
     fmt::print(stderr, "spindown-fitter: cannot subscribe (bad --bench regex?)\n");
     return 2;
   }
+  worker_alive_ns_.store(monotonic_ns());
   worker_ = std::thread([this] { worker(); });
+  feed_watchdog_from_loop(loop_, notify_, [this](std::int64_t now_ns) {
+    return now_ns - worker_alive_ns_.load(std::memory_order_relaxed) < notify_.stuck_after_ns();
+  });
+  notify_.ready(fmt::format("fitting benches matching '{}'", opt_.core.bench_regex));
   if (loop_.run({.stop = &stop}) == LcmLoopEnd::failed)
     fmt::print(stderr, "spindown-fitter: LCM keeps failing to receive; stopping\n");
+  notify_.stopping("stopping: finishing the queued messages");
   loop_.unsubscribe_all();
   queue_.close();
   worker_.join();

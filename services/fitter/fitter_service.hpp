@@ -3,6 +3,7 @@
 // a bounded queue (so a fit never stalls reception and LCM's own queue never overflows); one
 // worker thread feeds the core in arrival order, publishes RUN and FIT, and the heartbeat on
 // SPINDOWN.<instance>.STATUS.
+#include <atomic>
 #include <cstdint>
 #include <string>
 #include <thread>
@@ -12,6 +13,7 @@
 #include "spindown/fitter_core.hpp"
 #include "spindown/lcm_loop.hpp"
 #include "spindown/message_queue.hpp"
+#include "spindown/service_notifier.hpp"
 #include "spindown/stop_signal.hpp"
 
 namespace spindown {
@@ -35,7 +37,9 @@ class FitterService final : public FitterSink {
   ~FitterService() override;
 
   bool good() const { return loop_.good(); }
-  // Runs until a stop signal (or LCM keeps failing) and returns the exit code.
+  // Runs until a stop signal (or LCM keeps failing) and returns the exit code. Under systemd
+  // (Type=notify): READY=1 once subscribed, WATCHDOG=1 from the LCM loop while the worker
+  // thread shows signs of life, STOPPING=1 at the end.
   int run(const StopSignals& stop);
 
   // FitterSink (worker thread).
@@ -64,6 +68,8 @@ class FitterService final : public FitterSink {
   std::int64_t explains_ = 0, explain_failures_ = 0;
   std::int64_t last_samples_ = 0, last_rate_us_ = 0;
   double rate_hz_ = 0;
+  std::atomic<std::int64_t> worker_alive_ns_{0};  // monotonic time of the worker's latest round
+  ServiceNotifier notify_;
   std::thread worker_;
 };
 

@@ -1,10 +1,13 @@
 // spindown-logger: records LCM traffic (SPINDOWN.* by default) into standard LCM event logs,
 // with rotation by size and time, a flush on a timer, nothing lost on SIGINT/SIGTERM, and its
 // counters (events, bytes, files, drops, write errors, flushes) on SPINDOWN.logger.STATUS and
-// in the logs themselves. The logic lives in spindown::EventLogWriter and spindown::LogRecorder.
+// in the logs themselves; retention (--keep-files, --keep-mb) deletes its oldest files; under
+// systemd Type=notify with a watchdog. The logic lives in spindown::EventLogWriter,
+// spindown::LogRecorder, spindown::LogRetentionOptions and spindown::ServiceNotifier.
 #include <CLI/CLI.hpp>
 #include <cstdint>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <optional>
 #include <string>
 
@@ -14,7 +17,9 @@
 #include "spindown/lcm_status.hpp"
 #include "spindown/lcm_url.hpp"
 #include "spindown/log_recorder.hpp"
+#include "spindown/loop_watchdog.hpp"
 #include "spindown/network_checks.hpp"
+#include "spindown/service_notifier.hpp"
 #include "spindown/stop_signal.hpp"
 
 namespace {
@@ -46,6 +51,14 @@ std::optional<int> parse_options(int argc, char** argv, LoggerOptions& o) {
   app.add_option("--flush-interval", r.flush_interval_s, "seconds between flushes to the kernel (data a kill -9 can lose)")
       ->capture_default_str()
       ->check(CLI::Range(0.001, 3600.0));
+  app.add_option("--keep-files", w.retention.keep_files,
+                 "retention: at most this many log files (the one being written included), the oldest deleted first; "
+                 "0 = keep all")
+      ->capture_default_str();
+  app.add_option("--keep-mb", w.retention.keep_mb,
+                 "retention: at most this many MB (1e6 bytes) of log files, the oldest deleted first, never the one "
+                 "being written; 0 = no limit")
+      ->capture_default_str();
   app.add_flag("--fsync", w.sync_on_flush, "also fdatasync at every flush (always done at rotation and exit)");
   app.add_option("--max-event-bytes", r.max_event_bytes,
                  "larger messages are not recorded (counted as oversize_drops and named in the heartbeat)")
@@ -126,6 +139,9 @@ int report_stop(const spindown::EventLogWriter& writer, bool quiet) {
                c.events, c.bytes, c.files, c.queue_drops + c.events_lost, c.oversize_drops, c.write_errors,
                c.samples_missing, spindown::own_udp_drop_count());
     for (const auto& f : writer.files()) fmt::print(stderr, "spindown-logger: wrote {}\n", f);
+    if (c.files_deleted > 0)
+      fmt::print(stderr, "spindown-logger: retention deleted {} files ({} bytes): {}\n", c.files_deleted,
+                 c.bytes_deleted, fmt::join(writer.deleted_files(), ", "));
   }
   if (c.write_errors > 0) {
     fmt::print(stderr, "spindown-logger: {} write errors, {} events lost; last: {}\n", c.write_errors, c.events_lost,
@@ -178,15 +194,24 @@ int main(int argc, char** argv) {
     recorder.stop("subscribe failed");
     return 2;
   }
+  const std::string retention =
+      (w.retention.keep_files > 0 ? fmt::format(", keep {} files", w.retention.keep_files) : std::string()) +
+      (w.retention.keep_mb > 0 ? fmt::format(", keep {} MB", w.retention.keep_mb) : std::string());
   if (!o.quiet)
-    fmt::print(stderr, "spindown-logger: channels '{}' on {} -> {} (flush every {} s{}{})\n", o.channels, url,
+    fmt::print(stderr, "spindown-logger: channels '{}' on {} -> {} (flush every {} s{}{}{})\n", o.channels, url,
                first_file, r.flush_interval_s,
                w.rotate_size_mb > 0 ? fmt::format(", rotate at {} MB", w.rotate_size_mb) : "",
-               w.rotate_time_s > 0 ? fmt::format(", rotate every {} s", w.rotate_time_s) : "");
+               w.rotate_time_s > 0 ? fmt::format(", rotate every {} s", w.rotate_time_s) : "", retention);
 
   Heartbeat heartbeat(loop, recorder, w.status_channel);
   loop.every(1.0, [&](std::int64_t now) { heartbeat.beat(now); }, 0);
+  spindown::ServiceNotifier notify;
+  spindown::feed_watchdog_from_loop(loop, notify, [&](std::int64_t now_ns) {
+    return now_ns - recorder.writer_alive_ns() < notify.stuck_after_ns();
+  });
+  notify.ready(fmt::format("recording '{}' into {}", o.channels, w.dir));
   loop.run({.stop = &stop, .max_failures = -1});
+  notify.stopping("stopping: draining LCM and closing the log");
 
   // Drain what has reached this host: LCM's receive thread may still hold packets from the
   // socket, so dispatch until 50 ms pass with nothing new (at most 2 s under continuous

@@ -2,8 +2,9 @@
 # deploy/systemd/*.service pass `systemd-analyze verify` with no complaint at all (an unknown key
 # or a bad value is only a warning there, so any output fails the test), with the ExecStart paths
 # pointed at this build's programs through a temporary copy; the bridge template is verified as
-# an instance. Also checks what the units promise: the unprivileged user, the hardening, only the
-# bench's serial device, the bench file and the LCM env file. Skips (exit 77) only when
+# an instance. Also checks what the units promise: Type=notify with a watchdog, the logger's
+# retention, the unprivileged user, the hardening, only the bench's serial device, the bench file
+# and the LCM env file. Skips (exit 77) only when
 # systemd-analyze is not installed (Debian: apt-get install systemd).
 set -euo pipefail
 src="${SPINDOWN_SOURCE_DIR:?}"
@@ -63,7 +64,8 @@ expect() {  # UNIT LINE
 for u in spindown-bridge@.service spindown-fitter.service spindown-logger.service; do
   for line in User=spindown NoNewPrivileges=yes ProtectSystem=strict ProtectHome=yes PrivateTmp=yes \
     DevicePolicy=closed "RestrictAddressFamilies=AF_INET AF_UNIX" CapabilityBoundingSet= \
-    SystemCallFilter=@system-service Restart=on-failure EnvironmentFile=/etc/spindown/lcm.env; do
+    SystemCallFilter=@system-service Restart=on-failure EnvironmentFile=/etc/spindown/lcm.env \
+    Type=notify NotifyAccess=main WatchdogSec=30; do
     expect "$u" "$line"
   done
 done
@@ -72,6 +74,15 @@ expect spindown-bridge@.service "SupplementaryGroups=dialout"
 expect spindown-bridge@.service "ExecStart=/usr/local/bin/spindown-bridge --config /etc/spindown/benches/%i.toml --bench %i"
 expect spindown-fitter.service "ExecStart=/usr/local/bin/spindown-fitter --bench-config /etc/spindown/benches"
 expect spindown-logger.service "StateDirectory=spindown/logs"
+# Retention on by default (four benches at 50 Hz: ~2 GB a day), and its options the logger knows.
+grep -Eq '^ExecStart=.* --keep-mb [1-9][0-9]* --keep-files [1-9][0-9]*$' "$src/deploy/systemd/spindown-logger.service" ||
+  { echo "FAIL: spindown-logger.service does not set --keep-mb and --keep-files"; fail=1; }
+logger_help=$("$bin/spindown-logger" --help)
+if grep -q -- '--keep-mb' <<<"$logger_help" && grep -q -- '--keep-files' <<<"$logger_help"; then
+  echo "ok: spindown-logger has --keep-mb and --keep-files"
+else
+  echo "FAIL: spindown-logger --help lacks --keep-mb/--keep-files"; fail=1
+fi
 grep -q '^DeviceAllow=' "$src/deploy/systemd/spindown-fitter.service" && { echo "FAIL: the fitter may open devices"; fail=1; }
 grep -qx 'LCM_DEFAULT_URL=udpm://239.255.76.67:7667?ttl=1' "$src/deploy/systemd/lcm.env" ||
   { echo "FAIL: lcm.env does not set the lab URL with ttl=1"; fail=1; }

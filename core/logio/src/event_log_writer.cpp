@@ -53,6 +53,9 @@ bool EventLogWriterOptions::is_valid(std::string* why) const {
   if (buffer_bytes < 4096) return fail(fmt::format("buffer of {} bytes is below 4096", buffer_bytes));
   if (!std::isfinite(reopen_interval_s) || reopen_interval_s <= 0)
     return fail(fmt::format("reopen interval {} s must be > 0", reopen_interval_s));
+  if (!retention.is_valid(why)) return false;
+  if (!std::isfinite(prune_interval_s) || prune_interval_s <= 0)
+    return fail(fmt::format("prune interval {} s must be > 0", prune_interval_s));
   return true;
 }
 
@@ -86,12 +89,16 @@ void EventLogWriter::open(std::int64_t now_us) {
 void EventLogWriter::open_new_file(std::int64_t now_us) {
   const std::time_t t = static_cast<std::time_t>(now_us / 1000000);
   std::string name;
-  // O_EXCL: never overwrite a log (a restart or a rotation within the same second).
-  for (int suffix = 0;; ++suffix) {
+  int suffix_used = 0;
+  // O_EXCL: never overwrite a log (a restart or a rotation within the same second). Within a
+  // second the suffix only goes up, so a name that retention freed is not taken again and the
+  // names keep the order the files were written in.
+  for (int suffix = t == last_name_time_ ? last_suffix_ + 1 : 0;; ++suffix) {
     name = o_.dir + "/" + event_log_file_name(o_.prefix, o_.bench, t, suffix);
     const int fd = ::open(name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
     if (fd >= 0) {
       ::close(fd);
+      suffix_used = suffix;
       break;
     }
     if (errno != EEXIST || suffix >= 999)
@@ -102,6 +109,8 @@ void EventLogWriter::open_new_file(std::int64_t now_us) {
   // Our own buffer, flushed only between events (see raw_write), so the kernel only ever sees
   // whole events and a SIGKILL cannot leave half an event behind.
   std::setvbuf(log_->f, stdio_buffer_.data(), _IOFBF, stdio_buffer_.size());
+  last_name_time_ = t;
+  last_suffix_ = suffix_used;
   path_ = name;
   files_.push_back(name);
   ++counters_.files;
@@ -115,6 +124,25 @@ void EventLogWriter::open_new_file(std::int64_t now_us) {
   committed_file_events_ = 0;
   disk_full_ = false;
   write_status_event(now_us, "opened");
+  prune(now_us);
+}
+
+void EventLogWriter::prune(std::int64_t now_us) {
+  if (!o_.retention.enabled()) return;
+  next_prune_us_ = now_us + static_cast<std::int64_t>(o_.prune_interval_s * 1e6);
+  // The file being written counts with what has reached the kernel; its buffer is small beside
+  // any sane budget.
+  LogPruneResult r = prune_log_files(o_.dir, o_.prefix, o_.bench, path_, o_.retention);
+  for (auto& f : r.deleted) deleted_.push_back(std::move(f.path));
+  counters_.files_deleted += static_cast<std::int64_t>(r.deleted.size());
+  counters_.bytes_deleted += r.bytes_deleted;
+  kept_files_ = r.files_kept;
+  kept_bytes_ = r.bytes_kept;
+  if (!r.errors.empty()) {
+    counters_.retention_errors += static_cast<std::int64_t>(r.errors.size());
+    last_error_ = r.errors.back();
+    last_error_utime_ = now_us;
+  }
 }
 
 bool EventLogWriter::rotation_due(std::int64_t now_us, std::int64_t next_event_bytes) const {
@@ -219,6 +247,7 @@ bool EventLogWriter::flush(std::int64_t now_us) {
 }
 
 void EventLogWriter::tick(std::int64_t now_us) {
+  if (o_.retention.enabled() && now_us >= next_prune_us_) prune(now_us);
   resume_if_due(now_us);
   if (rotation_due(now_us, 0)) rotate(now_us, "rotating");
 }
@@ -386,12 +415,19 @@ status_t EventLogWriter::make_status(std::int64_t now_us) const {
       {"seq_repeats", counters_.seq_repeats},
       {"benches_untracked", counters_.benches_untracked},
       {"disk_full_episodes", counters_.disk_full_episodes},
+      {"files_deleted", counters_.files_deleted},
+      {"bytes_deleted", counters_.bytes_deleted},
+      {"retention_errors", counters_.retention_errors},
   };
   for (const auto& [name, value] : counters) status_.set_counter(name, value);
   status_.set_gauge("queue_depth", queue_depth_);
   status_.set_gauge("file_bytes", double(file_bytes_));
   status_.set_gauge("unflushed_events", double(unflushed_events_));
   status_.set_gauge("benches_tracked", double(next_seq_.size()));
+  if (o_.retention.enabled()) {
+    status_.set_gauge("kept_files", double(kept_files_));
+    status_.set_gauge("kept_bytes", double(kept_bytes_));
+  }
   status_.set_error(last_error_, last_error_utime_);
   return status_.message(now_us);
 }

@@ -45,6 +45,7 @@ LogRecorder::~LogRecorder() { stop(); }
 
 void LogRecorder::start() {
   if (thread_.joinable()) return;
+  writer_alive_ns_.store(monotonic_ns());
   thread_ = std::thread([this] { run(); });
 }
 
@@ -96,6 +97,7 @@ void LogRecorder::run() {
   auto next_flush = clock::now() + flush_every;
   std::deque<QueuedMessage> batch;
   for (;;) {
+    writer_alive_ns_.store(monotonic_ns(), std::memory_order_relaxed);
     // After stop() the queue is closed: this batch holds everything offered, and is the last.
     const bool open = queue_.take_all(batch, next_flush);
     for (const QueuedMessage& ev : batch)

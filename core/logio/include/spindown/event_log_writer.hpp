@@ -17,7 +17,10 @@
 //   (state "disk full", one error naming the file), and every reopen_interval_s a status event
 //   tries whether space is back; then writing goes on in the same file;
 // - other write errors (directory removed, I/O error) are counted with the path and errno text;
-//   the file is closed and a new one tried every reopen_interval_s.
+//   the file is closed and a new one tried every reopen_interval_s;
+// - retention (log_retention.hpp): with keep_files or keep_mb set, the oldest of its own files
+//   are deleted when a file is opened and every prune_interval_s (a full disk too gets space
+//   back that way), never the file being written.
 #include <cstdint>
 #include <cstdio>
 #include <ctime>
@@ -30,6 +33,7 @@
 #include <spindown/status_t.hpp>
 
 #include "spindown/lcm_status.hpp"
+#include "spindown/log_retention.hpp"
 
 struct _lcm_eventlog_t;
 
@@ -47,6 +51,8 @@ struct EventLogWriterOptions {
   std::size_t buffer_bytes = 1 << 20;      // events buffered before they go to the kernel
   std::size_t max_tracked_benches = 1024;  // benches whose sample sequence is followed
   double reopen_interval_s = 1.0;          // after a write error, wait before trying a new file
+  LogRetentionOptions retention;           // old files deleted past these limits (none by default)
+  double prune_interval_s = 10.0;          // retention is applied at least this often (and at each new file)
 
   bool is_valid(std::string* why) const;
 };
@@ -73,6 +79,9 @@ struct EventLogCounters {
   std::int64_t benches_untracked = 0;// SAMPLE messages of benches beyond max_tracked_benches
   std::int64_t disk_full_episodes = 0;  // times the disk filled up (each one write error)
   std::int64_t oversize_drops = 0;   // events larger than the recorder's max_event_bytes, not recorded
+  std::int64_t files_deleted = 0;    // old log files deleted by retention
+  std::int64_t bytes_deleted = 0;    // and their bytes
+  std::int64_t retention_errors = 0; // files retention could not delete (or list)
 };
 
 // File name for a log opened at unix_time (local time), without the directory; suffix 0 = none.
@@ -101,6 +110,9 @@ class EventLogWriter {
   // Time-based work: rotation by time, a new file after a write error. Call often.
   void tick(std::int64_t now_us);
 
+  // Applies retention now (also done by open and tick). Nothing when retention is off.
+  void prune(std::int64_t now_us);
+
   // Writes a status event (state why), flushes, syncs and closes. Nothing is open afterwards.
   void close(std::int64_t now_us, std::string_view why = "stopped");
 
@@ -118,6 +130,7 @@ class EventLogWriter {
   const EventLogCounters& counters() const { return counters_; }
   const std::string& current_path() const { return path_; }
   const std::vector<std::string>& files() const { return files_; }
+  const std::vector<std::string>& deleted_files() const { return deleted_; }  // by retention, in order
   const std::string& last_error() const { return last_error_; }
   std::int64_t last_error_utime() const { return last_error_utime_; }
   const EventLogWriterOptions& options() const { return o_; }
@@ -151,6 +164,11 @@ class EventLogWriter {
   std::int64_t pending_bytes_ = 0;      // written to the FILE* buffer, not yet to the kernel
   std::int64_t unflushed_events_ = 0;   // received events among them
   std::int64_t next_reopen_us_ = 0;
+  std::int64_t next_prune_us_ = 0;
+  std::time_t last_name_time_ = -1;  // the second of the latest file's name, and its suffix
+  int last_suffix_ = 0;
+  std::int64_t kept_files_ = 0, kept_bytes_ = 0;  // the logger's files after the last prune
+  std::vector<std::string> deleted_;
   // The file as it was after the last successful flush: whole events only.
   std::int64_t committed_bytes_ = 0;
   std::int64_t committed_eventcount_ = 0;

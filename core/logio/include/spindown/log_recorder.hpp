@@ -6,6 +6,7 @@
 //
 // Events beyond the queue's capacity are dropped and counted (never silently): they show in
 // the writer's status as queue_drops/drops.
+#include <atomic>
 #include <cstdint>
 #include <mutex>
 #include <string>
@@ -51,6 +52,10 @@ class LogRecorder {
   // The writer's latest status (refreshed by the writer thread), with utime set to now_us.
   status_t status(std::int64_t now_us) const;
 
+  // Monotonic time (monotonic_ns) of the writer thread's latest round: it comes round at least
+  // every flush interval, so an old value means it is stuck (a hung disk), for the watchdog.
+  std::int64_t writer_alive_ns() const { return writer_alive_ns_.load(std::memory_order_relaxed); }
+
   std::size_t queue_depth() const { return queue_.depth(); }
   std::int64_t dropped() const { return queue_.counts().full_drops; }
 
@@ -70,6 +75,7 @@ class LogRecorder {
   status_t status_;
   std::int64_t next_status_us_ = 0;
 
+  std::atomic<std::int64_t> writer_alive_ns_{0};
   std::thread thread_;
 };
 
