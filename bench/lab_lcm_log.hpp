@@ -82,6 +82,8 @@ inline spindown::config_t make_config(const std::string& bench, std::int64_t uti
   c.baud = 9600;
   c.device = "generated";
   c.host = "localhost";
+  c.inertia_rel_error = 0;
+  c.kb_rel_error = 0;
   return c;
 }
 

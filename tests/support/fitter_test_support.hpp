@@ -82,6 +82,8 @@ inline config_t config(const std::string& bench, double j) {
   c.kb_v_s_per_rad = 1.0 / 123.569311;
   c.kb_source = "test";
   c.quantity = samples_t::QUANTITY_BACK_EMF_V;
+  c.inertia_rel_error = 0;  // lcm-gen leaves numbers uninitialized
+  c.kb_rel_error = 0;
   return c;
 }
 
