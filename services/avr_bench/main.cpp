@@ -17,17 +17,12 @@
 #include "spindown/pseudo_terminal.hpp"
 #include "spindown/stop_signal.hpp"
 #include "spindown/virtual_bench.hpp"
+#include "spindown/virtual_bench_cli.hpp"
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
 
-void relink(const std::string& link, const std::string& target) {
-  if (link.empty()) return;
-  std::error_code ec;
-  std::filesystem::remove(link, ec);
-  std::filesystem::create_symlink(target, link);
-}
 
 // What reached the reader, line by line: a line is a sample, a banner/note ('#'), or broken (a
 // reset cut it, or the port was reopened inside it).
@@ -92,13 +87,7 @@ int main(int argc, char** argv) {
   app.add_option("--max-coast-s", m.max_coast_s, "longest coast");
   app.add_option("--e0", m.e0_v, "back-EMF at the cut (V)");
   app.add_option("--e0-step", m.e0_step_v, "added to e0 at each further run (V)");
-  app.add_option("--inertia", m.bench.inertia_kg_m2, "J (kg*m^2)");
-  app.add_option("--kb", m.bench.kb_v_s_per_rad, "K_b (V*s/rad)");
-  app.add_option("--viscous", m.friction.viscous, "c_v (N*m*s/rad)");
-  app.add_option("--coulomb", m.friction.coulomb, "c_c (N*m)");
-  app.add_option("--stribeck-static", m.friction.stribeck_static, "c_s (N*m)");
-  app.add_option("--stribeck-speed", m.friction.stribeck_speed, "w_s (rad/s)");
-  app.add_option("--windage", m.friction.windage, "c_w (N*m*s^2/rad^2)");
+  spindown::add_motor_options(app, m.bench, m.friction);
   app.add_option("--noise", m.noise_v, "white noise on A0 (V)");
   app.add_option("--seed", m.seed, "random seed of the noise");
   app.add_option("--reset-at", reset_at_s, "emulated seconds at which the board resets (reset button, a DTR pulse; repeatable)");
@@ -123,7 +112,7 @@ int main(int argc, char** argv) {
 
   spindown::StopSignals stop({.ignore_sigpipe = true});
   auto pty = std::make_unique<spindown::PseudoTerminal>();
-  relink(link, pty->slave_path());
+  pty->link_as(link);
   fmt::print("{}\n", pty->slave_path());
   std::fflush(stdout);
 
@@ -214,7 +203,7 @@ int main(int argc, char** argv) {
       board->take_output();
       pending.clear();
       pty = std::make_unique<spindown::PseudoTerminal>();
-      relink(link, pty->slave_path());
+      pty->link_as(link);
       fmt::print("{}\n", pty->slave_path());
       std::fflush(stdout);
       const auto waited_from = Clock::now();

@@ -16,12 +16,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-void relink(const std::string& link, const std::string& target) {
-  if (link.empty()) return;
-  std::error_code ec;
-  std::filesystem::remove(link, ec);
-  std::filesystem::create_symlink(target, link);
-}
 
 }  // namespace
 
@@ -62,7 +56,7 @@ int main(int argc, char** argv) {
 
   spindown::StopSignals stop({.ignore_sigpipe = true});
   auto pty = std::make_unique<spindown::PseudoTerminal>();
-  relink(link, pty->slave_path());
+  pty->link_as(link);
   fmt::print("{}\n", pty->slave_path());
   std::fflush(stdout);
 
@@ -103,7 +97,7 @@ int main(int argc, char** argv) {
       const auto back = Clock::now() + std::chrono::milliseconds(long(e.unplug_for_s * 1000 / (speed > 0 ? speed : 1e9)));
       stop.sleep_until(back);
       pty = std::make_unique<spindown::PseudoTerminal>();
-      relink(link, pty->slave_path());
+      pty->link_as(link);
       fmt::print("{}\n", pty->slave_path());
       std::fflush(stdout);
       const auto waited_from = Clock::now();

@@ -3,6 +3,7 @@
 #include <cerrno>
 #include <cstring>
 #include <fcntl.h>
+#include <filesystem>
 #include <fmt/format.h>
 #include <poll.h>
 #include <stdexcept>
@@ -140,6 +141,13 @@ std::string PseudoTerminal::read_available() {
     out.append(buf, static_cast<std::size_t>(got));
   }
   return out;
+}
+
+void PseudoTerminal::link_as(const std::string& link) const {
+  if (link.empty()) return;
+  std::error_code ec;
+  std::filesystem::remove(link, ec);
+  std::filesystem::create_symlink(slave_path_, link);
 }
 
 }  // namespace spindown

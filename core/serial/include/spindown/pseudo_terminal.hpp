@@ -32,6 +32,9 @@ class PseudoTerminal {
   // Reads what the reader sent (non-blocking); empty when nothing.
   std::string read_available();
   void close();  // the "cable pulled": the reader sees a hangup
+  // A stable name for the slave, as udev gives a board (/dev/spindown/bench-1): link (if not
+  // empty) becomes a symlink to slave_path(), replacing an old one. Throws on failure.
+  void link_as(const std::string& link) const;
 
  private:
   int master_ = -1;

@@ -1,7 +1,7 @@
 #pragma once
 // The simulated bench's command-line options, shared by spindown-virtual-bench (to a pseudo-
 // terminal) and `spindown simulate` (to a file), so both take the same names for the same
-// physics. Header-only: only programs that parse a command line include it (and link CLI11).
+// physics (spindown-avr-bench takes add_motor_options). Header-only: only programs that parse a command line include it (and link CLI11).
 #include <CLI/CLI.hpp>
 #include <string>
 
@@ -14,6 +14,18 @@ struct VirtualBenchCli {
   std::string protocol = "lab", lead_in = "zeros";
   double period_ms = 20, jitter_ms = 0.5;
 };
+
+// The motor's physics: J, K_b and the friction terms. Shared with spindown-avr-bench, whose motor
+// drives an emulated Arduino's A0, so that every simulated bench names the physics alike.
+inline void add_motor_options(CLI::App& app, BenchParams& bench, FrictionTerms& friction) {
+  app.add_option("--inertia", bench.inertia_kg_m2, "J (kg*m^2)");
+  app.add_option("--kb", bench.kb_v_s_per_rad, "K_b (V*s/rad)");
+  app.add_option("--viscous", friction.viscous, "c_v (N*m*s/rad)");
+  app.add_option("--coulomb", friction.coulomb, "c_c (N*m)");
+  app.add_option("--stribeck-static", friction.stribeck_static, "c_s (N*m)");
+  app.add_option("--stribeck-speed", friction.stribeck_speed, "w_s (rad/s)");
+  app.add_option("--windage", friction.windage, "c_w (N*m*s^2/rad^2)");
+}
 
 // The runs, the bench, friction, the reading and the faults (not the wire: baud, speed, pty).
 inline void add_virtual_bench_options(CLI::App& app, VirtualBenchOptions& o, VirtualBenchCli& cli) {
@@ -40,13 +52,7 @@ inline void add_virtual_bench_options(CLI::App& app, VirtualBenchOptions& o, Vir
   app.add_option("--lead-in-s", sp.lead_in_s, "seconds recorded before the cut");
   app.add_option("--tail-s", sp.tail_s, "seconds recorded after the stop");
   app.add_option("--max-coast-s", sp.max_coast_s, "longest coast simulated");
-  app.add_option("--inertia", sp.bench.inertia_kg_m2, "J (kg*m^2)");
-  app.add_option("--kb", sp.bench.kb_v_s_per_rad, "K_b (V*s/rad)");
-  app.add_option("--viscous", sp.friction.viscous, "c_v (N*m*s/rad)");
-  app.add_option("--coulomb", sp.friction.coulomb, "c_c (N*m)");
-  app.add_option("--stribeck-static", sp.friction.stribeck_static, "c_s (N*m)");
-  app.add_option("--stribeck-speed", sp.friction.stribeck_speed, "w_s (rad/s)");
-  app.add_option("--windage", sp.friction.windage, "c_w (N*m*s^2/rad^2)");
+  add_motor_options(app, sp.bench, sp.friction);
   app.add_option("--offset", sp.offset_v, "sensor offset after the cut (V)");
   app.add_option("--noise", sp.noise_v, "white noise (V)");
   app.add_option("--ripple", sp.ripple, "relative commutator ripple");
