@@ -24,6 +24,7 @@ for step in "install -m 0755 $bin/spindown-bridge /usr/local/bin/spindown-bridge
             "/etc/systemd/system/spindown-bridge@.service" "/etc/systemd/system/spindown-fitter.service" \
             "/etc/systemd/system/spindown-logger.service" "/etc/udev/rules.d/99-spindown.rules" \
             "/etc/spindown/lcm.env" "/etc/sysctl.d/60-spindown.conf" "sysctl -q -p /etc/sysctl.d/60-spindown.conf" \
+            "/usr/local/bin/spindown-lcm-spy" "/usr/local/bin/spindown-lcm-logplayer-gui" \
             "dry run: nothing was changed"; do
   check "dry run mentions $step" "grep -qF -- '$step' '$tmp/dry.out'"
 done
