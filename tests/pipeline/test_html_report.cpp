@@ -181,9 +181,30 @@ TEST(CoefficientTrend, ScatterWithinErrorsIsSteadyAndFewRunsAreNotATrend) {
                                       {1e-10, 1e-10, 1e-10, 1e-10, 1e-10});
   EXPECT_FALSE(wild.drifting) << wild.words;
   EXPECT_GT(wild.slope_stderr, 1e-9);
+  EXPECT_NE(wild.words.find("not steady: the runs disagree far beyond their errors"), std::string::npos) << wild.words;
+  EXPECT_EQ(steady.words.find("disagree"), std::string::npos) << steady.words;
+  EXPECT_NE(steady.words.find("steady within its uncertainty"), std::string::npos) << steady.words;
   const auto two = coefficient_trend("c_c", "N*m", "run", {1, 2}, {1e-4, 2e-4}, {1e-6, 1e-6});
   EXPECT_FALSE(two.enough);
   EXPECT_FALSE(two.drifting);
+}
+
+// Two runs 100 errors apart (a worn motor's file among a good one's): their mean is not known to
+// ±0.7 % as their own errors would say, and the words say they disagree.
+TEST(CoefficientTrend, RunsFarApartWidenTheMeanAndAreSaid) {
+  const auto two = coefficient_trend("c_c", "N*m", "run", {1, 2}, {1e-4, 2e-4}, {1e-6, 1e-6});
+  EXPECT_NEAR(two.scatter, 70.7, 0.1);             // |Δ| / (√2 σ)
+  EXPECT_NEAR(two.mean_stderr, 5e-5, 1e-7);        // half the spread, not 0.7e-6
+  EXPECT_NE(two.words.find("the runs disagree far beyond their errors (0.0001 to 0.0002 N*m"), std::string::npos)
+      << two.words;
+  // A step in four runs is not "steady within its uncertainty".
+  const auto step = coefficient_trend("c_c", "N*m", "run", {1, 2, 3, 4}, {1.14e-4, 1.14e-4, 2.5e-4, 2.5e-4},
+                                      {3e-7, 3e-7, 3e-7, 3e-7});
+  EXPECT_EQ(step.words.find("steady within"), std::string::npos) << step.words;
+  EXPECT_NE(step.words.find("disagree"), std::string::npos) << step.words;
+  // Runs that agree keep their own small error.
+  const auto agree = coefficient_trend("c_c", "N*m", "run", {1, 2}, {1.000e-4, 1.001e-4}, {1e-6, 1e-6});
+  EXPECT_NEAR(agree.mean_stderr, 1e-6 / std::sqrt(2.0), 1e-9);
 }
 
 TEST(SessionSummary, DryFrictionRisingOverWeeksIsDrifting) {

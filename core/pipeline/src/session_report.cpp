@@ -112,6 +112,21 @@ CoefficientTrend coefficient_trend(std::string name, std::string unit, std::stri
   }
   t.mean = swy / sw;
   t.mean_stderr = std::sqrt(1 / sw);
+  // Scatter about the mean beyond the runs' own errors widens the mean's error (two runs 400
+  // errors apart are not known to a hair), and is said when it is far beyond them.
+  if (n >= 2) {
+    double chi2_mean = 0;
+    for (std::size_t i = 0; i < n; ++i) chi2_mean += w[i] * (t.value[i] - t.mean) * (t.value[i] - t.mean);
+    t.scatter = std::sqrt(chi2_mean / static_cast<double>(n - 1));
+    t.mean_stderr *= std::max(1.0, t.scatter);
+  }
+  const bool disagree = t.scatter > rules.disagree_scatter;
+  const auto [lo, hi] = std::minmax_element(t.value.begin(), t.value.begin() + static_cast<std::ptrdiff_t>(n));
+  const std::string disagreement =
+      disagree ? fmt::format("the runs disagree far beyond their errors ({:.3g} to {:.3g} {}, {:.0f}× their standard "
+                             "errors apart): check which runs belong to this motor",
+                             *lo, *hi, t.unit, t.scatter)
+               : "";
   const double xm = swx / sw;
   double sxx = 0, sxy = 0;
   for (std::size_t i = 0; i < n; ++i) sxx += w[i] * (t.x[i] - xm) * (t.x[i] - xm), sxy += w[i] * (t.x[i] - xm) * (t.value[i] - t.mean);
@@ -119,7 +134,8 @@ CoefficientTrend coefficient_trend(std::string name, std::string unit, std::stri
   const double span = *xhi - *xlo;
   t.enough = n >= rules.min_runs && span > 0 && sxx > 0;
   if (!t.enough) {
-    t.words = fmt::format("{}: {} run{}, too few for a trend (need {})", what, n, n == 1 ? "" : "s", rules.min_runs);
+    t.words = fmt::format("{}: {} run{}, too few for a trend (need {}){}{}", what, n, n == 1 ? "" : "s",
+                          rules.min_runs, disagree ? "; " : "", disagreement);
     return t;
   }
   t.slope = sxy / sxx;
@@ -133,7 +149,6 @@ CoefficientTrend coefficient_trend(std::string name, std::string unit, std::stri
   // Scatter beyond the stated errors (run-to-run variation) widens the slope's error.
   const double birge = n > 2 ? std::max(1.0, std::sqrt(chi2 / static_cast<double>(n - 2))) : 1.0;
   t.slope_stderr = birge / std::sqrt(sxx);
-  t.mean_stderr *= birge;
   t.change = t.slope * span;
   t.change_stderr = t.slope_stderr * span;
   if (t.mean != 0) {
@@ -144,9 +159,14 @@ CoefficientTrend coefficient_trend(std::string name, std::string unit, std::stri
   t.drifting = significant && std::abs(t.relative_change) >= rules.drift_fraction;
   const std::string over = t.x_unit == "day" ? fmt::format("over {:.3g} days ({} runs)", span, n)
                                              : fmt::format("over {} runs", n);
-  const std::string verdict = t.drifting ? "drifting"
-                              : significant ? "a small but clear change"
-                                            : "steady within its uncertainty";
+  // A line that leaves the runs far beyond their errors (a step, a stray run) is no evidence of
+  // steadiness: "steady" only when the runs agree with the line.
+  const bool line_misses = birge > rules.disagree_scatter;
+  std::string verdict = t.drifting ? "drifting" : significant ? "a small but clear change" : "steady within its uncertainty";
+  if (disagree)
+    verdict = t.drifting || significant ? verdict + "; " + disagreement : "not steady: " + disagreement;
+  else if (line_misses && !t.drifting && !significant)
+    verdict = "not steady: the runs scatter far beyond their errors about any straight line";
   t.words = fmt::format("{} {} {} ± {} {}: {}", what, t.change >= 0 ? "rose" : "fell", percent(std::abs(t.relative_change)),
                         percent(t.relative_change_stderr), over, verdict);
   return t;

@@ -87,7 +87,10 @@ struct CoefficientTrend {
   std::string unit;               // ASCII SI unit
   std::vector<double> x, value, std_error;  // the points (x in x_unit)
   std::string x_unit;             // "day" when every run has a wall-clock time, else "run"
-  double mean = 0, mean_stderr = 0;
+  double mean = 0, mean_stderr = 0;          // weighted mean; its error widened by the scatter
+  // Run-to-run scatter about the mean in units of the runs' own errors, √(χ²/(n−1)) (1 for one
+  // run). Far above 1 the runs disagree: one number does not describe them, and the words say so.
+  double scatter = 1;
   double slope = 0, slope_stderr = 0;        // per x_unit
   double intercept = 0;                      // the line's value at x = 0
   double change = 0, change_stderr = 0;      // slope × span (SI)
@@ -101,6 +104,9 @@ struct TrendRules {
   std::size_t min_runs = 3;
   double drift_sigma = 3.0;
   double drift_fraction = 0.10;
+  // Scatter (in the runs' errors) above which the runs are said to disagree: a worn motor among
+  // good ones, another bench's file, a bad run. Below it, run-to-run variation a motor has.
+  double disagree_scatter = 5.0;
 };
 
 CoefficientTrend coefficient_trend(std::string name, std::string unit, std::string x_unit, std::vector<double> x,
