@@ -144,6 +144,7 @@ fit_t fit_message() {
   f.inertia_rel_error = 0.02;
   f.kb_rel_error = 0.05;
   f.param_bench_error = {8e-9, 1e-5, 9e-6, 2e-9};
+  f.reading_noise = 0.0042;
   return f;
 }
 

@@ -180,6 +180,7 @@ fit_t make_fit() {
     m.kb_rel_error = 0.05;
     m.param_bench_error = {2.8e-8, 7e-6, 3.6e-9, 6.6e-6};
   }
+  if constexpr (requires { m.reading_noise; }) m.reading_noise = 0.0042;  // the reading noise σ
   return m;
 }
 

@@ -130,6 +130,7 @@ fit_t make_fit() {
   f.inertia_rel_error = 0.02;
   f.kb_rel_error = 0.05;
   f.param_bench_error = {0.01, 0.02, 0.03};
+  f.reading_noise = 0.0042;
   return f;
 }
 explain_t make_explain() {

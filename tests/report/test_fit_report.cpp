@@ -213,13 +213,19 @@ TEST(FitReportText, FileHeaderAndFailures) {
   EXPECT_FALSE(file.usable());
 }
 
-// The run's noise is the standstill's spread when it stopped, the coast's when it did not.
-TEST(FitReportText, NoiseSaysWhereItWasMeasured) {
+// One noise figure, named as explain and the report name it: the reading noise σ of the coast (not
+// the detector's spread at standstill, which an ADC clipping at 0 shrinks), in text and JSON.
+TEST(FitReportText, NoiseIsTheReadingNoiseSigma) {
   RunFit f = lab_like_fit();
-  f.run.stopped = true;
-  EXPECT_NE(format_run_fit(f).find("standstill noise"), std::string::npos) << format_run_fit(f);
-  f.run.stopped = false;
-  EXPECT_NE(format_run_fit(f).find("coast noise"), std::string::npos) << format_run_fit(f);
+  f.reading_noise = 0.0042;
+  for (bool stopped : {true, false}) {
+    f.run.stopped = stopped;
+    const std::string text = format_run_fit(f);
+    EXPECT_NE(text.find("reading noise σ 0.0042 V"), std::string::npos) << text;
+    EXPECT_EQ(text.find("standstill noise"), std::string::npos) << text;
+    EXPECT_EQ(text.find("coast noise"), std::string::npos) << text;
+  }
+  EXPECT_DOUBLE_EQ(run_fit_json(f)["reading_noise"].get<double>(), 0.0042);
 }
 
 TEST(FitReportText, BestReasonFromTheFitWins) {

@@ -99,6 +99,7 @@ fit_t to_fit_message(const RunFit& fit, const FitProvenance& about, std::int64_t
   m.ndoubts = static_cast<std::int32_t>(fit.doubts.size());
   m.doubts = fit.doubts;
   m.reading_step = fit.reading_step;
+  m.reading_noise = fit.reading_noise;
   m.ncorrelations = 0;
   for (std::size_t i = 0; i < fit.models.size(); ++i) {
     const ModelFit& f = fit.models[i];
@@ -196,6 +197,7 @@ std::optional<RunFit> from_fit_message(const fit_t& m, std::string* why) {
   }
   fit.doubts = m.doubts;
   fit.reading_step = m.reading_step;
+  fit.reading_noise = m.reading_noise;
   for (std::size_t i = 0; i < nm; ++i) fit.models[i].reduced_chi2 = m.model_reduced_chi2[i];
   // Each model's correlation matrix again, from its pairs (omega0 first, as fit_run orders them).
   for (std::size_t c = 0; c < nc; ++c) {

@@ -217,6 +217,7 @@ constexpr WireField fit_fields[] = {
     {"inertia_rel_error", Wire::f64},               // 63
     {"kb_rel_error", Wire::f64},                    // 64
     {"param_bench_error", Wire::f64, 19},           // 65
+    {"reading_noise", Wire::f64},                   // 66
 };
 
 constexpr WireField explain_fields[] = {

@@ -220,6 +220,7 @@ RunFit fit_run(std::span<const double> t_s, std::span<const double> value, Quant
   const std::size_t moving =
       moving_end - begin - std::size_t(std::lower_bound(out_lo, out_hi, moving_end) - out_lo);
   const std::string_view runit = quantity_unit(q);
+  out.reading_noise = reading_noise_sigma(std::span<const double>(y).first(moving >= 3 ? moving : n));
   // Weights from the run's own noise (σ² growing with the reading), shared by every model.
   ReadingNoise noise;
   if (opt.weighted) noise = weigh_by_noise_into(y, weight);

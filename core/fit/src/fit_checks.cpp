@@ -104,16 +104,20 @@ double median_in_place(std::vector<double>& v) {
 }  // namespace
 
 ResidualStructure residual_structure(const ModelFit& m, std::span<const double> tau, std::span<const double> y,
-                                     std::size_t moving, double k, double step) {
+                                     std::size_t moving, double k, double step, double sigma) {
   ResidualStructure out;
   const std::size_t n = std::min({moving, tau.size(), y.size()});
   if (n < 4 * residual_bin) return out;
   std::vector<double> r(n);
   for (std::size_t i = 0; i < n; ++i) r[i] = y[i] - k * m.omega_at(tau[i]);
-  // The noise of one reading from first differences: the smooth misfit cancels in them.
-  std::vector<double> d(n - 1);
-  for (std::size_t i = 1; i < n; ++i) d[i - 1] = std::fabs(r[i] - r[i - 1]);
-  double sigma = 1.4826 * median_in_place(d) / std::sqrt(2.0);
+  // Without the run's reading noise: the noise of one reading from first differences of the
+  // residual (the smooth misfit cancels in them).
+  std::vector<double> d;
+  if (!(sigma > 0)) {
+    d.resize(n - 1);
+    for (std::size_t i = 1; i < n; ++i) d[i - 1] = std::fabs(r[i] - r[i - 1]);
+    sigma = 1.4826 * median_in_place(d) / std::sqrt(2.0);
+  }
   if (!(sigma > 0)) {  // mostly equal readings (a fine step): the rms of the differences instead
     double ss = 0;
     for (std::size_t i = 1; i < n; ++i) ss += (r[i] - r[i - 1]) * (r[i] - r[i - 1]);
@@ -123,6 +127,8 @@ ResidualStructure residual_structure(const ModelFit& m, std::span<const double> 
   // A slow reading sits on one printed step for many samples: its rounding does not average out
   // within a bin, so a bin's mean is known no better than the step's own spread, step/√12.
   const double se = std::hypot(sigma / std::sqrt(static_cast<double>(residual_bin)), step / std::sqrt(12.0));
+  out.sigma = sigma;
+  out.bin_se = se;
   double worst = 0;
   for (std::size_t b = 0; b + residual_bin <= n; b += residual_bin) {
     double mean = 0;
@@ -177,13 +183,15 @@ void check_fit(RunFit& fit, std::span<const double> tau, std::span<const double>
   // noise model expects (the lab's runs: 0.3 to 1.0; a missing Stribeck or windage term: 10 to 25):
   // the binned test then decides, and a run that fits pays nothing for it.
   if (best && fit.doubts.empty() && !(best->reduced_chi2 <= suspicious_chi2)) {
-    const ResidualStructure rs = residual_structure(*best, tau, y, moving, k, fit.reading_step);
+    const ResidualStructure rs = residual_structure(*best, tau, y, moving, k, fit.reading_step, fit.reading_noise);
+    const std::string_view unit = quantity_unit(fit.quantity);
     if (rs.bins >= 8 && rs.beyond * 4 >= rs.bins && rs.mean_z2 > 9)
       fit.doubts.push_back(fmt::format(
-          "the {} model misses: its residuals stand out of the run's noise in {} of {} stretches of {} samples "
-          "(worst {:.2g} {} at {:.1f} s after the cut) — friction the model lacks; run `spindown explain` on this "
-          "file to name it",
-          fit.best, rs.beyond, rs.bins, residual_bin, rs.worst_mean, quantity_unit(fit.quantity), rs.worst_tau_s));
+          "the {} model misses: in {} of {} stretches of {} samples its mean residual lies beyond 4 standard errors "
+          "(reading noise σ {:.2g} {}, so a stretch's mean ± {:.2g} {}; worst {:.2g} {} at {:.1f} s after the cut) — "
+          "friction the model lacks; run `spindown explain` on this file to name it",
+          fit.best, rs.beyond, rs.bins, residual_bin, rs.sigma, unit, rs.bin_se, unit, rs.worst_mean, unit,
+          rs.worst_tau_s));
   }
 }
 

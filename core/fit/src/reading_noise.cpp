@@ -109,4 +109,14 @@ NoiseWeights weigh_by_noise(std::span<const double> y, double max_ratio) {
   return out;
 }
 
+double reading_noise_sigma(std::span<const double> y) {
+  if (y.size() < 3) return 0;
+  double s = 0;
+  for (std::size_t i = 1; i + 1 < y.size(); ++i) {
+    const double d2 = y[i + 1] - 2 * y[i] + y[i - 1];
+    s += d2 * d2;
+  }
+  return std::sqrt(s / (6.0 * static_cast<double>(y.size() - 2)));
+}
+
 }  // namespace spindown

@@ -133,6 +133,7 @@ void write_run_fit(PrettyJsonWriter& w, const RunFit& fit, const ReportOptions& 
   w.member("lead_in", run.lead_in);
   w.member_number("zero_level", run.zero_level);
   w.member_number("noise_level", run.noise_level);
+  w.member_number("reading_noise", fit.reading_noise);
   w.member_number("period_s", run.period_s);
   w.member("quantity", residual_unit);
   w.key("bench");

@@ -78,7 +78,7 @@ std::string render_table(const std::vector<std::vector<std::string>>& rows, std:
   return out;
 }
 
-std::string display_name(const Parameter& p) { return p.name == "omega0" ? "ω0" : p.name; }
+std::string display_name(const Parameter& p) { return parameter_display_name(p.name); }
 
 std::string with_unit(std::string text, std::string_view ascii_unit) {
   if (ascii_unit.empty()) return text;
@@ -93,10 +93,7 @@ std::string coefficient_cell(const ModelFit& m, const ReportOptions& opt) {
     cell += display_name(p) + " = " + with_unit(format_value_error(p.value, p.std_error), p.unit);
     if (p.bench_error > 0)  // J and K_b's own uncertainty beside the statistical one
       cell += "\n  with J, K_b: " + format_value_error(p.value, std::hypot(p.std_error, p.bench_error));
-    if (opt.lab_units)
-      if (auto lab = lab_unit_for(p.unit))
-        cell += fmt::format(" = {} {}", format_value_error(p.value * lab->per_si, p.std_error * lab->per_si),
-                            lab->pretty);
+    if (opt.lab_units) cell += lab_unit_text(p);
   }
   return cell.empty() ? "-" : cell;
 }
@@ -158,6 +155,24 @@ std::string format_value_error(double value, double std_error) {
   const double scale = std::pow(10.0, magnitude);
   const int decimals = std::clamp(magnitude - err_exp + 1, 0, 12);
   return fmt::format("({:.{}f} ± {:.{}f})e{:+03d}", value / scale, decimals, std_error / scale, decimals, magnitude);
+}
+
+std::string parameter_display_name(std::string_view name) {
+  if (name == "omega0") return "ω0";
+  if (name == "w_s") return "ω_s";
+  if (name == "sensor_offset") return "sensor offset";
+  return std::string(name);
+}
+
+std::string lab_unit_text(const Parameter& p) {
+  const auto lab = lab_unit_for(p.unit);
+  return lab ? fmt::format(" = {} {}", format_value_error(p.value * lab->per_si, p.std_error * lab->per_si), lab->pretty)
+             : std::string();
+}
+
+std::string parameter_text(const Parameter& p, bool lab_units) {
+  return parameter_display_name(p.name) + " = " + with_unit(format_value_error(p.value, p.std_error), p.unit) +
+         (lab_units ? lab_unit_text(p) : std::string());
 }
 
 std::string explain_best(const RunFit& fit) {
@@ -240,10 +255,12 @@ std::string format_run_fit(const RunFit& fit, const ReportOptions& opt) {
     out += fmt::format(", did not stop: fitted to t = {:.3f} s ({})", run.t_end_s, end_name(run.end));
   out += fmt::format(", {} samples", samples_in(run));
   if (!run.lead_in.empty()) out += fmt::format(", lead-in: {}", run.lead_in);
-  // noise_level is the spread at standstill for a run that stopped (0 when every reading there is
-  // the same printed value), the coast's near the cut for one that did not: the label says which.
-  out += fmt::format("\n  zero level {:.3g} {}, {} noise {:.2g} {}, period {:.1f} ms\n", run.zero_level, unit,
-                     run.stopped ? "standstill" : "coast", run.noise_level, unit, run.period_s * 1e3);
+  // The reading noise σ (reading_noise.hpp), the one noise figure fit, explain and the report name.
+  // A zero level other than 0 is subtracted here; spindown explain names it as a sensor offset instead.
+  out += fmt::format("\n  zero level {:.3g} {}{}, reading noise σ {:.2g} {}, period {:.1f} ms\n", run.zero_level, unit,
+                     run.zero_level != 0 ? " (subtracted: every model reads zero level + k·ω; explain names it a sensor offset)"
+                                         : "",
+                     fit.reading_noise, unit, run.period_s * 1e3);
   out += fmt::format("  bench: J = {:.6g} kg·m² ({}), K_b = {:.6g} V·s/rad ({})", fit.bench.inertia_kg_m2,
                      fit.bench.inertia_source, fit.bench.kb_v_s_per_rad, fit.bench.kb_source);
   if (fit.bench.inertia_rel_error > 0 || fit.bench.kb_rel_error > 0)

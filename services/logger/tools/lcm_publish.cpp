@@ -121,6 +121,7 @@ spindown::fit_t make_fit(const std::string& bench, std::int64_t now) {
   f.inertia_rel_error = 0.02;
   f.kb_rel_error = 0.05;
   f.param_bench_error = {3e-8, 9e-6, 4e-9, 6e-6};
+  f.reading_noise = 0.0042;
   return f;
 }
 

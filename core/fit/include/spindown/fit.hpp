@@ -77,6 +77,9 @@ struct RunFit {
                             // reading's step cannot resolve what the extra term adds (fit_checks.hpp)
   std::string best_reason;  // why, in words (ΔBIC, RMSE)
   double reading_step = 0;  // the readings' quantization step (0: not quantized)
+  // The reading noise σ of the coast (reading_noise.hpp: second differences of the readings before
+  // the stop), in the reading's unit: the noise figure every output names.
+  double reading_noise = 0;
   // Why the numbers should not be trusted as they stand (units, a model that misses), in words for
   // the default output; empty when nothing is doubted (fit_checks.hpp).
   std::vector<std::string> doubts;

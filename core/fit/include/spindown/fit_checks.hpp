@@ -42,9 +42,10 @@ double largest_curve_difference(const ModelFit& a, const ModelFit& b, std::span<
 inline constexpr double suspicious_chi2 = 2.0;
 
 // How far the best model's residuals lie from zero in bins of residual_bin samples over the
-// moving part of the coast, against the run's own noise (from the residuals' first differences,
-// which the smooth part cancels) and the reading's step (a bin's mean is known no better than
-// step/√12): the bins' z-scores.
+// moving part of the coast, against the reading noise σ (RunFit::reading_noise; when not given,
+// from the residuals' first differences, which the smooth part cancels) and the reading's step (a
+// bin's mean is known no better than step/√12): the bins' z-scores, a bin's standard error being
+// hypot(σ/√residual_bin, step/√12).
 inline constexpr std::size_t residual_bin = 25;
 struct ResidualStructure {
   std::size_t bins = 0;
@@ -52,9 +53,11 @@ struct ResidualStructure {
   double mean_z2 = 0;         // mean squared z of the bins (about 1 for a model that holds)
   double worst_tau_s = 0;     // where the worst bin lies (s after the cut)
   double worst_mean = 0;      // its mean residual (reading unit)
+  double sigma = 0;           // the reading noise σ used (reading unit)
+  double bin_se = 0;          // a bin mean's standard error derived from it
 };
 ResidualStructure residual_structure(const ModelFit& m, std::span<const double> tau, std::span<const double> y,
-                                     std::size_t moving, double k, double step);
+                                     std::size_t moving, double k, double step, double sigma = 0);
 
 // All of the above for one fitted run (fit_run calls it last): sets reading_step and doubts,
 // and keeps the simpler model as best when the print cannot resolve what the extra term adds.

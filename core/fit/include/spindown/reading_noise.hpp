@@ -42,4 +42,11 @@ NoiseWeights weigh_by_noise(std::span<const double> y, double max_ratio = 4.0);
 // zeroing or allocation of its own.
 ReadingNoise weigh_by_noise_into(std::span<const double> y, std::span<double> weight, double max_ratio = 4.0);
 
+// The reading noise σ: the standard deviation of one reading's error, from the second differences
+// of the coasting readings y (E[d²] = 6σ² for independent errors; the smooth coast cancels), that is
+// the root mean square of σ(u) over the coast. The one noise figure fit, explain and the report
+// name ("reading noise σ"); what a bin of m readings' mean is known to is derived from it (σ/√m,
+// widened where the residual is correlated). 0 for fewer than 3 readings.
+double reading_noise_sigma(std::span<const double> y);
+
 }  // namespace spindown

@@ -109,4 +109,14 @@ std::string explain_best(const RunFit& fit);
 // place, e.g. "1.3973 ± 0.0021" or "(1.3973 ± 0.0021)e-06".
 std::string format_value_error(double value, double std_error);
 
+// The one vocabulary of fit, explain and the report. A parameter's name as people read it
+// ("omega0" → "ω0", "w_s" → "ω_s", "sensor_offset" → "sensor offset"; c1…c4 as they are); JSON
+// keeps the ASCII names.
+std::string parameter_display_name(std::string_view name);
+// "name = value ± error unit" with the unit spelled for people (N·m·s/rad), and with lab_units
+// " = value ± error g·cm²·s⁻¹" after it where the lab has a unit of its own (lab_units.hpp).
+std::string parameter_text(const Parameter& p, bool lab_units);
+// The lab-unit part alone (" = … g·cm²·s⁻¹"), "" when the lab used the SI unit.
+std::string lab_unit_text(const Parameter& p);
+
 }  // namespace spindown
