@@ -85,12 +85,16 @@ void setup_explain(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "explain", "Find where the base model and the measurement disagree, name the missing effect, add it, repeat");
   sub->footer("Effects: viscous, coulomb, stribeck, windage, sensor_offset (combined = viscous,coulomb).\n"
+              "Samples, zero level, weights and names are spindown fit's: the base model is fit's model of that name "
+              "(c1 viscous, c2 Coulomb, c3/c4 combined, ω0).\n"
               "Exit codes: 0 ok, 1 a file or run could not be used (the others are still reported), 2 bad usage.");
   sub->add_option("FILE", opt->files, "Arduino/PuTTY log, delimited text (CSV/TSV) or LCM log")->required();
   sub->add_option("--base", opt->base,
                   "Starting model: viscous (the lab's belief, default), coulomb, combined, or EFFECT,EFFECT,…");
   sub->add_flag("--json", opt->json, "Print one JSON object {\"files\":[{\"runs\":[{\"steps\":…}]}]} instead of text");
-  sub->add_option("--svg", opt->svg, "Write a figure (measurement, base and final model, residuals) to this file");
+  sub->add_option("--svg", opt->svg,
+                  "Write a figure (measurement, the model after each step with its RMSE, residuals) to this file");
+  sub->add_flag("--lab-units", opt->lab_units, "Also give the lab's units (g·cm², g·cm²·s⁻¹, g·cm²·rad·s⁻²), as fit does");
   sub->add_flag("-v,--verbose", opt->verbose, "Show every diagnostic, notes included");
 
   auto note_given = add_input_options(sub, opt->input);
@@ -104,6 +108,8 @@ void setup_explain(CLI::App& app) {
 
 int run_explain(const ExplainCommandOptions& options) {
   const ExplainPlan plan = plan_from(options);
+  ReportOptions report;
+  report.lab_units = options.lab_units;
   std::vector<FileExplain> files;
   bool all_usable = true;
   for (const auto& path : options.files) {
@@ -112,13 +118,13 @@ int run_explain(const ExplainCommandOptions& options) {
                          options.verbose ? 0 : 8);
     all_usable = all_usable && file.usable();
     if (!options.json) {
-      std::cout << format_file_explain(file) << std::flush;
+      std::cout << format_file_explain(file, report) << std::flush;
     }
     files.push_back(std::move(file));
   }
   // replace: bytes that are not UTF-8 (a Latin-1 file name) never abort the output.
   if (options.json)
-    std::cout << explain_report_json(files).dump(2, ' ', false, Json::error_handler_t::replace) << std::endl;
+    std::cout << explain_report_json(files, report).dump(2, ' ', false, Json::error_handler_t::replace) << std::endl;
   if (!options.svg.empty()) {
     std::ofstream svg(options.svg, std::ios::binary | std::ios::trunc);
     if (svg) svg << explain_svg(files);

@@ -18,6 +18,7 @@ struct ExplainCommandOptions {
   std::string base = "viscous";  // viscous|coulomb|combined|EFFECT,EFFECT…
   bool json = false;
   std::string svg;               // output file, empty = none
+  bool lab_units = false;        // also the lab's units, as `spindown fit --lab-units`
   bool verbose = false;
 
   InputOptions input;  // the bench and delimited-text columns, as for `spindown fit`

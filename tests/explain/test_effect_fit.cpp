@@ -68,13 +68,13 @@ TEST(EffectFit, RecoversEveryEffectFromExactReadings) {
       fit_effects(effects({"viscous", "coulomb", "stribeck", "windage", "sensor_offset"}), d.view());
   ASSERT_TRUE(fit.converged) << fit.message;
   EXPECT_LT(fit.rmse, 1e-5);
-  EXPECT_NEAR(fit.param("c_v")->value, 1.5e-7, 2e-9);
-  EXPECT_NEAR(fit.param("c_c")->value, 1e-4, 1e-7);
+  EXPECT_NEAR(fit.param("c3")->value, 1.5e-7, 2e-9);
+  EXPECT_NEAR(fit.param("c4")->value, 1e-4, 1e-7);
   EXPECT_NEAR(fit.param("c_s")->value, 2e-4, 2e-7);
   EXPECT_NEAR(fit.param("w_s")->value, 35, 0.1);
   EXPECT_NEAR(fit.param("c_w")->value, 5e-10, 5e-12);
-  EXPECT_NEAR(fit.param("offset")->value, 0.05, 1e-5);
-  EXPECT_EQ(fit.param("offset")->unit, "V");
+  EXPECT_NEAR(fit.param("sensor_offset")->value, 0.05, 1e-5);
+  EXPECT_EQ(fit.param("sensor_offset")->unit, "V");
   EXPECT_NEAR(fit.omega0, 2.9 / kb, 0.01);
 }
 
@@ -85,7 +85,7 @@ TEST(EffectFit, StandardErrorsCoverTheTruthOnNoisyData) {
     const Data d = simulate({1.5e-7, 1e-4, 0, 0, 5e-10}, 0.0, 0.004, seed);
     const EffectFit fit = fit_effects(effects({"viscous", "coulomb", "windage"}), d.view());
     ASSERT_TRUE(fit.converged) << fit.message;
-    for (auto [name, truth] : {std::pair{"c_v", 1.5e-7}, {"c_c", 1e-4}, {"c_w", 5e-10}}) {
+    for (auto [name, truth] : {std::pair{"c3", 1.5e-7}, {"c4", 1e-4}, {"c_w", 5e-10}}) {
       const Parameter* p = fit.param(name);
       ASSERT_TRUE(p && std::isfinite(p->std_error) && p->std_error > 0) << name;
       covered += std::abs(p->value - truth) < 2.5 * p->std_error;
@@ -105,6 +105,51 @@ TEST(EffectFit, NestedModelIsNeverWorseThanItsWarmStart) {
     const EffectFit bigger = fit_effects(e, d.view(), &base);
     EXPECT_LE(bigger.sse, base.sse * (1 + 1e-9)) << extra;
   }
+}
+
+// The lab's names, as spindown fit gives them: viscous alone c1, Coulomb alone c2, both c3 and c4.
+TEST(EffectFit, ParametersCarryFitsNames) {
+  const Data d = simulate({1.8e-7, 1.1e-4, 0, 0, 0}, 0.0, 0.003, 7);
+  const auto names = [&](std::initializer_list<const char*> model) {
+    std::vector<std::string> out;
+    for (const auto& p : fit_effects(effects(model), d.view()).params) out.push_back(p.name);
+    return out;
+  };
+  EXPECT_EQ(names({"viscous"}), (std::vector<std::string>{"c1", "omega0"}));
+  EXPECT_EQ(names({"coulomb"}), (std::vector<std::string>{"c2", "omega0"}));
+  EXPECT_EQ(names({"viscous", "coulomb"}), (std::vector<std::string>{"c3", "c4", "omega0"}));
+  EXPECT_EQ(names({"viscous", "coulomb", "stribeck", "sensor_offset"}),
+            (std::vector<std::string>{"c3", "c4", "c_s", "w_s", "sensor_offset", "omega0"}));
+  EXPECT_EQ(names({"viscous", "windage"}), (std::vector<std::string>{"c1", "c_w", "omega0"}));
+  const EffectFit combined = fit_effects(effects({"viscous", "coulomb"}), d.view());
+  EXPECT_EQ(combined.fit_model(), "combined");
+  EXPECT_EQ(combined.title(), "combined (viscous+coulomb)");
+}
+
+// Weighted least squares (spindown fit's objective): sse is Σ w·r², rmse stays the plain one; and a
+// sensor offset stays within the bound the zero level's uncertainty sets.
+TEST(EffectFit, WeightsAndTheOffsetBound) {
+  Data d = simulate({1.8e-7, 1.1e-4, 0, 0, 0}, 0.05, 0.003, 7);
+  std::vector<double> w(d.y.size());
+  for (std::size_t i = 0; i < w.size(); ++i) w[i] = i < w.size() / 2 ? 0.5 : 1.5;
+  EffectFitData view = d.view();
+  view.weight = w;
+  const EffectFit weighted = fit_effects(effects({"viscous", "coulomb"}), view);
+  double plain = 0, objective = 0;
+  for (std::size_t i = 0; i < d.y.size(); ++i) {
+    const double r = d.y[i] - weighted.simulated[i];
+    plain += r * r, objective += w[i] * r * r;
+  }
+  EXPECT_NEAR(weighted.sse, objective, 1e-9 * objective);
+  EXPECT_NEAR(weighted.rmse, std::sqrt(plain / double(d.y.size())), 1e-12);
+  // Unbounded, the offset is found (0.05 V); bounded to [-0.01, 0.01] V it stops at the bound.
+  EXPECT_NEAR(fit_effects(effects({"viscous", "coulomb", "sensor_offset"}), d.view()).param("sensor_offset")->value,
+              0.05, 1e-3);
+  EffectFitData bounded = d.view();
+  bounded.offset_lo = -0.01;
+  bounded.offset_hi = 0.01;
+  const EffectFit b = fit_effects(effects({"viscous", "coulomb", "sensor_offset"}), bounded);
+  EXPECT_NEAR(b.param("sensor_offset")->value, 0.01, 1e-12);
 }
 
 TEST(EffectFit, TooFewSamplesIsAMessageNotACrash) {

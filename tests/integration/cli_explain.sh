@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # spindown explain end to end: the lab's story on the sample data (text, §5 JSON, SVG), a hidden
-# windage effect named from the lab's belief, bad usage (exit 2), an unusable file (exit 1, the
-# other files still explained).
+# windage effect named from the lab's belief, fit's vocabulary (the base model is fit's model of the
+# same name: c1, ω0, the reading noise σ, --lab-units), Coulomb friction not mistaken for a sensor
+# offset below zero on a recording cut off before its stop (rpm), bad usage (exit 2), an unusable
+# file (exit 1, the other files still explained).
 set -euo pipefail
 bin="${SPINDOWN_BIN_DIR:?}/spindown"
 data="${SPINDOWN_SAMPLE_DATA:?}"
@@ -43,6 +45,58 @@ grep -q "time after the cut (s)" "$work/fig.svg" || fail "SVG without axis label
 # Base given as a list; bad usage exits 2; a missing file exits 1 but the good one is explained.
 timeout 60 "$bin" explain "$data/offset-example.tsv" --base viscous,coulomb > "$work/offset.txt"
 grep -q "missing effect: sensor_offset" "$work/offset.txt" || fail "offset not named"
+grep -q "zero level 0.06 V at standstill: spindown fit subtracts it" "$work/offset.txt" || fail "fit's zero level not said"
+
+# One vocabulary (issue 22): on one run, explain's base model is fit's viscous model (same c1, ω0,
+# RMSE, units), the noise is the reading noise σ in both, and --lab-units gives fit's conversion.
+timeout 60 "$bin" fit "$data/stribeck-example.tsv" --lab-units > "$work/fit.txt"
+timeout 60 "$bin" explain "$data/stribeck-example.tsv" --lab-units > "$work/vocab.txt"
+c1=$(grep -o 'c1 = ([0-9.]* ± [0-9.]*)e-07 N·m·s/rad' "$work/fit.txt" | head -1)
+[ -n "$c1" ] || fail "no c1 in fit's output"
+grep -qF "$c1" "$work/vocab.txt" || fail "explain's base is not fit's viscous ($c1): $(grep -A2 'base model' "$work/vocab.txt")"
+w0=$(grep -o 'ω0 = [0-9.]* ± [0-9.]* rad/s' "$work/fit.txt" | head -1)
+grep -qF "$w0" "$work/vocab.txt" || fail "explain's ω0 is not fit's ($w0)"
+rmse=$(awk '$1 == "viscous" { for (i = 1; i <= NF; ++i) if ($i == "V" && $(i-1) ~ /^0\./) { print $(i-1); exit } }' "$work/fit.txt")
+grep -q "base model: viscous - spindown fit's viscous model   RMSE $rmse V" "$work/vocab.txt" || fail "base RMSE is not fit's $rmse"
+sigma=$(grep -o 'reading noise σ [0-9.]* V' "$work/fit.txt" | head -1)
+[ -n "$sigma" ] && grep -qF "$sigma" "$work/vocab.txt" || fail "the reading noise σ differs: '$sigma'"
+grep -q 'c_v\|c_c\|omega0\|N\*m' "$work/vocab.txt" && fail "a second vocabulary in explain's text"
+# Coulomb added to the viscous base is fit's combined model: its c3, in SI and in the lab's units.
+lab=$(grep -o 'c3 = ([0-9.]* ± [0-9.]*)e-0[0-9] N·m·s/rad = [0-9.]* ± [0-9.]* g·cm²·s⁻¹' "$work/fit.txt" | head -1)
+[ -n "$lab" ] || fail "no c3 in lab units in fit's output"
+grep -qF "$lab" "$work/vocab.txt" || fail "explain --lab-units does not give fit's combined c3 ($lab)"
+timeout 60 "$bin" explain "$data/seed-3v-run1.tsv" --json --lab-units > "$work/lab.json"
+python3 - "$work/lab.json" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1]))["files"][0]["runs"][0]
+p = r["final_params"]
+assert set(p) == {"c3", "c4", "omega0"}, p
+assert p["c3"]["unit"] == "N*m*s/rad" and p["c4"]["unit"] == "N*m", p
+assert abs(p["c4"]["lab"]["value"] - 1e7 * p["c4"]["value"]) < 1e-9 * p["c4"]["lab"]["value"], p["c4"]
+assert p["c4"]["lab"]["unit"] == "g*cm^2*rad/s^2", p["c4"]
+assert "noise_level" not in r and r["reading_noise"] > 0 and r["bin_samples"] > 0, r
+assert r["base_params"].keys() == {"c1", "omega0"}, r["base_params"]
+PY
+
+# Coulomb friction, not a sensor offset of minus hundreds of rpm: a viscous coast with a little
+# Coulomb friction in rpm, the recording cut off before the stop (the two fit it identically).
+timeout 60 "$bin" simulate --viscous 1.2e-6 --coulomb 3e-5 --seed 7 -o "$work/tie.tsv" --truth "$work/tie.json"
+python3 - "$work/tie.tsv" "$work/tie.json" "$work/tie.csv" <<'PY'
+import json, math, sys
+truth = json.load(open(sys.argv[2]))
+kb, run = truth["kb_v_s_per_rad"], truth["runs"][0]
+cut = run["cut_device_us"] / 1e3
+end = cut + 0.6 * 1e3 * run["t_stop_s"]
+with open(sys.argv[3], "w") as out:
+    out.write("time_ms,speed_rpm\n")
+    for line in open(sys.argv[1]):
+        f = line.split()
+        if len(f) == 2 and float(f[0]) <= end:
+            out.write(f"{f[0]},{float(f[1]) / kb * 60 / (2 * math.pi):.1f}\n")
+PY
+timeout 60 "$bin" explain "$work/tie.csv" --value-unit rpm > "$work/tie.txt" 2>/dev/null
+grep -q "missing effect: coulomb" "$work/tie.txt" || fail "coulomb not named on the cut-off rpm run: $(grep 'missing effect' "$work/tie.txt")"
+grep -q "rejected sensor_offset: not physical here: a sensor offset of -" "$work/tie.txt" || fail "the offset below zero not rejected with its reason"
 set +e
 "$bin" explain "$data/seed-3v-run1.tsv" --base friction > /dev/null 2> "$work/usage.err"; code=$?
 [ $code -eq 2 ] || fail "bad --base gave exit $code"

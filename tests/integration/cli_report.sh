@@ -86,6 +86,25 @@ grep -q "$T/seed.toml" "$T/data.html" || fail "the verdict does not name its ref
 grep -q 'no reference configured' "$T/data.html" || fail "benches without a config must say so"
 grep -q 'Missing effect: <strong>coulomb</strong>' "$T/data.html" || fail "no explain story"
 grep -q 'Summary across benches and runs' "$T/data.html" || fail "no summary"
+# One viscous fit per run on the page (issue 22): the explain story's belief is the coefficient
+# table's viscous model, with the same c1 and ω0, and the page names one noise figure.
+python3 - "$T/data.html" <<'EOF' || fail "two different viscous fits of one run on the page"
+import html, re, sys
+page = html.unescape(open(sys.argv[1], encoding="utf-8").read())
+runs = page.split('<article class="run"')[1:]
+checked = 0
+for run in runs:
+    table = re.search(r'<td rowspan="\d+">viscous.*?<td>c1</td><td class="num">([^<]+)</td>.*?<td>ω0</td><td class="num">([^<]+)</td>', run, re.S)
+    story = re.search(r'Starting from the belief <strong>viscous</strong> — the fit\'s viscous model above: c1 = (.+?) = [^,]+, ω0 = (.+?) \(RMSE', run)
+    if not table or not story:
+        continue
+    assert table.group(1).strip() == story.group(1).strip(), (table.group(1), story.group(1))
+    assert table.group(2).strip() == story.group(2).strip(), (table.group(2), story.group(2))
+    checked += 1
+assert checked >= 5, f"only {checked} runs compared"
+assert "standstill noise" not in page and "reading noise σ" in page
+print(f"one viscous fit per run: {checked} runs, the story's c1 and ω0 are the table's")
+EOF
 echo "sample files: $(cat "$T/data.out")"
 
 # --- 2. text from files is escaped (a file name, a roster's student name) -------------------

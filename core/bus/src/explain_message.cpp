@@ -13,7 +13,7 @@ explain_t to_explain_message(const ExplainResult& r, const std::string& bench, s
   m.nbase = static_cast<std::int32_t>(m.base.size());
   m.rmse_base = r.rmse_base();
   m.rmse_final = r.rmse_final();
-  m.noise_level = r.noise_level;
+  m.noise_level = r.reading_noise;  // the reading noise σ
   for (std::size_t s = 0; s < r.steps.size(); ++s) {
     const ExplainStep& step = r.steps[s];
     m.step_added.push_back(step.added);

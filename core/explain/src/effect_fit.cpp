@@ -48,13 +48,17 @@ struct Setup {
   }
 };
 
+// Sample i's weight (1 when the fit is unweighted).
+inline double weight_of(const EffectFitData& d, std::size_t i) { return d.weight.empty() ? 1.0 : d.weight[i]; }
+
+// The objective: Σ w·r².
 double sse_of(const Setup& s, const std::vector<double>& th, std::vector<double>& model) {
   model.resize(s.data.tau.size());
   s.sim.simulate(th, s.data.tau, model);
   double sse = 0;
   for (std::size_t i = 0; i < model.size(); ++i) {
     const double r = s.data.y[i] - model[i];
-    sse += r * r;
+    sse += weight_of(s.data, i) * r * r;
   }
   return std::isfinite(sse) ? sse : std::numeric_limits<double>::infinity();
 }
@@ -236,14 +240,20 @@ double assemble_normal(const Setup& s, const std::vector<double>& t, Evaluation&
   ev.model.resize(n);
   ev.jac.resize(n * P);
   s.sim.simulate(t, s.data.tau, ev.model, ev.jac);
-  thread_local std::vector<double> r;  // residual scratch, reused across evaluations
+  thread_local std::vector<double> r, wjac;  // residual and weighted-Jacobian scratch, reused across evaluations
   r.resize(n);
   double sse = 0;
+  // Weighted least squares as √w·r and √w·J (ev.jac itself stays the model's sensitivities).
+  const bool weighted = !s.data.weight.empty();
+  if (weighted) wjac.resize(n * P);
   for (std::size_t i = 0; i < n; ++i) {
-    r[i] = s.data.y[i] - ev.model[i];
+    const double sw = weighted ? std::sqrt(s.data.weight[i]) : 1.0;
+    r[i] = sw * (s.data.y[i] - ev.model[i]);
     sse += r[i] * r[i];
+    if (weighted)
+      for (int j = 0; j < P; ++j) wjac[i * P + j] = sw * ev.jac[i * P + j];
   }
-  normal_equations(ev.jac.data(), r.data(), n, P, ev.jtj, ev.jtr);
+  normal_equations(weighted ? wjac.data() : ev.jac.data(), r.data(), n, P, ev.jtj, ev.jtr);
   return std::isfinite(sse) && ev.jtj.allFinite() && ev.jtr.allFinite() ? sse : std::numeric_limits<double>::infinity();
 }
 
@@ -343,9 +353,10 @@ std::string refine_with_nlopt(const Setup& s, std::vector<double>& th, int max_e
     double sse = 0;
     std::fill(grad.begin(), grad.end(), 0.0);
     for (std::size_t i = 0; i < m; ++i) {
+      const double w = weight_of(s.data, i);
       const double r = s.data.y[i] - simulated[i];
-      sse += r * r;
-      for (std::size_t j = 0; j < grad.size(); ++j) grad[j] -= 2 * r * jac[i * n + j];
+      sse += w * r * r;
+      for (std::size_t j = 0; j < grad.size(); ++j) grad[j] -= 2 * w * r * jac[i * n + j];
     }
     for (std::size_t j = 0; j < grad.size(); ++j) grad[j] *= scale[j] / sse0;
     return sse / sse0;
@@ -373,6 +384,9 @@ Eigen::MatrixXd covariance(const Setup& s, const std::vector<double>& model, con
     for (std::size_t i = 0; i < n; ++i) norm += jacv[i * P + j] * jacv[i * P + j];
     if (norm > 0 && std::isfinite(norm)) keep.push_back(j);
   }
+  // Weighted least squares: the rows scaled by √w (residual and sensitivities alike).
+  std::vector<double> sw(n);
+  for (std::size_t i = 0; i < n; ++i) sw[i] = std::sqrt(weight_of(s.data, i));
   const int p = static_cast<int>(keep.size());
   const auto N = static_cast<Eigen::Index>(n);
   ok = false;
@@ -381,13 +395,13 @@ Eigen::MatrixXd covariance(const Setup& s, const std::vector<double>& model, con
   std::vector<double> res(n), js(n * static_cast<std::size_t>(p));
   Eigen::VectorXd cs = Eigen::VectorXd::Zero(p);
   for (std::size_t i = 0; i < n; ++i)
-    for (int c = 0; c < p; ++c) cs[c] += jacv[i * P + keep[c]] * jacv[i * P + keep[c]];
+    for (int c = 0; c < p; ++c) cs[c] += sw[i] * sw[i] * jacv[i * P + keep[c]] * jacv[i * P + keep[c]];
   cs = cs.cwiseSqrt();
   double rss = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    res[i] = s.data.y[i] - model[i];
+    res[i] = sw[i] * (s.data.y[i] - model[i]);
     rss += res[i] * res[i];
-    for (int c = 0; c < p; ++c) js[i * p + c] = jacv[i * P + keep[c]] / cs[c];
+    for (int c = 0; c < p; ++c) js[i * p + c] = sw[i] * jacv[i * P + keep[c]] / cs[c];
   }
   Eigen::MatrixXd jtj;
   Eigen::VectorXd unused;
@@ -422,6 +436,16 @@ std::vector<std::string> EffectFit::names() const {
   return out;
 }
 
+std::string EffectFit::fit_model() const {
+  const std::string l = label();
+  return l == "viscous" || l == "coulomb" ? l : l == "viscous+coulomb" ? "combined" : std::string();
+}
+
+std::string EffectFit::title() const {
+  const std::string fit = fit_model();
+  return fit == "combined" ? "combined (viscous+coulomb)" : fit.empty() ? label() : fit;
+}
+
 std::string EffectFit::label() const {
   std::string out;
   for (const Effect* e : effects) out += (out.empty() ? "" : "+") + std::string(e->name);
@@ -445,6 +469,8 @@ RunScale run_scale(const EffectFitData& d) {
   const std::size_t m = std::clamp<std::size_t>(d.moving, 1, n);
   s.duration_s = std::max(d.tau[m - 1], 0.1);
   s.reading_max = std::max(ymax, 1e-9);
+  s.offset_lo = d.offset_lo;
+  s.offset_hi = std::max(d.offset_hi, d.offset_lo + 1e-12 * s.reading_max);
   return s;
 }
 
@@ -521,7 +547,9 @@ EffectFit fit_effects(const std::vector<const Effect*>& effects, const EffectFit
   out.sse = lm.sse;
   out.simulated = std::move(lm.state.model);
   const double dn = static_cast<double>(n);
-  out.rmse = std::sqrt(out.sse / dn);
+  double plain = 0;  // Σ r², unweighted: the RMSE in the reading's unit
+  for (std::size_t i = 0; i < n; ++i) plain += (data.y[i] - out.simulated[i]) * (data.y[i] - out.simulated[i]);
+  out.rmse = std::sqrt(plain / dn);
   const double ll = dn * std::log(std::max(out.sse / dn, 1e-300));
   out.aic = ll + 2.0 * P;
   out.bic = ll + P * std::log(dn);
@@ -541,25 +569,35 @@ EffectFit fit_effects(const std::vector<const Effect*>& effects, const EffectFit
     const double v = cov(j, j);
     return std::isfinite(v) && v >= 0 ? std::sqrt(v) * std::abs(factor) : nan;
   };
-  int stribeck_at = -1, coulomb_at = -1;
+  // The lab's names (effect_fit.hpp): c1/c3 viscous, c2/c4 Coulomb as in spindown fit's models.
+  bool viscous = false, coulomb = false;
+  for (const Effect* e : effects) viscous = viscous || e->name == "viscous", coulomb = coulomb || e->name == "coulomb";
+  int coulomb_at = -1;
+  for (std::size_t e = 0; e < effects.size(); ++e)
+    if (effects[e]->name == "coulomb") coulomb_at = s.sim.first_param(e);
   for (std::size_t e = 0; e < effects.size(); ++e) {
     const int at = s.sim.first_param(e);
-    if (effects[e]->name == "stribeck") stribeck_at = at;
-    if (effects[e]->name == "coulomb") coulomb_at = at;
+    const std::string_view effect = effects[e]->name;
     for (int j = 0; j < effects[e]->size(); ++j) {
       const EffectParam& p = effects[e]->params[j];
       const double f = p.per_inertia ? J : 1.0;
-      out.params.push_back({std::string(p.name), th[at + j] * f, se(at + j, f),
-                            p.unit == "reading" ? data.unit : std::string(p.unit)});
+      const std::string unit = p.unit == "reading" ? data.unit : std::string(p.unit);
+      std::string name(p.name);
+      if (effect == "viscous") name = coulomb ? "c3" : "c1";
+      if (effect == "coulomb") name = viscous ? "c4" : "c2";
+      if (effect == "sensor_offset") name = "sensor_offset";
+      if (effect == "stribeck" && j == 0) {
+        // Reported as the static friction c_s = c_c + (c_s − c_c): what the term rises to at standstill.
+        const double var = coulomb_at >= 0 ? cov(coulomb_at, coulomb_at) + cov(at, at) + 2 * cov(coulomb_at, at)
+                                           : cov(at, at);
+        const double amplitude = th[at] + (coulomb_at >= 0 ? th[coulomb_at] : 0.0);
+        out.params.push_back({"c_s", amplitude * J, std::isfinite(var) && var >= 0 ? std::sqrt(var) * J : nan, unit});
+        continue;
+      }
+      out.params.push_back({std::move(name), th[at + j] * f, se(at + j, f), unit});
     }
   }
   out.params.push_back({"omega0", th[0], se(0, 1.0), "rad/s"});
-  if (stribeck_at >= 0 && coulomb_at >= 0) {
-    // Derived: the static friction c_s = c_c + (c_s − c_c).
-    const double var = cov(coulomb_at, coulomb_at) + cov(stribeck_at, stribeck_at) + 2 * cov(coulomb_at, stribeck_at);
-    out.params.push_back({"c_s", (th[coulomb_at] + th[stribeck_at]) * J,
-                          std::isfinite(var) && var >= 0 ? std::sqrt(var) * J : nan, "N*m"});
-  }
   return out;
 }
 

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "spindown/effect_simulator.hpp"
+#include "spindown/reading_noise.hpp"
 
 namespace spindown {
 namespace {
@@ -146,14 +147,53 @@ bool ExplainOptions::is_valid(std::string* why) const {
   return true;
 }
 
-double white_noise(std::span<const double> y) {
-  if (y.size() < 3) return 0;
-  double s = 0;
-  for (std::size_t i = 1; i + 1 < y.size(); ++i) {
-    const double d2 = y[i + 1] - 2 * y[i] + y[i - 1];
-    s += d2 * d2;
+double white_noise(std::span<const double> y) { return reading_noise_sigma(y); }
+
+double ExplainResult::bin_noise_white() const {
+  return bin_samples > 0 ? reading_noise / std::sqrt(static_cast<double>(bin_samples)) : reading_noise;
+}
+
+std::string effect_term(const Effect& effect, const EffectFit& fit) {
+  const auto has = [&](std::string_view name) { return fit.param(name) != nullptr; };
+  const std::string coulomb = has("c4") ? "c4" : has("c2") ? "c2" : "";
+  if (effect.name == "viscous") return fmt::format("T = {}·ω", has("c3") ? "c3" : "c1");
+  if (effect.name == "coulomb") return fmt::format("T = {}", coulomb.empty() ? "c2" : coulomb);
+  if (effect.name == "stribeck")
+    return coulomb.empty() ? "T = c_s·exp(−(ω/ω_s)²)" : fmt::format("T = (c_s − {})·exp(−(ω/ω_s)²)", coulomb);
+  return std::string(effect.term);
+}
+
+namespace {
+
+// Stribeck friction whose speed scale is a third of the top speed or more.
+bool broad_stribeck(const Effect& effect, const EffectFit& fit, double top_speed) {
+  const Parameter* ws = fit.param("w_s");
+  return effect.name == "stribeck" && ws && std::isfinite(ws->value) && top_speed > 0 && ws->value >= top_speed / 3;
+}
+
+}  // namespace
+
+std::string effect_meaning(const Effect& effect, const EffectFit& fit, double top_speed) {
+  const Parameter* ws = fit.param("w_s");
+  if (broad_stribeck(effect, fit, top_speed)) {
+    // exp(−(ω/ω_s)²) halves at ω_s·√ln 2.
+    const double half = ws->value * std::sqrt(std::log(2.0));
+    return fmt::format("friction that falls with speed over much of the coast, not only near standstill: the extra "
+                       "friction above Coulomb's halves by {:.3g} rad/s, {:.0f} % of the top speed {:.3g} rad/s "
+                       "(ω_s = {:.3g} rad/s) - far wider than a lubricant film breaking down near standstill",
+                       half, 100 * half / top_speed, top_speed, ws->value);
   }
-  return std::sqrt(s / (6.0 * static_cast<double>(y.size() - 2)));
+  if (effect.name == "stribeck" && ws && std::isfinite(ws->value) && top_speed > 0)
+    return fmt::format("{} (ω_s = {:.3g} rad/s, {:.0f} % of the top speed {:.3g} rad/s)", effect.meaning, ws->value,
+                       100 * ws->value / top_speed, top_speed);
+  return std::string(effect.meaning);
+}
+
+std::string effect_signature(const Effect& effect, const EffectFit& fit, double top_speed) {
+  if (broad_stribeck(effect, fit, top_speed))
+    return "the coast decelerates harder as it slows over much of its length, more than viscous and Coulomb friction "
+           "allow: residuals of one sign early and late, of the other in between";
+  return std::string(effect.signature);
 }
 
 ResidualBins bin_residuals(std::span<const double> r, std::size_t m, double white_sigma) {
@@ -194,9 +234,11 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
     out.message = why;
     return out;
   }
+  // spindown fit's samples (fit.cpp): the window less its outliers.
   const std::size_t begin = std::min(run.cut_index, t_s.size());
   const std::size_t end = std::clamp(run.end_index, begin, std::min(t_s.size(), value.size()));
   const std::size_t stop = std::clamp(run.stop_index, begin, end);
+  out.zero_level = std::isfinite(run.zero_level) ? run.zero_level : 0.0;
   std::size_t moving = 0;  // samples kept before the stop
   for (std::size_t i = begin; i < end; ++i) {
     if (!std::isfinite(t_s[i]) || !std::isfinite(value[i])) continue;
@@ -205,15 +247,53 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
     out.y.push_back(value[i]);
     moving += i < stop || !run.stopped;
   }
+  const std::size_t n = out.tau.size();
+  // ... and its weights (reading_noise.hpp, from the readings less the zero level as fit takes them),
+  // so that the base model is fit's model of that name. The readings themselves keep their own zero:
+  // a zero level fit subtracts is a sensor offset here, an effect to name.
+  out.weight.assign(n, 1.0);
+  if (opt.weighted) {
+    std::vector<double> above_zero(out.y);
+    for (double& v : above_zero) v -= out.zero_level;
+    weigh_by_noise_into(above_zero, out.weight);
+  }
   const double k = value_per_rad_per_s(q, opt.bench.kb_v_s_per_rad);
+  // The reading's resolution and noise, the zero level's own uncertainty (a sensor offset is bounded
+  // by it when the run shows a standstill), and the lowest reading the sensor gave at all.
+  const double quantum = reading_quantum(out.y);
+  out.reading_noise = std::max(
+      reading_noise_sigma(std::span<const double>(out.y).first(std::max<std::size_t>(moving, std::min<std::size_t>(n, 3)))),
+      1e-12);
+  const std::size_t tail = n - std::min(moving, n);
+  out.standstill_seen = run.stopped && tail >= 5;
+  out.offset_lo = -std::numeric_limits<double>::infinity();
+  out.offset_hi = std::numeric_limits<double>::infinity();
+  if (out.standstill_seen) {
+    // The reading at rest is measured: an offset lies between 0 and it, give or take its uncertainty.
+    double sum = 0, sum2 = 0;
+    for (std::size_t i = moving; i < n; ++i) sum += out.y[i], sum2 += out.y[i] * out.y[i];
+    const double mean = sum / static_cast<double>(tail);
+    const double spread = std::sqrt(std::max(sum2 / static_cast<double>(tail) - mean * mean, 0.0));
+    double ymax = 0;
+    for (double v : out.y) ymax = std::max(ymax, std::abs(v));
+    const double slack = std::max({3.0 * std::max(spread, run.noise_level) / std::sqrt(static_cast<double>(tail)),
+                                   0.5 * quantum, 1e-6 * ymax});
+    out.offset_lo = std::min(0.0, out.zero_level) - slack;
+    out.offset_hi = std::max(0.0, out.zero_level) + slack;
+  }
+  double lowest_reading = std::numeric_limits<double>::infinity();
+  for (double v : value)
+    if (std::isfinite(v)) lowest_reading = std::min(lowest_reading, v);
   EffectFitData data;
   data.tau = out.tau;
   data.y = out.y;
+  data.weight = out.weight;
   data.moving = moving;
   data.k = k;
   data.inertia_kg_m2 = opt.bench.inertia_kg_m2;
   data.unit = out.unit;
-  const std::size_t n = out.tau.size();
+  data.offset_lo = out.offset_lo;
+  data.offset_hi = out.offset_hi;
 
   std::vector<const Effect*> model;
   for (const Effect& lib : effect_library())
@@ -231,8 +311,7 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
   const double period = n > 1 ? span_s / static_cast<double>(n - 1) : 0.02;
   const std::size_t m = std::max<std::size_t>(5, static_cast<std::size_t>(std::lround(opt.bin_s / std::max(period, 1e-6))));
   out.bin_samples = m;
-  out.noise_level = white_noise(std::span<const double>(out.y).first(std::max<std::size_t>(data.moving, std::min<std::size_t>(n, 3))));
-  out.noise_level = std::max(out.noise_level, 1e-12);
+  const double noise = out.reading_noise;
 
   std::vector<const Effect*> pool = opt.candidates;
   if (pool.empty())
@@ -242,11 +321,10 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
   // of the binned residual), not just shave the noise.
   constexpr double max_left = 0.5;
   // ... and move the model by at least half a reading step somewhere (else it fits rounding).
-  const double quantum = reading_quantum(out.y);
   EffectFit current = out.base;
   for (int step = 0;; ++step) {
     const std::vector<double> res = residual_of(out.y, current);
-    const ResidualBins bins = bin_residuals(res, m, out.noise_level);
+    const ResidualBins bins = bin_residuals(res, m, noise);
     if (step == 0) out.bin_noise = bins.bin_se;
     const std::vector<double> speed = model_speed(current, out.tau, k);
     std::vector<Disagreement> where = locate(bins, bins.bin_se, opt.systematic_z, out.tau, res, speed, run.t_cut_s);
@@ -257,7 +335,7 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
     if (where.empty() && !mass_significant(mass, bins.mean.size())) {
       out.remaining = where;
       out.conclusion = fmt::format(
-          "nothing significant remains: no {:.2g}-s stretch of the residual is beyond {:.0f}x its noise ({:.2g} {}), "
+          "nothing significant remains: no {:.2g}-s stretch of the residual is beyond {:.0f}x a bin's noise ({:.2g} {}), "
           "and the bins together are consistent with noise",
           opt.bin_s, opt.systematic_z, bins.bin_se, out.unit);
       break;
@@ -270,6 +348,7 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
 
     ExplainStep st;
     st.rmse_before = current.rmse;
+    st.bin_noise = bins.bin_se;
     st.where = where;
     for (const Effect* c : pool) {
       if (contains(current.effects, c)) continue;
@@ -290,9 +369,24 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
       if (std::isfinite(t.fit.sse) && (!lowest || t.fit.sse < lowest->fit.sse)) lowest = &t;
     double n_eff = static_cast<double>(n);
     if (lowest) {
-      const ResidualBins lb = bin_residuals(residual_of(out.y, lowest->fit), m, out.noise_level);
-      const double inflation = static_cast<double>(m) * lb.bin_se * lb.bin_se / (out.noise_level * out.noise_level);
+      const ResidualBins lb = bin_residuals(residual_of(out.y, lowest->fit), m, noise);
+      const double inflation = static_cast<double>(m) * lb.bin_se * lb.bin_se / (noise * noise);
       n_eff = std::clamp(static_cast<double>(n) / std::max(inflation, 1.0), 2.0, static_cast<double>(n));
+    }
+    // A sensor offset that would read below zero at standstill, on a sensor the recording shows
+    // reading zero (at rest before the spin-up, or after the stop) and never below it, is not
+    // physical, however well it fits: without a standstill in the window a viscous coast with Coulomb
+    // friction is an exponential plus a constant, and so is one with a negative offset.
+    const double tolerance = std::max(3 * noise, quantum);
+    const bool reads_zero = lowest_reading <= tolerance && lowest_reading >= -tolerance;
+    for (auto& t : st.trials) {
+      const Parameter* off = t.fit.param("sensor_offset");
+      if (!off || !std::isfinite(off->value)) continue;
+      if (off->value < -tolerance && reads_zero)
+        t.impossible = fmt::format("a sensor offset of {:.4g} {} would make the reading at standstill {:.4g} {}, below "
+                                   "zero, and this sensor reads zero, never below it (its lowest reading in the "
+                                   "recording: {:.4g} {})",
+                                   off->value, out.unit, off->value, out.unit, lowest_reading, out.unit);
     }
     CandidateTrial* best = nullptr;
     for (auto& t : st.trials) {
@@ -303,16 +397,36 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
       }
       const int extra = static_cast<int>(t.fit.theta.size()) - static_cast<int>(current.theta.size());
       t.delta_bic = n_eff * std::log(current.sse / t.fit.sse) - extra * std::log(n_eff);
-      const ResidualBins tb = bin_residuals(residual_of(out.y, t.fit), m, out.noise_level);
+      const ResidualBins tb = bin_residuals(residual_of(out.y, t.fit), m, noise);
       t.systematic_after = mass > 0 ? systematic_mass(tb, bins.bin_se) / mass : 0.0;
       t.change = largest_change(current, t.fit, m);
-      if (!best || t.delta_bic > best->delta_bic) best = &t;
+      if (t.impossible.empty() && (!best || t.delta_bic > best->delta_bic)) best = &t;
     }
     // Evidence that cannot separate two effects (within 3 in BIC) goes to the simpler one.
     for (auto& t : st.trials)
-      if (best && &t != best && std::isfinite(t.delta_bic) && t.delta_bic > best->delta_bic - 3 &&
-          t.fit.theta.size() < best->fit.theta.size() && t.systematic_after <= best->systematic_after + 0.05)
+      if (best && &t != best && t.impossible.empty() && std::isfinite(t.delta_bic) &&
+          t.delta_bic > best->delta_bic - 3 && t.fit.theta.size() < best->fit.theta.size() &&
+          t.systematic_after <= best->systematic_after + 0.05)
         best = &t;
+    // As many parameters and within 3 in BIC: the run cannot tell them apart. The choice is fixed
+    // (friction before a sensor effect, then library order) and said, never made silently.
+    std::vector<CandidateTrial*> twins;
+    if (best)
+      for (auto& t : st.trials)
+        if (&t != best && t.impossible.empty() && std::isfinite(t.delta_bic) &&
+            std::abs(t.delta_bic - best->delta_bic) < 3 && t.fit.theta.size() == best->fit.theta.size() &&
+            t.systematic_after < max_left && t.change >= 0.5 * quantum)
+          twins.push_back(&t);
+    if (!twins.empty()) {
+      const auto rank = [](const CandidateTrial* t) {
+        const Effect* e = find_effect(t->effect);
+        return (e && e->kind == EffectKind::sensor ? 100 : 0) + (e ? static_cast<int>(e - effect_library().data()) : 99);
+      };
+      twins.push_back(best);
+      std::sort(twins.begin(), twins.end(), [&](auto* a, auto* b) { return rank(a) < rank(b); });
+      best = twins.front();
+      twins.erase(twins.begin());
+    }
     const bool enough = best && best->delta_bic > opt.min_delta_bic && best->systematic_after < max_left &&
                         best->change >= 0.5 * quantum;
     for (auto& t : st.trials) {
@@ -321,7 +435,14 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
         t.verdict = "added";
         continue;
       }
-      if (t.delta_bic <= opt.min_delta_bic)
+      if (!t.impossible.empty())
+        t.verdict = fmt::format("not physical here: {} (dBIC {:.1f}, RMSE {:.4g} {})", t.impossible, t.delta_bic,
+                                t.fit.rmse, out.unit);
+      else if (enough && std::find(twins.begin(), twins.end(), &t) != twins.end())
+        t.verdict = fmt::format("fits this run as well as {} (dBIC {:.1f} vs {:.1f}, RMSE {:.4g} vs {:.4g} {}): the run "
+                                "cannot tell them apart",
+                                best->effect, t.delta_bic, best->delta_bic, t.fit.rmse, best->fit.rmse, out.unit);
+      else if (t.delta_bic <= opt.min_delta_bic)
         t.verdict = t.delta_bic <= 0 ? fmt::format("no real improvement (RMSE {:.4g} {}, dBIC {:.1f})", t.fit.rmse,
                                                    out.unit, t.delta_bic)
                                      : fmt::format("too little evidence (dBIC {:.1f} < {:.0f}, RMSE {:.4g} {})",
@@ -352,6 +473,32 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
     st.added = best->effect;
     st.rmse_after = best->fit.rmse;
     st.fit = best->fit;
+    if (const Effect* e = find_effect(st.added)) {
+      st.meaning = effect_meaning(*e, best->fit, best->fit.omega0);
+      st.signature = effect_signature(*e, best->fit, best->fit.omega0);
+    }
+    if (!twins.empty()) {
+      std::string names;
+      double apart = 0;
+      for (const CandidateTrial* t : twins) {
+        st.indistinguishable.push_back(t->effect);
+        names += (names.empty() ? "" : " or ") + t->effect;
+        apart = std::max(apart, largest_change(best->fit, t->fit, m));
+      }
+      const bool offset_or_friction =
+          std::any_of(twins.begin(), twins.end(), [](auto* t) { return t->effect == "sensor_offset"; }) ||
+          best->effect == "sensor_offset";
+      st.undecided = fmt::format(
+          "{} or {}: this run cannot tell them apart (dBIC {:.1f} vs {:.1f}; their curves differ by at most {:.2g} {}, "
+          "a bin's noise being {:.2g} {}){}; {} is kept by rule (friction before a sensor effect), not by the data",
+          best->effect, names, best->delta_bic, twins.front()->delta_bic, apart, out.unit, bins.bin_se, out.unit,
+          offset_or_friction && !out.standstill_seen
+              ? ": without a standstill in the window the reading's zero is not measured, and friction that "
+                "levels the coast off toward a speed below zero reads like a sensor offset; record the coast to "
+                "its stop to decide"
+              : "",
+          best->effect);
+    }
     st.why = fmt::format("{}: dBIC {:.1f} (n_eff {:.0f}), RMSE {:.4g} -> {:.4g} {} ({:.2g}x smaller), {:.0f}% of "
                          "the systematic disagreement left",
                          best->effect, best->delta_bic, n_eff, current.rmse, best->fit.rmse, out.unit,
@@ -383,6 +530,13 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
     out.steps.push_back(std::move(st));
   }
   out.final_fit = current;
+  out.top_speed = current.omega0;
+  for (std::size_t i = 0; i < out.steps.size(); ++i)
+    if (!out.steps[i].undecided.empty()) {
+      std::string names = out.steps[i].added;
+      for (const auto& other : out.steps[i].indistinguishable) names += " or " + other;
+      out.conclusion += fmt::format("; undecided at step {}: {} (this run cannot tell them apart)", i + 1, names);
+    }
   return out;
 }
 

@@ -14,7 +14,7 @@ Effect make_viscous() {
   Effect e;
   e.name = "viscous";
   e.meaning = "drag proportional to speed (lubricant shear, eddy currents)";
-  e.term = "T = c_v*w";
+  e.term = "T = c_v·ω";
   e.signature = "the decay rate stays proportional to speed: a straight-line model bends too little early on";
   e.params = {{"c_v", "N*m*s/rad", "viscous coefficient", true, zero, [](const RunScale&) { return 1e3; },
                [](const RunScale& s) { return 1.0 / s.duration_s; }}};
@@ -52,7 +52,7 @@ Effect make_stribeck() {
   Effect e;
   e.name = "stribeck";
   e.meaning = "friction rising toward standstill as the lubricant film breaks down (boundary lubrication)";
-  e.term = "T = (c_s - c_c)*exp(-(w/w_s)^2)";
+  e.term = "T = (c_s − c_c)·exp(−(ω/ω_s)²)";
   e.signature = "the last part of the coast decelerates harder than the model: the data reach zero earlier "
                 "and more abruptly, residuals negative just before the stop";
   e.params = {{"c_s_minus_c_c", "N*m", "static friction above Coulomb (c_s - c_c)", true, zero,
@@ -88,7 +88,7 @@ Effect make_windage() {
   Effect e;
   e.name = "windage";
   e.meaning = "aerodynamic drag of the flywheel, growing with the square of speed";
-  e.term = "T = c_w*w^2";
+  e.term = "T = c_w·ω²";
   e.signature = "the first seconds decelerate harder than the model, fading quickly as the speed drops: "
                 "residuals negative early, then positive";
   e.params = {{"c_w", "N*m*s^2/rad^2", "windage coefficient", true, zero,
@@ -107,12 +107,13 @@ Effect make_windage() {
 Effect make_sensor_offset() {
   Effect e;
   e.name = "sensor_offset";
-  e.meaning = "the sensor reads a constant offset: the reading does not return to zero at standstill";
-  e.term = "reading = k*w + offset";
+  e.meaning = "the sensor reads a constant offset: the reading does not return to its zero at standstill";
+  e.term = "reading = k·ω + sensor offset";
   e.signature = "a constant residual where the shaft stands still (and a shifted curve while it coasts)";
   e.kind = EffectKind::sensor;
-  e.params = {{"offset", "reading", "sensor offset", false, [](const RunScale& s) { return -0.5 * s.reading_max; },
-               [](const RunScale& s) { return 0.5 * s.reading_max; },
+  e.params = {{"offset", "reading", "sensor offset", false,
+               [](const RunScale& s) { return std::max(-0.5 * s.reading_max, s.offset_lo); },
+               [](const RunScale& s) { return std::min(0.5 * s.reading_max, s.offset_hi); },
                [](const RunScale& s) { return 0.01 * s.reading_max; }}};
   e.reading = [](const double* p, double, double* dp) {
     if (dp) dp[0] = 1;

@@ -266,7 +266,7 @@ std::string trend_figure_svg(const BenchSummary& b) {
     const double pad_x = x1 > x0 ? 0.05 * (x1 - x0) : 1, pad_y = y1 > y0 ? 0.1 * (y1 - y0) : std::abs(y0) * 0.1 + 1e-12;
     Panel p{left, 30, w / 2 - 120, h - 90, x0 - pad_x, x1 + pad_x, y0 - pad_y, y1 + pad_y};
     s += fmt::format("<text x=\"{:.1f}\" y=\"18\" font-weight=\"bold\">{} ({})</text>\n", p.x,
-                     t.name == "c_v" ? "viscous c_v" : "dry friction c_c", svg::escape(unit));
+                     t.name == "c3" ? "viscous c3" : "dry friction c4", svg::escape(unit));
     s += svg::axes(p, t.x_unit == "day" ? "days since the first run" : "run (time order)", unit);
     if (t.enough) {
       const double ya = (t.intercept + t.slope * p.x0) * scale, yb = (t.intercept + t.slope * p.x1) * scale;
@@ -314,14 +314,14 @@ std::string summary_section(const SessionReport& report) {
   std::string s = "<section id=\"summary\">\n<h2>Summary across benches and runs</h2>\n";
   std::size_t drifting = 0;
   for (const auto& b : report.benches) drifting += b.viscous.drifting || b.coulomb.drifting;
-  s += fmt::format("<p>{} run{} on {} bench{}; {} bench{} with drifting friction. Friction c_v (viscous) and c_c "
-                   "(dry) come from the combined model; a trend is a weighted straight line through the runs in "
+  s += fmt::format("<p>{} run{} on {} bench{}; {} bench{} with drifting friction. Friction c3 (viscous) and c4 "
+                   "(dry, Coulomb) come from the combined model; a trend is a weighted straight line through the runs in "
                    "time order, its error widened by the run-to-run scatter; it is called drifting when it is more "
                    "than 3 standard errors from flat and changes the coefficient by 10 % or more.</p>\n",
                    report.runs.size(), report.runs.size() == 1 ? "" : "s", report.benches.size(),
                    report.benches.size() == 1 ? "" : "es", drifting, drifting == 1 ? "" : "es");
   s += "<table class=\"summary\">\n<tr><th>bench</th><th>runs</th><th>health (worst run)</th><th>reference</th>"
-       "<th>viscous c_v</th><th>dry friction c_c</th></tr>\n";
+       "<th>viscous c3</th><th>dry friction c4</th></tr>\n";
   for (const auto& b : report.benches) {
     s += fmt::format("<tr><td><a href=\"#{}\">{}</a></td><td class=\"num\">{}</td><td>{}</td><td>{}</td><td>{}</td>"
                      "<td>{}</td></tr>\n",
@@ -429,7 +429,7 @@ std::string coefficient_table(const RunFit& fit) {
           lab ? fmt::format("{} {}", format_value_error(p.value * lab->per_si, p.std_error * lab->per_si), lab->pretty)
               : "–";
       s += fmt::format("<tr class=\"{}{}\">{}<td>{}</td><td class=\"num\">{}</td><td class=\"num\">{}</td>{}</tr>\n",
-                       i == 0 ? "model-first" : "", best ? " best" : "", i == 0 ? model_cell : "", esc(p.name),
+                       i == 0 ? "model-first" : "", best ? " best" : "", i == 0 ? model_cell : "", esc(parameter_display_name(p.name)),
                        esc(value_unit(p.value, p.std_error, p.unit)), esc(lab_text), i == 0 ? stats : "");
     }
   }
@@ -439,10 +439,10 @@ std::string coefficient_table(const RunFit& fit) {
   return s;
 }
 
+// fit's names and spellings (fit_report.hpp), the lab's units beside SI as the coefficient table gives them.
 std::string params_inline(const EffectFit& f) {
   std::string out;
-  for (const auto& p : f.params)
-    out += fmt::format("{}{} = {}", out.empty() ? "" : ", ", p.name, value_unit(p.value, p.std_error, p.unit));
+  for (const auto& p : f.params) out += (out.empty() ? "" : ", ") + parameter_text(p, true);
   return out;
 }
 
@@ -451,26 +451,39 @@ std::string explain_block(const ReportRun& r) {
   if (!r.explained) return s + "<p class=\"noref\">not explained</p>\n";
   const ExplainResult& e = r.explain;
   if (!e.ok) return s + fmt::format("<p class=\"fail\">could not be explained: {}</p>\n", esc(e.message));
-  s += fmt::format("<p>Starting from the belief <strong>{}</strong> (RMSE {:.3g} {}):</p>\n<ol class=\"story\">\n",
-                   esc(e.base.label()), e.base.rmse, esc(e.unit));
+  // The belief is the fit's model of the same name (the same samples and weights), but for the zero
+  // level, which the fit subtracts and explain names as a sensor offset.
+  const std::string fit_name = e.base.fit_model();
+  s += fmt::format("<p>Starting from the belief <strong>{}</strong>{}: {} (RMSE {:.3g} {}; reading noise σ {:.2g} {}):</p>\n"
+                   "<ol class=\"story\">\n",
+                   esc(e.base.title()),
+                   fit_name.empty()     ? std::string()
+                   : e.zero_level == 0 ? esc(" — the fit's " + fit_name + " model above")
+                                       : esc(" — the fit's " + fit_name + " model above but for its zero level"),
+                   esc(params_inline(e.base)), e.base.rmse, esc(e.unit), e.reading_noise, esc(e.unit));
   for (const auto& step : e.steps) {
     const Effect* effect = find_effect(step.added);
     std::string where;
     for (const auto& d : step.where)
       where += fmt::format("{}{:.1f}–{:.1f} s (data {} the model by {:.3g} {})", where.empty() ? "" : "; ", d.tau_from_s,
                            d.tau_to_s, d.mean_residual > 0 ? "above" : "below", std::abs(d.mean_residual), e.unit);
-    s += fmt::format("<li>Disagreement at {}. Missing effect: <strong>{}</strong>{}. Gap: RMSE {:.3g} → {:.3g} {}. "
-                     "<br><span class=\"meta\">{}</span></li>\n",
+    s += fmt::format("<li>Disagreement at {}. Missing effect: <strong>{}</strong>{}. Gap: RMSE {:.3g} → {:.3g} {}.{} "
+                     "<br><span class=\"meta\">{}: {}</span></li>\n",
                      esc(where.empty() ? "—" : where), esc(step.added),
-                     effect ? esc(" — " + std::string(effect->meaning)) : "", step.rmse_before, step.rmse_after,
-                     esc(e.unit), esc(params_inline(step.fit)));
+                     effect ? esc(" — " + (step.meaning.empty() ? std::string(effect->meaning) : step.meaning)) : "",
+                     step.rmse_before, step.rmse_after, esc(e.unit),
+                     step.undecided.empty() ? std::string() : " <em>" + esc("Undecided: " + step.undecided) + "</em>",
+                     esc(step.fit.title()), esc(params_inline(step.fit)));
   }
   if (e.steps.empty()) s += "<li>Nothing needed adding: the belief explains the data within the noise.</li>\n";
   s += "</ol>\n";
   s += fmt::format("<p>{}</p>\n", esc(e.conclusion.empty() ? "done" : e.conclusion));
-  s += fmt::format("<p>Final model <strong>{}</strong>, RMSE {:.3g} {}: {}</p>\n", esc(e.final_fit.label()),
+  s += fmt::format("<p>Final model <strong>{}</strong>, RMSE {:.3g} {}: {}</p>\n", esc(e.final_fit.title()),
                    e.final_fit.rmse, esc(e.unit), esc(params_inline(e.final_fit)));
-  s += fmt::format("<details><summary>the whole story</summary>\n<pre>{}</pre>\n</details>\n", esc(format_explain(e)));
+  ReportOptions lab;
+  lab.lab_units = true;  // the page gives the lab's units beside SI throughout
+  s += fmt::format("<details><summary>the whole story</summary>\n<pre>{}</pre>\n</details>\n",
+                   esc(format_explain(e, {}, lab)));
   return s;
 }
 
@@ -482,11 +495,12 @@ std::string run_article(const SessionReport& report, const ReportRun& r) {
                               anchor("run-", fmt::format("{}-{}", r.bench, r.order)), esc(r.bench), r.order,
                               run.number, esc(file));
   s += fmt::format("<p class=\"meta\">cut at {:.3f} s{} · {} · {} samples fitted · lead-in {} · period {:.1f} ms · "
-                   "zero level {:.3g} {} · J = {:.6g} kg·m² ({}) · K_b = {:.6g} V·s/rad ({})</p>\n",
+                   "zero level {:.3g} {} · reading noise σ {:.2g} {} · J = {:.6g} kg·m² ({}) · K_b = {:.6g} V·s/rad ({})</p>\n",
                    run.t_cut_s, r.cut_unix_s ? fmt::format(" ({} UTC)", utc_text(*r.cut_unix_s)) : "",
                    run.stopped ? fmt::format("stopped {:.2f} s after the cut", run.t_stop_s - run.t_cut_s)
                                : "did not stop",
                    r.tau.size(), esc(run.lead_in), 1e3 * run.period_s, run.zero_level, quantity_unit(r.fit.quantity),
+                   r.fit.reading_noise, quantity_unit(r.fit.quantity),
                    r.fit.bench.inertia_kg_m2, esc(r.fit.bench.inertia_source), r.fit.bench.kb_v_s_per_rad,
                    esc(r.fit.bench.kb_source));
   s += verdict_block(r);

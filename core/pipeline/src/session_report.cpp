@@ -92,7 +92,7 @@ CoefficientTrend coefficient_trend(std::string name, std::string unit, std::stri
   t.value = std::move(value);
   t.std_error = std::move(std_error);
   const std::size_t n = std::min({t.x.size(), t.value.size(), t.std_error.size()});
-  const std::string what = t.name == "c_v" ? "viscous friction" : t.name == "c_c" ? "dry friction" : t.name;
+  const std::string what = t.name == "c3" ? "viscous friction" : t.name == "c4" ? "dry friction" : t.name;
   // Weights 1/σ²; a zero or missing σ gets the median σ so one point cannot take all the weight.
   std::vector<double> sig;
   for (std::size_t i = 0; i < n; ++i)
@@ -258,8 +258,8 @@ void summarize_session(SessionReport& report) {
       for (std::size_t i : b.runs)
         if (combined_friction(report.runs[i].fit)) x.push_back(static_cast<double>(report.runs[i].order));
     }
-    b.viscous = coefficient_trend("c_v", "N*m*s/rad", x_unit, x, cv, cv_se);
-    b.coulomb = coefficient_trend("c_c", "N*m", x_unit, x, cc, cc_se);
+    b.viscous = coefficient_trend("c3", "N*m*s/rad", x_unit, x, cv, cv_se);
+    b.coulomb = coefficient_trend("c4", "N*m", x_unit, x, cc, cc_se);
   }
 }
 

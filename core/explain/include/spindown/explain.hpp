@@ -4,6 +4,17 @@
 // the library, name the one that explains the disagreement, add it, and repeat until nothing
 // significant remains. A run that needs nothing more comes back with nothing added.
 //
+// The samples, the objective and the names are spindown fit's: the run's window less its outliers,
+// each sample weighted by 1/σ²(u) from the run's own noise (reading_noise.hpp), so the base model is
+// fit's model of the same name (viscous: c1 and ω0 as fit gives them). One difference, said in both
+// outputs: fit subtracts the run's zero level, explain keeps the reading's own zero, since a reading
+// that does not return to 0 is an effect to name (sensor_offset); when the run shows a standstill
+// the offset is bounded by the zero level seen there (between 0 and it, give or take its own
+// uncertainty), and with the offset the model is fit's again. With a zero level of 0 (the lab's
+// runs) the two are the same model. Two candidates the run cannot tell apart are said to be, never
+// chosen between silently; one that is physically impossible (a sensor offset that would read below
+// zero at standstill, on a sensor that never reads below zero) is rejected with the reason.
+//
 // Judging "significant" robustly (ripple, quantization and aliasing make residuals
 // correlated): residuals are binned (~0.5 s); the noise of a bin mean is estimated from the
 // data itself (bin-to-bin differences of the residual, never below the white-noise value
@@ -30,6 +41,7 @@ struct ExplainOptions {
   double bin_s = 0.5;           // residual bin width for locating the disagreement
   double systematic_z = 4;      // a bin mean this many noise SEs from 0 is systematic
   int max_steps = 4;            // effects added at most
+  bool weighted = true;         // as FitOptions::weighted: 1/σ²(u) weights, spindown fit's objective
   bool is_valid(std::string* why) const;
 };
 
@@ -51,16 +63,24 @@ struct CandidateTrial {
   double systematic_after = 0;  // share of the systematic disagreement left (binned chi-square excess)
   double change = 0;            // largest change it makes to the model (bin means, reading unit)
   std::string verdict;        // "added", or why it was rejected
+  std::string impossible;     // why its fitted numbers cannot be physical ("" when they can)
 };
 
 struct ExplainStep {
   std::string added;
+  std::string meaning;              // what the added effect is, worded from its fitted numbers
+  std::string signature;            // what a model without it leaves in the residuals, the same way
   double rmse_before = 0, rmse_after = 0;
+  double bin_noise = 0;             // noise SE of a bin mean in the residual before the step
   std::vector<Disagreement> where;  // before the step
   std::vector<CandidateTrial> trials;
   std::string why;
   // Effects added earlier that the new one made unnecessary (backward check after each step).
   std::vector<std::string> removed;
+  // Candidates that fit this run as well as the one added (within 3 in BIC, as many parameters):
+  // the run cannot tell them apart; `undecided` says why and what would decide.
+  std::vector<std::string> indistinguishable;
+  std::string undecided;
   EffectFit fit;  // the model after the step
 };
 
@@ -69,10 +89,16 @@ struct ExplainResult {
   BenchParams bench;
   Quantity quantity = Quantity::back_emf_volts;
   std::string unit;                 // the reading's unit
-  std::vector<double> tau, y;       // samples used: seconds after the cut, raw readings
-  double noise_level = 0;           // white noise of a reading (second differences)
-  double bin_noise = 0;             // noise SE of a bin mean in the base residual
+  // Samples used, as spindown fit uses them: seconds after the cut, raw readings, fit's weights
+  // (all 1 when unweighted).
+  std::vector<double> tau, y, weight;
+  double zero_level = 0;            // the run's zero level (Run::zero_level), which spindown fit subtracts
+  bool standstill_seen = false;     // the window holds a standstill (the zero level was measured there)
+  double offset_lo = 0, offset_hi = 0;  // where a sensor offset may lie (±inf: no standstill, free)
+  double reading_noise = 0;         // the reading noise σ (reading_noise_sigma over the coast)
+  double bin_noise = 0;             // noise SE of a bin mean in the base residual (≥ σ/√bin_samples)
   std::size_t bin_samples = 0;
+  double top_speed = 0;             // the final model's speed at the window's first sample (rad/s)
   EffectFit base;
   std::vector<ExplainStep> steps;
   EffectFit final_fit;
@@ -84,6 +110,8 @@ struct ExplainResult {
 
   double rmse_base() const { return base.rmse; }
   double rmse_final() const { return final_fit.rmse; }
+  // A bin mean's noise if the readings' errors were independent: σ/√bin_samples.
+  double bin_noise_white() const;
 };
 
 ExplainResult explain_run(const Recording& rec, const Run& run, const ExplainOptions& opt);
@@ -100,7 +128,17 @@ struct ResidualBins {
   double bin_se = 0;                 // noise SE of a bin mean
 };
 ResidualBins bin_residuals(std::span<const double> residual, std::size_t m, double white_sigma);
-// White noise of the readings from second differences over [0, n) (robust to smooth signal).
+// White noise of the readings from second differences over [0, n) (robust to smooth signal): the
+// reading noise σ (reading_noise_sigma), under the name the workflow's tests know.
 double white_noise(std::span<const double> y);
+
+// What an effect in a fitted model is, in words from its fitted numbers. Stribeck friction with a
+// broad speed scale (ω_s at least a third of top_speed, the fastest the window saw) is not the
+// film breaking down near standstill but friction that falls with speed across the whole coast.
+std::string effect_meaning(const Effect& effect, const EffectFit& fit, double top_speed);
+// What a model without the effect leaves in the residuals, worded the same way.
+std::string effect_signature(const Effect& effect, const EffectFit& fit, double top_speed);
+// The effect's term with the fit's parameter names ("T = c4", "T = (c_s − c4)·exp(−(ω/ω_s)²)").
+std::string effect_term(const Effect& effect, const EffectFit& fit);
 
 }  // namespace spindown

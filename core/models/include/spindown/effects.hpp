@@ -7,6 +7,7 @@
 //
 // Internally the torque terms are divided by J (only c/J is identifiable from speed data):
 // a torque coefficient c is fitted as a = c/J and reported in SI as a·J.
+#include <limits>
 #include <span>
 #include <string>
 #include <string_view>
@@ -19,10 +20,15 @@ struct RunScale {
   double omega0 = 300;      // rad/s at the cut (estimate)
   double duration_s = 30;   // coast duration (to the stop, or recorded)
   double reading_max = 3;   // largest reading, in the reading's unit
+  // Where a sensor offset may lie (reading unit): between 0 and the zero level seen at standstill
+  // (with that level's own uncertainty) when the run shows one; anywhere within ±reading_max/2 when
+  // it does not.
+  double offset_lo = -std::numeric_limits<double>::infinity();
+  double offset_hi = std::numeric_limits<double>::infinity();
 };
 
 struct EffectParam {
-  std::string_view name;     // as reported: "c_v", "c_c", …
+  std::string_view name;     // internal: "c_v", "c_c", …; reported under the lab's names (effect_fit.hpp)
   std::string_view unit;     // SI unit of the reported value; "reading" = the recording's unit
   std::string_view meaning;
   bool per_inertia = true;   // reported SI value = internal value · J (a torque coefficient)

@@ -83,7 +83,7 @@ struct ReportFile {
 // (weights 1/stderr²), its slope's standard error widened by the scatter beyond the stated
 // errors (Birge ratio), and the change the line makes over the runs' span.
 struct CoefficientTrend {
-  std::string name;               // "c_v" or "c_c"
+  std::string name;               // "c3" or "c4" (the combined model's, as spindown fit names them)
   std::string unit;               // ASCII SI unit
   std::vector<double> x, value, std_error;  // the points (x in x_unit)
   std::string x_unit;             // "day" when every run has a wall-clock time, else "run"
