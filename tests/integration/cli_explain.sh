@@ -42,6 +42,23 @@ PY
 grep -q "<svg" "$work/fig.svg" && grep -q "</svg>" "$work/fig.svg" || fail "no SVG written"
 grep -q "time after the cut (s)" "$work/fig.svg" || fail "SVG without axis labels"
 
+# An LCM log of two benches: every run names its bench in the text, the JSON and the figure's titles,
+# and each figure draws the base and every step with its RMSE.
+if [ -x "${SPINDOWN_BIN_DIR}/make_lcm_log" ]; then
+  "${SPINDOWN_BIN_DIR}/make_lcm_log" "$work/two.lcm" 6000 2 > /dev/null
+  timeout 60 "$bin" explain "$work/two.lcm" --svg "$work/two.svg" > "$work/two.txt" 2> /dev/null
+  grep -q "^run 1 of bench bench000: " "$work/two.txt" && grep -q "^run 1 of bench bench001: " "$work/two.txt" ||
+    fail "the log's runs do not name their bench: $(grep '^run' "$work/two.txt")"
+  timeout 60 "$bin" explain "$work/two.lcm" --json 2> /dev/null | python3 -c '
+import json, sys
+runs = json.load(sys.stdin)["files"][0]["runs"]
+assert {r["bench"] for r in runs} == {"bench000", "bench001"}, [r.get("bench") for r in runs]' || fail "JSON without the bench"
+  grep -q "two.lcm bench bench001 - run 1: base viscous" "$work/two.svg" || fail "SVG titles without the bench"
+  [ "$(grep -c 'class="model" data-step="1"' "$work/two.svg")" -ge 4 ] || fail "SVG without each run's step curve"
+else
+  echo "cli_explain: make_lcm_log not built, the LCM-log part skipped"
+fi
+
 # Base given as a list; bad usage exits 2; a missing file exits 1 but the good one is explained.
 timeout 60 "$bin" explain "$data/offset-example.tsv" --base viscous,coulomb > "$work/offset.txt"
 grep -q "missing effect: sensor_offset" "$work/offset.txt" || fail "offset not named"
