@@ -160,7 +160,7 @@ TEST_F(HtmlReportTest, HealthVerdictAndExplainStory) {
 TEST(CoefficientTrend, FindsAStraightRiseAndItsUncertainty) {
   std::vector<double> x{0, 7, 14, 21, 28}, v, se;
   for (double d : x) v.push_back(1e-4 * (1 + 0.01 * d)), se.push_back(1e-6);  // +28 % over four weeks
-  const auto t = coefficient_trend("c_c", "N*m", "day", x, v, se);
+  const auto t = coefficient_trend("c4", "N*m", "day", x, v, se);
   EXPECT_TRUE(t.enough);
   EXPECT_TRUE(t.drifting) << t.words;
   EXPECT_NEAR(t.slope, 1e-6, 1e-9);
@@ -171,20 +171,20 @@ TEST(CoefficientTrend, FindsAStraightRiseAndItsUncertainty) {
 }
 
 TEST(CoefficientTrend, ScatterWithinErrorsIsSteadyAndFewRunsAreNotATrend) {
-  const auto steady = coefficient_trend("c_v", "N*m*s/rad", "run", {1, 2, 3, 4, 5},
+  const auto steady = coefficient_trend("c3", "N*m*s/rad", "run", {1, 2, 3, 4, 5},
                                         {1.00e-7, 1.02e-7, 0.99e-7, 1.01e-7, 1.00e-7}, {2e-9, 2e-9, 2e-9, 2e-9, 2e-9});
   EXPECT_TRUE(steady.enough);
   EXPECT_FALSE(steady.drifting) << steady.words;
   // Scatter far beyond the stated errors widens the slope's error (Birge ratio) rather than
   // calling a drift.
-  const auto wild = coefficient_trend("c_v", "N*m*s/rad", "run", {1, 2, 3, 4, 5}, {1.0e-7, 1.5e-7, 0.8e-7, 1.4e-7, 1.1e-7},
+  const auto wild = coefficient_trend("c3", "N*m*s/rad", "run", {1, 2, 3, 4, 5}, {1.0e-7, 1.5e-7, 0.8e-7, 1.4e-7, 1.1e-7},
                                       {1e-10, 1e-10, 1e-10, 1e-10, 1e-10});
   EXPECT_FALSE(wild.drifting) << wild.words;
   EXPECT_GT(wild.slope_stderr, 1e-9);
   EXPECT_NE(wild.words.find("not steady: the runs disagree far beyond their errors"), std::string::npos) << wild.words;
   EXPECT_EQ(steady.words.find("disagree"), std::string::npos) << steady.words;
   EXPECT_NE(steady.words.find("steady within its uncertainty"), std::string::npos) << steady.words;
-  const auto two = coefficient_trend("c_c", "N*m", "run", {1, 2}, {1e-4, 2e-4}, {1e-6, 1e-6});
+  const auto two = coefficient_trend("c4", "N*m", "run", {1, 2}, {1e-4, 2e-4}, {1e-6, 1e-6});
   EXPECT_FALSE(two.enough);
   EXPECT_FALSE(two.drifting);
 }
@@ -192,18 +192,18 @@ TEST(CoefficientTrend, ScatterWithinErrorsIsSteadyAndFewRunsAreNotATrend) {
 // Two runs 100 errors apart (a worn motor's file among a good one's): their mean is not known to
 // ±0.7 % as their own errors would say, and the words say they disagree.
 TEST(CoefficientTrend, RunsFarApartWidenTheMeanAndAreSaid) {
-  const auto two = coefficient_trend("c_c", "N*m", "run", {1, 2}, {1e-4, 2e-4}, {1e-6, 1e-6});
+  const auto two = coefficient_trend("c4", "N*m", "run", {1, 2}, {1e-4, 2e-4}, {1e-6, 1e-6});
   EXPECT_NEAR(two.scatter, 70.7, 0.1);             // |Δ| / (√2 σ)
   EXPECT_NEAR(two.mean_stderr, 5e-5, 1e-7);        // half the spread, not 0.7e-6
   EXPECT_NE(two.words.find("the runs disagree far beyond their errors (0.0001 to 0.0002 N*m"), std::string::npos)
       << two.words;
   // A step in four runs is not "steady within its uncertainty".
-  const auto step = coefficient_trend("c_c", "N*m", "run", {1, 2, 3, 4}, {1.14e-4, 1.14e-4, 2.5e-4, 2.5e-4},
+  const auto step = coefficient_trend("c4", "N*m", "run", {1, 2, 3, 4}, {1.14e-4, 1.14e-4, 2.5e-4, 2.5e-4},
                                       {3e-7, 3e-7, 3e-7, 3e-7});
   EXPECT_EQ(step.words.find("steady within"), std::string::npos) << step.words;
   EXPECT_NE(step.words.find("disagree"), std::string::npos) << step.words;
   // Runs that agree keep their own small error.
-  const auto agree = coefficient_trend("c_c", "N*m", "run", {1, 2}, {1.000e-4, 1.001e-4}, {1e-6, 1e-6});
+  const auto agree = coefficient_trend("c4", "N*m", "run", {1, 2}, {1.000e-4, 1.001e-4}, {1e-6, 1e-6});
   EXPECT_NEAR(agree.mean_stderr, 1e-6 / std::sqrt(2.0), 1e-9);
 }
 
