@@ -43,6 +43,7 @@ RunFit run_fit(int number, bool stopped) {
                            {param("c3", 1.8e-7, 3e-9, 4e-9), param("c4", 1.14e-4, 2e-7), param("omega0", 346.0, 0.12)},
                            0.004));
   f.best = "combined";
+  f.reading_noise = 0.0042;
   return f;
 }
 
@@ -115,6 +116,7 @@ TEST(RunTable, OneCsvRowPerRunWithTheHeadersColumns) {
   EXPECT_EQ(at(0, "health_reason"), "friction 3x the baseline");
   EXPECT_EQ(at(1, "health"), "");  // not assessed
   EXPECT_DOUBLE_EQ(std::stod(at(0, "J_rel_error")), 0.02);
+  EXPECT_DOUBLE_EQ(std::stod(at(0, "reading_noise")), 0.0042);  // one noise figure, fit's and explain's σ
 }
 
 TEST(RunTable, JsonRowsHaveTheCsvColumnsAndReadBack) {

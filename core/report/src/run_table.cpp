@@ -67,6 +67,7 @@ std::vector<Column> row(const FileFit& file, std::size_t i) {
   r.push_back({"rmse", best ? best->rmse : none});
   r.push_back({"residual_unit", std::string(quantity_unit(fit.quantity))});
   r.push_back({"reduced_chi2", best ? best->reduced_chi2 : none});
+  r.push_back({"reading_noise", fit.reading_noise > 0 ? fit.reading_noise : none});  // σ, residual_unit
   const bool judged = i < file.health.size() && file.health[i].has_value();
   r.push_back({"health", judged ? std::string(health_level_name(file.health[i]->level)) : std::string()});
   r.push_back({"health_reason", judged ? file.health[i]->reason : std::string()});

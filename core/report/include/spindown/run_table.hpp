@@ -12,7 +12,8 @@
 //   c1 (viscous model, N·m·s/rad), c2 (Coulomb model, N·m), c3, c4 (combined model), each with
 //   _stderr (statistical) and _total_stderr (with J's and K_b's own uncertainty)
 //   omega0, omega0_stderr      of the best model (rad/s)
-//   rmse, residual_unit, reduced_chi2 of the best model
+//   rmse, residual_unit, reduced_chi2 of the best model; reading_noise (σ of one reading, as fit
+//                              and explain give it)
 //   health, health_reason      the verdict against the bench's --bench-config reference
 //                              (ok | check | service | not_judged; empty: no bench file)
 //   J_kg_m2, J_rel_error, Kb_V_s_per_rad, Kb_rel_error
