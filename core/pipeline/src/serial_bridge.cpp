@@ -36,6 +36,9 @@ std::int8_t to_lcm_quantity(Quantity q) {
   return samples_t::QUANTITY_BACK_EMF_V;
 }
 
+// Samples before any banner are converted with the protocol's defaults.
+const SpindownBanner default_banner{};
+
 }  // namespace
 
 std::string_view wire_protocol_name(WireProtocol p) {
@@ -202,8 +205,8 @@ void SerialBridge::on_spindown_line(std::string_view text, std::int64_t now_us) 
       return;
     case SpindownLine::Kind::sample: break;
   }
-  const int bits = banner_seen_ ? banner_.adc_bits : 10;
-  if (l.adc > (1 << bits) - 1) {
+  const SpindownBanner& conversion = banner_seen_ ? banner_ : default_banner;
+  if (l.adc > conversion.max_count()) {
     bad_line(text, "ADC count above the converter's range", now_us);
     return;
   }
@@ -223,8 +226,7 @@ void SerialBridge::on_spindown_line(std::string_view text, std::int64_t now_us) 
   }
   have_device_seq_ = true;
   last_device_seq_ = l.seq;
-  const double vpc = banner_seen_ ? banner_.volts_per_count() : SpindownBanner{}.volts_per_count();
-  add_sample(r, now_us, l.adc * vpc, l.adc);
+  add_sample(r, now_us, conversion.volts(l.adc), l.adc);
 }
 
 void SerialBridge::add_sample(const DeviceClock::Reading& r, std::int64_t host_us, double value, std::int32_t raw) {

@@ -23,8 +23,14 @@ struct SpindownBanner {
   double adc_ref_v = 5.0;
   std::uint32_t period_us = 0;   // nominal loop period
   std::int32_t baud = 0;
+  // The largest count the converter gives (2^bits − 1).
+  std::int32_t max_count() const { return (std::int32_t{1} << adc_bits) - 1; }
   // Volts per ADC count, as the lab sketch converts (ref / (2^bits − 1)).
-  double volts_per_count() const { return adc_ref_v / double((1 << adc_bits) - 1); }
+  double volts_per_count() const { return adc_ref_v / double(max_count()); }
+  // A sample's count in volts: the one conversion of spindown-v1 counts, shared by the serial
+  // bridge and the file reader (spindown_text.hpp) so that both give the same numbers. Before
+  // any banner, a default-constructed banner gives the protocol's defaults.
+  double volts(std::int32_t adc) const { return adc * volts_per_count(); }
 };
 
 struct SpindownLine {
