@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "spindown/read_recording.hpp"
+#include "spindown/spindown_protocol.hpp"
 #include "spindown/synthetic_run.hpp"
 
 #include "lcm_log_events.hpp"
@@ -316,4 +317,121 @@ TEST(ReadRecordings, AnLcmLogThroughAPipeIsRefusedByName) {
   ASSERT_EQ(recs.size(), 1u);
   EXPECT_TRUE(recs[0].has_errors());
   EXPECT_TRUE(mentions(recs[0], "it is a pipe or device")) << all_diagnostics(recs[0]);
+}
+
+namespace {
+
+SpindownBanner coast_banner() {
+  SpindownBanner b;
+  b.firmware = "spindown-coast";
+  b.version = "1.0.0";
+  b.period_us = 5000;
+  b.baud = 115200;
+  return b;
+}
+
+// n samples from seq 0, every 5 ms from 1.6 s after boot, falling counts.
+std::string v1_samples(int n, int skip_from = -1, int skip = 0) {
+  std::string s;
+  for (int i = 0; i < n; ++i)
+    if (i < skip_from || i >= skip_from + skip)
+      s += format_spindown_sample(std::uint32_t(i), std::uint32_t(1'600'000 + 5000 * i), 900 - i / 3);
+  return s;
+}
+
+std::string file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+}  // namespace
+
+TEST(ReadRecording, ASpindownV1CaptureIsReadAsOne) {
+  // Saved by PuTTY from the port of a board running spindown_coast: 3 lines lost on the wire.
+  const std::string text = "=~=~=~=~=~=~=~=~=~=~=~= PuTTY log 2024.03.05 14:02:11 =~=~=~=~=~=~=~=~=~=~=~=\r\n" +
+                           format_spindown_banner(coast_banner()) + v1_samples(400, 200, 3);
+  TempFile f("coast.log", text);
+  std::vector<RecordingInfo> info;
+  const auto recs = read_recordings(f.path, {}, &info);
+  ASSERT_EQ(recs.size(), 1u);
+  ASSERT_EQ(info.size(), 1u);
+  EXPECT_EQ(info[0].format, FileFormat::spindown_v1);
+  EXPECT_EQ(info[0].samples_lost, 3);
+  const Recording& r = recs[0];
+  EXPECT_FALSE(r.has_errors()) << all_diagnostics(r);
+  EXPECT_EQ(r.source, f.path);
+  EXPECT_EQ(r.quantity, Quantity::back_emf_volts);
+  ASSERT_EQ(r.size(), 397u);
+  EXPECT_EQ(r.t_s[0], 1.6);
+  EXPECT_EQ(r.value[0], coast_banner().volts(900));
+  EXPECT_TRUE(mentions(r, "3 samples lost"));
+  EXPECT_TRUE(mentions(r, "banner: spindown-coast 1.0.0"));
+  // The same bytes named as Arduino text are not read as samples: the format was the reader's choice.
+  ReadOptions o;
+  o.format = FileFormat::arduino_text;
+  const auto as_lab = read_recordings(f.path, o);
+  ASSERT_EQ(as_lab.size(), 1u);
+  EXPECT_TRUE(as_lab[0].has_errors());
+}
+
+TEST(ReadRecording, DetectSpindownV1) {
+  const std::string banner = format_spindown_banner(coast_banner());
+  const std::string putty = "=~=~=~ PuTTY log 2024.03.05 14:02:11 =~=~=~\r\n";
+  EXPECT_EQ(detect_format(banner + v1_samples(60)), FileFormat::spindown_v1);
+  EXPECT_EQ(detect_format(putty + banner + v1_samples(60)), FileFormat::spindown_v1);
+  EXPECT_EQ(detect_format(v1_samples(60)), FileFormat::spindown_v1);  // capture began after the banner
+  EXPECT_EQ(detect_format(putty + "000,612*3A\r\n" + v1_samples(5)), FileFormat::spindown_v1);  // cut first line
+  EXPECT_EQ(detect_format(banner + "garbage\r\nmore garbage\r\n"), FileFormat::spindown_v1);  // the banner says it
+  // Half or more of the content lines must be valid samples; bad checksums do not count.
+  std::string noisy = v1_samples(10);
+  for (int i = 0; i < 11; ++i) noisy += "S,1,2,3*00\r\n";
+  EXPECT_NE(detect_format(noisy), FileFormat::spindown_v1);
+  // Lab text with '#' comments and a lone v1-looking line stays Arduino text.
+  EXPECT_EQ(detect_format("# motor 3\r\n8245\t2.81\r\n8265\t2.80\r\n8285\t2.79\r\n" + v1_samples(1)),
+            FileFormat::arduino_text);
+  ReadOptions o;
+  o.format = FileFormat::delimited_text;
+  EXPECT_EQ(detect_format(banner + v1_samples(5), o), FileFormat::delimited_text);  // a named format wins
+  o.format = FileFormat::spindown_v1;
+  EXPECT_EQ(detect_format("8245\t2.81\r\n", o), FileFormat::spindown_v1);
+  EXPECT_EQ(parse_file_format("spindown-v1"), FileFormat::spindown_v1);
+  EXPECT_EQ(parse_file_format("v1"), FileFormat::spindown_v1);
+  EXPECT_EQ(file_format_name(FileFormat::spindown_v1), "spindown-v1");
+  // The fuzz seeds of the protocol's parser that are captures (a stream, the banner, a sample).
+  const std::string corpus = std::string(SPINDOWN_SOURCE_DIR) + "/fuzz/corpus/fuzz_spindown_protocol/";
+  for (const char* name : {"stream", "banner", "sample"})
+    EXPECT_EQ(detect_format(file_bytes(corpus + name)), FileFormat::spindown_v1) << name;
+}
+
+// The lab's files, the fuzz corpora of the other readers and the hostile inputs' kinds are detected
+// as they were before spindown-v1 was: no lab or delimited file passes for a capture.
+TEST(ReadRecording, OtherReadersCorporaKeepTheirFormats) {
+  const std::string fuzz = std::string(SPINDOWN_SOURCE_DIR) + "/fuzz/corpus/";
+  const std::vector<std::pair<std::string, FileFormat>> want = {
+      {"fuzz_arduino_text/crash-putty-header-not-utf8", FileFormat::arduino_text},
+      {"fuzz_arduino_text/cut.tsv", FileFormat::arduino_text},
+      {"fuzz_arduino_text/hostile.tsv", FileFormat::arduino_text},
+      {"fuzz_arduino_text/millis_wrap.tsv", FileFormat::arduino_text},
+      {"fuzz_arduino_text/putty_head.tsv", FileFormat::arduino_text},
+      {"fuzz_arduino_text/reset.tsv", FileFormat::arduino_text},
+      {"fuzz_arduino_text/two_sessions.tsv", FileFormat::arduino_text},
+      {"fuzz_delimited_text/blanks_rpm", FileFormat::delimited_text},
+      {"fuzz_delimited_text/crash-field-not-utf8", FileFormat::arduino_text},
+      {"fuzz_delimited_text/csv_header", FileFormat::delimited_text},
+      {"fuzz_delimited_text/ragged", FileFormat::delimited_text},
+      {"fuzz_delimited_text/real_lines", FileFormat::arduino_text},
+      {"fuzz_delimited_text/semicolon_decimal_comma", FileFormat::delimited_text},
+      {"fuzz_delimited_text/tsv_ms", FileFormat::arduino_text},
+      {"fuzz_spindown_protocol/lab_line", FileFormat::arduino_text},
+      {"fuzz_spindown_protocol/bad_crc", FileFormat::delimited_text},
+      {"fuzz_spindown_protocol/note", FileFormat::delimited_text},
+      {"fuzz_lcm_log/damaged.lcmlog", FileFormat::lcm_log},
+  };
+  for (const auto& [name, format] : want)
+    EXPECT_EQ(detect_format(file_bytes(fuzz + name)), format) << name;
+  for (const auto& entry : std::filesystem::directory_iterator(data_dir)) {
+    if (entry.path().extension() == ".tsv") {
+      EXPECT_EQ(detect_format(file_bytes(entry.path().string())), FileFormat::arduino_text) << entry.path();
+    }
+  }
 }

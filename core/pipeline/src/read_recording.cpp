@@ -12,6 +12,7 @@
 
 #include "spindown/file_bytes.hpp"
 #include "spindown/lab_line.hpp"
+#include "spindown/spindown_protocol.hpp"
 #include "spindown/text_repairs.hpp"
 #include "spindown/text_support.hpp"
 
@@ -23,6 +24,7 @@ std::string_view file_format_name(FileFormat format) {
     case FileFormat::arduino_text: return "arduino";
     case FileFormat::delimited_text: return "delimited";
     case FileFormat::lcm_log: return "lcm";
+    case FileFormat::spindown_v1: return spindown_protocol_name;
   }
   return "?";
 }
@@ -32,6 +34,7 @@ std::optional<FileFormat> parse_file_format(std::string_view name) {
   if (name == "arduino" || name == "putty" || name == "lab") return FileFormat::arduino_text;
   if (name == "delimited" || name == "csv" || name == "tsv" || name == "text") return FileFormat::delimited_text;
   if (name == "lcm" || name == "lcm-log" || name == "log") return FileFormat::lcm_log;
+  if (name == spindown_protocol_name || name == "v1" || name == "spindown") return FileFormat::spindown_v1;
   return std::nullopt;
 }
 
@@ -47,6 +50,10 @@ bool ReadOptions::is_valid(std::string* why) const {
   }
   if (!lcm.is_valid(&w)) {
     if (why) *why = "LCM log: " + w;
+    return false;
+  }
+  if (!spindown.is_valid(&w)) {
+    if (why) *why = "spindown-v1 text: " + w;
     return false;
   }
   return true;
@@ -69,8 +76,10 @@ FileFormat detect_format(std::string_view head, const ReadOptions& options) {
   }
   if (options.format != FileFormat::automatic) return options.format;
   if (options.delimited.names_columns()) return FileFormat::delimited_text;
-  // Arduino text when at least half of the first 50 lines with content are lab samples.
-  std::size_t content = 0, samples = 0;
+  // A spindown-v1 capture when the firmware's banner is there or at least half of the first 50
+  // lines with content are its samples (checksums valid: no other text passes for one), else
+  // Arduino text when at least half are lab samples.
+  std::size_t content = 0, samples = 0, v1_samples = 0;
   text::LineCursor lines(head.substr(0, 64 * 1024));
   while (content < 50 && !lines.at_end()) {  // stop there: splitting the rest cost as much as parsing it
     LabLine printed;
@@ -82,11 +91,21 @@ FileFormat detect_format(std::string_view head, const ReadOptions& options) {
     }
     const std::string_view line = lines.next_line();
     if (line.starts_with("=~=~=~")) continue;
+    if (looks_like_spindown_line(line)) {
+      const SpindownLine v1 = parse_spindown_line(line);
+      if (v1.kind == SpindownLine::Kind::banner) return FileFormat::spindown_v1;
+      if (v1.kind == SpindownLine::Kind::sample) {
+        ++content;
+        ++v1_samples;
+        continue;
+      }
+    }
     const LabLine parsed = parse_lab_line(line);
     if (parsed.kind == LabLine::Kind::blank) continue;
     ++content;
     samples += parsed.kind == LabLine::Kind::sample;
   }
+  if (v1_samples > 0 && v1_samples * 2 >= content) return FileFormat::spindown_v1;
   if (content == 0 || samples * 2 >= content) return FileFormat::arduino_text;
   return FileFormat::delimited_text;
 }
@@ -206,10 +225,15 @@ std::vector<Recording> read_recordings(const std::string& path, const ReadOption
     bytes = repaired;
   }
   const FileFormat format = detect_format(bytes, options);
-  if (format == FileFormat::delimited_text)
+  if (format == FileFormat::delimited_text) {
     add(read_delimited_text(bytes, path, options.delimited), {FileFormat::delimited_text, {}, {}, 0});
-  else
+  } else if (format == FileFormat::spindown_v1) {
+    std::int64_t lost = 0;
+    Recording rec = read_spindown_text(bytes, path, options.spindown, &lost);
+    add(std::move(rec), {FileFormat::spindown_v1, {}, {}, lost});
+  } else {
     add(read_arduino_text(bytes, path, options.arduino), {FileFormat::arduino_text, {}, {}, 0});
+  }
   for (auto it = repairs.rbegin(); it != repairs.rend(); ++it)
     out.back().diagnostics.insert(out.back().diagnostics.begin(),
                                   Diagnostic{Diagnostic::Severity::note, path, 0, std::move(*it)});

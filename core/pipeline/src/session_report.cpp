@@ -286,7 +286,7 @@ SessionReport build_session_report(std::span<const std::string> paths, const Ses
     f.format = format;
     if (format == FileFormat::lcm_log)
       f.start_unix_s = lcm_log_start(path);
-    else if (format == FileFormat::arduino_text)
+    else if (format == FileFormat::arduino_text || format == FileFormat::spindown_v1)
       f.start_unix_s = putty_log_time(head);
     report.files.push_back(std::move(f));
   }

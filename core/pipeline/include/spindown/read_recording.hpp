@@ -1,6 +1,7 @@
 #pragma once
 // One entry point for every recorded file the suite reads: detects the format (LCM event log
-// by its magic word, else Arduino/PuTTY text when most lines are millis<TAB>volts samples,
+// by its magic word, else a spindown-v1 capture when its head has the firmware's banner or mostly
+// its checksummed samples, else Arduino/PuTTY text when most lines are millis<TAB>volts samples,
 // else delimited text) and returns one Recording per bench (text files: exactly one).
 #include <optional>
 #include <string>
@@ -14,11 +15,13 @@
 #include "spindown/file_bytes.hpp"
 #include "spindown/lcm_log_reader.hpp"
 #include "spindown/recording.hpp"
+#include "spindown/spindown_text.hpp"
 
 namespace spindown {
 
-enum class FileFormat { automatic, arduino_text, delimited_text, lcm_log };
-std::string_view file_format_name(FileFormat format);  // "auto", "arduino", "delimited", "lcm"
+enum class FileFormat { automatic, arduino_text, delimited_text, lcm_log, spindown_v1 };
+// "auto", "arduino", "delimited", "lcm", "spindown-v1"
+std::string_view file_format_name(FileFormat format);
 std::optional<FileFormat> parse_file_format(std::string_view name);
 
 struct ReadOptions {
@@ -26,6 +29,7 @@ struct ReadOptions {
   ArduinoTextOptions arduino;
   DelimitedTextOptions delimited;  // naming a column or unit makes a text file delimited
   LcmLogOptions lcm;
+  SpindownTextOptions spindown;
   bool is_valid(std::string* why) const;
 };
 
@@ -34,7 +38,7 @@ struct RecordingInfo {
   FileFormat format = FileFormat::automatic;
   std::string bench;               // LCM logs: the bench id; text: empty
   std::optional<config_t> config;  // LCM logs: the latest SPINDOWN.<bench>.CONFIG
-  std::int64_t samples_lost = 0;   // LCM logs: from sequence gaps
+  std::int64_t samples_lost = 0;   // LCM logs and spindown-v1 captures: from sequence gaps
 };
 
 // J and K_b of a recording's CONFIG (LCM logs) when it has a usable one; an unusable one is a
