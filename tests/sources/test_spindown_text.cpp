@@ -307,6 +307,7 @@ TEST(SpindownText, APuttyLogCutInItsFirstAndLastLine) {
   EXPECT_NE(last->message.find("the file ends mid-line"), std::string::npos) << last->message;
   EXPECT_EQ(r.t_s[0], 2.0);
   EXPECT_EQ(r.lines_read, 103u);
+  EXPECT_TRUE(mentions(r, "100 spindown-v1 samples from 103 lines, 1 PuTTY header, 2 cut short, 100 before any banner"));
 }
 
 TEST(SpindownText, SamplesBeforeAnyBannerUseTheDefaultsWithAWarning) {

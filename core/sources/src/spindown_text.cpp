@@ -88,7 +88,7 @@ Recording read_spindown_text(std::string_view text, std::string source, const Sp
     raw = text::RawSamples(text);
   };
 
-  std::size_t blank = 0, headers = 0, garbled = 0, banners = 0, notes = 0, before_banner = 0;
+  std::size_t blank = 0, headers = 0, garbled = 0, cut = 0, banners = 0, notes = 0, before_banner = 0;
   std::int64_t lost = 0, first_before_banner = 0, first_bad_line = 0;
   std::string first_bad_why;
   bool first_content = true;  // the next non-blank line is the first of a logging session
@@ -125,13 +125,13 @@ Recording read_spindown_text(std::string_view text, std::string source, const Sp
       bad = range;
     }
     if (parsed.kind == SpindownLine::Kind::garbled || !range.empty()) {
-      ++garbled;
       if (garbled_since_sample++ == 0) first_garbled_since = n;
       if (first_bad_line == 0) {
         first_bad_line = n;
         first_bad_why = bad;
       }
       const bool ends_file = cursor.at_end() && text.back() != '\n' && text.back() != '\r';
+      ++(first || ends_file ? cut : garbled);
       if (first)
         reporter.report(Severity::note, n,
                         fmt::format("first line {} is not a sample ({}), probably cut short when logging started "
@@ -245,6 +245,7 @@ Recording read_spindown_text(std::string_view text, std::string source, const Sp
                                          {banners, "banner"},
                                          {notes, "firmware note"},
                                          {blank, "blank"},
+                                         {cut, "cut short"},
                                          {garbled, "garbled"},
                                          {static_cast<std::size_t>(lost), "lost in sequence gaps"},
                                          {before_banner, "before any banner"}},
