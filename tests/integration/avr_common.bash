@@ -60,12 +60,39 @@ start_bridge() {
   BRIDGE_PID=$!; PIDS+=($BRIDGE_PID)
 }
 
-# capture NAME FILE: what PuTTY does: opens the port once (the board boots), sets 8N1 raw at the
-# sketch's rate, and logs every byte after its header line until the board goes away.
+# capture NAME FILE BAUD: what PuTTY does: opens the port once (the board boots), sets 8N1 raw at
+# the sketch's rate, and logs every byte after its header line until the board goes away.
+# The rate is set on the descriptor just opened, in the same process: the emulated board has no
+# bootloader delay and prints as soon as the bench sees the open (polled every 5 ms), so a
+# separate `stty` after the open could come late, and the first bytes, read at the pty's default
+# rate, were garbled by the bench as a UART at the wrong rate would (seen: 5 garbled chunks at
+# the start of the lab sketch's capture).
 capture() {
   local tty=$WORK/$1.tty out=$2 baud=$3
   printf '=~=~=~=~=~=~=~=~=~=~=~= PuTTY log 2024.03.05 14:02:11 =~=~=~=~=~=~=~=~=~=~=~=\r\n' >"$out"
-  { stty "$baud" raw -echo -hupcl 2>/dev/null; timeout 200 cat; } <"$tty" >>"$out" 2>/dev/null || true
+  timeout 200 python3 - "$tty" "$baud" >>"$out" 2>/dev/null <<'PY' || true
+import os, sys, termios
+fd = os.open(sys.argv[1], os.O_RDONLY | os.O_NOCTTY)
+speed = getattr(termios, "B" + sys.argv[2])
+iflag, oflag, cflag, lflag, _, _, cc = termios.tcgetattr(fd)
+# stty raw -echo -hupcl: bytes as sent (no CR/LF translation), 8N1, no hangup on close.
+iflag &= ~(termios.IGNBRK | termios.BRKINT | termios.IGNPAR | termios.PARMRK | termios.INPCK | termios.ISTRIP |
+           termios.INLCR | termios.IGNCR | termios.ICRNL | termios.IXON | termios.IXOFF | termios.IXANY)
+oflag &= ~termios.OPOST
+cflag = (cflag & ~(termios.CSIZE | termios.PARENB | termios.HUPCL)) | termios.CS8 | termios.CREAD
+lflag &= ~(termios.ECHO | termios.ICANON | termios.IEXTEN | termios.ISIG)
+cc[termios.VMIN], cc[termios.VTIME] = 1, 0
+termios.tcsetattr(fd, termios.TCSANOW, [iflag, oflag, cflag, lflag, speed, speed, cc])
+while True:
+    try:
+        chunk = os.read(fd, 65536)
+    except OSError:  # EIO: the board (the pty's master) went away
+        break
+    if not chunk:
+        break
+    while chunk:
+        chunk = chunk[os.write(1, chunk):]
+PY
 }
 
 # check_fits LIVE_JSON TRUTH_JSON [MIN_RUNS]: every run of the truth that coasted whole on one
