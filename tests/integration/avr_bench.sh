@@ -5,7 +5,8 @@
 # network namespace) -> spindown-fitter and spindown-logger. The FIT messages' c3, c4 and cut
 # match the bench's truth within their errors; the bridge published every sample line the board
 # sent; and `spindown fit` of a PuTTY-like capture of the same port (the same emulation again,
-# read with stty + cat) gives the same numbers as the live fitter.
+# read with stty + cat) gives the same numbers as the live fitter, for each sketch: the lab
+# sketch's millis<TAB>volts and spindown_coast's spindown-v1 lines (read by read_spindown_text).
 source "$(dirname "$0")/avr_common.bash"
 
 build_firmware "$WORK/fw"
@@ -74,4 +75,33 @@ PY
 same_fits "$WORK/avr-lab.live.json" "$WORK/capture.json" ||
   fail "spindown fit of the PuTTY capture differs from the live FIT messages"
 echo "capture: spindown fit of the PuTTY log of the same port = the live FIT messages ($(truth cap "t['samples']") lines)"
+
+# The same for spindown_coast at 115200 baud: a capture of its spindown-v1 lines (banner, then
+# S,seq,micros,adc*CRC) is read as a spindown-v1 file, every sample the board sent used with the
+# bridge's conversion and clock, and fitted to the live FIT messages' numbers.
+start_avr cap1 "$WORK/fw/spindown_coast.elf" --speed 0 --runs 1 --seed 7 "${AVR_PHYSICS[@]}"
+capture cap1 "$WORK/capture-v1.log" 115200
+wait_pid "$AVR_PID" 60 || fail "v1 capture: spindown-avr-bench failed: $(tail -5 "$WORK/cap1.avr.log")"
+"$BIN/spindown" fit "$WORK/capture-v1.log" --json >"$WORK/capture-v1.json" 2>"$WORK/capture-v1.err" ||
+  fail "spindown fit of the spindown-v1 capture: $(cat "$WORK/capture-v1.err")"
+head -3 "$WORK/capture-v1.log" | cat -A | sed 's/^/  v1 capture: /'
+python3 - "$WORK/capture-v1.log" "$WORK/capture-v1.json" "$(truth cap1 "t['samples']")" <<'PY' || fail "the spindown-v1 capture was not read whole as spindown-v1"
+import json, re, sys
+lines = open(sys.argv[1], "rb").read().split(b"\n")[1:-1]
+# The board's bytes: its banner, then spindown-v1 samples (the reader, not this script, checks the CRCs).
+assert lines[0].startswith(b"#spindown-v1 firmware=spindown-coast "), lines[0]
+bad = [l for l in lines[1:] if not re.fullmatch(rb"S,[0-9]+,[0-9]+,[0-9]+\*[0-9A-F]{2}\r", l)]
+assert len(lines) > 300 and not bad, (len(lines), bad[:3])
+f = json.load(open(sys.argv[2]))["files"][0]
+diags = f["diagnostics"]
+summary = [d["message"] for d in diags if d["line"] == 0]
+problems = [d for d in diags if d["severity"] != "note"]
+assert any("spindown-v1 samples from" in m for m in summary), ("not read as spindown-v1", summary)
+assert not problems, problems
+assert f["samples_read"] == int(sys.argv[3]), (f["samples_read"], "samples read, the board sent", sys.argv[3])
+print(f"  v1 capture: read as spindown-v1, {f['samples_read']} samples, no warnings: {summary[0]}")
+PY
+same_fits "$WORK/avr-v1.live.json" "$WORK/capture-v1.json" ||
+  fail "spindown fit of the spindown-v1 capture differs from the live FIT messages"
+echo "v1 capture: spindown fit of the PuTTY log of spindown_coast's port = the live FIT messages ($(truth cap1 "t['samples']") lines)"
 echo "PASS avr_bench"
