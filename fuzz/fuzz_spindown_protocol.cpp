@@ -1,6 +1,7 @@
 // The spindown-v1 firmware protocol: the input as one line through parse_spindown_line (what
 // parses must print back identically), then as a serial byte stream through the bridge's path:
-// LineSplitter, and each line to the spindown-v1 or the lab parser as the bridge chooses.
+// LineSplitter, and each line to the spindown-v1 or the lab parser as the bridge chooses, then
+// as a file (a PuTTY capture of the port) through read_spindown_text.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -11,6 +12,7 @@
 #include "spindown/lab_line.hpp"
 #include "spindown/line_splitter.hpp"
 #include "spindown/spindown_protocol.hpp"
+#include "spindown/spindown_text.hpp"
 
 namespace {
 
@@ -72,5 +74,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   FUZZ_CHECK(splitter.buffered() <= splitter.max_line_bytes());
   FUZZ_CHECK(handed_out == splitter.lines() + splitter.oversize_lines());
+
+  // The whole input as a capture saved from the port.
+  SpindownTextOptions options;
+  options.max_line_reports = 5;
+  std::int64_t lost = -1;
+  const Recording rec = read_spindown_text(text, "fuzz.log", options, &lost);
+  fuzz::check_recording(rec);
+  FUZZ_CHECK(lost >= 0);
+  FUZZ_CHECK(rec.lines_read == rec.size() + rec.lines_skipped);
   return 0;
 }

@@ -397,9 +397,9 @@ TEST(ReadRecording, DetectSpindownV1) {
   EXPECT_EQ(parse_file_format("spindown-v1"), FileFormat::spindown_v1);
   EXPECT_EQ(parse_file_format("v1"), FileFormat::spindown_v1);
   EXPECT_EQ(file_format_name(FileFormat::spindown_v1), "spindown-v1");
-  // The fuzz seeds of the protocol's parser that are captures (a stream, the banner, a sample).
+  // The fuzz seeds of the protocol that are captures (a stream, the banner, a sample, avr_bench.sh's port).
   const std::string corpus = std::string(SPINDOWN_SOURCE_DIR) + "/fuzz/corpus/fuzz_spindown_protocol/";
-  for (const char* name : {"stream", "banner", "sample"})
+  for (const char* name : {"stream", "banner", "sample", "putty_capture"})
     EXPECT_EQ(detect_format(file_bytes(corpus + name)), FileFormat::spindown_v1) << name;
 }
 
