@@ -51,6 +51,11 @@ AvrBoard::AvrBoard(const std::string& firmware_path, std::uint32_t f_cpu, AdcSou
       throw std::runtime_error(fmt::format("{}: not a readable AVR ELF file (want the .elf or .hex that "
                                            "deploy/firmware builds)", firmware_path));
     avr_load_firmware(avr_, &fw);
+    for (void* block : {static_cast<void*>(fw.flash), static_cast<void*>(fw.eeprom), static_cast<void*>(fw.fuse),
+                        static_cast<void*>(fw.lockbits)})
+      if (block) firmware_blocks_.push_back(block);
+    for (std::uint32_t i = 0; fw.symbol && i < fw.symbolcount; ++i) firmware_blocks_.push_back(fw.symbol[i]);
+    if (fw.symbol) firmware_blocks_.push_back(fw.symbol);
   }
   // An Uno: 16 MHz crystal, 5 V from USB on VCC, AVCC and AREF (analogRead's default
   // reference is AVCC).
@@ -76,6 +81,7 @@ AvrBoard::~AvrBoard() {
     avr_terminate(avr_);
     std::free(avr_);
   }
+  for (void* block : firmware_blocks_) std::free(block);
 }
 
 void AvrBoard::reset() {

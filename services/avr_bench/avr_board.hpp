@@ -7,6 +7,7 @@
 #include <deque>
 #include <functional>
 #include <string>
+#include <vector>
 
 struct avr_t;
 struct avr_irq_t;
@@ -59,6 +60,9 @@ class AvrBoard {
   bool rx_full_ = false;
   long conversions_ = 0;
   std::uint64_t fixed_for_ = 0;  // cycles_per_byte value already corrected
+  // What elf_read_firmware allocated (flash image, EEPROM, fuses, symbols): ours to free, after
+  // the core that may point into the symbols is gone.
+  std::vector<void*> firmware_blocks_;
 };
 
 }  // namespace spindown
