@@ -40,25 +40,15 @@ Recording read_arduino_text(std::string_view text, std::string source, const Ard
   Recording rec;
   rec.source = std::move(source);
   rec.quantity = Quantity::back_emf_volts;
-  std::string why;
-  if (!options.is_valid(&why)) {
-    rec.error(0, "invalid reader options: " + why);
-    return rec;
-  }
-  if (text.empty()) {
-    rec.error(0, "no samples: the file is empty");
-    return rec;
-  }
   // Binary data is refused as soon as the first 8 KiB are read, with only this error.
+  if (!text::readable_text(text, options, "Arduino text", rec, false)) return rec;
   text::BinaryCheck binary(text);
   bool binary_decided = false;
   auto refuse_binary = [&] {
     Recording junk;
     junk.source = std::move(rec.source);
     junk.quantity = rec.quantity;
-    junk.error(0, fmt::format("no samples: binary data, not Arduino text ({} of the first {} bytes are control "
-                              "characters or NUL)",
-                              binary.control_bytes(), binary.looked_at()));
+    junk.error(0, text::binary_data_error("Arduino text", binary.control_bytes(), binary.looked_at()));
     return junk;
   };
 

@@ -239,22 +239,7 @@ bool DelimitedTextOptions::is_valid(std::string* why) const {
 Recording read_delimited_text(std::string_view text, std::string source, const DelimitedTextOptions& options) {
   Recording rec;
   rec.source = std::move(source);
-  std::string why;
-  if (!options.is_valid(&why)) {
-    rec.error(0, "invalid reader options: " + why);
-    return rec;
-  }
-  if (text.empty()) {
-    rec.error(0, "no samples: the file is empty");
-    return rec;
-  }
-  std::size_t control = 0, looked = 0;
-  if (text::looks_binary(text, &control, &looked)) {
-    rec.error(0, fmt::format("no samples: binary data, not delimited text ({} of the first {} bytes are control "
-                             "characters or NUL)",
-                             control, looked));
-    return rec;
-  }
+  if (!text::readable_text(text, options, "delimited text", rec)) return rec;
 
   // Content lines (not blank, not a comment, not a PuTTY header), as views into text.
   struct Line {
@@ -324,6 +309,7 @@ Recording read_delimited_text(std::string_view text, std::string source, const D
 
   // Columns.
   int tcol = -1, vcol = -1;
+  std::string why;
   if (!options.time_column.empty()) {
     tcol = resolve_named(options.time_column, cols, have_header, &why);
     if (tcol < 0) return give_up("time column: " + why);

@@ -42,22 +42,7 @@ Recording read_spindown_text(std::string_view text, std::string source, const Sp
   Recording rec;
   rec.source = std::move(source);
   rec.quantity = Quantity::back_emf_volts;
-  std::string why;
-  if (!options.is_valid(&why)) {
-    rec.error(0, "invalid reader options: " + why);
-    return rec;
-  }
-  if (text.empty()) {
-    rec.error(0, "no samples: the file is empty");
-    return rec;
-  }
-  std::size_t control = 0, looked_at = 0;
-  if (text::looks_binary(text, &control, &looked_at)) {
-    rec.error(0, fmt::format("no samples: binary data, not spindown-v1 text ({} of the first {} bytes are control "
-                             "characters or NUL)",
-                             control, looked_at));
-    return rec;
-  }
+  if (!text::readable_text(text, options, "spindown-v1 text", rec)) return rec;
 
   text::LineReporter reporter(rec, options.max_line_reports);
   // micros() as the bridge reads it: one tick a µs, wrapping at 2^32.

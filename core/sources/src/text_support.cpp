@@ -376,4 +376,9 @@ std::string summary_with_counts(std::string head, std::initializer_list<Count> c
   return head;
 }
 
+std::string binary_data_error(std::string_view what, std::size_t control_bytes, std::size_t looked_at) {
+  return fmt::format("no samples: binary data, not {} ({} of the first {} bytes are control characters or NUL)", what,
+                     control_bytes, looked_at);
+}
+
 }  // namespace spindown::text

@@ -109,6 +109,9 @@ class BinaryCheck {
   std::size_t control_bytes_ = 0;
 };
 
+// "no samples: binary data, not WHAT (N of the first M bytes are control characters or NUL)".
+std::string binary_data_error(std::string_view what, std::size_t control_bytes, std::size_t looked_at);
+
 // A line for a message: quoted, control bytes and bytes that are not UTF-8 escaped (\xNN),
 // cut to 40 characters (never inside one). Messages stay valid UTF-8, which JSON needs.
 std::string quote_line(std::string_view line);
@@ -226,6 +229,29 @@ struct Count {
   std::string_view what;
 };
 std::string summary_with_counts(std::string head, std::initializer_list<Count> counts, const TimelineCounts& timeline);
+
+// The checks every text reader makes before it reads a line: its options, an empty file and (unless
+// the reader decides that itself on its fast path, binary_check false) bytes that are not text.
+// False when rec now holds the error; `what` names what the reader expected ("delimited text").
+template <class Options>
+bool readable_text(std::string_view text, const Options& options, std::string_view what, Recording& rec,
+                   bool binary_check = true) {
+  std::string why;
+  if (!options.is_valid(&why)) {
+    rec.error(0, "invalid reader options: " + why);
+    return false;
+  }
+  if (text.empty()) {
+    rec.error(0, "no samples: the file is empty");
+    return false;
+  }
+  std::size_t control = 0, looked_at = 0;
+  if (binary_check && looks_binary(text, &control, &looked_at)) {
+    rec.error(0, binary_data_error(what, control, looked_at));
+    return false;
+  }
+  return true;
+}
 
 // A reader's *_file variant: the file's bytes, or a Recording holding why they could not be read.
 template <class Options, class Reader>
