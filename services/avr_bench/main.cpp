@@ -111,10 +111,7 @@ int main(int argc, char** argv) {
   std::sort(reset_at_s.begin(), reset_at_s.end());
 
   spindown::StopSignals stop({.ignore_sigpipe = true});
-  auto pty = std::make_unique<spindown::PseudoTerminal>();
-  pty->link_as(link);
-  fmt::print("{}\n", pty->slave_path());
-  std::fflush(stdout);
+  auto pty = spindown::plug_in_pty(link);
 
   const auto unlink = [&]() {
     std::error_code ec;
@@ -202,10 +199,7 @@ int main(int argc, char** argv) {
       board->run_until(board->cycle() + std::uint64_t(unplug_for_s * f_cpu));
       board->take_output();
       pending.clear();
-      pty = std::make_unique<spindown::PseudoTerminal>();
-      pty->link_as(link);
-      fmt::print("{}\n", pty->slave_path());
-      std::fflush(stdout);
+      pty = spindown::plug_in_pty(link);
       const auto waited_from = Clock::now();
       if (!wait_reader()) {
         fmt::print(stderr, "spindown-avr-bench: nobody reopened {} within {} s\n", pty->slave_path(), wait_reader_s);

@@ -55,10 +55,7 @@ int main(int argc, char** argv) {
   }
 
   spindown::StopSignals stop({.ignore_sigpipe = true});
-  auto pty = std::make_unique<spindown::PseudoTerminal>();
-  pty->link_as(link);
-  fmt::print("{}\n", pty->slave_path());
-  std::fflush(stdout);
+  auto pty = spindown::plug_in_pty(link);
 
   const auto wait_reader = [&]() {
     if (wait_reader_s <= 0) return true;
@@ -96,10 +93,7 @@ int main(int argc, char** argv) {
       if (!link.empty()) std::filesystem::remove(link);
       const auto back = Clock::now() + std::chrono::milliseconds(long(e.unplug_for_s * 1000 / (speed > 0 ? speed : 1e9)));
       stop.sleep_until(back);
-      pty = std::make_unique<spindown::PseudoTerminal>();
-      pty->link_as(link);
-      fmt::print("{}\n", pty->slave_path());
-      std::fflush(stdout);
+      pty = spindown::plug_in_pty(link);
       const auto waited_from = Clock::now();
       if (!wait_reader()) {
         fmt::print(stderr, "spindown-virtual-bench: nobody reopened {} within {} s\n", pty->slave_path(), wait_reader_s);

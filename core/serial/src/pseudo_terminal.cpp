@@ -1,6 +1,7 @@
 #include "spindown/pseudo_terminal.hpp"
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <fcntl.h>
 #include <filesystem>
@@ -148,6 +149,14 @@ void PseudoTerminal::link_as(const std::string& link) const {
   std::error_code ec;
   std::filesystem::remove(link, ec);
   std::filesystem::create_symlink(slave_path_, link);
+}
+
+std::unique_ptr<PseudoTerminal> plug_in_pty(const std::string& link) {
+  auto pty = std::make_unique<PseudoTerminal>();
+  pty->link_as(link);
+  std::fputs((pty->slave_path() + '\n').c_str(), stdout);
+  std::fflush(stdout);
+  return pty;
 }
 
 }  // namespace spindown

@@ -3,6 +3,7 @@
 // opens the slave path as if it were /dev/ttyACM0. The slave starts raw so bytes pass unchanged.
 // Used by the virtual bench and by tests in place of hardware.
 #include <chrono>
+#include <memory>
 #include <string>
 #include <string_view>
 
@@ -40,5 +41,10 @@ class PseudoTerminal {
   int master_ = -1;
   std::string slave_path_;
 };
+
+// A new pty for a simulated board that was just plugged in: linked as link (when not empty), its
+// slave path printed on a line of stdout and flushed, which is how the benches tell their
+// scripts where to connect. Throws as PseudoTerminal() does.
+std::unique_ptr<PseudoTerminal> plug_in_pty(const std::string& link);
 
 }  // namespace spindown
