@@ -10,6 +10,7 @@
 #include <unistd.h>
 #include <vector>
 
+#include "diagnostic_queries.hpp"
 #include "spindown/read_recording.hpp"
 #include "spindown/spindown_protocol.hpp"
 #include "spindown/synthetic_run.hpp"
@@ -17,6 +18,8 @@
 #include "lcm_log_events.hpp"
 
 using namespace spindown;
+
+using namespace spindown::testing;
 
 namespace {
 
@@ -48,16 +51,6 @@ samples_t batch(const std::string& bench, std::int64_t seq, int n, std::int8_t q
   return m;
 }
 
-bool mentions(const Recording& r, const std::string& text) {
-  return std::any_of(r.diagnostics.begin(), r.diagnostics.end(),
-                     [&](const Diagnostic& d) { return d.message.find(text) != std::string::npos; });
-}
-
-std::string all_diagnostics(const Recording& r) {
-  std::string out;
-  for (const auto& d : r.diagnostics) out += d.to_string() + "\n";
-  return out;
-}
 
 }  // namespace
 

@@ -15,39 +15,19 @@
 
 #include <fmt/format.h>
 
+#include "diagnostic_queries.hpp"
 #include "spindown/arduino_text.hpp"
 #include "spindown/synthetic_run.hpp"
 
 using namespace spindown;
 using Severity = Diagnostic::Severity;
 
+using namespace spindown::testing;
+
 namespace {
 
 const std::string data_dir = SPINDOWN_SAMPLE_DATA;
 
-std::vector<const Diagnostic*> with(const Recording& r, Severity s) {
-  std::vector<const Diagnostic*> out;
-  for (const auto& d : r.diagnostics)
-    if (d.severity == s) out.push_back(&d);
-  return out;
-}
-
-const Diagnostic* at_line(const Recording& r, std::int64_t line) {
-  for (const auto& d : r.diagnostics)
-    if (d.line == line) return &d;
-  return nullptr;
-}
-
-bool mentions(const Recording& r, const std::string& text) {
-  return std::any_of(r.diagnostics.begin(), r.diagnostics.end(),
-                     [&](const Diagnostic& d) { return d.message.find(text) != std::string::npos; });
-}
-
-std::string all_diagnostics(const Recording& r) {
-  std::string out;
-  for (const auto& d : r.diagnostics) out += d.to_string() + "\n";
-  return out;
-}
 
 bool strictly_increasing(const std::vector<double>& t) {
   return std::adjacent_find(t.begin(), t.end(), [](double a, double b) { return b <= a; }) == t.end();

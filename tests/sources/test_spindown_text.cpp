@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "diagnostic_queries.hpp"
 #include "spindown/spindown_protocol.hpp"
 #include "spindown/spindown_text.hpp"
 #include "spindown/synthetic_run.hpp"
@@ -15,31 +16,10 @@
 using namespace spindown;
 using Severity = Diagnostic::Severity;
 
+using namespace spindown::testing;
+
 namespace {
 
-std::vector<const Diagnostic*> with(const Recording& r, Severity s) {
-  std::vector<const Diagnostic*> out;
-  for (const auto& d : r.diagnostics)
-    if (d.severity == s) out.push_back(&d);
-  return out;
-}
-
-const Diagnostic* at_line(const Recording& r, std::int64_t line) {
-  for (const auto& d : r.diagnostics)
-    if (d.line == line) return &d;
-  return nullptr;
-}
-
-bool mentions(const Recording& r, const std::string& text) {
-  return std::any_of(r.diagnostics.begin(), r.diagnostics.end(),
-                     [&](const Diagnostic& d) { return d.message.find(text) != std::string::npos; });
-}
-
-std::string all_diagnostics(const Recording& r) {
-  std::string out;
-  for (const auto& d : r.diagnostics) out += d.to_string() + "\n";
-  return out;
-}
 
 bool strictly_increasing(const std::vector<double>& t, std::size_t from = 0, std::size_t to = SIZE_MAX) {
   to = std::min(to, t.size());

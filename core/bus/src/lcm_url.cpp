@@ -1,4 +1,5 @@
 #include "spindown/lcm_url.hpp"
+#include "spindown/trim.hpp"
 
 #include <charconv>
 #include <cstdlib>
@@ -13,12 +14,6 @@ bool to_long(std::string_view s, long& out) {
   return ec == std::errc() && p == s.data() + s.size();
 }
 
-std::string_view trim(std::string_view s) {
-  const auto b = s.find_first_not_of(" \t\r");
-  if (b == std::string_view::npos) return {};
-  const auto e = s.find_last_not_of(" \t\r");
-  return s.substr(b, e - b + 1);
-}
 }  // namespace
 
 std::optional<LcmUrl> parse_lcm_url(std::string_view url, std::string* why) {

@@ -9,17 +9,11 @@
 #include "spindown/lcm_channels.hpp"
 #include "spindown/text_repairs.hpp"
 #include "spindown/text_support.hpp"
+#include "spindown/trim.hpp"
 
 namespace spindown {
 
 namespace {
-
-std::string trim(std::string_view s) {
-  const auto b = s.find_first_not_of(" \t");
-  if (b == std::string_view::npos) return {};
-  const auto e = s.find_last_not_of(" \t");
-  return std::string(s.substr(b, e - b + 1));
-}
 
 // One row's fields; a field in double quotes may hold the delimiter ("Smith, Anna") and "" for a quote.
 std::vector<std::string> split_row(std::string_view line, char delim) {
@@ -41,13 +35,13 @@ std::vector<std::string> split_row(std::string_view line, char delim) {
       field.clear();
       quoted = true;
     } else if (c == delim) {
-      out.push_back(trim(field));
+      out.emplace_back(trim(field));
       field.clear();
     } else {
       field += c;
     }
   }
-  out.push_back(trim(field));
+  out.emplace_back(trim(field));
   return out;
 }
 
@@ -83,7 +77,7 @@ ClassRoster load_class_roster(const std::string& path) {
   std::optional<std::size_t> col_file, col_bench, col_student;
   std::size_t columns = 0;
   text::for_each_line(*bytes, [&](std::int64_t number, std::string_view raw) {
-    const std::string line = trim(raw);
+    const std::string line(trim(raw));
     if (line.empty() || line.front() == '#') return;
     const auto at = [&](std::string_view what) {
       return std::runtime_error(fmt::format("{}:{}: {}", path, number, what));

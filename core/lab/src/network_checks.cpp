@@ -1,4 +1,5 @@
 #include "spindown/network_checks.hpp"
+#include "spindown/trim.hpp"
 
 #include <algorithm>
 #include <arpa/inet.h>
@@ -15,13 +16,6 @@
 namespace spindown {
 
 namespace {
-
-std::string_view trim(std::string_view s) {
-  const auto b = s.find_first_not_of(" \t\r\n");
-  if (b == std::string_view::npos) return {};
-  const auto e = s.find_last_not_of(" \t\r\n");
-  return s.substr(b, e - b + 1);
-}
 
 std::vector<std::string_view> split_lines(std::string_view text) {
   std::vector<std::string_view> out;
