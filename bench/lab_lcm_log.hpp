@@ -66,7 +66,7 @@ void write_event(lcm::LogFile& log, const std::string& channel, std::int64_t uti
 }
 
 inline spindown::config_t make_config(const std::string& bench, std::int64_t utime) {
-  spindown::config_t c;
+  spindown::config_t c{};
   c.utime = utime;
   c.bench = bench;
   c.inertia_kg_m2 = 1.12687602e-5;
@@ -109,7 +109,7 @@ inline LabLogStats write_lab_lcm_log(const std::string& path, long long samples,
   for (int b = 0; b < benches; ++b) due.push({streams[static_cast<std::size_t>(b)].host_us(), b});
 
   std::vector<unsigned char> buf;
-  spindown::samples_t msg;
+  spindown::samples_t msg{};
   msg.quantity = spindown::samples_t::QUANTITY_BACK_EMF_V;
   msg.clock_epoch = 0;
   LabLogStats st;

@@ -38,7 +38,7 @@ class CheckingSink : public FitterSink {
     const fit_t msg = to_fit_message(r.fit, about, now_us);
     std::vector<std::uint8_t> bytes(static_cast<std::size_t>(msg.getEncodedSize()));
     FUZZ_CHECK(msg.encode(bytes.data(), 0, static_cast<int>(bytes.size())) == static_cast<int>(bytes.size()));
-    fit_t back;
+    fit_t back{};
     std::string why;
     FUZZ_CHECK(decode_message(back, bytes.data(), static_cast<std::int64_t>(bytes.size()), &why));
     FUZZ_CHECK(from_fit_message(back, &why).has_value());

@@ -1,6 +1,7 @@
 // Writes the binary part of the seed corpus: one or more encoded messages of each LCM type
 // (fuzz/corpus/fuzz_<type>/) and small LCM logs, sound and damaged (fuzz/corpus/fuzz_lcm_log/).
 // The text seeds are plain files kept by hand. Usage: fuzz_make_seeds CORPUS_DIR
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -17,6 +18,9 @@
 #include <spindown/samples_t.hpp>
 #include <spindown/status_t.hpp>
 
+#include "spindown/lab_key.hpp"
+#include "spindown/message_stamp.hpp"
+
 namespace fs = std::filesystem;
 using namespace spindown;
 
@@ -24,10 +28,43 @@ namespace {
 
 constexpr std::int64_t t0_us = 1'694'686'893'000'000;  // 2023-09-14 10:21:33
 
+// Every seed names its source, as the lab's programs send them (lab, host, session, count).
+MessageStamp& stamp() {
+  static MessageStamp s(SourceIdentity{"lab", "239.255.76.67:7667", "lab-pc-3", 0x3f9a0c1d5e7b2a48, t0_us});
+  return s;
+}
+
 template <class Msg>
-std::vector<std::uint8_t> encode(const Msg& m) {
+std::vector<std::uint8_t> encode(Msg m) {
+  stamp().stamp(m);
   std::vector<std::uint8_t> b(static_cast<std::size_t>(m.getEncodedSize()));
   m.encode(b.data(), 0, static_cast<int>(b.size()));
+  return b;
+}
+
+// The same message signed with a fixed test key on channel.
+template <class Msg>
+std::vector<std::uint8_t> signed_bytes(const std::string& channel, const Msg& m) {
+  std::array<unsigned char, lab_key_bytes> key{};
+  key.fill(0x42);
+  MessageStamp signer(SourceIdentity{"lab", "239.255.76.67:7667", "lab-pc-3", 0x3f9a0c1d5e7b2a48, t0_us}, lab_key_from_bytes(key));
+  const auto b = signer.encode(channel, m);
+  return {b.begin(), b.end()};
+}
+
+// The encoding spindown wrote before the source and signature fields (samples_t's older
+// fingerprint; a log recorded then holds these).
+std::vector<std::uint8_t> legacy_samples(samples_t m) {
+  m.lab.clear();
+  m.sent_to.clear();
+  m.source_host.clear();
+  m.source_session = m.source_seq = 0;
+  m.auth_key_id = 0;
+  std::vector<std::uint8_t> b(static_cast<std::size_t>(m.getEncodedSize()));
+  m.encode(b.data(), 0, static_cast<int>(b.size()));
+  b.resize(b.size() - (5 + 5 + 5 + 8 + 8 + 4 + 32));
+  const std::uint64_t old = 0x6366464c24ab26e1ull;
+  for (int k = 0; k < 8; ++k) b[static_cast<std::size_t>(k)] = static_cast<std::uint8_t>(old >> (56 - 8 * k));
   return b;
 }
 
@@ -40,7 +77,7 @@ void write(const fs::path& path, const std::vector<std::uint8_t>& bytes) {
 // A lab-like coast: 20 samples powered at 3 V, the cut, an exponential-linear decay to a stop
 // over about 2 s, then zeros; 20 ms cadence, 2-decimal volts.
 samples_t coast_samples(std::int64_t seq, int first, int count) {
-  samples_t s;
+  samples_t s{};
   s.utime = t0_us + seq * 20'000;
   s.bench = "bench-a";
   s.seq = seq;
@@ -60,7 +97,7 @@ samples_t coast_samples(std::int64_t seq, int first, int count) {
 }
 
 config_t bench_config() {
-  config_t c;
+  config_t c{};
   c.utime = t0_us;
   c.bench = "bench-a";
   c.inertia_kg_m2 = 1.2e-5;
@@ -82,7 +119,7 @@ config_t bench_config() {
 }
 
 run_t run_message(std::int8_t state) {
-  run_t r;
+  run_t r{};
   r.utime = t0_us + 3'000'000;
   r.bench = "bench-a";
   r.run = 1;
@@ -97,7 +134,7 @@ run_t run_message(std::int8_t state) {
 }
 
 fit_t fit_message() {
-  fit_t f;
+  fit_t f{};
   f.utime = t0_us + 4'000'000;
   f.bench = "bench-a";
   f.run = 1;
@@ -149,7 +186,7 @@ fit_t fit_message() {
 }
 
 explain_t explain_message() {
-  explain_t e;
+  explain_t e{};
   e.utime = t0_us + 4'100'000;
   e.bench = "bench-a";
   e.run = 1;
@@ -180,7 +217,7 @@ explain_t explain_message() {
 }
 
 status_t status_message() {
-  status_t s;
+  status_t s{};
   s.utime = t0_us + 1'000'000;
   s.service = "bridge";
   s.instance = "bench-a";
@@ -237,6 +274,9 @@ int main(int argc, char** argv) {
   write(dir / "fuzz_fit_t/combined", encode(fit_message()));
   write(dir / "fuzz_explain_t/windage", encode(explain_message()));
   write(dir / "fuzz_status_t/bridge", encode(status_message()));
+  write(dir / "fuzz_samples_t/signed", signed_bytes("SPINDOWN.fz.SAMPLE", coast_samples(150, 150, 3)));
+  write(dir / "fuzz_samples_t/legacy", legacy_samples(coast_samples(0, 0, 20)));
+  write(dir / "fuzz_fit_t/signed", signed_bytes("SPINDOWN.fz.FIT", fit_message()));
 
   // A small sound log: config, a coast in three messages, a heartbeat, a foreign channel.
   const fs::path logs = dir / "fuzz_lcm_log";

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include "exit_codes.hpp"
+#include "spindown/clock.hpp"
 #include "spindown/clock_checks.hpp"
 #include "spindown/doctor_check.hpp"
 #include "spindown/host_name.hpp"
@@ -26,7 +27,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const std::vector<std::string> all_checks = {"ttl", "route", "firewall", "buffer", "selftest", "serial", "clock"};
+const std::vector<std::string> all_checks = {"ttl", "route", "firewall", "buffer", "selftest", "serial", "clock", "lab"};
 
 bool wanted(const DoctorCommandOptions& o, const std::string& check) {
   return o.checks.empty() || std::find(o.checks.begin(), o.checks.end(), check) != o.checks.end();
@@ -69,7 +70,9 @@ void setup_doctor(CLI::App& app) {
       "(nft/iptables rules dropping UDP to the LCM port or multicast; read-only, needs root to read them), buffer "
       "(net.core.rmem_max vs LCM's recommended 2 MB), selftest (an LCM message published and received on the URL), "
       "serial (bench files; each bench's device exists and the service user may read and write it), clock (this PC's "
-      "NTP sync; the clock skew of every lab PC heard on LCM during --listen).\n"
+      "NTP sync; the clock skew of every lab PC heard on LCM during --listen), lab (who sends on the group and port during "
+      "--listen: another lab's traffic, senders that name no lab, unsigned messages with --key, a bench with two "
+      "sources, two services with one name).\n"
       "The LCM URL: --lcm-url, else LCM_DEFAULT_URL, else the one in /etc/spindown/lcm.env (the services'), else "
       "LCM's default.\n"
       "Exit codes: 0 every check ok (or skipped), 1 warnings, 2 failures or bad usage. --serial-numbers: 0 ports "
@@ -80,14 +83,16 @@ void setup_doctor(CLI::App& app) {
                   "Bench files or directories (default /etc/spindown/benches when it exists); repeat the flag for more")
       ->allow_extra_args(false);
   sub->add_option("--service-user", opt->service_user, "User the services run as")->capture_default_str();
-  sub->add_option("--checks", opt->checks, "Only these checks: ttl,route,firewall,buffer,selftest,serial,clock")
+  sub->add_option("--checks", opt->checks, "Only these checks: ttl,route,firewall,buffer,selftest,serial,clock,lab")
       ->delimiter(',')
       ->allow_extra_args(false)
       ->check(CLI::IsMember(all_checks));
   sub->add_option("--timeout", opt->timeout_s, "Seconds the LCM self-test waits for its message")
       ->capture_default_str()
       ->check(CLI::Range(0.1, 30.0));
-  sub->add_option("--listen", opt->listen_s, "Seconds to listen for other lab PCs' clocks (0: do not listen)")
+  add_lab_options(sub, opt->lab, "");
+  sub->add_option("--listen", opt->listen_s,
+                  "Seconds to listen for the lab's traffic: other PCs' clocks, other labs, sources (0: do not listen)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 60.0));
   sub->add_flag("--single-host", opt->single_host, "The whole lab runs on this PC: ttl=0 is intended");
@@ -107,9 +112,14 @@ int run_doctor(const DoctorCommandOptions& o) {
 
   // The URL: what this process would use, and what the services use.
   std::optional<std::string> services_url;
+  LabOptions lab_options = o.lab;  // the services' lab when neither --lab nor $SPINDOWN_LAB names one
   if (const auto text = read_file(o.env_file)) {
     const auto env = parse_env_file(*text);
     if (const auto it = env.find("LCM_DEFAULT_URL"); it != env.end() && !it->second.empty()) services_url = it->second;
+    const char* lab_env = std::getenv("SPINDOWN_LAB");
+    if (const auto it = env.find("SPINDOWN_LAB");
+        it != env.end() && !it->second.empty() && lab_options.lab.empty() && !(lab_env && *lab_env))
+      lab_options.lab = it->second;
   }
   const char* env = std::getenv("LCM_DEFAULT_URL");
   const auto resolved = resolve_lcm_url(o.lcm_url, env && *env ? std::optional<std::string>(env) : std::nullopt,
@@ -182,15 +192,31 @@ int run_doctor(const DoctorCommandOptions& o) {
     }
   }
 
+  // One listen for the clocks and the lab's traffic.
+  const LabSettings lab = lab_settings_from(lab_options);
+  std::optional<LabListen> heard;
+  if ((wanted(o, "clock") || wanted(o, "lab")) && o.listen_s > 0 && url && lcm_works) {
+    if (!o.json)
+      std::fprintf(stderr, "spindown doctor: listening %.3g s to the lab on %s\n", o.listen_s, resolved.url.c_str());
+    heard = listen_to_lab(resolved.url, o.listen_s, lab.key ? &*lab.key : nullptr);
+  }
   if (wanted(o, "clock")) {
     checks.push_back(check_clock_sync(read_kernel_clock_state(), running_ntp_client()));
-    if (o.listen_s > 0 && url && lcm_works) {
-      if (!o.json) std::fprintf(stderr, "spindown doctor: listening %.3g s for the lab's clocks on %s\n", o.listen_s,
-                                resolved.url.c_str());
-      for (auto& c : check_clock_skew(listen_for_clocks(resolved.url, o.listen_s), host_name(), o.listen_s))
-        checks.push_back(std::move(c));
+    if (heard && heard->listened) {
+      for (auto& c : check_clock_skew(heard->clocks, host_name(), o.listen_s)) checks.push_back(std::move(c));
     } else if (o.listen_s > 0) {
       checks.push_back({"clock skew", CheckLevel::skip, "LCM does not work here: no other PC's clock to compare", ""});
+    }
+  }
+  if (wanted(o, "lab")) {
+    if (heard && heard->listened) {
+      for (auto& c : heard->traffic.checks(lab.lab, lab.key, resolved.url, o.listen_s, wall_us()))
+        checks.push_back(std::move(c));
+    } else {
+      checks.push_back({"lab traffic", CheckLevel::skip,
+                        o.listen_s > 0 ? "LCM does not work here: cannot listen to the lab"
+                                       : "not listened (--listen 0)",
+                        ""});
     }
   }
 

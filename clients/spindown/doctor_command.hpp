@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "lab_options.hpp"
+
 namespace CLI {
 class App;
 }
@@ -23,6 +25,7 @@ struct DoctorCommandOptions {
   std::string service_user = "spindown";
   std::vector<std::string> checks;         // subset of: ttl route firewall buffer selftest serial clock
   double timeout_s = 2.0;                  // LCM self-test
+  LabOptions lab;                          // this PC's lab and key (--lab, --key)
   double listen_s = 3.0;                   // listening for other hosts' clocks; 0 = no listening
   bool single_host = false;                // ttl=0 is intended (the whole lab on this PC)
   bool json = false;

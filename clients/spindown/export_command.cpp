@@ -109,8 +109,17 @@ bool is_lcm_log(const std::string& path) {
 
 // An LCM log: every SAMPLE message as recorded, and the log refitted as spindown-fitter fits live.
 LogRefit export_log(const ExportCommandOptions& o, const std::regex& wanted, std::FILE* f, std::size_t& rows) {
+  FitterOptions fopt;
+  fopt.bench_regex = o.bench_regex;
+  fopt.max_rate_hz = 0;
+  fopt.gate = gate_options_from(o.input.lab);
+  // The samples of this lab (and with --key, signed ones); the refit's core names the rest.
+  MessageGate gate(fopt.gate);
   auto each = [&](const LcmLogEvent& ev) {
     if (ev.kind != LcmLogEvent::Kind::samples || !std::regex_match(ev.bench.begin(), ev.bench.end(), wanted)) return;
+    if (!gate.accepts_at_once(ev.samples_view.lab, ev.samples_view.sent_to) &&
+        !gate.check(ev.channel, ev.data, ev.data_size, ev.log_utime).accepted())
+      return;
     const samples_t& m = ev.samples;
     const auto q = quantity_from_samples_code(m.quantity);
     const std::string unit = q ? std::string(quantity_unit(*q)) : fmt::format("code {}", int(m.quantity));
@@ -123,9 +132,6 @@ LogRefit export_log(const ExportCommandOptions& o, const std::regex& wanted, std
       ++rows;
     }
   };
-  FitterOptions fopt;
-  fopt.bench_regex = o.bench_regex;
-  fopt.max_rate_hz = 0;
   return refit_log(o.log, fopt, false, each);
 }
 

@@ -99,6 +99,8 @@ std::function<void()> add_input_options(CLI::App* sub, InputOptions& opt) {
                   "e.g. '(bench[0-9]+)_([a-z]+)'")
       ->group(klass);
 
+  add_lab_options(sub, opt.lab, "LCM logs");
+
   return [&opt, inertia, radius, kb, kv, j_error, kb_error]() {
     opt.inertia_error_given = j_error->count() > 0;
     opt.kb_error_given = kb_error->count() > 0;
@@ -177,6 +179,7 @@ ReadOptions read_options_from(const InputOptions& o) {
     if (!d.quantity) bad_usage(fmt::format("--value-unit '{}' is not one of: V, rpm, rad/s", o.value_unit));
   }
   if (!o.delimiter.empty()) d.delimiter = parse_delimiter(o.delimiter);
+  read.lcm.gate = gate_options_from(o.lab);
   std::string why;
   if (!read.is_valid(&why)) bad_usage(why);
   return read;

@@ -12,6 +12,8 @@
 #include "spindown/fit.hpp"
 #include "spindown/read_recording.hpp"
 
+#include "lab_options.hpp"
+
 namespace CLI {
 class App;
 }
@@ -33,6 +35,9 @@ struct InputOptions {
 
   // A class's text files: which bench (and student) each is from.
   std::string roster, bench_pattern;
+
+  // LCM logs: whose messages are read (--lab, --key).
+  LabOptions lab;
 };
 
 // Adds the bench ("Bench" group) and delimited-text options to sub, bound to opt. Call the

@@ -8,6 +8,7 @@
 #include "exit_codes.hpp"
 #include "explain_command.hpp"
 #include "fit_command.hpp"
+#include "keygen_command.hpp"
 #include "refit_command.hpp"
 #include "export_command.hpp"
 #include "watch_command.hpp"
@@ -27,6 +28,7 @@ int main(int argc, char** argv) {
   spindown::cli::setup_report(app);
   spindown::cli::setup_doctor(app);
   spindown::cli::setup_simulate(app);
+  spindown::cli::setup_keygen(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::RuntimeError& e) {  // a subcommand finished with a non-zero exit code

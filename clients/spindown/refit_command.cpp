@@ -114,6 +114,9 @@ FitterOptions fitter_options(const RefitCommandOptions& o) {
   f.admit_rate_hz = o.admit_rate_hz;
   f.silent_s = o.silent_s;
   f.max_rate_hz = 0;  // a log is read as fast as the disk allows; live caps were applied live
+  f.gate = gate_options_from(o.lab);
+  f.gate.replay_window_s = o.replay_window_s;
+  f.stream.takeover_s = o.takeover_s;
   if (o.inertia_given) {
     f.default_bench.inertia_kg_m2 = o.inertia_kg_m2;
     f.default_bench.inertia_source = "--inertia";
@@ -193,6 +196,10 @@ void setup_refit(CLI::App& app) {
   sub->add_option("--silent", opt->silent_s,
                   "Seconds without samples (log time) that close a bench's open run, as spindown-fitter --silent")
       ->check(CLI::PositiveNumber);
+  add_lab_options(sub, opt->lab, "");
+  sub->add_option("--replay-window", opt->replay_window_s, "With --key: as spindown-fitter --replay-window")
+      ->check(CLI::PositiveNumber);
+  sub->add_option("--takeover", opt->takeover_s, "As spindown-fitter --takeover")->check(CLI::NonNegativeNumber);
   sub->add_flag("--ignore-config", opt->ignore_config, "Use --inertia/--kb (or the lab's) even where CONFIG says otherwise")
       ->group("Bench");
   sub->callback([opt, j, kb, kv]() {

@@ -21,6 +21,8 @@
 #include "spindown/lcm_log_reader.hpp"
 #include "spindown/log_refit.hpp"
 
+#include "lab_options.hpp"
+
 namespace CLI {
 class App;
 }
@@ -43,6 +45,9 @@ struct RefitCommandOptions {
   std::size_t max_benches = FitterOptions{}.max_benches;  // as spindown-fitter --max-benches
   double admit_rate_hz = FitterOptions{}.admit_rate_hz;   // as spindown-fitter --admit-rate
   double silent_s = FitterOptions{}.silent_s;             // as spindown-fitter --silent
+  LabOptions lab;                                         // as spindown-fitter --lab, --key
+  double replay_window_s = FitterOptions{}.gate.replay_window_s;  // as spindown-fitter --replay-window
+  double takeover_s = FitterOptions{}.stream.takeover_s;          // as spindown-fitter --takeover
 };
 
 void setup_refit(CLI::App& app);

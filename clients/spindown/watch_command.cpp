@@ -17,6 +17,7 @@
 #include "spindown/lab_table.hpp"
 #include "spindown/lcm_channels.hpp"
 #include "spindown/lcm_loop.hpp"
+#include "spindown/lcm_url.hpp"
 #include "spindown/stop_signal.hpp"
 
 namespace spindown::cli {
@@ -39,8 +40,11 @@ std::size_t terminal_width() {
 // The table hears SPINDOWN.<bench>.<KIND> as Msg: table_call(bench id, message, receive time).
 // A channel whose name is not the suite's is ignored, and so is (before decoding) a bench the
 // --bench regex does not want, unless every bench is kept (the services' heartbeats).
+// Before the table sees a message, the gate: another lab's (and with --key an unsigned, wrongly
+// signed or replayed one) is counted and named as not shown, never shown as data.
 template <class Msg, class TableCall>
-bool listen(LcmLoop& loop, ChannelKind kind, const std::regex& wanted, bool every_bench, TableCall table_call) {
+bool listen(LcmLoop& loop, ChannelKind kind, const std::regex& wanted, bool every_bench, MessageGate& gate,
+            LabTable& table, TableCall table_call) {
   LcmSubscribeOptions options;
   options.queue_capacity = 10000;  // LCM's default of 30 drops silently in a burst (design §7)
   options.accept = [kind, &wanted, every_bench](std::string_view channel) {
@@ -49,33 +53,38 @@ bool listen(LcmLoop& loop, ChannelKind kind, const std::regex& wanted, bool ever
   };
   return loop.subscribe<Msg>(
       fmt::format("SPINDOWN\\..*\\.{}", channel_suffix(kind)),
-      [table_call](const Msg& m, const LcmMessage& r) {
-        table_call(parse_channel(r.channel)->bench, m, r.recv_utime > 0 ? r.recv_utime : wall_us());
+      [table_call, &gate, &table](const Msg& m, const LcmMessage& r) {
+        const std::int64_t now = r.recv_utime > 0 ? r.recv_utime : wall_us();
+        if (const GateResult g = gate.check(r.channel, r.data, r.size, now); g.refused()) {
+          table.on_refused(g, now);
+          return;
+        }
+        table_call(parse_channel(r.channel)->bench, m, now);
       },
       std::move(options));
 }
 
 // The suite's channels into the table (EXPLAIN is not shown); what does not decode, or makes
 // the table throw, is one of the table's bad messages.
-bool listen_to_lab(LcmLoop& loop, LabTable& table, const std::regex& wanted) {
+bool listen_to_lab(LcmLoop& loop, LabTable& table, const std::regex& wanted, MessageGate& gate) {
   loop.on_decode_error([&table](const LcmDecodeError& e) { table.on_bad_message(e.text(), e.recv_utime); });
   loop.on_handler_error([&table](const LcmMessage& m, const std::exception& e) {
     table.on_bad_message(fmt::format("{}: {}", m.channel, e.what()), m.recv_utime);
   });
-  return listen<samples_t>(loop, ChannelKind::sample, wanted, false,
+  return listen<samples_t>(loop, ChannelKind::sample, wanted, false, gate, table,
                            [&table](const std::string& id, const samples_t& m, std::int64_t now) {
                              table.on_samples(id, m, now);
                            }) &&
-         listen<config_t>(loop, ChannelKind::config, wanted, false,
+         listen<config_t>(loop, ChannelKind::config, wanted, false, gate, table,
                           [&table](const std::string& id, const config_t& m, std::int64_t now) {
                             table.on_config(id, m, now);
                           }) &&
-         listen<run_t>(loop, ChannelKind::run, wanted, false,
+         listen<run_t>(loop, ChannelKind::run, wanted, false, gate, table,
                        [&table](const std::string& id, const run_t& m, std::int64_t now) { table.on_run(id, m, now); }) &&
-         listen<fit_t>(loop, ChannelKind::fit, wanted, false,
+         listen<fit_t>(loop, ChannelKind::fit, wanted, false, gate, table,
                        [&table](const std::string& id, const fit_t& m, std::int64_t now) { table.on_fit(id, m, now); }) &&
          // A bridge's heartbeat belongs to its bench (filtered); services are always shown.
-         listen<status_t>(loop, ChannelKind::status, wanted, true,
+         listen<status_t>(loop, ChannelKind::status, wanted, true, gate, table,
                           [&table, &wanted](const std::string& id, const status_t& m, std::int64_t now) {
                             if (m.service != "bridge" || std::regex_match(id, wanted)) table.on_status(id, m, now);
                           });
@@ -108,6 +117,7 @@ void setup_watch(CLI::App& app) {
       ->check(CLI::Range(0.05, 3600.0));
   sub->add_flag("--lab-units", opt->lab_units, "Coefficients in the lab's units (g·cm²·s⁻¹, g·cm²·rad·s⁻²)");
   sub->add_flag("--no-events", opt->no_events, "With --plain: tables only, no event lines")->excludes(once);
+  add_lab_options(sub, opt->lab, "");
   sub->callback([opt]() {
     try {
       std::regex check(opt->bench_regex);
@@ -128,9 +138,13 @@ int run_watch(const WatchCommandOptions& o) {
   }
   LabTableOptions topt;
   topt.lab_units = o.lab_units;
+  MessageGateOptions gate_options = gate_options_from(o.lab);
+  gate_options.sent_to = lcm_destination(o.lcm_url);
+  MessageGate gate(gate_options);
+  topt.signatures_checked = gate.signing();
   LabTable table(topt);
   const std::regex wanted(o.bench_regex);
-  if (!listen_to_lab(loop, table, wanted)) {
+  if (!listen_to_lab(loop, table, wanted, gate)) {
     std::fprintf(stderr, "spindown watch: cannot subscribe to SPINDOWN\\..*\n");
     return exit_unusable;
   }
@@ -152,8 +166,10 @@ int run_watch(const WatchCommandOptions& o) {
   };
 
   if (!redraw && !o.once)
-    print(fmt::format("spindown watch: listening{}{} (benches matching '{}')\n", o.lcm_url.empty() ? "" : " on ",
-                      o.lcm_url, o.bench_regex));
+    print(fmt::format("spindown watch: listening{}{} (benches matching '{}'; lab '{}', {})\n",
+                      o.lcm_url.empty() ? "" : " on ", o.lcm_url, o.bench_regex, gate.options().lab,
+                      gate.signing() ? fmt::format("signatures checked with key {}", key_id_text(gate.options().key->id))
+                                     : std::string("signatures not checked")));
   // After every wait: the table's events, as lines or under the redrawn table.
   loop.every(0, [&](std::int64_t t) {
     for (auto& e : table.take_events()) {

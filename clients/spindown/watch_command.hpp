@@ -7,6 +7,8 @@
 // table now and then. Ends on SIGINT/SIGTERM or after --duration; --once prints one table.
 #include <string>
 
+#include "lab_options.hpp"
+
 namespace CLI {
 class App;
 }
@@ -22,6 +24,7 @@ struct WatchCommandOptions {
   double interval_s = 0;           // redraw period; 0 = 1 s on a terminal, 10 s with --plain
   bool lab_units = false;          // coefficients in the lab's g·cm² units
   bool no_events = false;          // --plain: only tables, no event lines
+  LabOptions lab;                  // only this lab's messages; with a key only signed ones
 };
 
 void setup_watch(CLI::App& app);

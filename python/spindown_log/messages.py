@@ -39,6 +39,31 @@ def split_channel(channel):
     return bench, kind
 
 
+# Logs written before issue 31 appended the source and signature fields to every type hold each
+# type under an older fingerprint. Such a message is the current encoding without the appended
+# fields: it is read as the current type with those fields empty (lab "", session 0, not signed),
+# as spindown's own reader does.
+_EMPTY_STRING = b"\x00\x00\x00\x01\x00"
+_SOURCE_FIELDS = _EMPTY_STRING * 3 + bytes(8 + 8 + 4 + 32)  # lab, sent_to, source_host, session, seq, key id, auth
+_BRIDGE_FIELDS = _EMPTY_STRING + bytes(8)                   # run_t, fit_t: bridge_host, bridge_session
+_LEGACY = {
+    samples_t: (0x6366464c24ab26e1, _SOURCE_FIELDS),
+    config_t: (0xf33bcecf4e9c80bd, _SOURCE_FIELDS),
+    run_t: (0x52fa3d633257d3ef, _BRIDGE_FIELDS + _SOURCE_FIELDS),
+    fit_t: (0x9a6ae2b7c7c8e61c, _BRIDGE_FIELDS + _SOURCE_FIELDS),
+    explain_t: (0x8e7064d4b8398716, _SOURCE_FIELDS),
+    status_t: (0x056ac82d6252dc21, bytes(8) + _SOURCE_FIELDS),  # start_utime
+}
+
+
+def _current_encoding(cls, data):
+    """data itself, or a legacy encoding of cls rewritten as the current one."""
+    legacy = _LEGACY.get(cls)
+    if legacy is None or len(data) < 8 or struct.unpack(">Q", data[:8])[0] != legacy[0]:
+        return data
+    return cls._get_packed_fingerprint() + bytes(data[8:]) + legacy[1]
+
+
 class DecodeError(ValueError):
     """A message whose bytes are not its channel's type (wrong fingerprint, truncated, damaged)."""
 
@@ -51,7 +76,7 @@ def decode(channel, data):
         return None
     cls = TYPES[parts[1]]
     try:
-        msg = cls.decode(data)
+        msg = cls.decode(_current_encoding(cls, data))
     except (ValueError, struct.error, UnicodeDecodeError) as e:
         raise DecodeError("%s is not a %s: %s" % (channel, cls.__name__, e or "decode error")) from None
     if cls is samples_t and not (len(msg.device_time_us) == len(msg.host_time_us) == len(msg.value)

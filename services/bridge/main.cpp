@@ -11,33 +11,43 @@
 
 #include "spindown/bridge_settings.hpp"
 #include "spindown/clock.hpp"
+#include "spindown/lab_settings.hpp"
 #include "spindown/lcm_channels.hpp"
+#include "spindown/message_stamp.hpp"
 #include "spindown/serial_bridge.hpp"
 #include "spindown/serial_port.hpp"
 #include "spindown/service_notifier.hpp"
+#include "spindown/session_id.hpp"
 #include "spindown/stop_signal.hpp"
 
 namespace {
 
 using spindown::wall_us;
 
+// Every message carries this bridge's source (lab, host, session) and, with the lab key, its
+// signature: the stamp encodes it.
 class LcmSink : public spindown::BridgeSink {
  public:
-  LcmSink(lcm::LCM& lcm, const std::string& bench)
+  LcmSink(lcm::LCM& lcm, const std::string& bench, spindown::MessageStamp& stamp)
       : lcm_(lcm),
+        stamp_(stamp),
         sample_(spindown::channel_name(bench, spindown::ChannelKind::sample)),
         config_(spindown::channel_name(bench, spindown::ChannelKind::config)),
         status_(spindown::channel_name(bench, spindown::ChannelKind::status)) {}
-  void publish(const spindown::samples_t& m) override { check(lcm_.publish(sample_, &m), sample_); }
-  void publish(const spindown::config_t& m) override { check(lcm_.publish(config_, &m), config_); }
-  void publish(const spindown::status_t& m) override { check(lcm_.publish(status_, &m), status_); }
+  void publish(const spindown::samples_t& m) override { send(sample_, m); }
+  void publish(const spindown::config_t& m) override { send(config_, m); }
+  void publish(const spindown::status_t& m) override { send(status_, m); }
 
  private:
-  void check(int rc, const std::string& channel) {
+  template <class Msg>
+  void send(const std::string& channel, const Msg& m) {
+    const std::vector<unsigned char> bytes = stamp_.encode(channel, m);
+    const int rc = bytes.empty() ? -1 : lcm_.publish(channel, bytes.data(), static_cast<unsigned>(bytes.size()));
     if (rc != 0 && ++failures_ % 100 == 1)
       fmt::print(stderr, "spindown-bridge: publishing on {} failed ({} times so far)\n", channel, failures_);
   }
   lcm::LCM& lcm_;
+  spindown::MessageStamp& stamp_;
   std::string sample_, config_, status_;
   long failures_ = 0;
 };
@@ -45,6 +55,8 @@ class LcmSink : public spindown::BridgeSink {
 struct BridgeOptions {
   spindown::BridgeSettings settings;
   std::string lcm_url;
+  std::string lab_option, key_option;
+  spindown::LabSettings lab;
   bool exit_on_missing = false;
   double retry_s = 0.25;
 };
@@ -58,6 +70,8 @@ std::optional<int> parse_options(int argc, char** argv, BridgeOptions& o) {
   app.add_option("--bench", s.bench, "bench id [A-Za-z0-9_-]{1,32}");
   auto* baud_opt = app.add_option("--baud", s.baud, "baud rate (lab sketch 9600, spindown firmware 115200)");
   app.add_option("--lcm-url", o.lcm_url, "LCM URL (default: LCM_DEFAULT_URL or LCM's default)");
+  app.add_option("--lab", o.lab_option, spindown::lab_option_help);
+  app.add_option("--key", o.key_option, spindown::key_option_help);
   app.add_option("--config", config_file, "TOML file: bench J, K_b, quantity, ADC, serial (see README)")
       ->check(CLI::ExistingFile);
   bool retry_flag = false;
@@ -90,6 +104,12 @@ std::optional<int> parse_options(int argc, char** argv, BridgeOptions& o) {
     fmt::print(stderr, "spindown-bridge: {}\n", why);
     return 2;
   }
+  auto lab = spindown::resolve_lab_settings(o.lab_option, o.key_option, &why);
+  if (!lab) {
+    fmt::print(stderr, "spindown-bridge: {}\n", why);
+    return 2;
+  }
+  o.lab = std::move(*lab);
   return std::nullopt;
 }
 
@@ -172,10 +192,13 @@ int main(int argc, char** argv) {
   }
   spindown::StopSignals stop({.ignore_sigpipe = true});
 
-  LcmSink sink(lcm, s.bench);
+  spindown::MessageStamp stamp(spindown::this_process_identity(o.lab.lab, o.lcm_url), o.lab.key);
+  if (o.lab.key && !o.lab.key->warning.empty()) fmt::print(stderr, "spindown-bridge: warning: {}\n", o.lab.key->warning);
+  LcmSink sink(lcm, s.bench, stamp);
   spindown::SerialBridge bridge(s, sink);
   bridge.start(wall_us());
-  fmt::print(stderr, "spindown-bridge: bench {} device {} at {} baud\n", s.bench, s.device, s.baud);
+  fmt::print(stderr, "spindown-bridge: bench {} device {} at {} baud; {}; session {}\n", s.bench, s.device, s.baud,
+             spindown::lab_settings_text(o.lab), spindown::session_text(stamp.identity().session));
   spindown::ServiceNotifier notify;
   const int rc = pump(o, bridge, stop, notify);
   notify.stopping();

@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <deque>
+#include <utility>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <unistd.h>
@@ -29,8 +30,11 @@ std::string subscription_regex(const std::string& bench_regex) {
 
 FitterService::FitterService(FitterServiceOptions options)
     : opt_(std::move(options)),
+      stamp_(this_process_identity(opt_.lab.lab, opt_.lcm_url), opt_.lab.key),
       loop_(opt_.lcm_url),
       core_(opt_.core, *this),
+      status_channel_(channel_name(opt_.instance, ChannelKind::status)),
+      instances_("fitter", opt_.instance),
       host_(host_name()),
       queue_({.max_messages = opt_.max_queue_messages,
               .max_bytes = opt_.max_queue_bytes,
@@ -57,6 +61,8 @@ void FitterService::fit_ready(const FitResult& r) {
   const std::int64_t now = wall_us();
   about.latency_s = 1e-6 * double(now - r.detected_utime);
   about.health = r.health;
+  about.bridge_host = r.bridge_host;
+  about.bridge_session = r.bridge_session;
   const fit_t msg = to_fit_message(r.fit, about, now);
   if (loop_.publish(channel_name(r.bench, ChannelKind::fit), msg) != 0) ++publish_failures_;
   last_latency_s_ = about.latency_s;
@@ -101,6 +107,26 @@ void FitterService::diagnostic(const std::string& bench, const Diagnostic& d) {
     fmt::print(stderr, "spindown-fitter: {}: {}\n", bench, d.to_string());
 }
 
+// Said on stderr at once, at most once a minute per kind and channel (another lab's traffic or a
+// forger would otherwise flood the journal); the counts are in the heartbeat.
+void FitterService::notice(std::string_view kind, std::string_view channel, const std::string& text) {
+  constexpr std::int64_t every_us = 60'000'000;
+  const std::int64_t now = wall_us();
+  std::string key = fmt::format("{} {}", kind, channel);
+  auto it = said_.find(key);
+  if (it == said_.end()) {
+    if (said_.size() >= 1000) said_.clear();  // bounded: a flood of channel names starts afresh
+    it = said_.emplace(std::move(key), Said{}).first;
+  } else if (now - it->second.at_us < every_us) {
+    ++it->second.quiet;
+    return;
+  }
+  const std::int64_t quiet = std::exchange(it->second.quiet, 0);
+  it->second.at_us = now;
+  fmt::print(stderr, "spindown-fitter: {}{}\n", text,
+             quiet > 0 ? fmt::format(" ({} more of these in the last minute not shown)", quiet) : std::string());
+}
+
 void FitterService::publish_status(std::int64_t now_us, const char* state) {
   status_t s = core_.make_status(now_us, opt_.instance, host_, static_cast<std::int32_t>(::getpid()), state,
                                  1e-6 * double(now_us - start_us_));
@@ -143,6 +169,12 @@ void FitterService::publish_status(std::int64_t now_us, const char* state) {
                                q.oversize_drops, opt_.max_queue_bytes, q.last_oversize_bytes, q.last_oversize_channel);
   if (s.last_error.empty() && q.full_drops > 0)
     s.last_error = fmt::format("{} messages dropped: receive queue full", q.full_drops);
+  // Another fitter with this name alive now: said in every heartbeat while it lasts.
+  s.counter_name.emplace_back("instance_collisions");
+  s.counter_value.push_back(instances_.collisions());
+  s.ncounters = static_cast<std::int32_t>(s.counter_name.size());
+  if (instances_.alive(now_us).size() > 1 && !collision_.empty()) s.last_error = collision_;
+  s.start_utime = stamp_.identity().start_utime;
   if (loop_.publish(channel_name(opt_.instance, ChannelKind::status), s) != 0) ++publish_failures_;
 }
 
@@ -156,8 +188,12 @@ void FitterService::worker() {
     worker_alive_ns_.store(monotonic_ns(), std::memory_order_relaxed);
     // Closed (the service stops): this batch is the last.
     const bool open = queue_.take_all(batch, std::min(next_status, std::chrono::steady_clock::now() + poll_wait));
-    for (const QueuedMessage& m : batch)
-      core_.on_message(m.channel, m.data.data(), static_cast<std::int64_t>(m.data.size()), m.recv_utime);
+    for (const QueuedMessage& m : batch) {
+      if (m.channel == status_channel_)
+        own_channel_status(m);
+      else
+        core_.on_message(m.channel, m.data.data(), static_cast<std::int64_t>(m.data.size()), m.recv_utime);
+    }
     // Benches gone silent mid-coast, by the time of the traffic just handled (as refit does with
     // a log), so a backlog in the queue is never taken for silence; the clock when none came.
     const std::int64_t now = batch.empty() ? wall_us() : batch.back().recv_utime;
@@ -175,15 +211,34 @@ void FitterService::worker() {
   }
 }
 
+void FitterService::own_channel_status(const QueuedMessage& m) {
+  const auto size = static_cast<std::int64_t>(m.data.size());
+  if (!core_.admit(m.channel, m.data.data(), size, m.recv_utime)) return;  // another lab's, unsigned, …
+  status_t s{};
+  if (!decode_message(s, m.data.data(), size)) return;
+  if (auto text = instances_.heard(s, m.recv_utime)) {
+    collision_ = *text;
+    fmt::print(stderr, "spindown-fitter: {}\n", collision_);
+  }
+}
+
 int FitterService::run(const StopSignals& stop) {
   start_us_ = wall_us();
+  loop_.set_stamp(&stamp_);
+  instances_.set_own({host_, static_cast<std::int32_t>(::getpid()), stamp_.identity().session,
+                      stamp_.identity().start_utime, 0, true});
   // The handler only copies into the service's queue, but LCM's own default of 30 queued
   // messages drops silently in a burst (design §7).
   const bool subscribed = loop_.subscribe_raw(
       subscription_regex(opt_.core.bench_regex),
       [this](const LcmMessage& m) { queue_.offer(m.recv_utime, m.channel, m.data, static_cast<std::size_t>(m.size)); },
       {.queue_capacity = 100000});
-  if (!subscribed) {
+  // Its own heartbeat channel too: another fitter started with the same --instance is heard there.
+  const bool own_channel = loop_.subscribe_raw(
+      status_channel_,
+      [this](const LcmMessage& m) { queue_.offer(m.recv_utime, m.channel, m.data, static_cast<std::size_t>(m.size)); },
+      {.queue_capacity = 1000});
+  if (!subscribed || !own_channel) {
     fmt::print(stderr, "spindown-fitter: cannot subscribe (bad --bench regex?)\n");
     return 2;
   }
@@ -212,6 +267,12 @@ int FitterService::run(const StopSignals& stop) {
              core_.bench_count(), c.samples, c.runs, c.fits, c.decode_errors, c.seq_gaps, c.duplicates, c.nan_values,
              c.time_backwards, c.dropped_benches, c.benches_refused, c.partial_runs, c.silent_benches, c.flood_drops,
              q.full_drops, q.oversize_drops, own_udp_drop_count());
+  fmt::print(stderr,
+             "spindown-fitter: sources: {} new sources, {} two sources at once ({} samples refused), {} far jumps "
+             "dropped ({} samples); not used: {} of another lab, {} unsigned, {} badly signed, {} replayed; {} "
+             "instance collisions\n",
+             c.new_sources, c.two_sources, c.other_source_samples, c.seq_jumps, c.seq_jump_samples, c.other_lab,
+             c.unsigned_messages, c.bad_signatures, c.replays, instances_.collisions());
   return 0;
 }
 

@@ -4,6 +4,8 @@
 // worker thread feeds the core in arrival order, publishes RUN and FIT, and the heartbeat on
 // SPINDOWN.<instance>.STATUS.
 #include <atomic>
+#include <map>
+#include <string_view>
 #include <cstdint>
 #include <string>
 #include <thread>
@@ -11,8 +13,11 @@
 
 #include "spindown/effects.hpp"
 #include "spindown/fitter_core.hpp"
+#include "spindown/lab_settings.hpp"
 #include "spindown/lcm_loop.hpp"
 #include "spindown/message_queue.hpp"
+#include "spindown/message_stamp.hpp"
+#include "spindown/service_instances.hpp"
 #include "spindown/service_notifier.hpp"
 #include "spindown/stop_signal.hpp"
 
@@ -29,6 +34,7 @@ struct FitterServiceOptions {
   // The discrepancy workflow on every fitted run, published on SPINDOWN.<bench>.EXPLAIN,
   // starting from this base (the lab's belief: viscous). Empty = off.
   std::vector<const Effect*> explain_base{find_effect("viscous")};
+  LabSettings lab{"lab", std::nullopt, ""};  // the lab's name and key (also in core.gate)
 };
 
 class FitterService final : public FitterSink {
@@ -37,6 +43,7 @@ class FitterService final : public FitterSink {
   ~FitterService() override;
 
   bool good() const { return loop_.good(); }
+  std::uint64_t session() const { return stamp_.identity().session; }
   // Runs until a stop signal (or LCM keeps failing) and returns the exit code. Under systemd
   // (Type=notify): READY=1 once subscribed, WATCHDOG=1 from the LCM loop while the worker
   // thread shows signs of life, STOPPING=1 at the end.
@@ -46,16 +53,29 @@ class FitterService final : public FitterSink {
   void run_changed(const run_t& run) override;
   void fit_ready(const FitResult& result) override;
   void diagnostic(const std::string& bench, const Diagnostic& d) override;
+  void notice(std::string_view kind, std::string_view channel, const std::string& text) override;
 
  private:
   void worker();
   void publish_status(std::int64_t now_us, const char* state);
+  // A STATUS on this instance's own channel: another fitter with the same name is named.
+  void own_channel_status(const QueuedMessage& m);
   // SPINDOWN.<bench>.EXPLAIN, after the FIT (the workflow takes tens of ms; FIT goes first).
   void publish_explain(const FitResult& result);
 
   FitterServiceOptions opt_;
+  MessageStamp stamp_;  // this fitter's lab, host, session and key on everything it publishes
   LcmLoop loop_;
   FitterCore core_;
+  std::string status_channel_;
+  ServiceInstances instances_;      // fitters heard on status_channel_ (worker thread)
+  std::string collision_;           // the latest collision named ("" none)
+  // notice(): when each (kind, channel) was last said on stderr, and how many were not said since.
+  struct Said {
+    std::int64_t at_us = 0;
+    std::int64_t quiet = 0;
+  };
+  std::map<std::string, Said, std::less<>> said_;
   std::string host_;
   std::int64_t start_us_ = 0;
   // A message larger than the whole queue may hold is no sign of a full queue: it is oversize

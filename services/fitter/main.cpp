@@ -11,8 +11,10 @@
 #include "spindown/bench_file.hpp"
 #include "spindown/effects.hpp"
 #include "spindown/fit.hpp"
+#include "spindown/lab_settings.hpp"
 #include "spindown/lcm_channels.hpp"
 #include "spindown/lcm_url.hpp"
+#include "spindown/session_id.hpp"
 #include "spindown/stop_signal.hpp"
 
 namespace {
@@ -25,6 +27,17 @@ std::optional<int> parse_options(int argc, char** argv, spindown::FitterServiceO
   long recv_buf = spindown::services_recv_buf_bytes;
   std::vector<std::string> bench_configs;
   app.add_option("--lcm-url", o.lcm_url, "LCM URL (default: LCM_DEFAULT_URL or LCM's default)");
+  std::string lab_option, key_option;
+  app.add_option("--lab", lab_option, spindown::lab_option_help);
+  app.add_option("--key", key_option, spindown::key_option_help);
+  app.add_option("--replay-window", o.core.gate.replay_window_s,
+                 "with --key: a signed message sent more than this many seconds from its receive time is refused "
+                 "(a replay, or a clock that is off)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--takeover", o.core.stream.takeover_s,
+                 "seconds a bench's source must be quiet before another source on its channel (a restarted bridge) "
+                 "starts a new stream; while both send, the second is named and refused")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--recv-buf", recv_buf, "udpm receive buffer bytes added to the URL (0 = leave the URL alone)");
   app.add_option("--bench", o.core.bench_regex, "benches to fit: regex on the bench id (default all)");
   app.add_option("--instance", o.instance, "instance name: heartbeat on SPINDOWN.<instance>.STATUS")
@@ -105,12 +118,21 @@ std::optional<int> parse_options(int argc, char** argv, spindown::FitterServiceO
       return 2;
     }
   }
+  auto lab = spindown::resolve_lab_settings(lab_option, key_option, &why);
+  if (!lab) {
+    fmt::print(stderr, "spindown-fitter: {}\n", why);
+    return 2;
+  }
+  o.lab = *lab;
+  o.core.gate.lab = lab->lab;
+  o.core.gate.key = lab->key;
   if (!o.core.is_valid(&why)) {
     fmt::print(stderr, "spindown-fitter: {}\n", why);
     return 2;
   }
 
   o.lcm_url = spindown::with_receive_buffer(o.lcm_url, recv_buf);
+  o.core.gate.sent_to = spindown::lcm_destination(o.lcm_url);  // another group's traffic on this port: another lab
   return std::nullopt;
 }
 
@@ -126,8 +148,10 @@ int main(int argc, char** argv) {
     return 1;
   }
   spindown::StopSignals stop;
-  fmt::print(stderr, "spindown-fitter: fitting benches matching '{}'{}; heartbeat on SPINDOWN.{}.STATUS\n",
-             o.core.bench_regex, o.lcm_url.empty() ? "" : " on " + o.lcm_url, o.instance);
+  fmt::print(stderr, "spindown-fitter: fitting benches matching '{}'{}; heartbeat on SPINDOWN.{}.STATUS; {}; session {}\n",
+             o.core.bench_regex, o.lcm_url.empty() ? "" : " on " + o.lcm_url, o.instance,
+             spindown::lab_settings_text(o.lab), spindown::session_text(service.session()));
+  if (o.lab.key && !o.lab.key->warning.empty()) fmt::print(stderr, "spindown-fitter: warning: {}\n", o.lab.key->warning);
   if (!o.core.health.empty()) {
     std::string benches;
     for (const auto& [bench, cfg] : o.core.health) benches += (benches.empty() ? "" : ", ") + bench;

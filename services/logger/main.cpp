@@ -13,10 +13,13 @@
 
 #include "spindown/clock.hpp"
 #include "spindown/event_log_writer.hpp"
+#include "spindown/lab_settings.hpp"
 #include "spindown/lcm_loop.hpp"
 #include "spindown/lcm_status.hpp"
 #include "spindown/lcm_url.hpp"
 #include "spindown/log_recorder.hpp"
+#include "spindown/message_gate.hpp"
+#include "spindown/message_stamp.hpp"
 #include "spindown/loop_watchdog.hpp"
 #include "spindown/network_checks.hpp"
 #include "spindown/service_notifier.hpp"
@@ -26,6 +29,8 @@ namespace {
 
 struct LoggerOptions {
   std::string lcm_url, channels;
+  std::string lab_option, key_option;
+  spindown::LabSettings lab;
   spindown::EventLogWriterOptions writer;
   spindown::LogRecorderOptions recorder;
   long recv_buf = spindown::services_recv_buf_bytes;
@@ -38,6 +43,12 @@ std::optional<int> parse_options(int argc, char** argv, LoggerOptions& o) {
   spindown::EventLogWriterOptions& w = o.writer;
   spindown::LogRecorderOptions& r = o.recorder;
   app.add_option("--lcm-url", o.lcm_url, "LCM URL (default: LCM_DEFAULT_URL or LCM's default)");
+  app.add_option("--lab", o.lab_option,
+                 "lab name: every message is recorded, and another lab's messages are counted (other_lab) and "
+                 "named; the heartbeat names it (default: $SPINDOWN_LAB, else 'lab')");
+  app.add_option("--key", o.key_option,
+                 "lab key file: every message is recorded, and unsigned, wrongly signed and replayed ones are counted "
+                 "and named; the heartbeat is signed (default: the systemd credential lab-key when loaded)");
   app.add_option("--channels", o.channels,
                  "channel regex (default SPINDOWN\\..*, or SPINDOWN\\.<bench>\\..* with --bench)");
   app.add_option("--dir", w.dir, "directory for the logs (must exist)")->capture_default_str();
@@ -84,6 +95,12 @@ std::optional<int> parse_options(int argc, char** argv, LoggerOptions& o) {
     fmt::print(stderr, "spindown-logger: {}\n", why);
     return 2;
   }
+  auto lab = spindown::resolve_lab_settings(o.lab_option, o.key_option, &why);
+  if (!lab) {
+    fmt::print(stderr, "spindown-logger: {}\n", why);
+    return 2;
+  }
+  o.lab = std::move(*lab);
   return std::nullopt;
 }
 
@@ -92,12 +109,30 @@ std::optional<int> parse_options(int argc, char** argv, LoggerOptions& o) {
 // and its problems said once on stderr when they start (and a full disk once when it ends).
 class Heartbeat {
  public:
-  Heartbeat(spindown::LcmLoop& loop, spindown::LogRecorder& recorder, std::string channel)
-      : loop_(loop), recorder_(recorder), channel_(std::move(channel)) {}
+  Heartbeat(spindown::LcmLoop& loop, spindown::LogRecorder& recorder, std::string channel,
+            const spindown::MessageGate& gate)
+      : loop_(loop), recorder_(recorder), channel_(std::move(channel)), gate_(gate) {}
+
+  // A message the gate refused (recorded all the same): in the heartbeat's last_error while
+  // nothing else is (and so on stderr, once per change, as every last_error).
+  void refused(const spindown::GateResult& g) { last_refusal_ = g.text; }
 
   void beat(std::int64_t now, const char* state = nullptr) {
     spindown::status_t st = recorder_.status(now);
     if (state) st.state = state;
+    const spindown::GateCounters& g = gate_.counters();
+    const std::pair<const char*, std::int64_t> gate_counts[] = {
+        {"other_lab", g.other_lab},
+        {"unsigned_messages", g.not_signed},
+        {"bad_signatures", g.other_key + g.bad_signature},
+        {"replays", g.replayed + g.outside_window},
+    };
+    for (const auto& [name, value] : gate_counts) {
+      st.counter_name.emplace_back(name);
+      st.counter_value.push_back(value);
+    }
+    st.ncounters = static_cast<std::int32_t>(st.counter_name.size());
+    if (st.last_error.empty() && !last_refusal_.empty()) st.last_error = "recorded, not this lab's own: " + last_refusal_;
     if (const std::int64_t drops = spindown::own_udp_drop_count(); drops >= 0) {
       st.gauge_name.emplace_back("udp_drops");
       st.gauge_value.push_back(double(drops));
@@ -123,6 +158,8 @@ class Heartbeat {
   spindown::LcmLoop& loop_;
   spindown::LogRecorder& recorder_;
   std::string channel_;
+  const spindown::MessageGate& gate_;
+  std::string last_refusal_;
   std::string reported_error_, reported_state_;
   std::int64_t lost_when_full_ = 0;
 };
@@ -178,6 +215,14 @@ int main(int argc, char** argv) {
   const std::string first_file = writer.current_path();
   spindown::LogRecorder recorder(writer, r);
   recorder.start();
+  spindown::MessageStamp stamp(spindown::this_process_identity(o.lab.lab, url), o.lab.key);
+  loop.set_stamp(&stamp);
+  spindown::MessageGateOptions gate_options;
+  gate_options.lab = o.lab.lab;
+  gate_options.sent_to = spindown::lcm_destination(url);
+  gate_options.key = o.lab.key;
+  spindown::MessageGate gate(gate_options);
+  Heartbeat heartbeat(loop, recorder, w.status_channel, gate);
 
   // LCM 1.3.1 drops silently past a subscription's queue capacity (30 unless set): no limit
   // there, so every message LCM reads reaches the recorder, whose queue is the one that bounds
@@ -187,6 +232,9 @@ int main(int argc, char** argv) {
       o.channels,
       [&](const spindown::LcmMessage& m) {
         recorder.offer(m.recv_utime, m.channel, m.data, static_cast<std::int32_t>(m.size));
+        // Recorded whatever it is (the log is the evidence); counted when it is not the lab's own.
+        const spindown::GateResult g = gate.check(m.channel, m.data, m.size, m.recv_utime);
+        if (g.refused()) heartbeat.refused(g);
       },
       {.queue_capacity = 0});
   if (!subscribed) {
@@ -198,12 +246,12 @@ int main(int argc, char** argv) {
       (w.retention.keep_files > 0 ? fmt::format(", keep {} files", w.retention.keep_files) : std::string()) +
       (w.retention.keep_mb > 0 ? fmt::format(", keep {} MB", w.retention.keep_mb) : std::string());
   if (!o.quiet)
-    fmt::print(stderr, "spindown-logger: channels '{}' on {} -> {} (flush every {} s{}{}{})\n", o.channels, url,
+    fmt::print(stderr, "spindown-logger: channels '{}' on {} -> {} (flush every {} s{}{}{}); {}\n", o.channels, url,
                first_file, r.flush_interval_s,
                w.rotate_size_mb > 0 ? fmt::format(", rotate at {} MB", w.rotate_size_mb) : "",
-               w.rotate_time_s > 0 ? fmt::format(", rotate every {} s", w.rotate_time_s) : "", retention);
+               w.rotate_time_s > 0 ? fmt::format(", rotate every {} s", w.rotate_time_s) : "", retention,
+               spindown::lab_settings_text(o.lab));
 
-  Heartbeat heartbeat(loop, recorder, w.status_channel);
   loop.every(1.0, [&](std::int64_t now) { heartbeat.beat(now); }, 0);
   spindown::ServiceNotifier notify;
   spindown::feed_watchdog_from_loop(loop, notify, [&](std::int64_t now_ns) {

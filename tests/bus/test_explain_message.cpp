@@ -46,7 +46,7 @@ TEST(ExplainMessage, CarriesTheStepsOfACombinedRunExplainedFromViscous) {
   // The message survives LCM's encoding (every array length consistent with its count).
   std::vector<unsigned char> buf(m.getEncodedSize());
   ASSERT_EQ(m.encode(buf.data(), 0, static_cast<int>(buf.size())), static_cast<int>(buf.size()));
-  explain_t back;
+  explain_t back{};
   ASSERT_EQ(back.decode(buf.data(), 0, static_cast<int>(buf.size())), static_cast<int>(buf.size()));
   EXPECT_EQ(back.step_added, m.step_added);
   EXPECT_EQ(back.story, m.story);

@@ -27,7 +27,7 @@ RunFit sample_fit() {
 
 TEST(FitMessage, RoundTripKeepsTheReport) {
   const RunFit fit = sample_fit();
-  FitProvenance about{"lab-3", "config", 100, 1500, 0.004, std::nullopt};
+  FitProvenance about{"lab-3", "config", 100, 1500, 0.004, std::nullopt, "", 0};
   const fit_t msg = to_fit_message(fit, about, 123);
   EXPECT_EQ(msg.nmodels, 3);
   EXPECT_EQ(msg.nparams, static_cast<std::int32_t>(msg.param_name.size()));
@@ -38,7 +38,7 @@ TEST(FitMessage, RoundTripKeepsTheReport) {
   // Over the wire.
   std::vector<unsigned char> buf(static_cast<std::size_t>(msg.getEncodedSize()));
   ASSERT_GT(msg.encode(buf.data(), 0, static_cast<int>(buf.size())), 0);
-  fit_t back;
+  fit_t back{};
   ASSERT_GT(back.decode(buf.data(), 0, static_cast<int>(buf.size())), 0);
 
   std::string why;
@@ -65,7 +65,7 @@ TEST(FitMessage, TheUncertaintyOfJAndKbTravelsWithEachParameter) {
   fo.bench.inertia_rel_error = 0.02;
   fo.bench.kb_rel_error = 0.05;
   const RunFit fit = fit_run(rec, find_runs(rec).runs.at(0), fo);
-  const fit_t msg = to_fit_message(fit, FitProvenance{"b", "config", 0, 0, 0, std::nullopt}, 1);
+  const fit_t msg = to_fit_message(fit, FitProvenance{"b", "config", 0, 0, 0, std::nullopt, "", 0}, 1);
   EXPECT_DOUBLE_EQ(msg.inertia_rel_error, 0.02);
   EXPECT_DOUBLE_EQ(msg.kb_rel_error, 0.05);
   ASSERT_EQ(msg.param_bench_error.size(), msg.param_name.size());
@@ -82,7 +82,7 @@ TEST(FitMessage, TheUncertaintyOfJAndKbTravelsWithEachParameter) {
 }
 
 TEST(FitMessage, InconsistentArraysAreRefused) {
-  fit_t msg = to_fit_message(sample_fit(), {"b", "config", 0, 0, 0, std::nullopt}, 0);
+  fit_t msg = to_fit_message(sample_fit(), {"b", "config", 0, 0, 0, std::nullopt, "", 0}, 0);
   fit_t bad = msg;
   bad.nmodels = 5;
   std::string why;
@@ -107,7 +107,7 @@ TEST(FitMessage, HealthVerdictTravelsWithTheFit) {
   cfg.baseline->c_coulomb_stderr = 2e-7;
   const HealthVerdict verdict = assess_health(fit, cfg);
   ASSERT_EQ(verdict.level, HealthLevel::service) << verdict.reason;
-  FitProvenance about{"lab-3", "config", 100, 1500, 0.004, verdict};
+  FitProvenance about{"lab-3", "config", 100, 1500, 0.004, verdict, "", 0};
   const fit_t msg = to_fit_message(fit, about, 123);
   EXPECT_EQ(msg.verdict, "service");
   EXPECT_EQ(msg.verdict_reason, verdict.reason);
@@ -116,7 +116,7 @@ TEST(FitMessage, HealthVerdictTravelsWithTheFit) {
 
   std::vector<unsigned char> buf(static_cast<std::size_t>(msg.getEncodedSize()));
   ASSERT_GT(msg.encode(buf.data(), 0, static_cast<int>(buf.size())), 0);
-  fit_t back;
+  fit_t back{};
   ASSERT_GT(back.decode(buf.data(), 0, static_cast<int>(buf.size())), 0);
   std::string why;
   const auto again = health_from_fit_message(back, &why);
@@ -127,7 +127,7 @@ TEST(FitMessage, HealthVerdictTravelsWithTheFit) {
   EXPECT_EQ((*j)["health"]["level"], "service");
 
   // Without a bench file: no verdict, no "health" in the JSON.
-  const fit_t plain = to_fit_message(fit, {"lab-3", "config", 100, 1500, 0.004, std::nullopt}, 123);
+  const fit_t plain = to_fit_message(fit, {"lab-3", "config", 100, 1500, 0.004, std::nullopt, "", 0}, 123);
   EXPECT_EQ(plain.verdict, "");
   EXPECT_EQ(plain.nfindings, 0);
   EXPECT_FALSE(health_from_fit_message(plain));
@@ -147,7 +147,7 @@ TEST(FitMessage, HealthVerdictTravelsWithTheFit) {
 TEST(FitMessage, NeverStoppedRunHasNanStop) {
   RunFit fit = sample_fit();
   fit.run.stopped = false;
-  const fit_t msg = to_fit_message(fit, {"b", "config", 0, 0, 0, std::nullopt}, 0);
+  const fit_t msg = to_fit_message(fit, {"b", "config", 0, 0, 0, std::nullopt, "", 0}, 0);
   EXPECT_TRUE(std::isnan(msg.t_stop_s));
   const auto back = from_fit_message(msg);
   ASSERT_TRUE(back);

@@ -22,7 +22,7 @@ using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 
 samples_t samples(std::int64_t seq, const std::string& bench = "b1") {
-  samples_t m;
+  samples_t m{};
   m.utime = 1;
   m.bench = bench;
   m.seq = seq;

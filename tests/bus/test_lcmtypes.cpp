@@ -59,7 +59,7 @@ void refuses_other_type(const M& m) {
 }
 
 samples_t make_samples() {
-  samples_t m;
+  samples_t m{};
   m.utime = 1694686893123456;
   m.bench = "lab-2_B";
   m.seq = 4242;
@@ -74,7 +74,7 @@ samples_t make_samples() {
 }
 
 config_t make_config() {
-  config_t m;
+  config_t m{};
   m.utime = 99;
   m.bench = "bench1";
   m.inertia_kg_m2 = 1.12687602e-5;
@@ -98,7 +98,7 @@ config_t make_config() {
 }
 
 run_t make_run() {
-  run_t m;
+  run_t m{};
   m.utime = 7;
   m.bench = "b";
   m.run = 2;
@@ -113,7 +113,7 @@ run_t make_run() {
 }
 
 fit_t make_fit() {
-  fit_t m;
+  fit_t m{};
   m.utime = 1;
   m.bench = "bench1";
   m.run = 1;
@@ -185,7 +185,7 @@ fit_t make_fit() {
 }
 
 explain_t make_explain() {
-  explain_t m;
+  explain_t m{};
   m.utime = 5;
   m.bench = "b";
   m.run = 1;
@@ -216,7 +216,7 @@ explain_t make_explain() {
 }
 
 status_t make_status() {
-  status_t m;
+  status_t m{};
   m.utime = 11;
   m.service = "bridge";
   m.instance = "bench1";
@@ -239,8 +239,9 @@ status_t make_status() {
 
 TEST(LcmTypes, SamplesRoundTrip) {
   const samples_t m = make_samples();
-  // Fixed part 8 (hash) + 8 + (4 + 7 + 1) + 8 + 4 + 1 + 4, then 28 bytes per sample.
-  EXPECT_EQ(m.getEncodedSize(), 8 + 8 + 12 + 8 + 4 + 1 + 4 + 5 * 28);
+  // Fixed part 8 (hash) + 8 + (4 + 7 + 1) + 8 + 4 + 1 + 4, then 28 bytes per sample, then the
+  // source fields: three empty strings (5 bytes each), session, seq, key id and auth[32].
+  EXPECT_EQ(m.getEncodedSize(), 8 + 8 + 12 + 8 + 4 + 1 + 4 + 5 * 28 + 3 * 5 + 8 + 8 + 4 + 32);
   const samples_t b = round_trip(m);
   EXPECT_EQ(b.bench, m.bench);
   EXPECT_EQ(b.seq, m.seq);
@@ -348,7 +349,7 @@ TEST(LcmTypes, DecodingAtAnOffset) {
   const auto bytes = encode(make_samples());
   std::vector<std::uint8_t> padded(13 + bytes.size(), 0xAB);
   std::copy(bytes.begin(), bytes.end(), padded.begin() + 13);
-  samples_t b;
+  samples_t b{};
   EXPECT_EQ(b.decode(padded.data(), 13, static_cast<int>(bytes.size())), static_cast<int>(bytes.size()));
   EXPECT_EQ(b.value, make_samples().value);
 }

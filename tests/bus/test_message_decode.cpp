@@ -12,9 +12,12 @@
 #include <vector>
 
 #include "spindown/message_decode.hpp"
+#include "spindown_messages.hpp"
 
 namespace spindown {
 namespace {
+
+using namespace spindown::test;
 
 template <class Msg>
 std::vector<std::uint8_t> encode(const Msg& m) {
@@ -29,150 +32,6 @@ void put_be32(std::vector<std::uint8_t>& b, std::size_t at, std::int32_t v) {
   b[at + 1] = std::uint8_t(u >> 16);
   b[at + 2] = std::uint8_t(u >> 8);
   b[at + 3] = std::uint8_t(u);
-}
-
-// Every field non-empty, every array with distinct lengths, so a layout error shifts bytes.
-samples_t make_samples() {
-  samples_t s;
-  s.utime = 1;
-  s.bench = "bench-a";
-  s.seq = 7;
-  s.clock_epoch = 2;
-  s.quantity = samples_t::QUANTITY_RPM;
-  s.n = 3;
-  s.device_time_us = {1, 2, 3};
-  s.host_time_us = {4, 5, 6};
-  s.value = {1.5, 2.5, 3.5};
-  s.raw_adc = {-1, -1, 7};
-  return s;
-}
-config_t make_config() {
-  config_t c;
-  c.bench = "b";
-  c.inertia_kg_m2 = 1e-5;
-  c.inertia_source = "lab default";
-  c.kb_v_s_per_rad = 0.008;
-  c.kb_source = "x";
-  c.quantity = 1;
-  c.adc_bits = 10;
-  c.firmware = "fw";
-  c.protocol = "lab-tsv";
-  c.baud = 9600;
-  c.device = "/dev/ttyACM0";
-  c.host = "h";
-  c.inertia_rel_error = 0.02;
-  c.kb_rel_error = 0.05;
-  return c;
-}
-run_t make_run() {
-  run_t r;
-  r.bench = "b";
-  r.run = 3;
-  r.state = run_t::STATE_STOPPED;
-  r.t_cut_s = 1;
-  r.t_stop_s = NAN;
-  r.samples = 9;
-  r.note = "note";
-  return r;
-}
-fit_t make_fit() {
-  fit_t f;
-  f.bench = "bench-a";
-  f.residual_unit = "V";
-  f.bench_source = "config";
-  f.nmodels = 2;
-  f.model = {"viscous", "combined"};
-  f.rmse = {1, 2};
-  f.r2 = {1, 2};
-  f.aic = {1, 2};
-  f.bic = {1, 2};
-  f.t_stop_pred_s = {INFINITY, 2};
-  f.converged = {1, 0};
-  f.model_samples = {10, 11};
-  f.model_message = {"", "did not converge"};
-  f.nparams = 3;
-  f.param_model = {0, 1, 1};
-  f.param_name = {"c4", "c3", "c4"};
-  f.param_value = {1, 2, 3};
-  f.param_stderr = {0.1, 0.2, 0.3};
-  f.param_unit = {"a", "b", "c"};
-  f.best = "viscous";
-  f.best_reason = "r";
-  f.verdict = "ok";
-  f.verdict_reason = "v";
-  f.inertia_source = "i";
-  f.kb_source = "k";
-  f.lead_in = "zeros";
-  f.first_seq = 1;
-  f.last_seq = 2;
-  f.health_reference = 1;
-  f.nfindings = 2;
-  f.finding_what = {"dry friction", "time to stop"};
-  f.finding_level = {"ok", "check"};
-  f.finding_reason = {"r1", "r2"};
-  f.finding_value = {1, 2};
-  f.finding_stderr = {1, 2};
-  f.finding_reference = {1, 2};
-  f.finding_reference_stderr = {1, 2};
-  f.finding_reference_name = {"baseline", "lab limit"};
-  f.finding_ratio = {1, 2};
-  f.finding_ratio_stderr = {1, 2};
-  f.finding_unit = {"N*m", "s"};
-  f.ndoubts = 2;
-  f.doubts = {"d1", "d2"};
-  f.reading_step = 0.01;
-  f.model_reduced_chi2 = {1, 2};
-  f.ncorrelations = 3;
-  f.corr_model = {0, 1, 1};
-  f.corr_a = {"omega0", "omega0", "c3"};
-  f.corr_b = {"c1", "c3", "c4"};
-  f.corr_value = {0.5, 0.6, -0.9};
-  f.inertia_rel_error = 0.02;
-  f.kb_rel_error = 0.05;
-  f.param_bench_error = {0.01, 0.02, 0.03};
-  f.reading_noise = 0.0042;
-  return f;
-}
-explain_t make_explain() {
-  explain_t e;
-  e.bench = "b";
-  e.nbase = 1;
-  e.base = {"viscous"};
-  e.nsteps = 2;
-  e.step_added = {"coulomb", "windage"};
-  e.step_rmse_before = {3, 2};
-  e.step_rmse_after = {2, 1};
-  e.step_why = {"w1", "w2"};
-  e.nwhere = 3;
-  e.where_step = {0, 0, 1};
-  e.where_t_from_s = {0, 1, 2};
-  e.where_t_to_s = {1, 2, 3};
-  e.where_mean_residual = {0.1, 0.2, 0.3};
-  e.nfinal = 3;
-  e.final_effects = {"viscous", "coulomb", "windage"};
-  e.nparams = 4;
-  e.param_name = {"c1", "c2", "c3", "c4"};
-  e.param_value = {1, 2, 3, 4};
-  e.param_stderr = {1, 2, 3, 4};
-  e.param_unit = {"u", "u", "u", "u"};
-  e.story = "story";
-  return e;
-}
-status_t make_status() {
-  status_t s;
-  s.service = "bridge";
-  s.instance = "bench-a";
-  s.host = "h";
-  s.pid = 1;
-  s.state = "connected";
-  s.ncounters = 2;
-  s.counter_name = {"lines_good", "lines_bad"};
-  s.counter_value = {10, 1};
-  s.ngauges = 1;
-  s.gauge_name = {"rate_hz"};
-  s.gauge_value = {50};
-  s.last_error = "e";
-  return s;
 }
 
 template <class Msg>
@@ -204,7 +63,7 @@ TEST(MessageDecode, LayoutOfEveryTypeMatchesTheGeneratedEncoder) {
 
 TEST(MessageDecode, WrongFingerprintIsNamed) {
   const auto bytes = encode(make_config());
-  samples_t m;
+  samples_t m{};
   std::string why;
   EXPECT_FALSE(decode_message(m, bytes.data(), static_cast<std::int64_t>(bytes.size()), &why));
   EXPECT_NE(why.find("not a samples_t"), std::string::npos) << why;
@@ -221,7 +80,7 @@ TEST(MessageDecode, HugeArrayCountIsRefusedBeforeAnyAllocation) {
   for (int k = 0; k < 4; ++k) was = (was << 8) | bytes[at + k];
   ASSERT_EQ(was, 2);
   put_be32(bytes, at, 0x7fffffff);
-  fit_t m;
+  fit_t m{};
   std::string why;
   EXPECT_FALSE(decode_message(m, bytes.data(), static_cast<std::int64_t>(bytes.size()), &why));
   EXPECT_NE(why.find("nmodels = 2147483647"), std::string::npos) << why;
@@ -236,7 +95,7 @@ TEST(MessageDecode, BadStringLengthsAreRefused) {
   auto bytes = encode(make_run());
   for (const std::int32_t len : {0, -1, std::int32_t(0x80000000u), 0x7fffffff}) {
     put_be32(bytes, 16, len);  // bench's length word, after the fingerprint and utime
-    run_t m;
+    run_t m{};
     std::string why;
     EXPECT_FALSE(decode_message(m, bytes.data(), static_cast<std::int64_t>(bytes.size()), &why)) << len;
     EXPECT_NE(why.find("string bench has length"), std::string::npos) << why;
@@ -246,15 +105,19 @@ TEST(MessageDecode, BadStringLengthsAreRefused) {
 TEST(MessageDecode, SampleCountLargerThanTheArraysSentIsRefused) {
   auto bytes = encode(make_samples());
   const std::size_t n_at = 8 + 8 + (4 + 8) + 8 + 4 + 1;
-  put_be32(bytes, n_at, 4);  // says 4 samples, carries 3
-  samples_t m;
+  put_be32(bytes, n_at, 100);  // says 100 samples, carries 3 (and the source fields after them)
+  samples_t m{};
   std::string why;
   EXPECT_FALSE(decode_message(m, bytes.data(), static_cast<std::int64_t>(bytes.size()), &why));
-  EXPECT_NE(why.find("n = 4"), std::string::npos) << why;
+  EXPECT_NE(why.find("n = 100"), std::string::npos) << why;
+  // One more than it carries: the arrays then end inside the source fields, which are refused.
+  put_be32(bytes, n_at, 4);
+  EXPECT_FALSE(decode_message(m, bytes.data(), static_cast<std::int64_t>(bytes.size()), &why));
+  EXPECT_NE(why.find("samples_t: string lab has length"), std::string::npos) << why;
 }
 
 TEST(MessageDecode, NoDataOrTooMuchIsRefused) {
-  status_t m;
+  status_t m{};
   std::string why;
   EXPECT_FALSE(decode_message(m, nullptr, 0, &why));
   EXPECT_FALSE(decode_message(m, "x", std::int64_t{1} << 32, &why));
@@ -274,15 +137,22 @@ TEST(MessageDecode, SamplesViewAgreesWithTheGeneratedDecoder) {
   EXPECT_EQ(view.seq, sent.seq);
   EXPECT_EQ(view.clock_epoch, sent.clock_epoch);
   EXPECT_EQ(view.quantity, sent.quantity);
+  EXPECT_FALSE(view.legacy);
+  EXPECT_EQ(view.lab, sent.lab);
+  EXPECT_EQ(view.sent_to, sent.sent_to);
+  EXPECT_EQ(view.source_host, sent.source_host);
+  EXPECT_EQ(view.source_session, static_cast<std::uint64_t>(sent.source_session));
+  EXPECT_EQ(view.source_seq, sent.source_seq);
+  EXPECT_EQ(view.auth_key_id, sent.auth_key_id);
   ASSERT_EQ(view.n, sent.n);
   for (std::int32_t i = 0; i < view.n; ++i) {
     EXPECT_EQ(view.device_time_us(i), sent.device_time_us[static_cast<std::size_t>(i)]);
     EXPECT_EQ(view.value(i), sent.value[static_cast<std::size_t>(i)]);
   }
-  samples_t copied;
+  samples_t copied{};
   copied.value = {9, 9, 9, 9, 9};  // storage reused, resized to n
   samples_from_view(view, copied);
-  samples_t decoded;
+  samples_t decoded{};
   ASSERT_TRUE(decode_message(decoded, bytes.data(), static_cast<std::int64_t>(bytes.size()), &why)) << why;
   EXPECT_EQ(encode(copied), encode(decoded));
 }
@@ -292,9 +162,12 @@ TEST(MessageDecode, SamplesViewRefusesWhatTheDecoderRefusesInTheReadersWords) {
   std::string why;
   auto bytes = encode(make_samples());
   const std::size_t n_at = 8 + 8 + (4 + 8) + 8 + 4 + 1;
-  put_be32(bytes, n_at, 4);  // says 4 samples, carries 3
+  put_be32(bytes, n_at, 100);  // says 100 samples, carries 3
   EXPECT_FALSE(view_samples_message(view, bytes.data(), static_cast<std::int64_t>(bytes.size()), &why));
-  EXPECT_EQ(why, fmt::format("sample count 4 does not fit in {} bytes (truncated or damaged)", bytes.size()));
+  EXPECT_EQ(why, fmt::format("sample count 100 does not fit in {} bytes (truncated or damaged)", bytes.size()));
+  put_be32(bytes, n_at, 4);  // the arrays then end inside the source fields
+  EXPECT_FALSE(view_samples_message(view, bytes.data(), static_cast<std::int64_t>(bytes.size()), &why));
+  EXPECT_NE(why.find("lab string length"), std::string::npos) << why;
   put_be32(bytes, n_at, -1);
   EXPECT_FALSE(view_samples_message(view, bytes.data(), static_cast<std::int64_t>(bytes.size()), &why));
   EXPECT_NE(why.find("sample count -1"), std::string::npos) << why;
@@ -313,7 +186,7 @@ TEST(MessageDecode, SamplesViewRefusesWhatTheDecoderRefusesInTheReadersWords) {
   // Not a samples_t at all: decode_message's words.
   const auto config_bytes = encode(make_config());
   std::string decoder_why;
-  samples_t m;
+  samples_t m{};
   EXPECT_FALSE(view_samples_message(view, config_bytes.data(), static_cast<std::int64_t>(config_bytes.size()), &why));
   EXPECT_FALSE(decode_message(m, config_bytes.data(), static_cast<std::int64_t>(config_bytes.size()), &decoder_why));
   EXPECT_EQ(why, decoder_why);
@@ -369,6 +242,113 @@ TEST(MessageDecode, SamplesViewInlineChecksAgreeWithTheWordedOnes) {
   }
   EXPECT_GT(accepted, 20u);                 // the bytes that do not matter to the layout
   EXPECT_LT(accepted, cases.size() - 100);  // and plenty that do
+}
+
+// A message of the encoding spindown wrote before the source and signature fields: the current
+// one without its appended fields, under the type's older fingerprint (what a log recorded then
+// holds). `appended` is how many bytes the appended fields take at their defaults.
+template <class Msg>
+std::vector<std::uint8_t> legacy_bytes(Msg m, std::size_t appended, std::uint64_t old_hash) {
+  m.lab.clear();
+  m.sent_to.clear();
+  m.source_host.clear();
+  auto b = encode(m);
+  b.resize(b.size() - appended);
+  for (int k = 0; k < 8; ++k) b[static_cast<std::size_t>(k)] = static_cast<std::uint8_t>(old_hash >> (56 - 8 * k));
+  return b;
+}
+
+// Every type's legacy encoding decodes to the same message with the new fields empty; the
+// trailer reads as legacy; the samples view reads it in place.
+template <class Msg>
+void expect_legacy_decodes(Msg sent, std::size_t appended, std::uint64_t old_hash) {
+  const auto old = legacy_bytes(sent, appended, old_hash);
+  Msg back{};
+  std::string why;
+  ASSERT_TRUE(decode_message(back, old.data(), static_cast<std::int64_t>(old.size()), &why)) << Msg::getTypeName() << ": " << why;
+  Msg expected = sent;
+  expected.lab.clear();
+  expected.sent_to.clear();
+  expected.source_host.clear();
+  expected.source_session = 0;
+  expected.source_seq = 0;
+  expected.auth_key_id = 0;
+  std::memset(expected.auth, 0, sizeof expected.auth);
+  if constexpr (requires { expected.bridge_session; }) {
+    expected.bridge_host.clear();
+    expected.bridge_session = 0;
+  }
+  if constexpr (requires { expected.start_utime; }) expected.start_utime = 0;
+  EXPECT_EQ(encode(back), encode(expected)) << Msg::getTypeName();
+  MessageTrailer t;
+  ASSERT_TRUE(read_message_trailer(old.data(), static_cast<std::int64_t>(old.size()), t, &why)) << why;
+  EXPECT_TRUE(t.legacy);
+  EXPECT_EQ(t.type, Msg::getTypeName());
+  EXPECT_EQ(t.end, static_cast<std::int64_t>(old.size()));
+  // Every proper prefix is still refused.
+  for (std::size_t cut = 0; cut < old.size(); ++cut)
+    EXPECT_FALSE(decode_message(back, old.data(), static_cast<std::int64_t>(cut))) << Msg::getTypeName() << " " << cut;
+}
+
+TEST(MessageDecode, EncodingsFromBeforeTheSourceFieldsStillDecode) {
+  // lab, sent_to, source_host (empty: 5 bytes each), source_session, source_seq, auth_key_id, auth[32].
+  constexpr std::size_t trailer = 5 + 5 + 5 + 8 + 8 + 4 + 32;
+  expect_legacy_decodes(make_samples(), trailer, 0x6366464c24ab26e1ull);
+  expect_legacy_decodes(make_config(), trailer, 0xf33bcecf4e9c80bdull);
+  expect_legacy_decodes(make_run(), trailer + 5 + 8, 0x52fa3d633257d3efull);  // + bridge_host, bridge_session
+  expect_legacy_decodes(make_fit(), trailer + 5 + 8, 0x9a6ae2b7c7c8e61cull);
+  expect_legacy_decodes(make_explain(), trailer, 0x8e7064d4b8398716ull);
+  expect_legacy_decodes(make_status(), trailer + 8, 0x056ac82d6252dc21ull);  // + start_utime
+
+  const auto old = legacy_bytes(make_samples(), trailer, 0x6366464c24ab26e1ull);
+  SamplesView view;
+  std::string why;
+  ASSERT_TRUE(view_samples_message(view, old.data(), static_cast<std::int64_t>(old.size()), &why)) << why;
+  EXPECT_TRUE(view.legacy);
+  EXPECT_EQ(view.n, 3);
+  EXPECT_EQ(view.value(2), 3.5);
+  EXPECT_TRUE(view.lab.empty());
+  EXPECT_EQ(view.source_session, 0u);
+  samples_t copied{};
+  samples_from_view(view, copied);
+  EXPECT_EQ(copied.source_seq, 0);
+}
+
+// The six fields that end every type, read in place for any type by its fingerprint.
+TEST(MessageDecode, TrailerOfEveryTypeIsReadInPlace) {
+  const auto check = [](auto m) {
+    set_source(m, "physics-2", "pc-17", 0x0102030405060708, 77);
+    m.auth_key_id = 0x11223344;
+    for (int i = 0; i < 32; ++i) m.auth[i] = static_cast<std::uint8_t>(i + 1);
+    const auto b = encode(m);
+    MessageTrailer t;
+    std::string why;
+    ASSERT_TRUE(read_message_trailer(b.data(), static_cast<std::int64_t>(b.size()), t, &why)) << why;
+    EXPECT_FALSE(t.legacy);
+    EXPECT_EQ(t.type, decltype(m)::getTypeName());
+    EXPECT_EQ(t.utime, m.utime);
+    EXPECT_EQ(t.lab, "physics-2");
+    EXPECT_EQ(t.sent_to, "239.255.76.67:7667");
+    EXPECT_EQ(t.source_host, "pc-17");
+    EXPECT_EQ(t.source_session, 0x0102030405060708u);
+    EXPECT_EQ(t.source_seq, 77);
+    EXPECT_EQ(t.auth_key_id, 0x11223344);
+    EXPECT_EQ(t.auth_offset, static_cast<std::int64_t>(b.size()) - 32);
+    EXPECT_EQ(t.auth[0], 1);
+    EXPECT_EQ(t.auth[31], 32);
+    EXPECT_EQ(t.end, static_cast<std::int64_t>(b.size()));
+  };
+  check(make_samples());
+  check(make_config());
+  check(make_run());
+  check(make_fit());
+  check(make_explain());
+  check(make_status());
+  MessageTrailer t;
+  std::string why;
+  const std::vector<std::uint8_t> junk(40, 0x5a);
+  EXPECT_FALSE(read_message_trailer(junk.data(), 40, t, &why));
+  EXPECT_NE(why.find("not a spindown message"), std::string::npos) << why;
 }
 
 // The fingerprint view_samples_message compares against is read once; it is the generated one.

@@ -220,12 +220,85 @@ TEST(LabTable, SequenceGapsRepeatsAndRestarts) {
   events = table.take_events();
   ASSERT_EQ(events.size(), 1u) << joined(events);
   EXPECT_TRUE(contains(events[0], "sequence gaps: 3 so far, 16 samples lost")) << events[0];
-  // A restarted bridge numbers from 0 again: not a gap.
-  table.on_samples("b", samples_msg("b", 0, 4), t0 + 13 * sec);
+  // A restarted bridge (a new session) numbers from 0 again: a new stream, not a gap, not repeated.
+  auto restarted = samples_msg("b", 0, 4);
+  restarted.source_session = 2;
+  table.on_samples("b", restarted, t0 + 14 * sec);
   EXPECT_EQ(table.bench("b")->seq_restarts, 1);
   EXPECT_EQ(table.bench("b")->seq_gaps, 3);
-  table.on_samples("b", samples_msg("b", 4, 4), t0 + 13 * sec);
+  restarted = samples_msg("b", 4, 4);
+  restarted.source_session = 2;
+  table.on_samples("b", restarted, t0 + 14 * sec);
   EXPECT_EQ(table.bench("b")->seq_gaps, 3);
+  EXPECT_EQ(table.bench("b")->samples, 23);
+  events = table.take_events();
+  ASSERT_FALSE(events.empty());
+  EXPECT_TRUE(contains(events[0], "b: a new source: host ? (session 0000000000000002)")) << events[0];
+}
+
+// A second source on a bench's channel at the same time is named in an event, in the row and
+// under the table while it lasts; its samples are not counted as the bench's.
+TEST(LabTable, TwoSourcesOnABenchAreShown) {
+  LabTable table;
+  for (int i = 0; i < 20; ++i) {
+    auto a = samples_msg("b", i, 1);
+    a.source_session = 1;
+    a.source_host = "pc-a";
+    table.on_samples("b", a, t0 + i * 20000);
+    auto b = samples_msg("b", 1000 + i, 1);
+    b.source_session = 2;
+    b.source_host = "laptop";
+    table.on_samples("b", b, t0 + i * 20000 + 5000);
+  }
+  const auto* row = table.bench("b");
+  ASSERT_NE(row, nullptr);
+  EXPECT_EQ(row->samples, 20);
+  EXPECT_GT(row->other_source_samples, 10);
+  const std::string shown = table.render(t0 + sec);
+  EXPECT_TRUE(contains(shown, "TWO SOURCES")) << shown;
+  EXPECT_TRUE(contains(shown, "SPINDOWN.b.SAMPLE has two sources: host pc-a (session 0000000000000001) and host "
+                              "laptop (session 0000000000000002)"))
+      << shown;
+  EXPECT_FALSE(contains(table.render(t0 + 30 * sec), "TWO SOURCES"));  // gone quiet: no longer shown
+}
+
+// Two fitters with one instance name: one row that says so, an event naming both; a FIT from a
+// session no fitter heard on STATUS is marked NOT VERIFIED; refused messages are counted, not shown.
+TEST(LabTable, CollidingFittersUnknownFitsAndRefusedMessages) {
+  LabTable table;
+  auto f1 = status_msg("fitter", "fitter", "running", {{"fits", 1}});
+  f1.source_session = 11;
+  f1.source_host = "pc-a";
+  f1.pid = 100;
+  auto f2 = f1;
+  f2.source_session = 12;
+  f2.source_host = "pc-b";
+  f2.pid = 200;
+  table.on_status("fitter", f1, t0);
+  table.on_status("fitter", f2, t0 + 100000);
+  const auto events = table.take_events();
+  EXPECT_TRUE(std::any_of(events.begin(), events.end(), [](const std::string& e) {
+    return contains(e, "two fitters with the same instance name 'fitter' on this lab at once") && contains(e, "pid 100") &&
+           contains(e, "pid 200");
+  })) << joined(events);
+  EXPECT_TRUE(contains(table.render(t0 + sec), "2 INSTANCES!")) << table.render(t0 + sec);
+  auto fit = fit_msg("b", 1, "combined");
+  fit.source_session = 99;
+  fit.source_host = "laptop";
+  table.on_fit("b", fit, t0 + sec);
+  EXPECT_FALSE(table.bench("b")->fit_doubt.empty());
+  EXPECT_TRUE(contains(table.render(t0 + sec), "NOT VERIFIED")) << table.render(t0 + sec);
+  fit.source_session = 11;  // a fitter heard on STATUS
+  table.on_fit("b", fit, t0 + sec);
+  EXPECT_TRUE(table.bench("b")->fit_doubt.empty());
+  GateResult refused;
+  refused.verdict = GateVerdict::not_signed;
+  refused.text = "SPINDOWN.b.FIT: fit_t from host laptop (session 0000000000000063): not signed; not used";
+  table.on_refused(refused, t0 + sec);
+  table.on_refused(refused, t0 + sec);
+  EXPECT_EQ(table.refused_messages(), 2);
+  EXPECT_TRUE(contains(table.render(t0 + sec), "2 messages not shown (2 not signed); last: SPINDOWN.b.FIT"))
+      << table.render(t0 + sec);
 }
 
 TEST(LabTable, BridgeStatusGoesToItsBenchServicesToTheirOwnRows) {

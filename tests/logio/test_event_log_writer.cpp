@@ -90,7 +90,7 @@ std::vector<status_t> status_events(const std::vector<ReadEvent>& all, const std
   std::vector<status_t> out;
   for (const auto& e : all)
     if (e.channel == status_channel) {
-      status_t st;
+      status_t st{};
       EXPECT_GE(st.decode(e.data.data(), 0, static_cast<int>(e.data.size())), 0);
       out.push_back(st);
     }
@@ -542,7 +542,7 @@ TEST(StatusHeartbeat, PublishesOnLcm) {
   // dispatch reports a null subscription pointer inside LCM's own header.
   std::vector<status_t> got;
   auto on_status = [](const lcm_recv_buf_t* rbuf, const char*, void* user) {
-    status_t st;
+    status_t st{};
     if (st.decode(rbuf->data, 0, static_cast<int>(rbuf->data_size)) >= 0)
       static_cast<std::vector<status_t>*>(user)->push_back(st);
   };

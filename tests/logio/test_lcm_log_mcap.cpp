@@ -38,7 +38,7 @@ RunFit sample_fit() {
 }
 
 samples_t samples(const std::string& bench, std::int64_t seq, int n, std::int64_t t0_us, bool with_adc) {
-  samples_t m;
+  samples_t m{};
   m.utime = 1'700'000'000'000'000 + t0_us + 5000;
   m.bench = bench;
   m.seq = seq;
@@ -112,7 +112,7 @@ class LcmLogMcap : public ::testing::Test {
     run.t_stop_s = NAN;
     testing::write_event(log, "SPINDOWN.b1.RUN", run, t += 1000);
     fit_ = sample_fit();
-    const fit_t fit = to_fit_message(fit_, {"b1", "config", 3, 4, 0.01, std::nullopt}, t);
+    const fit_t fit = to_fit_message(fit_, {"b1", "config", 3, 4, 0.01, std::nullopt, "", 0}, t);
     testing::write_event(log, "SPINDOWN.b1.FIT", fit, t += 1000);
     // An event on FIT that is not a fit_t: reported, not exported.
     samples_t wrong = samples("b1", 0, 1, 0, true);

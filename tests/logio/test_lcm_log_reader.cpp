@@ -54,7 +54,7 @@ class LogWriter {
 
 samples_t batch(const std::string& bench, std::int64_t seq, std::int64_t t0_us, int n, double v0 = 2.0,
                 std::int32_t epoch = 0) {
-  samples_t m;
+  samples_t m{};
   m.utime = 1;
   m.bench = bench;
   m.seq = seq;
@@ -71,7 +71,7 @@ samples_t batch(const std::string& bench, std::int64_t seq, std::int64_t t0_us, 
 }
 
 config_t config(const std::string& bench, double j = 1.12687602e-5) {
-  config_t c;
+  config_t c{};
   c.utime = 1;
   c.bench = bench;
   c.inertia_kg_m2 = j;
@@ -196,7 +196,7 @@ TEST(LcmLogReader, SyntheticRunSurvivesTheLog) {
     LogWriter w(f.path);
     w.write("SPINDOWN.lab1.CONFIG", config("lab1"));
     for (std::size_t i = 0; i < run.t_ms.size(); i += 10) {
-      samples_t m;
+      samples_t m{};
       m.bench = "lab1";
       m.seq = static_cast<std::int64_t>(i);
       m.quantity = samples_t::QUANTITY_BACK_EMF_V;

@@ -60,7 +60,7 @@ TEST(LogRefit, SameRunsAndNumbersAsTheCoreFedDirectly) {
   core.finish(utime);
   ASSERT_EQ(sink.fits.size(), 2u);
 
-  const fit_t live = to_fit_message(sink.fits[0].fit, FitProvenance{"a", "config", 0, 0, 0, std::nullopt}, 0);
+  const fit_t live = to_fit_message(sink.fits[0].fit, FitProvenance{"a", "config", 0, 0, 0, std::nullopt, "", 0}, 0);
   TempLog f;
   write_log(f.path, s, &live);
   const LogRefit r = refit_log(f.path, FitterOptions{}, true);

@@ -75,7 +75,7 @@ inline samples_t batch(const std::string& bench, const Stream& s, std::size_t fr
 }
 
 inline config_t config(const std::string& bench, double j) {
-  config_t c;
+  config_t c{};
   c.bench = bench;
   c.inertia_kg_m2 = j;
   c.inertia_source = "test geometry";

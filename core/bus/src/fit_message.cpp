@@ -21,7 +21,7 @@ bool fail(std::string* why, std::string text) {
 }  // namespace
 
 fit_t to_fit_message(const RunFit& fit, const FitProvenance& about, std::int64_t utime) {
-  fit_t m;
+  fit_t m{};
   m.utime = utime;
   m.bench = about.bench;
   m.run = fit.run.number;
@@ -115,6 +115,8 @@ fit_t to_fit_message(const RunFit& fit, const FitProvenance& about, std::int64_t
         ++m.ncorrelations;
       }
   }
+  m.bridge_host = about.bridge_host;
+  m.bridge_session = static_cast<std::int64_t>(about.bridge_session);
   return m;
 }
 
@@ -286,7 +288,7 @@ std::optional<Json> fit_message_json(const fit_t& msg, const ReportOptions& opt,
 
 run_t to_run_message(std::string_view bench, const Run& run, std::int8_t state, std::int64_t first_seq,
                      std::int64_t last_seq, std::int32_t samples, std::string note, std::int64_t utime) {
-  run_t m;
+  run_t m{};
   m.utime = utime;
   m.bench = std::string(bench);
   m.run = run.number;

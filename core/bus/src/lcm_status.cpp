@@ -56,7 +56,7 @@ void StatusHeartbeat::mark_sent(std::int64_t now_us) {
 }
 
 status_t StatusHeartbeat::message(std::int64_t now_us) const {
-  status_t st;
+  status_t st{};
   st.utime = now_us;
   st.service = service_;
   st.instance = instance_;

@@ -104,4 +104,15 @@ std::string with_receive_buffer(std::string url, long bytes) {
   return url + (url.find('?') == std::string::npos ? "?" : "&") + fmt::format("recv_buf_size={}", bytes);
 }
 
+std::string lcm_destination(const std::string& url) {
+  std::string effective = url;
+  if (effective.empty()) {
+    const char* env = std::getenv("LCM_DEFAULT_URL");
+    effective = env && *env ? std::string(env) : std::string(lcm_builtin_default_url);
+  }
+  const auto parsed = parse_lcm_url(effective);
+  if (!parsed || parsed->provider != "udpm") return {};
+  return parsed->address + ":" + std::to_string(parsed->port);
+}
+
 }  // namespace spindown

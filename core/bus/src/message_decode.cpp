@@ -3,11 +3,13 @@
 #include <array>
 #include <bit>
 #include <cstddef>
+#include <cstring>
 #include <exception>
 #include <fmt/format.h>
 #include <limits>
 #include <span>
 #include <string_view>
+#include <vector>
 
 namespace spindown {
 
@@ -22,7 +24,15 @@ struct WireField {
   std::string_view name;
   Wire wire;
   int count_of = -1;  // index of the earlier int32 field holding the array length; -1: scalar
+  int fixed = 0;      // > 0: a fixed-size array of this many (byte auth[32])
 };
+
+// The seven fields that end every type (lcmtypes/*.lcm: who sent it and its signature).
+#define SPINDOWN_TRAILER_FIELDS                                                                     \
+  {"lab", Wire::string}, {"sent_to", Wire::string}, {"source_host", Wire::string},                  \
+      {"source_session", Wire::i64}, {"source_seq", Wire::i64}, {"auth_key_id", Wire::i32},         \
+      {"auth", Wire::i8, -1, message_auth_bytes}
+constexpr std::size_t trailer_field_count = 7;
 
 constexpr std::int64_t fixed_bytes(Wire w) {
   switch (w) {
@@ -50,8 +60,15 @@ bool fail(std::string* why, std::string text) {
   return false;
 }
 
+constexpr std::size_t max_fields = 96;
+
+// Offsets of a walk: each field's, then the end of the last one.
+using Positions = std::array<std::int64_t, max_fields + 1>;
+
+// Walks the encoding field by field; positions, when given, receives each field's byte offset and
+// then the end of the last one (at index fields.size()).
 bool walk(std::string_view type, std::uint64_t expected_hash, std::span<const WireField> fields,
-          const void* data, std::int64_t size, std::string* why) {
+          const void* data, std::int64_t size, std::string* why, Positions* positions = nullptr) {
   if (data == nullptr && size != 0) return fail(why, fmt::format("{}: no data", type));
   if (size < hash_bytes) return fail(why, fmt::format("{} bytes, too short for {}", size, type));
   if (size > std::numeric_limits<int>::max())
@@ -62,11 +79,12 @@ bool walk(std::string_view type, std::uint64_t expected_hash, std::span<const Wi
     return fail(why, fmt::format("not a {} (type fingerprint {:#018x}, expected {:#018x})", type, hash,
                                  expected_hash));
 
-  std::array<std::int64_t, 64> ints{};  // int32 scalars by field index (array counts)
+  std::array<std::int64_t, max_fields> ints{};  // int32 scalars by field index (array counts)
   std::int64_t pos = hash_bytes;
   for (std::size_t i = 0; i < fields.size(); ++i) {
     const WireField& f = fields[i];
-    std::int64_t n = 1;
+    if (positions) (*positions)[i] = pos;
+    std::int64_t n = f.fixed > 0 ? f.fixed : 1;
     if (f.count_of >= 0) {
       n = ints[static_cast<std::size_t>(f.count_of)];
       if (n < 0)
@@ -107,6 +125,7 @@ bool walk(std::string_view type, std::uint64_t expected_hash, std::span<const Wi
       pos += len;
     }
   }
+  if (positions) (*positions)[fields.size()] = pos;
   return true;
 }
 
@@ -115,6 +134,7 @@ constexpr WireField samples_fields[] = {
     {"clock_epoch", Wire::i32},  {"quantity", Wire::i8},           {"n", Wire::i32},
     {"device_time_us", Wire::i64, 5}, {"host_time_us", Wire::i64, 5}, {"value", Wire::f64, 5},
     {"raw_adc", Wire::i32, 5},
+    SPINDOWN_TRAILER_FIELDS,
 };
 
 constexpr WireField config_fields[] = {
@@ -124,12 +144,15 @@ constexpr WireField config_fields[] = {
     {"firmware", Wire::string},     {"protocol", Wire::string},     {"sample_period_s", Wire::f64},
     {"baud", Wire::i32},            {"device", Wire::string},       {"host", Wire::string},
     {"inertia_rel_error", Wire::f64}, {"kb_rel_error", Wire::f64},
+    SPINDOWN_TRAILER_FIELDS,
 };
 
 constexpr WireField run_fields[] = {
     {"utime", Wire::i64},     {"bench", Wire::string},  {"run", Wire::i32},      {"state", Wire::i8},
     {"t_cut_s", Wire::f64},   {"t_stop_s", Wire::f64},  {"first_seq", Wire::i64}, {"last_seq", Wire::i64},
     {"samples", Wire::i32},   {"note", Wire::string},   {"lead_in", Wire::string},
+    {"bridge_host", Wire::string},  {"bridge_session", Wire::i64},
+    SPINDOWN_TRAILER_FIELDS,
 };
 
 constexpr WireField status_fields[] = {
@@ -148,6 +171,8 @@ constexpr WireField status_fields[] = {
     {"gauge_value", Wire::f64, 10},    // 12
     {"last_error", Wire::string},      // 13
     {"last_error_utime", Wire::i64},   // 14
+    {"start_utime", Wire::i64},        // 15
+    SPINDOWN_TRAILER_FIELDS,
 };
 
 constexpr WireField fit_fields[] = {
@@ -218,6 +243,9 @@ constexpr WireField fit_fields[] = {
     {"kb_rel_error", Wire::f64},                    // 64
     {"param_bench_error", Wire::f64, 19},           // 65
     {"reading_noise", Wire::f64},                   // 66
+    {"bridge_host", Wire::string},                  // 67
+    {"bridge_session", Wire::i64},                  // 68
+    SPINDOWN_TRAILER_FIELDS,
 };
 
 constexpr WireField explain_fields[] = {
@@ -247,31 +275,96 @@ constexpr WireField explain_fields[] = {
     {"param_stderr", Wire::f64, 20},         // 23
     {"param_unit", Wire::string, 20},        // 24
     {"story", Wire::string},                 // 25
+    SPINDOWN_TRAILER_FIELDS,
+};
+
+// Each type: its layout, and the fingerprint and field count of its encoding before issue 31
+// appended the source and signature fields (what spindown wrote until then: those logs still
+// read, their messages with the new fields empty).
+struct TypeInfo {
+  std::string_view name;
+  std::uint64_t hash;
+  std::span<const WireField> fields;
+  std::uint64_t legacy_hash;
+  std::size_t legacy_fields;
 };
 
 template <class Msg>
-std::span<const WireField> layout_of();
-template <>
-std::span<const WireField> layout_of<samples_t>() { return samples_fields; }
-template <>
-std::span<const WireField> layout_of<config_t>() { return config_fields; }
-template <>
-std::span<const WireField> layout_of<run_t>() { return run_fields; }
-template <>
-std::span<const WireField> layout_of<status_t>() { return status_fields; }
-template <>
-std::span<const WireField> layout_of<fit_t>() { return fit_fields; }
-template <>
-std::span<const WireField> layout_of<explain_t>() { return explain_fields; }
+const TypeInfo& type_info();
+#define SPINDOWN_TYPE_INFO(T, layout, old_hash, old_fields)                                          \
+  template <>                                                                                      \
+  const TypeInfo& type_info<T>() {                                                                 \
+    static_assert(std::size(layout) <= max_fields);                                                \
+    static const TypeInfo info{T::getTypeName(), static_cast<std::uint64_t>(T::getHash()), layout, \
+                               old_hash, old_fields};                                              \
+    return info;                                                                                   \
+  }
+SPINDOWN_TYPE_INFO(samples_t, samples_fields, 0x6366464c24ab26e1ull, 10)
+SPINDOWN_TYPE_INFO(config_t, config_fields, 0xf33bcecf4e9c80bdull, 17)
+SPINDOWN_TYPE_INFO(run_t, run_fields, 0x52fa3d633257d3efull, 11)
+SPINDOWN_TYPE_INFO(fit_t, fit_fields, 0x9a6ae2b7c7c8e61cull, 67)
+SPINDOWN_TYPE_INFO(explain_t, explain_fields, 0x8e7064d4b8398716ull, 26)
+SPINDOWN_TYPE_INFO(status_t, status_fields, 0x056ac82d6252dc21ull, 15)
+#undef SPINDOWN_TYPE_INFO
+
+const TypeInfo* type_of_hash(std::uint64_t hash, bool* legacy) {
+  for (const TypeInfo* t : {&type_info<samples_t>(), &type_info<config_t>(), &type_info<run_t>(),
+                            &type_info<fit_t>(), &type_info<explain_t>(), &type_info<status_t>()}) {
+    if (hash == t->hash || hash == t->legacy_hash) {
+      *legacy = hash == t->legacy_hash;
+      return t;
+    }
+  }
+  return nullptr;
+}
+
+std::uint64_t hash_of(const void* data, std::int64_t size) {
+  return data != nullptr && size >= hash_bytes ? be64u(static_cast<const unsigned char*>(data)) : 0;
+}
+
+// The walk of either encoding of a type: the legacy one is the current layout without the
+// appended fields. legacy tells which it was.
+bool walk_type(const TypeInfo& t, const void* data, std::int64_t size, std::string* why, bool* legacy,
+               Positions* positions = nullptr) {
+  *legacy = size >= hash_bytes && data != nullptr && hash_of(data, size) == t.legacy_hash;
+  if (*legacy) return walk(t.name, t.legacy_hash, t.fields.first(t.legacy_fields), data, size, why, positions);
+  return walk(t.name, t.hash, t.fields, data, size, why, positions);
+}
+
+// The encoding of a field the legacy encoding lacks, at its default (all appended fields are
+// scalars or fixed arrays): "" for a string, zeros otherwise.
+void append_default(std::vector<unsigned char>& out, const WireField& f) {
+  if (f.wire == Wire::string) {
+    const unsigned char empty[5] = {0, 0, 0, 1, 0};
+    out.insert(out.end(), empty, empty + 5);
+    return;
+  }
+  out.insert(out.end(), static_cast<std::size_t>(fixed_bytes(f.wire) * (f.fixed > 0 ? f.fixed : 1)), 0);
+}
 
 template <class Msg>
 bool check_impl(const void* data, std::int64_t size, std::string* why) {
-  return walk(Msg::getTypeName(), static_cast<std::uint64_t>(Msg::getHash()), layout_of<Msg>(), data, size, why);
+  bool legacy = false;
+  return walk_type(type_info<Msg>(), data, size, why, &legacy);
 }
 
 template <class Msg>
 bool decode_impl(Msg& msg, const void* data, std::int64_t size, std::string* why) {
-  if (!check_impl<Msg>(data, size, why)) return false;
+  const TypeInfo& t = type_info<Msg>();
+  bool legacy = false;
+  Positions positions;
+  if (!walk_type(t, data, size, why, &legacy, &positions)) return false;
+  std::vector<unsigned char> upgraded;
+  if (legacy) {  // the current encoding of the same message: its fields, then the new ones empty
+    const auto* d = static_cast<const unsigned char*>(data);
+    const std::int64_t end = positions[t.legacy_fields];
+    upgraded.reserve(static_cast<std::size_t>(end) + 128);
+    for (int k = 56; k >= 0; k -= 8) upgraded.push_back(static_cast<unsigned char>(t.hash >> k));
+    upgraded.insert(upgraded.end(), d + hash_bytes, d + end);
+    for (std::size_t i = t.legacy_fields; i < t.fields.size(); ++i) append_default(upgraded, t.fields[i]);
+    data = upgraded.data();
+    size = static_cast<std::int64_t>(upgraded.size());
+  }
   try {
     if (msg.decode(data, 0, static_cast<int>(size)) < 0)
       return fail(why, fmt::format("{}: {} bytes do not decode", Msg::getTypeName(), size));
@@ -285,8 +378,10 @@ bool decode_impl(Msg& msg, const void* data, std::int64_t size, std::string* why
 
 bool view_samples_message_worded(SamplesView& view, const void* data, std::int64_t size, std::string* why) {
   const auto* d = static_cast<const unsigned char*>(data);
+  const TypeInfo& t = type_info<samples_t>();
+  const bool legacy = d != nullptr && size >= hash_bytes && be64u(d) == t.legacy_hash;
   if (d == nullptr || size < hash_bytes || size > std::numeric_limits<int>::max() ||
-      be64u(d) != static_cast<std::uint64_t>(samples_t::getHash())) {
+      (be64u(d) != t.hash && !legacy)) {
     check_impl<samples_t>(data, size, why);  // rejects it, in its own words
     return false;
   }
@@ -301,7 +396,27 @@ bool view_samples_message_worded(SamplesView& view, const void* data, std::int64
   constexpr std::int64_t bytes_per_sample = 8 + 8 + 8 + 4;
   if (n < 0 || n * bytes_per_sample > size - n_at - 4)
     return fail(why, fmt::format("sample count {} does not fit in {} bytes (truncated or damaged)", n, size));
-  fill_samples_view(view, d, bench_len, n_at, n);
+  const std::int64_t trailer_at = n_at + 4 + n * bytes_per_sample;
+  if (legacy) {
+    fill_samples_view(view, d, bench_len, n_at, n, -1, 0, 0, 0);
+    return true;
+  }
+  if (trailer_at + 4 > size)
+    return fail(why, fmt::format("truncated: {} bytes end before the source fields (lab, host, session)", size));
+  const std::int64_t lab_len = be32(d + trailer_at);
+  if (lab_len < 1 || lab_len > size - trailer_at - 8)
+    return fail(why, fmt::format("lab string length {} does not fit in {} bytes", lab_len, size));
+  const std::int64_t to_at = trailer_at + 4 + lab_len;
+  const std::int64_t to_len = be32(d + to_at);
+  if (to_len < 1 || to_len > size - to_at - 8)
+    return fail(why, fmt::format("sent_to string length {} does not fit in {} bytes", to_len, size));
+  const std::int64_t host_at = to_at + 4 + to_len;
+  const std::int64_t host_len = be32(d + host_at);
+  constexpr std::int64_t trailer_fixed = 8 + 8 + 4 + message_auth_bytes;
+  if (host_len < 1 || host_len > size - host_at - 4 - trailer_fixed)
+    return fail(why, fmt::format("source_host string length {} does not fit in {} bytes (truncated or damaged)",
+                                 host_len, size));
+  fill_samples_view(view, d, bench_len, n_at, n, trailer_at, lab_len, to_len, host_len);
   return true;
 }
 
@@ -323,6 +438,48 @@ void samples_from_view(const SamplesView& view, samples_t& m) {
     m.value[i] = view.value(static_cast<std::int32_t>(i));
     m.raw_adc[i] = be32(view.raw_adc_bytes + 4 * i);
   }
+  m.lab.assign(view.lab);
+  m.sent_to.assign(view.sent_to);
+  m.source_host.assign(view.source_host);
+  m.source_session = static_cast<std::int64_t>(view.source_session);
+  m.source_seq = view.source_seq;
+  m.auth_key_id = view.auth_key_id;
+  if (view.auth)
+    std::memcpy(m.auth, view.auth, sizeof m.auth);
+  else
+    std::memset(m.auth, 0, sizeof m.auth);
+}
+
+bool read_message_trailer(const void* data, std::int64_t size, MessageTrailer& out, std::string* why) {
+  out = MessageTrailer{};
+  if (data == nullptr || size < hash_bytes)
+    return fail(why, fmt::format("{} bytes, too short for a spindown message", std::max<std::int64_t>(size, 0)));
+  bool legacy = false;
+  const TypeInfo* t = type_of_hash(hash_of(data, size), &legacy);
+  if (!t)
+    return fail(why, fmt::format("not a spindown message (type fingerprint {:#018x})", hash_of(data, size)));
+  Positions at;  // each field's offset, then the end
+  if (!walk_type(*t, data, size, why, &legacy, &at)) return false;
+  const auto* d = static_cast<const unsigned char*>(data);
+  out.type = t->name;
+  out.legacy = legacy;
+  out.end = at[legacy ? t->legacy_fields : t->fields.size()];
+  out.utime = static_cast<std::int64_t>(be64u(d + hash_bytes));  // every type starts with utime
+  if (legacy) return true;
+  const std::size_t first = t->fields.size() - trailer_field_count;
+  auto string_at = [&](std::size_t field) {
+    const std::int64_t p = at[field];
+    return std::string_view(reinterpret_cast<const char*>(d + p + 4), static_cast<std::size_t>(be32(d + p) - 1));
+  };
+  out.lab = string_at(first);
+  out.sent_to = string_at(first + 1);
+  out.source_host = string_at(first + 2);
+  out.source_session = be64u(d + at[first + 3]);
+  out.source_seq = static_cast<std::int64_t>(be64u(d + at[first + 4]));
+  out.auth_key_id = be32(d + at[first + 5]);
+  out.auth_offset = at[first + 6];
+  out.auth = d + out.auth_offset;
+  return true;
 }
 
 #define SPINDOWN_DEFINE_MESSAGE_DECODE(T)                                                      \

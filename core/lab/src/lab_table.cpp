@@ -49,6 +49,7 @@ std::string fit_text(const LabBenchRow& r) {
   if (!r.has_fit) return "-";
   if (r.best.empty()) return fmt::format("run {}: no model converged", r.fit_run);
   std::string s = fmt::format("run {}{} {}", r.fit_run, r.fit_partial ? " (partial)" : "", r.best);
+  if (!r.fit_doubt.empty()) s += " NOT VERIFIED";
   if (!r.coefficients.empty()) s += ": " + r.coefficients;
   if (r.bench_source != "config" && !r.bench_source.empty()) s += " (default J/K_b)";
   if (!r.health.empty()) s += "; health " + r.health;
@@ -84,6 +85,7 @@ std::string fit_short(const LabBenchRow& r) {
   if (!r.has_fit) return "-";
   if (r.best.empty()) return fmt::format("run {}: no model converged", r.fit_run);
   std::string s = fmt::format("{}{} {}", r.fit_run, r.fit_partial ? " (partial)" : "", r.best);
+  if (!r.fit_doubt.empty()) s += " NOT VERIFIED";
   if (const std::string rmse = rmse_text(r); rmse != "-") s += " " + rmse;
   if (!r.health.empty()) s += "; " + r.health;
   if (!r.coefficients.empty()) s += "; " + r.coefficients;
@@ -184,6 +186,7 @@ LabBenchRow& LabTable::row(std::string_view bench, std::int64_t now_us) {
     }
     it = benches_.emplace(std::string(bench), LabBenchRow{}).first;
     it->second.bench = std::string(bench);
+    it->second.stream.options = opt_.stream;
   }
   it->second.last_message_us = std::max(it->second.last_message_us, now_us);
   changed_ = true;
@@ -206,24 +209,45 @@ std::vector<std::string> LabTable::take_events() {
 
 void LabTable::on_samples(std::string_view bench, const samples_t& msg, std::int64_t now_us) {
   LabBenchRow& r = row(bench, now_us);
-  const std::int64_t n = std::max<std::int32_t>(0, msg.n);
-  if (r.has_samples && r.sample_messages > 0) {
-    if (msg.seq > r.next_seq) {
-      ++r.seq_gaps;
-      r.samples_missing += msg.seq - r.next_seq;
-    } else if (msg.seq < r.next_seq) {
-      // Back before what we saw: a repeat (ignored) or a restarted bridge (seq from 0 again).
-      if (msg.seq + n <= r.next_seq && msg.seq != 0) return;
-      if (msg.seq == 0) {
-        ++r.seq_restarts;
-        event(fmt::format("{}: sample sequence restarted (bridge restarted?)", r.bench));
+  if (msg.auth_key_id != 0) signed_traffic_ = true;
+  // The fitter's rules (sample_stream.hpp): its words for a new source, two at once, a far jump.
+  struct Sink {
+    LabTable& table;
+    LabBenchRow& r;
+    std::int64_t now_us;
+    void problem(SampleProblem kind, std::int64_t count, std::string text) {
+      switch (kind) {
+        case SampleProblem::samples_lost:
+          ++r.seq_gaps;
+          r.samples_missing += count;
+          return;
+        case SampleProblem::new_source:
+          ++r.seq_restarts;
+          table.event(fmt::format("{}: {}", r.bench, text));
+          return;
+        case SampleProblem::two_sources:
+          r.two_sources = fmt::format("SPINDOWN.{}.SAMPLE {}", r.bench, text);
+          r.other_source_us = now_us;
+          table.event(r.two_sources);
+          return;
+        case SampleProblem::other_source:
+          r.other_source_samples += count;
+          r.other_source_us = now_us;
+          return;
+        case SampleProblem::jump:
+          ++r.seq_jumps;
+          table.event(fmt::format("{}: {}", r.bench, text));
+          return;
+        default: return;  // repeats, restarts, NaN…: the fitter's STATUS counts them
       }
     }
-  }
+    void sample(std::int64_t, std::int64_t, double) { ++r.samples; }
+  };
+  const auto n = static_cast<std::size_t>(std::max<std::int32_t>(0, std::min<std::int32_t>(
+                                              msg.n, static_cast<std::int32_t>(std::min(msg.device_time_us.size(),
+                                                                                          msg.value.size())))));
+  if (r.stream.take(msg, n, now_us, Sink{*this, r, now_us})) ++r.sample_messages;
   r.has_samples = true;
-  ++r.sample_messages;
-  r.samples += n;
-  r.next_seq = msg.seq + n;
   const double since = 1e-6 * double(now_us - r.last_gap_event_us);
   if (r.seq_gaps > r.gaps_at_last_event && (r.last_gap_event_us == 0 || since >= opt_.gap_event_every_s)) {
     event(fmt::format("{}: sequence gaps: {} so far, {} samples lost on the way to this listener", r.bench,
@@ -286,6 +310,18 @@ void LabTable::on_fit(std::string_view bench, const fit_t& msg, std::int64_t now
   r.bench_source = msg.bench_source;
   r.health = msg.verdict;
   r.health_reason = msg.verdict_reason;
+  // Who published it: with signatures checked, the gate let only the lab's own through; without,
+  // a signed FIT cannot be checked here, and one from a session no fitter heard on STATUS has is
+  // not the lab fitter's (a forged FIT, or a fitter of another name).
+  r.fit_doubt.clear();
+  const auto session = static_cast<std::uint64_t>(msg.source_session);
+  if (msg.auth_key_id != 0) signed_traffic_ = true;
+  if (!opt_.signatures_checked && msg.auth_key_id != 0) {
+    r.fit_doubt = "signed, signature not checked (watch --key)";
+  } else if (!opt_.signatures_checked && !fitter_sessions_.empty() && session != 0 &&
+             std::find(fitter_sessions_.begin(), fitter_sessions_.end(), session) == fitter_sessions_.end()) {
+    r.fit_doubt = fmt::format("from {}, no fitter heard on STATUS: forged?", source_text(msg.source_host, session));
+  }
   std::string text;
   if (msg.best.empty()) {
     text = fmt::format("{}: run {} fit: no model converged", r.bench, msg.run);
@@ -297,6 +333,7 @@ void LabTable::on_fit(std::string_view bench, const fit_t& msg, std::int64_t now
   }
   if (!msg.bench_source.empty() && msg.bench_source != "config") text += fmt::format(" [J/K_b: {}]", msg.bench_source);
   if (!msg.verdict.empty()) text += fmt::format("; health {}: {}", msg.verdict, msg.verdict_reason);
+  if (!r.fit_doubt.empty()) text += fmt::format(" [NOT VERIFIED: {}]", r.fit_doubt);
   event(std::move(text));
 }
 
@@ -315,7 +352,15 @@ void LabTable::on_status(std::string_view channel_id, const status_t& msg, std::
     if (before != msg.state) event(fmt::format("{}: bridge {}", r.bench, msg.state));
     return;
   }
-  const std::string key = fmt::format("{}/{}", msg.service, msg.instance.empty() ? channel_id : msg.instance);
+  const std::string instance_name = msg.instance.empty() ? std::string(channel_id) : msg.instance;
+  const std::string key = fmt::format("{}/{}", msg.service, instance_name);
+  if (msg.service == "fitter" && msg.source_session != 0) {
+    const auto session = static_cast<std::uint64_t>(msg.source_session);
+    if (std::find(fitter_sessions_.begin(), fitter_sessions_.end(), session) == fitter_sessions_.end()) {
+      if (fitter_sessions_.size() >= 64) fitter_sessions_.erase(fitter_sessions_.begin());
+      fitter_sessions_.push_back(session);
+    }
+  }
   auto it = services_.find(key);
   if (it == services_.end()) {
     if (opt_.max_services > 0 && services_.size() >= opt_.max_services) {
@@ -325,10 +370,14 @@ void LabTable::on_status(std::string_view channel_id, const status_t& msg, std::
       services_.erase(oldest);
       ++forgotten_rows_;
     }
-    it = services_.emplace(key, LabServiceRow{}).first;
+    it = services_.emplace(key, LabServiceRow(msg.service, instance_name)).first;
     event(fmt::format("{} {} on {} (pid {}): {}", msg.service, msg.instance, msg.host, msg.pid, msg.state));
   }
   LabServiceRow& s = it->second;
+  if (auto collision = s.instances.heard(msg, now_us)) {
+    s.collision = *collision;
+    event(*collision);
+  }
   if (!s.state.empty() && s.state != msg.state)
     event(fmt::format("{} {}: {}", msg.service, msg.instance, msg.state));
   if (!msg.last_error.empty() && msg.last_error != s.last_error)
@@ -358,6 +407,17 @@ void LabTable::on_status(std::string_view channel_id, const status_t& msg, std::
   changed_ = true;
 }
 
+void LabTable::on_refused(const GateResult& g, std::int64_t) {
+  ++refused_;
+  const std::string kind(gate_verdict_name(g.verdict));
+  ++refused_by_kind_[kind];
+  // The first of each kind on each channel is an event (bounded: a flood of channels stops adding).
+  const std::string where = kind + " " + g.text.substr(0, g.text.find(':'));
+  if (refused_said_.size() < 256 && refused_said_.insert(where).second) event("not shown: " + g.text);
+  last_refused_ = g.text;
+  changed_ = true;
+}
+
 void LabTable::on_bad_message(std::string text, std::int64_t) {
   ++bad_messages_;
   if (bad_messages_ == 1) event(text);
@@ -375,6 +435,15 @@ std::string LabTable::render(std::int64_t now_us, std::size_t width) const {
                                   services_.size(), services_.size() == 1 ? "" : "s"),
                       width) +
          '\n';
+  if (signed_traffic_ && !opt_.signatures_checked)
+    out += cut_to_width("signed lab traffic, signatures NOT checked: run with --key FILE (the lab key) to see only the "
+                        "lab's own messages",
+                        width) +
+           '\n';
+  // A second source on a bench's SAMPLE channel heard lately: said in its row and under the table.
+  const auto two_sources_now = [&](const LabBenchRow& r) {
+    return !r.two_sources.empty() && now_us - r.other_source_us <= static_cast<std::int64_t>(opt_.stale_s * 1e6);
+  };
   std::vector<std::vector<std::string>> rows;
   // Health first, the long fit last: a narrow terminal cuts only the end of the coefficients.
   // Below compact_width columns (an 80-column terminal) the columns are short and the last fit
@@ -382,15 +451,22 @@ std::string LabTable::render(std::int64_t now_us, std::size_t width) const {
   if (width > 0 && width < compact_width) {
     rows.push_back({"BENCH", "RUN", "AGE", "BRIDGE", "GAPS", "LAST FIT"});
     for (const auto& [id, r] : benches_)
-      rows.push_back({id, run_state_text(r), age_text(r.last_message_us, now_us, opt_.stale_s), bridge_short(r),
+      rows.push_back({id, run_state_text(r), age_text(r.last_message_us, now_us, opt_.stale_s),
+                      bridge_short(r) + (two_sources_now(r) ? " 2 SOURCES" : ""),
                       r.has_samples ? fmt::format("{}", r.seq_gaps) : "-", fit_short(r)});
   } else {
     rows.push_back({"BENCH", "RUN", "AGE", "BRIDGE (lines ok/bad, rate)", "SEQ GAPS", "RMSE", "LAST FIT (best model)"});
     for (const auto& [id, r] : benches_)
-      rows.push_back({id, run_state_text(r), age_text(r.last_message_us, now_us, opt_.stale_s), bridge_text(r),
-                      gaps_text(r), rmse_text(r), fit_text(r)});
+      rows.push_back({id, run_state_text(r), age_text(r.last_message_us, now_us, opt_.stale_s),
+                      bridge_text(r) + (two_sources_now(r) ? " TWO SOURCES" : ""), gaps_text(r), rmse_text(r),
+                      fit_text(r)});
   }
   out += format_columns(rows, width);
+  for (const auto& [id, r] : benches_) {
+    if (two_sources_now(r)) out += cut_to_width("  " + r.two_sources, width) + '\n';
+    if (!r.fit_doubt.empty())
+      out += cut_to_width(fmt::format("  {}: run {} fit NOT VERIFIED: {}", id, r.fit_run, r.fit_doubt), width) + '\n';
+  }
   if (benches_.empty()) out += "(no bench heard yet)\n";
   if (!benches_.empty())
     out += cut_to_width(opt_.lab_units ? "coefficients in g·cm²·s⁻¹ (c1, c3) and g·cm²·rad·s⁻² (c2, c4)"
@@ -400,19 +476,33 @@ std::string LabTable::render(std::int64_t now_us, std::size_t width) const {
   if (!services_.empty()) {
     std::vector<std::vector<std::string>> srows;
     srows.push_back({"SERVICE", "STATE", "HOST/PID", "COUNTERS", "AGE"});
-    for (const auto& [key, s] : services_)
-      srows.push_back({s.service + " " + s.instance, s.state, fmt::format("{}/{}", s.host, s.pid), counters_text(s),
+    for (const auto& [key, s] : services_) {
+      const std::size_t alive = s.instances.alive(now_us).size();
+      srows.push_back({s.service + " " + s.instance, alive > 1 ? fmt::format("{} INSTANCES!", alive) : s.state,
+                       fmt::format("{}/{}", s.host, s.pid), counters_text(s),
                        age_text(s.last_message_us, now_us, opt_.stale_s)});
+    }
     out += '\n' + format_columns(srows, width);
-    for (const auto& [key, s] : services_)
+    for (const auto& [key, s] : services_) {
+      if (s.instances.alive(now_us).size() > 1 && !s.collision.empty())
+        out += cut_to_width("  " + s.collision, width) + '\n';
       if (!s.last_error.empty())
         out += cut_to_width(fmt::format("  {} {}: last error: {}", s.service, s.instance, s.last_error), width) + '\n';
+    }
   }
   if (bad_messages_ > 0)
     out += cut_to_width(fmt::format("{} undecodable message{}; last: {}", bad_messages_, bad_messages_ == 1 ? "" : "s",
                                     last_bad_message_),
                         width) +
            '\n';
+  if (refused_ > 0) {
+    std::string kinds;
+    for (const auto& [kind, count] : refused_by_kind_) kinds += fmt::format("{}{} {}", kinds.empty() ? "" : ", ", count, kind);
+    out += cut_to_width(fmt::format("{} message{} not shown ({}); last: {}", refused_, refused_ == 1 ? "" : "s", kinds,
+                                    last_refused_),
+                        width) +
+           '\n';
+  }
   return out;
 }
 

@@ -130,31 +130,37 @@ std::string running_ntp_client() {
   return {};
 }
 
-std::vector<HostSkew> listen_for_clocks(const std::string& url, double seconds) {
+LabListen listen_to_lab(const std::string& url, double seconds, const LabKey* key) {
+  LabListen out;
   ClockSkewTracker tracker;
   // LCM 1.3.1 prints its own multicast advice on stderr; the self-test above has reported it.
   QuietStderr quiet;
   LcmLoop loop(url);
-  if (!loop.good()) return {};
-  const auto received = [](const LcmMessage& r) { return r.recv_utime > 0 ? r.recv_utime : wall_us(); };
-  const LcmSubscribeOptions lab_channels{.queue_capacity = 10000,
-                                         .accept = [](std::string_view ch) { return parse_channel(ch).has_value(); }};
-  const bool subscribed =
-      loop.subscribe<status_t>(
-          "SPINDOWN\\..*\\.STATUS",
-          [&](const status_t& m, const LcmMessage& r) {
-            tracker.add(m.host, m.service + " " + m.instance, m.utime, received(r));
-          },
-          lab_channels) &&
-      loop.subscribe<config_t>(
-          "SPINDOWN\\..*\\.CONFIG",
-          [&](const config_t& m, const LcmMessage& r) { tracker.add(m.host, "bridge " + m.bench, m.utime, received(r)); },
-          lab_channels);
+  if (!loop.good()) return out;
+  const bool subscribed = loop.subscribe_raw(
+      "SPINDOWN\\..*",
+      [&](const LcmMessage& r) {
+        const std::int64_t received = r.recv_utime > 0 ? r.recv_utime : wall_us();
+        const auto parsed = parse_channel(r.channel);
+        if (!parsed) return;
+        status_t status{};
+        const bool is_status = parsed->kind == ChannelKind::status && decode_message(status, r.data, r.size);
+        if (is_status) tracker.add(status.host, status.service + " " + status.instance, status.utime, received);
+        if (parsed->kind == ChannelKind::config) {
+          config_t config{};
+          if (decode_message(config, r.data, r.size))
+            tracker.add(config.host, "bridge " + config.bench, config.utime, received);
+        }
+        out.traffic.add(r.channel, r.data, r.size, received, is_status ? &status : nullptr, key);
+      },
+      {.queue_capacity = 10000});
   // LCM 1.3.1: no receive socket after its own loopback self-test failed.
-  if (!subscribed || !loop.can_receive()) return {};
+  if (!subscribed || !loop.can_receive()) return out;
   quiet.restore();
   loop.run({.timeout_s = seconds, .max_wait_ms = 50, .max_failures = 0});
-  return tracker.hosts();
+  out.listened = true;
+  out.clocks = tracker.hosts();
+  return out;
 }
 
 }  // namespace spindown

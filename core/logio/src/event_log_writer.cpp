@@ -373,25 +373,28 @@ void EventLogWriter::fail_text(std::int64_t now_us, std::string text) {
 void EventLogWriter::track_samples(std::string_view channel, const void* data, std::int32_t size) {
   const auto parsed = parse_channel(channel);
   if (!parsed || parsed->kind != ChannelKind::sample) return;
-  samples_t s;
+  samples_t s{};
   if (size <= 0 || !decode_message(s, data, size)) {  // layout checked first: no allocation bombs
     ++counters_.decode_errors;
     return;
   }
-  auto it = next_seq_.find(parsed->bench);
+  // Per bench and bridge session: a restarted bridge (a new session) numbers from 0 again without
+  // being a repeat.
+  const std::string key = parsed->bench + "/" + std::to_string(s.source_session);
+  auto it = next_seq_.find(key);
   if (it == next_seq_.end()) {
     if (next_seq_.size() >= o_.max_tracked_benches) {
       ++counters_.benches_untracked;
       return;
     }
-    next_seq_.emplace(parsed->bench, s.seq + std::max<std::int32_t>(s.n, 0));
+    next_seq_.emplace(key, s.seq + std::max<std::int32_t>(s.n, 0));
     return;
   }
   if (s.seq > it->second) {
     ++counters_.seq_gaps;
     counters_.samples_missing += s.seq - it->second;
   } else if (s.seq < it->second) {
-    ++counters_.seq_repeats;  // a restarted bridge or a duplicate: follow the new sequence
+    ++counters_.seq_repeats;  // a duplicate (or an unnamed bridge restarted): follow the new sequence
   }
   it->second = s.seq + std::max<std::int32_t>(s.n, 0);
 }

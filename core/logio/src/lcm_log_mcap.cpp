@@ -228,7 +228,7 @@ class Converter {
   }
 
   void run_message(Topic& t, const LcmLogEvent& ev) {
-    run_t m;
+    run_t m{};
     std::string why;
     if (!decode_message(m, ev.data, ev.data_size, &why)) {
       problem(ev, fmt::format("does not decode as run_t: {}; not exported", why));
@@ -250,7 +250,7 @@ class Converter {
   }
 
   void fit_message(Topic& t, const LcmLogEvent& ev) {
-    fit_t m;
+    fit_t m{};
     std::string why;
     if (!decode_message(m, ev.data, ev.data_size, &why)) {
       problem(ev, fmt::format("does not decode as fit_t: {}; not exported", why));

@@ -379,10 +379,11 @@ bool LcmLogContents::has_errors() const {
 namespace {
 
 struct BenchState {
-  BenchState(std::string bench, const std::string& path, std::size_t max_reports)
+  BenchState(std::string bench, const std::string& path, std::size_t max_reports, const SampleStreamOptions& o)
       : reporter(log.recording, max_reports) {
     log.bench = std::move(bench);
     log.recording.source = fmt::format("{} SPINDOWN.{}.SAMPLE", path, log.bench);
+    stream.options = o;
   }
   BenchLog log;
   text::LineReporter reporter;
@@ -414,11 +415,17 @@ void take_samples(BenchState& st, const LcmLogEvent& ev) {
         case SampleProblem::quantity_change:
         case SampleProblem::repeated: ++st.skipped_messages; break;
         case SampleProblem::sequence_restart: st.reporter.report(Diagnostic::Severity::note, event, text); return;
+        case SampleProblem::new_source: ++st.log.new_sources; [[fallthrough]];
         case SampleProblem::clock_restart:
           if (!rec.empty() && (rec.clock_restarts.empty() || rec.clock_restarts.back() != rec.size()))
             rec.clock_restarts.push_back(rec.size());
           st.reporter.report(Diagnostic::Severity::note, event, text);
           return;
+        case SampleProblem::two_sources:
+          st.reporter.warn(event, fmt::format("SPINDOWN.{}.SAMPLE {}", st.log.bench, text));
+          return;
+        case SampleProblem::other_source:
+        case SampleProblem::jump: break;
         case SampleProblem::bad_value:
         case SampleProblem::time_backwards: break;
       }
@@ -426,8 +433,26 @@ void take_samples(BenchState& st, const LcmLogEvent& ev) {
     }
     void sample(std::int64_t, std::int64_t t_us, double v) { rec.push(static_cast<double>(t_us) / 1e6, v); }
   };
-  st.stream.take(m, static_cast<std::size_t>(std::max(m.n, 0)), Sink{st, rec, ev.number});
+  st.stream.take(m, static_cast<std::size_t>(std::max(m.n, 0)), ev.log_utime, Sink{st, rec, ev.number});
   if (st.stream.quantity_known) rec.quantity = st.stream.quantity;
+}
+
+// The end of the log: what the stream still holds (sample_stream.hpp flush).
+void flush_samples(BenchState& st) {
+  Recording& rec = st.log.recording;
+  struct Sink {
+    BenchState& st;
+    Recording& rec;
+    void problem(SampleProblem kind, std::int64_t count, std::string text) {
+      if (kind == SampleProblem::samples_lost) st.log.samples_lost += count;
+      if (kind == SampleProblem::clock_restart && !rec.empty() &&
+          (rec.clock_restarts.empty() || rec.clock_restarts.back() != rec.size()))
+        rec.clock_restarts.push_back(rec.size());
+      st.reporter.warn(st.last_event, text);
+    }
+    void sample(std::int64_t, std::int64_t t_us, double v) { rec.push(static_cast<double>(t_us) / 1e6, v); }
+  };
+  st.stream.flush(Sink{st, rec});
 }
 
 void take_config(BenchState& st, const LcmLogEvent& ev) {
@@ -466,15 +491,31 @@ LcmLogContents read_lcm_log(const std::string& path, const LcmLogOptions& option
   auto bench = [&](std::string_view id) -> BenchState& {
     for (auto& b : benches)
       if (b->log.bench == id) return *b;
-    benches.push_back(std::make_unique<BenchState>(std::string(id), path, options.max_event_reports));
+    benches.push_back(std::make_unique<BenchState>(std::string(id), path, options.max_event_reports, options.stream));
     return *benches.back();
+  };
+  MessageGate gate(options.gate);
+  // The gate's verdict on a SAMPLE or CONFIG event; a refused one is named on its bench.
+  auto admitted = [&](const LcmLogEvent& e, std::string_view lab, std::string_view sent_to) {
+    if (gate.accepts_at_once(lab, sent_to)) return true;
+    const GateResult g = gate.check(e.channel, e.data, e.data_size, e.log_utime);
+    if (!g.refused()) return true;
+    BenchState& st = bench(e.bench);
+    ++st.log.refused_messages;
+    if (e.channel.ends_with(".SAMPLE")) ++st.skipped_messages, ++st.log.sample_messages;
+    st.reporter.warn(e.number, g.text);
+    return false;
   };
   std::size_t file_problems = 0;
   LcmLogEvent ev;
   while (reader.next(ev)) {
     switch (ev.kind) {
-      case LcmLogEvent::Kind::samples: take_samples(bench(ev.bench), ev); break;
-      case LcmLogEvent::Kind::config: take_config(bench(ev.bench), ev); break;
+      case LcmLogEvent::Kind::samples:
+        if (admitted(ev, ev.samples_view.lab, ev.samples_view.sent_to)) take_samples(bench(ev.bench), ev);
+        break;
+      case LcmLogEvent::Kind::config:
+        if (admitted(ev, ev.config.lab, ev.config.sent_to)) take_config(bench(ev.bench), ev);
+        break;
       case LcmLogEvent::Kind::other: ++out.other_channels[std::string(ev.channel)]; break;
       case LcmLogEvent::Kind::problem:
         if (!ev.bench.empty() && ev.number > 0) {
@@ -494,6 +535,7 @@ LcmLogContents read_lcm_log(const std::string& path, const LcmLogOptions& option
                                            file_problems - options.max_event_reports, file_problems)});
 
   for (auto& b : benches) {
+    flush_samples(*b);
     b->reporter.finish();
     Recording& rec = b->log.recording;
     rec.lines_read = static_cast<std::size_t>(b->log.sample_messages);

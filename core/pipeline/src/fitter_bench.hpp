@@ -47,8 +47,10 @@ struct FitterCore::Bench {
     std::vector<Sample> slots_;  // size a power of two
     std::size_t head_ = 0, count_ = 0, mask_ = 0;
   };
-  Bench(std::string bench_id, const RunOptions& runs)
-      : id(std::move(bench_id)), channel(fmt::format("SPINDOWN.{}.SAMPLE", id)), detector(runs, channel) {}
+  Bench(std::string bench_id, const RunOptions& runs, const SampleStreamOptions& stream_options)
+      : id(std::move(bench_id)), channel(fmt::format("SPINDOWN.{}.SAMPLE", id)), detector(runs, channel) {
+    stream.options = stream_options;
+  }
 
   std::string id;
   std::string channel;
@@ -57,11 +59,21 @@ struct FitterCore::Bench {
   std::uint64_t last_active = 0, arrival = 0;
   std::int64_t last_sample_utime = 0;  // host time of its last samples (poll(): silent benches)
 
-  std::optional<BenchParams> config;
+  std::optional<BenchParams> config;  // from the CONFIG of the stream's source
   std::string config_problem;
+  // The latest CONFIG of other sources on the channel (a restarted bridge announces itself before
+  // its samples take over; a second source's is never used): applied when that source takes over.
+  struct OtherConfig {
+    std::uint64_t session = 0;
+    std::string host;
+    std::optional<BenchParams> params;
+    std::string problem;
+  };
+  std::vector<OtherConfig> other_configs;  // at most 4
 
   SampleStream stream;  // the log reader's checks too (sample_stream.hpp), so refit == fit
   bool pending_restart = false;  // the clock restarted: tell the detector before the next sample
+  std::string pending_new_source;  // not empty: the restart is a new source taking over, in these words
 
   // Rate cap (token bucket on host receive time).
   double tokens = 0;
@@ -71,6 +83,8 @@ struct FitterCore::Bench {
   // The open run as last published: 0 none, 1 coasting, 2 stopped (provisional).
   int open_state = 0;
   Run open_run;
+  std::string run_host;            // the source of the open (or last) run's samples
+  std::uint64_t run_session = 0;
 
   std::size_t base() const { return detector.samples_seen() - mirror.size(); }
   const Sample* at(std::size_t index) const {

@@ -21,7 +21,7 @@
 namespace spindown {
 
 FitterCore::FitterCore(FitterOptions options, FitterSink& sink)
-    : opt_(std::move(options)), sink_(sink), bench_filter_(opt_.bench_regex) {}
+    : opt_(std::move(options)), sink_(sink), gate_(opt_.gate), bench_filter_(opt_.bench_regex) {}
 
 FitterCore::~FitterCore() = default;
 
@@ -68,7 +68,7 @@ FitterCore::Bench* FitterCore::find_bench(std::string_view id, std::int64_t recv
     return nullptr;
   }
   if (!admit(id, recv_utime, kind)) return nullptr;
-  auto b = std::make_unique<Bench>(std::string(id), opt_.runs);
+  auto b = std::make_unique<Bench>(std::string(id), opt_.runs, opt_.stream);
   b->last_active = activity_;
   b->arrival = ++arrivals_;
   Bench* p = b.get();
@@ -149,9 +149,11 @@ void FitterCore::on_message(std::string_view channel, const void* data, std::int
       error(fmt::format("{}: {}; message skipped", channel, why), recv_utime);
       return;
     }
+    if (!admit_samples(channel, msg, data, size, recv_utime)) return;
     on_samples(bench, msg, recv_utime);
   } else {
-    config_t msg;
+    if (!admit(channel, data, size, recv_utime)) return;
+    config_t msg{};
     if (!decode_message(msg, data, size, &why)) {
       ++counters_.decode_errors;
       error(fmt::format("{}: {}; message skipped", channel, why), recv_utime);
@@ -159,6 +161,23 @@ void FitterCore::on_message(std::string_view channel, const void* data, std::int
     }
     on_config(bench, msg, recv_utime);
   }
+}
+
+bool FitterCore::admit(std::string_view channel, const void* data, std::int64_t size, std::int64_t recv_utime) {
+  const GateResult g = gate_.check(channel, data, size, recv_utime);
+  switch (g.verdict) {
+    case GateVerdict::accepted:
+    case GateVerdict::undecodable: return true;  // the decoder names what is wrong
+    case GateVerdict::other_lab: ++counters_.other_lab; break;
+    case GateVerdict::not_signed: ++counters_.unsigned_messages; break;
+    case GateVerdict::other_key:
+    case GateVerdict::bad_signature: ++counters_.bad_signatures; break;
+    case GateVerdict::replayed:
+    case GateVerdict::outside_window: ++counters_.replays; break;
+  }
+  sink_.notice(gate_verdict_name(g.verdict), channel, g.text);
+  error(g.text, recv_utime);
+  return false;
 }
 
 void FitterCore::on_config(std::string_view bench, const config_t& msg, std::int64_t recv_utime) {
@@ -172,13 +191,32 @@ void FitterCore::on_config(std::string_view bench, const config_t& msg, std::int
           recv_utime);
   }
   std::string why;
-  if (auto p = bench_params_from_config(msg, &why)) {
-    b->config = *p;
+  std::optional<BenchParams> params = bench_params_from_config(msg, &why);
+  if (!params) {
+    ++counters_.bad_configs;
+    error(fmt::format("SPINDOWN.{}.CONFIG: {}; not used", b->id, why), recv_utime);
+  }
+  // Another source's CONFIG is kept for when that source takes over the stream, never used for
+  // the stream's own samples (two sources at once: the second's J and K_b are not the first's).
+  const auto session = static_cast<std::uint64_t>(msg.source_session);
+  if (b->stream.have_source && (session != b->stream.session || msg.source_host != b->stream.host)) {
+    auto it = std::find_if(b->other_configs.begin(), b->other_configs.end(), [&](const Bench::OtherConfig& c) {
+      return c.session == session && c.host == msg.source_host;
+    });
+    if (it == b->other_configs.end()) {
+      if (b->other_configs.size() >= 4) b->other_configs.erase(b->other_configs.begin());
+      b->other_configs.push_back({session, msg.source_host, {}, {}});
+      it = b->other_configs.end() - 1;
+    }
+    it->params = params;
+    it->problem = params ? std::string() : why;
+    return;
+  }
+  if (params) {
+    b->config = *params;
     b->config_problem.clear();
   } else {
-    ++counters_.bad_configs;
     b->config_problem = why;
-    error(fmt::format("SPINDOWN.{}.CONFIG: {}; not used", b->id, why), recv_utime);
   }
 }
 
@@ -231,6 +269,54 @@ FitterCore::Bench* FitterCore::bench_for_channel(std::int32_t channel_id, std::s
   return b;
 }
 
+// The per-bench stream's words become the core's counters and errors; its samples go to the
+// detector.
+struct FitterCore::StreamSink {
+  FitterCore& core;
+  Bench& b;
+  std::int64_t recv_utime;
+  void problem(SampleProblem kind, std::int64_t count, std::string text) {
+    FitterCounters& c = core.counters_;
+    switch (kind) {
+      case SampleProblem::unknown_quantity:
+      case SampleProblem::quantity_change: ++c.quantity_errors; break;
+      case SampleProblem::samples_lost: ++c.seq_gaps, c.samples_lost += count; break;
+      case SampleProblem::repeated: ++c.duplicates; break;
+      case SampleProblem::sequence_restart: ++c.seq_restarts; return;  // the clock's restart says it
+      case SampleProblem::clock_restart:  // the detector says it when it closes the run
+        ++c.clock_restarts;
+        b.pending_restart = true;
+        return;
+      case SampleProblem::new_source:  // a restart too, with its own reason
+        ++c.new_sources;
+        b.pending_restart = true;
+        b.pending_new_source = text;
+        core.sink_.notice("new source", b.channel, b.channel + ": " + text);
+        break;
+      case SampleProblem::two_sources: {
+        ++c.two_sources;
+        std::string named = b.channel + " " + text;  // "SPINDOWN.b.SAMPLE has two sources: …"
+        core.sink_.notice("two sources", b.channel, named);
+        core.error(std::move(named), recv_utime);
+        return;
+      }
+      case SampleProblem::other_source: c.other_source_samples += count; break;
+      case SampleProblem::jump:
+        ++c.seq_jumps, c.seq_jump_samples += count;
+        core.sink_.notice("jump", b.channel, b.channel + ": " + text);
+        break;
+      case SampleProblem::bad_value: ++c.nan_values; break;
+      case SampleProblem::time_backwards: ++c.time_backwards; break;
+    }
+    core.error(b.channel + ": " + text, recv_utime);
+  }
+  [[gnu::always_inline]] void sample(std::int64_t seq, std::int64_t t_us, double v) {
+    core.push_sample(b, seq, static_cast<double>(t_us) / 1e6, v, recv_utime);
+  }
+};
+
+void FitterCore::flush_stream(Bench& b, std::int64_t utime) { b.stream.flush(StreamSink{*this, b, utime}); }
+
 // Inlined into each on_samples(): at one sample per message a call's register saves and
 // argument moves cost as much as the checks.
 template <class Message>
@@ -267,41 +353,32 @@ template <class Message>
                       text::escape_invalid_utf8(m.bench.substr(0, 40))),
           recv_utime);
   }
-  struct Sink {
-    FitterCore& core;
-    Bench& b;
-    std::int64_t recv_utime;
-    void problem(SampleProblem kind, std::int64_t count, std::string text) {
-      FitterCounters& c = core.counters_;
-      switch (kind) {
-        case SampleProblem::unknown_quantity:
-        case SampleProblem::quantity_change: ++c.quantity_errors; break;
-        case SampleProblem::samples_lost: ++c.seq_gaps, c.samples_lost += count; break;
-        case SampleProblem::repeated: ++c.duplicates; break;
-        case SampleProblem::sequence_restart: ++c.seq_restarts; return;  // the clock's restart says it
-        case SampleProblem::clock_restart:  // the detector says it when it closes the run
-          ++c.clock_restarts;
-          b.pending_restart = true;
-          return;
-        case SampleProblem::bad_value: ++c.nan_values; break;
-        case SampleProblem::time_backwards: ++c.time_backwards; break;
-      }
-      core.error(b.channel + ": " + text, recv_utime);
-    }
-    [[gnu::always_inline]] void sample(std::int64_t seq, std::int64_t t_us, double v) {
-      core.push_sample(b, seq, static_cast<double>(t_us) / 1e6, v, recv_utime);
-    }
-  };
-  b.stream.take(m, n, Sink{*this, b, recv_utime});
+  b.stream.take(m, n, recv_utime, StreamSink{*this, b, recv_utime});
 }
 
 void FitterCore::restart_clock(Bench& b, std::int64_t recv_utime) {
   b.pending_restart = false;
+  const std::string new_source = std::move(b.pending_new_source);
+  b.pending_new_source.clear();
   // find_runs() restarts the detector only between samples, never before the first one.
-  if (b.detector.samples_seen() == 0) return;
-  b.detector.clock_restart();
-  handle_events(b, recv_utime);
-  trim_mirror(b);
+  if (b.detector.samples_seen() > 0) {
+    if (new_source.empty())
+      b.detector.clock_restart();
+    else
+      b.detector.new_source(new_source);
+    handle_events(b, recv_utime);  // the old stream's run is closed and fitted with its own J, K_b
+    trim_mirror(b);
+  }
+  if (!new_source.empty()) {  // then the new source's own CONFIG, when it sent one before taking over
+    auto it = std::find_if(b.other_configs.begin(), b.other_configs.end(), [&](const Bench::OtherConfig& c) {
+      return c.session == b.stream.session && c.host == b.stream.host;
+    });
+    if (it != b.other_configs.end()) {
+      if (it->params) b.config = it->params;
+      b.config_problem = it->problem;
+      b.other_configs.erase(it);
+    }
+  }
 }
 
 // Inlined into the per-sample loop (not left to the compiler, which kept it a call): everything

@@ -33,8 +33,11 @@ void FitterCore::publish_run(Bench& b, const Run& run, std::int8_t state, std::s
     end = std::max(run.end_index, run.cut_index + 1);
   const Bench::Sample* last = b.at(end - 1);
   const std::int64_t samples = end > run.cut_index ? std::int64_t(end - run.cut_index) : 0;
-  sink_.run_changed(to_run_message(b.id, run, state, first ? first->seq : -1, last ? last->seq : -1,
-                                   static_cast<std::int32_t>(samples), std::move(note), utime));
+  run_t m = to_run_message(b.id, run, state, first ? first->seq : -1, last ? last->seq : -1,
+                           static_cast<std::int32_t>(samples), std::move(note), utime);
+  m.bridge_host = b.run_host;
+  m.bridge_session = static_cast<std::int64_t>(b.run_session);
+  sink_.run_changed(m);
 }
 
 void FitterCore::handle_events(Bench& b, std::int64_t recv_utime) {
@@ -43,6 +46,8 @@ void FitterCore::handle_events(Bench& b, std::int64_t recv_utime) {
     switch (e.kind) {
       case RunEvent::Kind::cut:
         ++counters_.runs_started;
+        b.run_host = b.stream.host;  // the run is this source's, whoever comes later
+        b.run_session = b.stream.session;
         b.open_state = 1;
         b.open_run = e.run;
         publish_run(b, e.run, run_t::STATE_COASTING,
@@ -108,6 +113,8 @@ void FitterCore::fit_and_publish(Bench& b, const Run& run, const std::string& wh
 
   FitResult r;
   r.bench = b.id;
+  r.bridge_host = b.run_host;
+  r.bridge_session = b.run_session;
   r.first_seq = first->seq;
   r.last_seq = last->seq;
   r.detected_utime = recv_utime;
@@ -160,6 +167,7 @@ void FitterCore::finish(std::int64_t now_utime) {
   std::sort(order.begin(), order.end(), [](const Bench* a, const Bench* b) { return a->arrival < b->arrival; });
   for (Bench* b : order) {
     try {
+      flush_stream(*b, now_utime);  // a held jump nothing contradicted, sources that never took over
       b->detector.finish();
       handle_events(*b, now_utime);
     } catch (const std::exception& e) {

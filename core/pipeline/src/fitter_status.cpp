@@ -10,6 +10,7 @@
 #include <regex>
 
 #include "spindown/fit_message.hpp"
+#include "spindown/lab_name.hpp"
 #include "spindown/lcm_channels.hpp"
 
 #include "fitter_bench.hpp"
@@ -34,6 +35,13 @@ bool FitterOptions::is_valid(std::string* why) const {
   if (!(std::isfinite(max_rate_hz) && max_rate_hz >= 0))
     return fail(fmt::format("max_rate_hz must be >= 0 (got {})", max_rate_hz));
   if (!(std::isfinite(burst_s) && burst_s > 0)) return fail(fmt::format("burst_s must be > 0 (got {})", burst_s));
+  if (!(std::isfinite(gate.replay_window_s) && gate.replay_window_s > 0))
+    return fail(fmt::format("replay window must be > 0 s (got {})", gate.replay_window_s));
+  if (!gate.lab.empty() && !is_valid_lab_name(gate.lab, &inner)) return fail(inner);
+  if (!(std::isfinite(stream.takeover_s) && stream.takeover_s >= 0))
+    return fail(fmt::format("takeover must be >= 0 s (got {})", stream.takeover_s));
+  if (!(std::isfinite(stream.confirm_s) && stream.confirm_s >= 0))
+    return fail(fmt::format("confirm must be >= 0 s (got {})", stream.confirm_s));
   try {
     std::regex re(bench_regex);
   } catch (const std::regex_error& e) {
@@ -50,7 +58,7 @@ std::size_t FitterCore::buffered_samples() const {
 
 status_t FitterCore::make_status(std::int64_t now_utime, std::string_view instance, std::string_view host,
                                  std::int32_t pid, std::string_view state, double uptime_s) const {
-  status_t s;
+  status_t s{};
   s.utime = now_utime;
   s.service = "fitter";
   s.instance = std::string(instance);
@@ -76,6 +84,11 @@ status_t FitterCore::make_status(std::int64_t now_utime, std::string_view instan
       {"silent_benches", c.silent_benches},
       {"flood_drops", c.flood_drops},     {"flood_messages", c.flood_messages},
       {"internal_errors", c.internal_errors},
+      {"other_lab", c.other_lab},         {"unsigned_messages", c.unsigned_messages},
+      {"bad_signatures", c.bad_signatures}, {"replays", c.replays},
+      {"new_sources", c.new_sources},     {"two_sources", c.two_sources},
+      {"other_source_samples", c.other_source_samples}, {"seq_jumps", c.seq_jumps},
+      {"seq_jump_samples", c.seq_jump_samples},
   };
   for (const auto& [name, value] : counters) {
     s.counter_name.emplace_back(name);

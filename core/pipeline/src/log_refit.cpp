@@ -6,6 +6,7 @@
 #include <map>
 
 #include "spindown/fit_message.hpp"
+#include "spindown/session_id.hpp"
 
 namespace spindown {
 
@@ -68,6 +69,7 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
   FitterCore core(options, sink);
   std::map<std::string, std::size_t, std::less<>> order;
   std::vector<char> channel_done;  // by LcmLogEvent::channel_id: its bench's place is known
+  std::vector<std::uint64_t> fitter_sessions;  // of the fitters' heartbeats in the log (keep_live_fits)
   std::int64_t last_utime = 0, next_poll = std::numeric_limits<std::int64_t>::min();
   std::size_t file_problems = 0;
   LcmLogEvent ev;
@@ -100,12 +102,14 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
       }
     }
     switch (ev.kind) {
-      // Decoded (and checked) once, by the reader: the core takes the message as it is.
+      // Decoded (and checked) once, by the reader: the core takes the message as it is, once its
+      // gate let it through (the lab, and with a key its signature, as live).
       case LcmLogEvent::Kind::samples:
-        core.on_samples(ev.channel_id, ev.bench, ev.samples_view, ev.log_utime);
+        if (core.admit_samples(ev.channel, ev.samples_view, ev.data, ev.data_size, ev.log_utime))
+          core.on_samples(ev.channel_id, ev.bench, ev.samples_view, ev.log_utime);
         break;
       case LcmLogEvent::Kind::config:
-        core.on_config(ev.bench, ev.config, ev.log_utime);
+        if (core.admit(ev.channel, ev.data, ev.data_size, ev.log_utime)) core.on_config(ev.bench, ev.config, ev.log_utime);
         break;
       case LcmLogEvent::Kind::problem:
         if (ev.number > 0 && ev.data) {  // a message that does not decode: the core counts it
@@ -115,14 +119,24 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
         }
         break;
       case LcmLogEvent::Kind::other:
+        if (keep_live_fits && ev.channel.starts_with("SPINDOWN.") && ev.channel.ends_with(".STATUS")) {
+          status_t st{};
+          if (core.admit(ev.channel, ev.data, ev.data_size, ev.log_utime) &&
+              decode_message(st, ev.data, ev.data_size) && st.service == "fitter" && st.source_session != 0 &&
+              std::find(fitter_sessions.begin(), fitter_sessions.end(), std::uint64_t(st.source_session)) ==
+                  fitter_sessions.end() &&
+              fitter_sessions.size() < 1024)
+            fitter_sessions.push_back(static_cast<std::uint64_t>(st.source_session));
+          break;
+        }
         if (keep_live_fits && ev.channel.starts_with("SPINDOWN.") && ev.channel.ends_with(".FIT")) {
-          fit_t m;
-          try {
-            if (m.decode(ev.data, 0, ev.data_size) >= 0) {
-              out.live.push_back(std::move(m));
-              break;
-            }
-          } catch (const std::exception&) {
+          // A FIT the log holds is the live fitter's only when the gate lets it through (the lab,
+          // and with a key its signature): a forged one is counted and named, never compared.
+          if (!core.admit(ev.channel, ev.data, ev.data_size, ev.log_utime)) break;
+          fit_t m{};
+          if (decode_message(m, ev.data, ev.data_size)) {
+            out.live.push_back(std::move(m));
+            break;
           }
           out.file.diagnostics.push_back({Diagnostic::Severity::warning, path, ev.number,
                                           fmt::format("event {} on {}: not a decodable fit_t; skipped", ev.number,
@@ -133,6 +147,21 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
   }
   core.finish(last_utime);
   out.counters = core.counters();
+  // A FIT whose source is no fitter heard in the log is not a live result (a forged one): left out.
+  if (!fitter_sessions.empty()) {
+    std::erase_if(out.live, [&](const fit_t& m) {
+      const auto session = static_cast<std::uint64_t>(m.source_session);
+      if (session == 0 || std::find(fitter_sessions.begin(), fitter_sessions.end(), session) != fitter_sessions.end())
+        return false;
+      ++out.live_left_out;
+      out.file.diagnostics.push_back(
+          {Diagnostic::Severity::warning, path, 0,
+           fmt::format("SPINDOWN.{}.FIT: run {} from {}: no fitter heard in this log has that session (a forged "
+                       "FIT?); not taken as a live result",
+                       shown_name(m.bench), m.run, source_text(m.source_host, session))});
+      return true;
+    });
+  }
   const FitterCounters& c = out.counters;
   if (file_problems > max_problems_listed)
     out.file.diagnostics.push_back({Diagnostic::Severity::warning, path, 0,

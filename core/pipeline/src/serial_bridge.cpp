@@ -301,7 +301,7 @@ void SerialBridge::stop(std::int64_t now_us) {
 }
 
 config_t SerialBridge::make_config(std::int64_t now_us) const {
-  config_t c;
+  config_t c{};
   c.utime = now_us;
   c.bench = s_.bench;
   c.inertia_kg_m2 = s_.params.inertia_kg_m2;
@@ -333,7 +333,7 @@ config_t SerialBridge::make_config(std::int64_t now_us) const {
 }
 
 status_t SerialBridge::make_status(std::int64_t now_us) const {
-  status_t st;
+  status_t st{};
   st.utime = now_us;
   st.service = "bridge";
   st.instance = s_.bench;

@@ -393,12 +393,19 @@ std::size_t RunDetector::coast_loop(const double* t_s, const double* value, std:
 }
 
 void RunDetector::clock_restart() {
+  restart_stream("the device clock restarted mid-coast (an Arduino reset?): the coast is cut short there",
+                 Run::End::clock_restart);
+}
+
+void RunDetector::new_source(const std::string& why) {
+  restart_stream(why + ": the coast is cut short there", Run::End::new_source);
+}
+
+void RunDetector::restart_stream(const std::string& why, Run::End reason) {
   restarted_mid_coast_ = state_ == State::coasting;
   if (state_ == State::coasting) {
     run_note_severity_ = Diagnostic::Severity::warning;  // the run is cut short: it changes the result
-    close_unstopped(next_index_,
-                    "the device clock restarted mid-coast (an Arduino reset?): the coast is cut short there",
-                    Run::End::clock_restart);
+    close_unstopped(next_index_, why, reason);
   }
   else if (state_ == State::tail) complete_run(next_index_);
   base_ = next_index_;

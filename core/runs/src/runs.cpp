@@ -35,13 +35,15 @@ const char* end_name(Run::End e) {
     case Run::End::clock_restart: return "clock restart";
     case Run::End::asymptotic: return "asymptotic";
     case Run::End::silent: return "silent";
+    case Run::End::new_source: return "new source";
   }
   return "?";
 }
 
 Run::End end_from_name(std::string_view name) {
   for (Run::End e : {Run::End::stopped, Run::End::signal_lost, Run::End::gap, Run::End::end_of_data, Run::End::cap,
-                     Run::End::power_back, Run::End::clock_restart, Run::End::asymptotic, Run::End::silent})
+                     Run::End::power_back, Run::End::clock_restart, Run::End::asymptotic, Run::End::silent,
+                     Run::End::new_source})
     if (name == end_name(e)) return e;
   return Run::End::end_of_data;
 }

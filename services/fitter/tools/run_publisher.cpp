@@ -204,7 +204,7 @@ int main(int argc, char** argv) {
 
   auto send_config = [&](const BenchPlan& p, int b) {
     if (o.config_benches >= 0 && b >= o.config_benches) return;
-    spindown::config_t c;
+    spindown::config_t c{};
     c.utime = wall_us();
     c.bench = p.id;
     c.inertia_kg_m2 = o.config_inertia > 0 ? o.config_inertia : 1.12687602e-5;
@@ -239,7 +239,7 @@ int main(int argc, char** argv) {
     due.push({p.host_at(p.samples[last].t_us, o.speed), b});
   }
   long messages = 0, new_bench_counter = 0;
-  spindown::samples_t msg;
+  spindown::samples_t msg{};
   while (!due.empty()) {
     const auto [when, b] = due.top();
     due.pop();

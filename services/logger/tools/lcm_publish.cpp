@@ -26,7 +26,7 @@ namespace {
 using spindown::wall_us;
 
 spindown::config_t make_config(const std::string& bench, std::int64_t now) {
-  spindown::config_t c;
+  spindown::config_t c{};
   c.utime = now;
   c.bench = bench;
   c.inertia_kg_m2 = 1.12687602e-5;
@@ -48,7 +48,7 @@ spindown::config_t make_config(const std::string& bench, std::int64_t now) {
 }
 
 spindown::run_t make_run(const std::string& bench, std::int64_t now, std::int64_t seq) {
-  spindown::run_t r;
+  spindown::run_t r{};
   r.utime = now;
   r.bench = bench;
   r.run = 1;
@@ -63,7 +63,7 @@ spindown::run_t make_run(const std::string& bench, std::int64_t now, std::int64_
 }
 
 spindown::fit_t make_fit(const std::string& bench, std::int64_t now) {
-  spindown::fit_t f;
+  spindown::fit_t f{};
   f.utime = now;
   f.bench = bench;
   f.run = 1;
@@ -126,7 +126,7 @@ spindown::fit_t make_fit(const std::string& bench, std::int64_t now) {
 }
 
 spindown::explain_t make_explain(const std::string& bench, std::int64_t now) {
-  spindown::explain_t e;
+  spindown::explain_t e{};
   e.utime = now;
   e.bench = bench;
   e.run = 1;
@@ -206,7 +206,7 @@ int main(int argc, char** argv) {
   const std::int64_t start_us = wall_us();
   std::vector<std::string> sample_channels;
   for (const auto& b : benches) sample_channels.push_back(spindown::channel_name(b, spindown::ChannelKind::sample));
-  spindown::samples_t msg;
+  spindown::samples_t msg{};
   msg.quantity = spindown::samples_t::QUANTITY_BACK_EMF_V;
   msg.n = batch;
   msg.device_time_us.resize(batch);

@@ -105,7 +105,7 @@ int main(int argc, char** argv) {
       } else if (ev.kind == spindown::LcmLogEvent::Kind::other && ev.data) {
         const auto parsed = spindown::parse_channel(ev.channel);
         if (parsed && parsed->kind == spindown::ChannelKind::status) {
-          spindown::status_t st;
+          spindown::status_t st{};
           if (st.decode(ev.data, 0, ev.data_size) >= 0 && st.service == "logger" && st.pid > 0) {
             // Only the logger's own events written into this file (its heartbeats have other states too).
             ++statuses;

@@ -27,6 +27,8 @@ struct FitProvenance {
   std::int64_t last_seq = 0;
   double latency_s = 0;       // host seconds from detection to publishing (0 offline)
   std::optional<HealthVerdict> health;  // the motor health verdict, when the bench has a bench file
+  std::string bridge_host;              // the source whose samples were fitted (samples_t.source_*)
+  std::uint64_t bridge_session = 0;
 };
 
 fit_t to_fit_message(const RunFit& fit, const FitProvenance& about, std::int64_t utime);

@@ -31,6 +31,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "spindown/message_decode.hpp"
+#include "spindown/message_stamp.hpp"
 
 namespace spindown {
 
@@ -87,10 +88,16 @@ class LcmLoop {
 
   bool good() const { return lcm_.good(); }
   lcm::LCM& lcm() { return lcm_; }
-  // 0 when sent (LCM's result).
+  // Every message published from now on carries the stamp's source fields, signed when it has
+  // the lab key (message_stamp.hpp). The stamp must outlive the loop's publishing.
+  void set_stamp(MessageStamp* stamp) { stamp_ = stamp; }
+  // 0 when sent (LCM's result); -1 when the message could not be encoded.
   template <class Msg>
   int publish(const std::string& channel, const Msg& msg) {
-    return lcm_.publish(channel, &msg);
+    if (!stamp_) return lcm_.publish(channel, &msg);
+    const std::vector<unsigned char> bytes = stamp_->encode(channel, msg);
+    if (bytes.empty()) return -1;
+    return lcm_.publish(channel, bytes.data(), static_cast<unsigned>(bytes.size()));
   }
 
   // handler(const Msg&, const LcmMessage&) or handler(const Msg&), for each message on a
@@ -147,6 +154,7 @@ class LcmLoop {
   void decode_failed(const LcmMessage& m, const char* type, std::string why);
 
   lcm::LCM lcm_;
+  MessageStamp* stamp_ = nullptr;
   std::vector<std::unique_ptr<Subscription>> subscriptions_;
   std::vector<Timer> timers_;
   std::function<void(const LcmDecodeError&)> decode_report_;

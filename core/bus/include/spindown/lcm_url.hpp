@@ -42,6 +42,11 @@ std::optional<LcmUrl> parse_lcm_url(std::string_view url, std::string* why = nul
 // lines, "export " prefixes, single or double quotes around the value.
 std::map<std::string, std::string> parse_env_file(std::string_view text);
 
+// "239.255.76.67:7667": the udpm group and port a program with this URL sends to and listens on
+// ("" = LCM_DEFAULT_URL, else LCM's default, as lcm_create takes it); "" when it is not udpm. Every
+// message names it (sent_to): a message heard on a port but sent to another group is another lab's.
+std::string lcm_destination(const std::string& url);
+
 struct ResolvedLcmUrl {
   std::string url;
   std::string source;  // "--lcm-url", "LCM_DEFAULT_URL", "/etc/spindown/lcm.env", "LCM's default"

@@ -12,6 +12,7 @@
 #include <deque>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -22,6 +23,10 @@
 #include <spindown/samples_t.hpp>
 #include <spindown/status_t.hpp>
 
+#include "spindown/message_gate.hpp"
+#include "spindown/sample_stream.hpp"
+#include "spindown/service_instances.hpp"
+
 namespace spindown {
 
 struct LabTableOptions {
@@ -31,6 +36,8 @@ struct LabTableOptions {
   std::size_t max_services = 16;
   std::size_t max_events = 200;    // events not yet taken; older ones are dropped (and counted)
   double gap_event_every_s = 10.0; // sequence-gap events at most this often per bench
+  bool signatures_checked = false; // messages pass a gate with the lab key first (watch --key)
+  SampleStreamOptions stream;      // a bench's SAMPLE sources, as the fitter follows them
 };
 
 // What the table knows about one bench.
@@ -50,6 +57,7 @@ struct LabBenchRow {
   bool has_fit = false;
   std::int32_t fit_run = 0;
   bool fit_partial = false;          // fitted from its first sample: the cut was not seen
+  std::string fit_doubt;             // why this fit may not be the lab fitter's ("" when nothing says so)
   std::int32_t fits = 0;             // FIT messages seen
   std::string best;                  // best model ("" when none converged)
   std::string coefficients;          // the best model's friction coefficients ± error (no units)
@@ -66,14 +74,19 @@ struct LabBenchRow {
   double rate_hz = 0;
   std::string bridge_error;
 
-  // From SPINDOWN.<bench>.SAMPLE, as this listener saw it.
+  // From SPINDOWN.<bench>.SAMPLE, as this listener saw it: the stream as the fitter follows it
+  // (sample_stream.hpp: its source, gaps, a new source, two at once).
   bool has_samples = false;
-  std::int64_t next_seq = 0;         // expected seq of the next message
+  SampleStream stream;
   std::int64_t samples = 0;
   std::int64_t sample_messages = 0;
   std::int64_t seq_gaps = 0;         // gaps in samples_t.seq
   std::int64_t samples_missing = 0;  // samples in those gaps
-  std::int64_t seq_restarts = 0;     // seq went back (bridge restarted)
+  std::int64_t seq_restarts = 0;     // a new source took over (bridge restarted, board replugged)
+  std::int64_t other_source_samples = 0;  // samples of a second source, not the stream's
+  std::int64_t seq_jumps = 0;        // messages that jumped far from the stream and were dropped
+  std::string two_sources;           // the latest "has two sources: …" ("" never)
+  std::int64_t other_source_us = 0;  // when a second source was last heard
   std::int64_t last_gap_event_us = 0;
   std::int64_t gaps_at_last_event = 0;
 
@@ -82,11 +95,15 @@ struct LabBenchRow {
 
 // A service's heartbeat (fitter, logger, …), keyed by service and instance.
 struct LabServiceRow {
+  LabServiceRow(const std::string& service_name, const std::string& instance_name)
+      : instances(service_name, instance_name) {}
   std::string service, instance, host, state, last_error;
   std::int32_t pid = 0;
   double uptime_s = 0;
   std::vector<std::pair<std::string, std::int64_t>> counters;  // the ones worth showing
   std::int64_t last_message_us = 0;
+  ServiceInstances instances;        // every process heard under this name (two at once: named)
+  std::string collision;             // the latest "two …s with the same instance name …" ("" never)
 };
 
 class LabTable {
@@ -103,6 +120,9 @@ class LabTable {
   void on_status(std::string_view channel_id, const status_t& msg, std::int64_t now_us);
   // A message that could not be decoded (counted, the text kept for the footer).
   void on_bad_message(std::string text, std::int64_t now_us);
+  // A message the gate refused (another lab's; with the key, unsigned, wrongly signed, replayed):
+  // never shown as data; counted, the first of each kind an event, the latest in the footer.
+  void on_refused(const GateResult& refused, std::int64_t now_us);
 
   // The table at now_us. width > 0 cuts lines to that many characters (a terminal's width).
   std::string render(std::int64_t now_us, std::size_t width = 0) const;
@@ -119,6 +139,7 @@ class LabTable {
   const LabServiceRow* service(std::string_view service, std::string_view instance) const;
   std::size_t service_count() const { return services_.size(); }
   std::int64_t bad_messages() const { return bad_messages_; }
+  std::int64_t refused_messages() const { return refused_; }
   std::int64_t forgotten_rows() const { return forgotten_rows_; }
   std::int64_t dropped_events() const { return dropped_events_; }
 
@@ -132,6 +153,12 @@ class LabTable {
   std::deque<std::string> events_;
   std::int64_t bad_messages_ = 0;
   std::string last_bad_message_;
+  std::int64_t refused_ = 0;
+  std::map<std::string, std::int64_t, std::less<>> refused_by_kind_;  // gate_verdict_name -> count
+  std::set<std::string> refused_said_;                                // "kind channel" said as an event
+  std::string last_refused_;
+  std::vector<std::uint64_t> fitter_sessions_;  // sessions of every fitter heard on STATUS (bounded)
+  bool signed_traffic_ = false;                 // a signed message seen (matters when not checked)
   std::int64_t forgotten_rows_ = 0;
   std::int64_t dropped_events_ = 0;
   bool changed_ = false;

@@ -9,6 +9,8 @@
 #include <vector>
 
 #include "spindown/clock_checks.hpp"
+#include "spindown/lab_key.hpp"
+#include "spindown/lab_traffic.hpp"
 #include "spindown/network_checks.hpp"
 
 namespace spindown {
@@ -26,8 +28,14 @@ std::optional<std::string> capture(const std::vector<std::string>& argv, std::st
 std::vector<NetInterface> read_interfaces();
 // The NTP client running here ("chrony", "systemd-timesyncd", "ntpd", "openntpd"), "" if none.
 std::string running_ntp_client();
-// Listens on url for `seconds` to the lab's STATUS and CONFIG messages and returns each host's
-// clock skew against this one; empty when LCM cannot listen.
-std::vector<HostSkew> listen_for_clocks(const std::string& url, double seconds);
+// Listens on url for `seconds` to every SPINDOWN.* message: each host's clock skew against this
+// one (from STATUS and CONFIG), and who sends (lab_traffic.hpp; signatures checked with key
+// when given). listened is false when LCM cannot listen.
+struct LabListen {
+  bool listened = false;
+  std::vector<HostSkew> clocks;
+  LabTraffic traffic;
+};
+LabListen listen_to_lab(const std::string& url, double seconds, const LabKey* key = nullptr);
 
 }  // namespace spindown

@@ -49,7 +49,7 @@ struct EventLogWriterOptions {
   std::string status_channel = "SPINDOWN.logger.STATUS";
   std::string instance;                    // status_t.instance; empty = bench, else prefix
   std::size_t buffer_bytes = 1 << 20;      // events buffered before they go to the kernel
-  std::size_t max_tracked_benches = 1024;  // benches whose sample sequence is followed
+  std::size_t max_tracked_benches = 1024;  // benches (bridge sessions) whose sample sequence is followed
   double reopen_interval_s = 1.0;          // after a write error, wait before trying a new file
   LogRetentionOptions retention;           // old files deleted past these limits (none by default)
   double prune_interval_s = 10.0;          // retention is applied at least this often (and at each new file)
@@ -176,7 +176,7 @@ class EventLogWriter {
   bool disk_full_ = false;
   double queue_depth_ = 0;
   EventLogCounters counters_;
-  std::unordered_map<std::string, std::int64_t> next_seq_;  // bench -> expected samples_t.seq
+  std::unordered_map<std::string, std::int64_t> next_seq_;  // "bench/session" -> expected samples_t.seq
   std::string last_error_;
   std::int64_t last_error_utime_ = 0;
   mutable StatusHeartbeat status_;

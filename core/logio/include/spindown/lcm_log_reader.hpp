@@ -27,6 +27,7 @@
 
 #include "spindown/bench.hpp"
 #include "spindown/message_decode.hpp"
+#include "spindown/message_gate.hpp"
 #include "spindown/recording.hpp"
 #include "spindown/sample_stream.hpp"
 #include "spindown/short_name_cache.hpp"
@@ -64,8 +65,8 @@ struct LcmLogEvent {
   std::int32_t channel_id = -1;
   std::string_view bench;
   SamplesView samples_view;      // Kind::samples: the message in place, valid until the next next()
-  samples_t samples;             // Kind::samples, unless the reader was made with LcmSamples::view_only
-  config_t config;               // Kind::config
+  samples_t samples{};             // Kind::samples, unless the reader was made with LcmSamples::view_only
+  config_t config{};               // Kind::config
   const void* data = nullptr;    // Kind::other: the payload, valid until the next next()
   std::int32_t data_size = 0;
   std::string problem;           // Kind::problem: what was wrong and what was done
@@ -147,6 +148,10 @@ class LcmLogReader {
 
 struct LcmLogOptions {
   std::size_t max_event_reports = 20;  // problems per bench listed one by one before a count
+  // Whose SAMPLE and CONFIG are read: the lab (default: every lab) and with a key only signed ones
+  // (message_gate.hpp); the others are named and skipped.
+  MessageGateOptions gate = MessageGateOptions::every_lab();
+  SampleStreamOptions stream;          // the samples' sources and far jumps (sample_stream.hpp)
   bool is_valid(std::string* why) const;
 };
 
@@ -157,6 +162,8 @@ struct BenchLog {
   std::int64_t sample_messages = 0;
   std::int64_t config_messages = 0;
   std::int64_t samples_lost = 0;     // from gaps in samples_t.seq
+  std::int64_t refused_messages = 0; // SAMPLE and CONFIG the gate refused (another lab, unsigned, …)
+  std::int64_t new_sources = 0;      // other sources that took over the stream (restarted bridges)
 };
 
 struct LcmLogContents {

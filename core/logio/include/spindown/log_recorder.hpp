@@ -72,7 +72,7 @@ class LogRecorder {
   std::int64_t dropped_reported_ = 0, oversize_reported_ = 0;  // writer thread
 
   mutable std::mutex status_mutex_;
-  status_t status_;
+  status_t status_{};
   std::int64_t next_status_us_ = 0;
 
   std::atomic<std::int64_t> writer_alive_ns_{0};

@@ -4,8 +4,11 @@
 // wraps it with LCM; `spindown refit` feeds it the events of a log in log order; tests drive
 // it directly. The same input gives the same runs and the same numbers everywhere.
 //
+// Every raw message first passes a MessageGate (message_gate.hpp): another lab's message, and
+// with the lab key an unsigned, wrongly signed or replayed one, is counted and named, never used.
 // Per bench: samples are checked like the log reader checks them (decode, quantity, sequence
-// gaps, repeated messages, clock epochs, NaN values, device time that does not advance), fed
+// gaps, repeated messages, clock epochs, NaN values, device time that does not advance, the
+// stream's source: a new source is a new stream, two at once are named; sample_stream.hpp), fed
 // one by one to a RunDetector, and each completed run is fitted with fit_run() using J and K_b
 // of the bench's latest CONFIG (or the configured default, said so in bench_source).
 //
@@ -32,6 +35,8 @@
 #include "spindown/bench.hpp"
 #include "spindown/fit.hpp"
 #include "spindown/message_decode.hpp"
+#include "spindown/message_gate.hpp"
+#include "spindown/sample_stream.hpp"
 #include "spindown/motor_health.hpp"
 #include "spindown/recording.hpp"
 #include "spindown/run_detector.hpp"
@@ -61,6 +66,10 @@ struct FitterOptions {
   // Motor health references per bench id (the benches' TOML files): each fit of such a bench
   // carries a verdict (FitResult::health); other benches' fits carry none.
   std::map<std::string, MotorHealthConfig, std::less<>> health;
+  // The lab this fitter serves, and with a key the signatures and replay window (message_gate.hpp).
+  MessageGateOptions gate;
+  // A bench stream's sources and far jumps (sample_stream.hpp).
+  SampleStreamOptions stream;
   bool is_valid(std::string* why) const;
 };
 
@@ -95,6 +104,17 @@ struct FitterCounters {
   std::int64_t flood_drops = 0;        // samples dropped by the rate cap
   std::int64_t flood_messages = 0;     // messages dropped by the rate cap
   std::int64_t internal_errors = 0;    // exceptions caught from the fit or detector
+  // The gate (issue 31): messages not used for who sent them.
+  std::int64_t other_lab = 0;          // messages of another lab
+  std::int64_t unsigned_messages = 0;  // not signed, with signatures required
+  std::int64_t bad_signatures = 0;     // signed with another key, or a signature that does not match
+  std::int64_t replays = 0;            // signed messages seen before, or sent outside the replay window
+  // A bench stream's sources (sample_stream.hpp).
+  std::int64_t new_sources = 0;        // another source took over a bench's stream (bridge restarted, replugged)
+  std::int64_t two_sources = 0;        // a second source sending at the same time on a bench's channel (named)
+  std::int64_t other_source_samples = 0;  // samples of a source that is not its bench's stream's, refused
+  std::int64_t seq_jumps = 0;          // messages far from their stream that did not continue it (forged/damaged)
+  std::int64_t seq_jump_samples = 0;   // their samples, dropped
 };
 
 // One completed run's fit, as published.
@@ -108,6 +128,8 @@ struct FitResult {
   std::optional<HealthVerdict> health;  // when FitterOptions::health has the bench
   std::span<const double> t_s;     // the run's samples [cut, end), valid during the call only
   std::span<const double> value;
+  std::string bridge_host;         // the source whose samples these are (samples_t.source_*)
+  std::uint64_t bridge_session = 0;
 };
 
 class FitterSink {
@@ -118,6 +140,16 @@ class FitterSink {
   // A message or sample that could not be used, in words naming the channel (also kept as
   // last_error for the heartbeat). Default: ignored.
   virtual void problem(const std::string& text) { (void)text; }
+  // What a technician must see at once, not only in the heartbeat (issue 31): a new source on a
+  // bench's channel, two sources at once, a far jump dropped as forged or damaged, and a message
+  // the gate refused (another lab's, unsigned, wrongly signed, replayed). kind names it
+  // ("new source", "two sources", "jump", or the gate's verdict), channel where. Also given to
+  // problem(). Default: ignored.
+  virtual void notice(std::string_view kind, std::string_view channel, const std::string& text) {
+    (void)kind;
+    (void)channel;
+    (void)text;
+  }
   // Detector notes (runs ignored, clock restarts, …) with the bench channel as source. Default: ignored.
   virtual void diagnostic(const std::string& bench, const Diagnostic& d) {
     (void)bench;
@@ -133,10 +165,18 @@ class FitterCore {
   FitterCore(const FitterCore&) = delete;
   FitterCore& operator=(const FitterCore&) = delete;
 
-  // A raw LCM message: SPINDOWN.<bench>.SAMPLE and .CONFIG are decoded and used, other
-  // channels counted. recv_utime is the host receive time (µs since the epoch; from the log
-  // when refitting) used by the rate cap and for latency.
+  // A raw LCM message: SPINDOWN.<bench>.SAMPLE and .CONFIG pass the gate (admit()) and are
+  // decoded and used, other channels counted. recv_utime is the host receive time (µs since the
+  // epoch; from the log when refitting) used by the rate cap, the replay window and for latency.
   void on_message(std::string_view channel, const void* data, std::int64_t size, std::int64_t recv_utime);
+  // The gate alone, for a reader that decodes itself (refit): false when the message must not be
+  // used (counted and named). A message that does not decode passes (its decoder names it).
+  bool admit(std::string_view channel, const void* data, std::int64_t size, std::int64_t recv_utime);
+  // admit() for a SAMPLE already viewed (its lab read): nearly always one comparison.
+  bool admit_samples(std::string_view channel, const SamplesView& view, const void* data, std::int64_t size,
+                     std::int64_t recv_utime) {
+    return gate_.accepts_at_once(view.lab, view.sent_to) || admit(channel, data, size, recv_utime);
+  }
   // Already decoded messages (tests, tools; a log reader's view); bench is the channel's bench id.
   void on_samples(std::string_view bench, const samples_t& msg, std::int64_t recv_utime);
   void on_samples(std::string_view bench, const SamplesView& msg, std::int64_t recv_utime);
@@ -168,6 +208,8 @@ class FitterCore {
 
  private:
   struct Bench;
+  struct StreamSink;  // SampleStream's problems and samples -> counters, errors, the detector
+  void flush_stream(Bench& b, std::int64_t utime);
   inline Bench* bench_for(std::string_view id, std::int64_t recv_utime, std::string_view kind);
   Bench* find_bench(std::string_view id, std::int64_t recv_utime, std::string_view kind);  // past the cache
   bool admit(std::string_view id, std::int64_t recv_utime, std::string_view kind);  // room for a new bench?
@@ -190,6 +232,7 @@ class FitterCore {
 
   FitterOptions opt_;
   FitterSink& sink_;
+  MessageGate gate_;
   std::regex bench_filter_;
   std::map<std::string, std::unique_ptr<Bench>, std::less<>> benches_;
   ShortNameCache<Bench> bench_cache_;  // bench id -> bench, before the map

@@ -28,7 +28,11 @@ struct LogRefit {
   FileFit file;                 // runs ordered by bench (first appearance), then run number
   std::vector<RefitRun> runs;   // the same runs, with their bench ids (empty when streamed)
   std::size_t runs_fitted = 0;  // runs fitted, kept or streamed
-  std::vector<fit_t> live;      // SPINDOWN.<bench>.FIT messages recorded in the log (when asked)
+  // SPINDOWN.<bench>.FIT messages recorded in the log (when asked) that passed the gate (the lab;
+  // with a key, signed) and came from a fitter: when the log holds fitters' heartbeats, a FIT from a
+  // session none of them has is not one (a forged FIT) and is left out, named in the diagnostics.
+  std::vector<fit_t> live;
+  std::size_t live_left_out = 0;  // FITs from a session no fitter in the log has
   FitterCounters counters;
   std::vector<std::string> bench_order;  // benches in order of first appearance
 };

@@ -111,7 +111,7 @@ class SerialBridge {
   bool have_device_seq_ = false;
   std::uint32_t last_device_seq_ = 0;
 
-  samples_t batch_;
+  samples_t batch_{};
   std::int64_t next_seq_ = 0;
   std::int64_t feed_start_ns_ = 0;  // steady clock at the start of the current feed()
 

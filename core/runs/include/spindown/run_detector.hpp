@@ -65,6 +65,10 @@ class RunDetector {
   void push_many(const double* t_s, const double* value, std::size_t n);
   // The device clock restarted before the next sample: an open run is closed there.
   void clock_restart();
+  // Another source took over the stream before the next sample (a restarted bridge, a replugged
+  // board: SampleStream's new_source): like clock_restart(), an open run is closed there with why
+  // as its reason (End::new_source).
+  void new_source(const std::string& why);
   // End of the stream: an open coast is closed (never stopped), a tail is cut short.
   void finish();
   // Live: no sample came for silent_s (host time). An open coast is closed there (End::silent,
@@ -234,6 +238,7 @@ class RunDetector {
   bool signal_lost(std::size_t i, std::size_t first_in, double z, double amp);
   void tail_ends_by_time(std::size_t upto);
   void close_unstopped(std::size_t end, const std::string& why, Run::End reason);
+  void restart_stream(const std::string& why, Run::End reason);  // clock_restart(), new_source()
   void complete_run(std::size_t end);
   // Why the finished coast r (falling amp in coast_s) is a fragment and not a run: too small for
   // the reading's resolution, or small and short beside the runs found before it in this stream;

@@ -53,6 +53,7 @@ struct Run {
     clock_restart,  // the device clock restarted (reset, reconnect)
     asymptotic,     // the decay was lost in the noise before a stop (pure viscous)
     silent,         // live: the bench sent no samples for FitterOptions::silent_s mid-coast
+    new_source,     // another source took over the bench's stream (a restarted bridge, a replugged board)
   };
   End end = End::end_of_data;
   double t_end_s = std::numeric_limits<double>::quiet_NaN();

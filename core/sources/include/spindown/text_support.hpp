@@ -14,6 +14,7 @@
 
 #include "spindown/file_bytes.hpp"
 #include "spindown/recording.hpp"
+#include "spindown/utf8_text.hpp"
 
 namespace spindown::text {
 
@@ -115,11 +116,6 @@ std::string binary_data_error(std::string_view what, std::size_t control_bytes, 
 // A line for a message: quoted, control bytes and bytes that are not UTF-8 escaped (\xNN),
 // cut to 40 characters (never inside one). Messages stay valid UTF-8, which JSON needs.
 std::string quote_line(std::string_view line);
-
-// Length of the valid UTF-8 sequence starting at s[i] (1 to 4); 0 when none starts there.
-std::size_t utf8_sequence_length(std::string_view s, std::size_t i);
-// s unquoted and uncut, every byte that is not part of valid UTF-8 written as \xNN.
-std::string escape_invalid_utf8(std::string_view s);
 
 // Per-line problems go to the Recording one by one up to a limit, then only as a count, so
 // a file of garbage still gives readable output.

@@ -1,0 +1,34 @@
+#include "spindown/lab_settings.hpp"
+
+#include <fmt/format.h>
+#include <stdexcept>
+
+#include "spindown/lab_name.hpp"
+
+namespace spindown {
+
+std::optional<LabSettings> resolve_lab_settings(const std::string& lab_option, const std::string& key_option,
+                                                std::string* why) {
+  LabSettings s;
+  try {
+    s.lab = choose_lab_name(lab_option);
+  } catch (const std::invalid_argument& e) {
+    if (why) *why = e.what();
+    return std::nullopt;
+  }
+  LabKeyChoice k = choose_lab_key(key_option);
+  if (!k.error.empty()) {
+    if (why) *why = k.error;
+    return std::nullopt;
+  }
+  s.key = std::move(k.key);
+  s.key_source = std::move(k.source);
+  return s;
+}
+
+std::string lab_settings_text(const LabSettings& s) {
+  if (!s.key) return fmt::format("lab '{}'; messages not signed (no lab key)", s.lab);
+  return fmt::format("lab '{}'; messages signed with key {} ({})", s.lab, key_id_text(s.key->id), s.key_source);
+}
+
+}  // namespace spindown
