@@ -43,13 +43,7 @@ lab_session() {
   local benches=("$@")
   lab_netns_up "sdlab$$" "${#benches[@]}" || fail "could not build the namespaces"
   if declare -F lab_before_benches >/dev/null; then lab_before_benches; fi
-  mkdir -p "$LAB_WORK/log"
-  lab_start "$LAB_NS_LAB" logger "$LAB_BIN/spindown-logger" --lcm-url "$URL" --dir "$LAB_WORK/log" --prefix lab \
-    --flush-interval 0.2
-  lab_start "$LAB_NS_LAB" fitter "$LAB_BIN/spindown-fitter" --lcm-url "$URL" --status-period 0.5 -v
-  lab_start "$LAB_NS_LAB" watch "$LAB_BIN/spindown" watch --lcm-url "$URL" --plain --interval 5 --duration 250
-  lab_wait "grep -q channels '$LAB_WORK/logger.err' && grep -q 'fitting benches' '$LAB_WORK/fitter.err' &&
-            grep -q listening '$LAB_WORK/watch.out'" 30 || fail "the lab services did not start"
+  lab_start_services
   for ((i = 0; i < ${#benches[@]}; ++i)); do
     lab_start_bench "${LAB_NS_BENCH[i]}" "${benches[i]}" "$((i % 3 + 1))" "$URL" "$runs" "$speed" ||
       fail "bench ${benches[i]} did not start"
@@ -65,16 +59,51 @@ lab_session() {
     truth+=("$LAB_WORK/$b.truth.json")
     TRUTH_ARGS+=("$b=$LAB_WORK/$b.truth.json")
   done
+  lab_end_session "${truth[@]}" -- "${benches[@]/%/.bridge}"
+}
+
+# lab_start_services [-k KEY] [-c CREDENTIALS_DIR]: in PREFIX-lab, the logger, the fitter (-v) and
+# `spindown watch --plain` on $URL, waited for until each says it listens. -k: the fitter and watch
+# take --key KEY; -c: the logger finds its key as a systemd credential in that directory.
+lab_start_services() {
+  local key=() cred=() opt
+  OPTIND=1
+  while getopts k:c: opt; do
+    case $opt in
+      k) key=(--key "$OPTARG") ;;
+      c) cred=(env CREDENTIALS_DIRECTORY="$OPTARG") ;;
+      *) fail "lab_start_services: bad option" ;;
+    esac
+  done
+  mkdir -p "$LAB_WORK/log"
+  lab_start "$LAB_NS_LAB" logger "${cred[@]}" "$LAB_BIN/spindown-logger" --lcm-url "$URL" --dir "$LAB_WORK/log" \
+    --prefix lab --flush-interval 0.2
+  lab_start "$LAB_NS_LAB" fitter "$LAB_BIN/spindown-fitter" --lcm-url "$URL" --status-period 0.5 -v "${key[@]}"
+  lab_start "$LAB_NS_LAB" watch "$LAB_BIN/spindown" watch --lcm-url "$URL" --plain --interval 5 --duration 250 \
+    "${key[@]}"
+  lab_wait "grep -q channels '$LAB_WORK/logger.err' && grep -q 'fitting benches' '$LAB_WORK/fitter.err' &&
+            grep -q listening '$LAB_WORK/watch.out'" 30 || fail "the lab services did not start"
+}
+
+# lab_end_session TRUTH... -- BRIDGE...: waits for the fitter's fits (as many as the truth files
+# have runs, or 60 s), stops the bridges (named as lab_start named them), the fitter, watch and the
+# logger with SIGTERM (a non-zero exit is a failure), prints the fitter's last counts and sets
+# EXPECTED and LOG.
+lab_end_session() {
+  local truth=() b
+  while (($#)) && [[ $1 != -- ]]; do truth+=("$1"); shift; done
+  shift
   EXPECTED=$(lab_truth_runs "${truth[@]}")
   lab_wait "(( \$(lab_fits_published) >= $EXPECTED ))" 60 ||
     echo "note: the fitter published $(lab_fits_published) fits; the benches sent $EXPECTED runs"
   sleep 1.2  # a last heartbeat of every bridge reaches the log
-  for b in "${benches[@]}"; do lab_stop "$b.bridge" 5 || fail "bridge $b: exit code $? on SIGTERM (want 0)"; done
+  for b in "$@"; do lab_stop "$b" 5 || fail "$b: exit code $? on SIGTERM (want 0)"; done
   lab_stop fitter 10 || fail "fitter: exit code $? on SIGTERM"
   sleep 0.5
   lab_stop watch 5 || fail "watch: exit code $? on SIGTERM"
   lab_stop logger 15 || fail "logger: exit code $? on SIGTERM"
   echo "fitter: $(grep 'spindown-fitter: stopped:' "$LAB_WORK/fitter.err" | sed 's/^spindown-fitter: //')"
+  echo "fitter: $(grep 'spindown-fitter: sources:' "$LAB_WORK/fitter.err" | sed 's/^spindown-fitter: //')"
   LOG=$(lab_only_log "$LAB_WORK/log")
   [[ -n $LOG ]] || fail "no log written"
 }

@@ -15,13 +15,7 @@ source "$(dirname "$0")/lab_common.bash"
 
 lab_netns_up "sdfg$$" 2 || fail "could not build the namespaces"
 LAPTOP=${LAB_NS_BENCH[1]}
-mkdir -p "$LAB_WORK/log"
-lab_start "$LAB_NS_LAB" logger "$LAB_BIN/spindown-logger" --lcm-url "$URL" --dir "$LAB_WORK/log" --prefix lab \
-  --flush-interval 0.2
-lab_start "$LAB_NS_LAB" fitter "$LAB_BIN/spindown-fitter" --lcm-url "$URL" --status-period 0.5 -v
-lab_start "$LAB_NS_LAB" watch "$LAB_BIN/spindown" watch --lcm-url "$URL" --plain --interval 5 --duration 250
-lab_wait "grep -q channels '$LAB_WORK/logger.err' && grep -q 'fitting benches' '$LAB_WORK/fitter.err' &&
-          grep -q listening '$LAB_WORK/watch.out'" 30 || fail "the lab services did not start"
+lab_start_services
 lab_start_bench "${LAB_NS_BENCH[0]}" bench-1 1 "$URL" 2 5 || fail "bench-1 did not start"
 
 # Mid-coast of run 1: one forged SAMPLE, then a forged FIT, from the laptop.
@@ -39,19 +33,7 @@ cat "$LAB_WORK/inject-fit.out"
 rc=0
 lab_wait_exit bench-1.bench 150 || rc=$?
 ((rc == 0)) || fail "virtual bench bench-1 ended with code $rc"
-EXPECTED=$(lab_truth_runs "$LAB_WORK/bench-1.truth.json")
-lab_wait "(( \$(lab_fits_published) >= $EXPECTED ))" 60 ||
-  echo "note: the fitter published $(lab_fits_published) fits; the bench sent $EXPECTED runs"
-sleep 1.2
-lab_stop bench-1.bridge 5 || fail "bridge: exit code $? on SIGTERM"
-lab_stop fitter 10 || fail "fitter: exit code $? on SIGTERM"
-sleep 0.5
-lab_stop watch 5 || fail "watch: exit code $? on SIGTERM"
-lab_stop logger 15 || fail "logger: exit code $? on SIGTERM"
-LOG=$(lab_only_log "$LAB_WORK/log")
-[[ -n $LOG ]] || fail "no log written"
-echo "fitter: $(grep 'spindown-fitter: stopped:' "$LAB_WORK/fitter.err" | sed 's/^spindown-fitter: //')"
-echo "fitter: $(grep 'spindown-fitter: sources:' "$LAB_WORK/fitter.err" | sed 's/^spindown-fitter: //')"
+lab_end_session "$LAB_WORK/bench-1.truth.json" -- bench-1.bridge
 
 # 1. Every run fitted live, against the truth.
 "$LAB_BIN/spindown" refit "$LOG" --live --json >"$LAB_WORK/live.json" 2>/dev/null || fail "refit --live"

@@ -13,13 +13,7 @@
 source "$(dirname "$0")/lab_common.bash"
 
 lab_netns_up "sdrp$$" 2 || fail "could not build the namespaces"
-mkdir -p "$LAB_WORK/log"
-lab_start "$LAB_NS_LAB" logger "$LAB_BIN/spindown-logger" --lcm-url "$URL" --dir "$LAB_WORK/log" --prefix lab \
-  --flush-interval 0.2
-lab_start "$LAB_NS_LAB" fitter "$LAB_BIN/spindown-fitter" --lcm-url "$URL" --status-period 0.5 -v
-lab_start "$LAB_NS_LAB" watch "$LAB_BIN/spindown" watch --lcm-url "$URL" --plain --interval 5 --duration 250
-lab_wait "grep -q channels '$LAB_WORK/logger.err' && grep -q 'fitting benches' '$LAB_WORK/fitter.err' &&
-          grep -q listening '$LAB_WORK/watch.out'" 30 || fail "the lab services did not start"
+lab_start_services
 
 # bench-1: 4 runs; the cable is pulled for 2 s (bench time) in the idle after run 2.
 SPEED=20
@@ -55,19 +49,7 @@ stop2, cut3 = runs[1]["cut_bench_s"] + runs[1]["t_stop_s"], runs[2]["cut_bench_s
 print(f"bench-1: unplugged at bench time {unplug:.2f} s, between run 2's stop ({stop2:.2f} s) and run 3's cut ({cut3:.2f} s)")
 sys.exit(0 if stop2 < unplug and unplug + t["unplug"]["for_s"] < cut3 else 1)
 PY
-EXPECTED=$(lab_truth_runs "$LAB_WORK/bench-1.truth.json" "$LAB_WORK/bench-2.truth.json")
-lab_wait "(( \$(lab_fits_published) >= $EXPECTED ))" 60 ||
-  echo "note: the fitter published $(lab_fits_published) fits; the benches sent $EXPECTED runs"
-sleep 1.2
-for b in bench-1.bridge2 bench-2.bridge; do lab_stop "$b" 5 || fail "$b: exit code $? on SIGTERM"; done
-lab_stop fitter 10 || fail "fitter: exit code $? on SIGTERM"
-sleep 0.5
-lab_stop watch 5 || fail "watch: exit code $? on SIGTERM"
-lab_stop logger 15 || fail "logger: exit code $? on SIGTERM"
-LOG=$(lab_only_log "$LAB_WORK/log")
-[[ -n $LOG ]] || fail "no log written"
-echo "fitter: $(grep 'spindown-fitter: stopped:' "$LAB_WORK/fitter.err" | sed 's/^spindown-fitter: //')"
-echo "fitter: $(grep 'spindown-fitter: sources:' "$LAB_WORK/fitter.err" | sed 's/^spindown-fitter: //')"
+lab_end_session "$LAB_WORK/bench-1.truth.json" "$LAB_WORK/bench-2.truth.json" -- bench-1.bridge2 bench-2.bridge
 
 # 1. Every run of both benches has its live fit, the replugged board's too.
 "$LAB_BIN/spindown" refit "$LOG" --live --json >"$LAB_WORK/live.json" 2>"$LAB_WORK/refit-live.err" || fail "refit --live"

@@ -26,14 +26,7 @@ mkdir -p "$LAB_WORK/credentials"
 cp "$KEY" "$LAB_WORK/credentials/lab-key"  # what LoadCredential=lab-key:/etc/spindown/lab.key gives a unit
 CRED=(env CREDENTIALS_DIRECTORY="$LAB_WORK/credentials")
 
-mkdir -p "$LAB_WORK/log"
-lab_start "$LAB_NS_LAB" logger "${CRED[@]}" "$LAB_BIN/spindown-logger" --lcm-url "$URL" --dir "$LAB_WORK/log" \
-  --prefix lab --flush-interval 0.2
-lab_start "$LAB_NS_LAB" fitter "$LAB_BIN/spindown-fitter" --lcm-url "$URL" --status-period 0.5 -v --key "$KEY"
-lab_start "$LAB_NS_LAB" watch "$LAB_BIN/spindown" watch --lcm-url "$URL" --plain --interval 5 --duration 250 \
-  --key "$KEY"
-lab_wait "grep -q channels '$LAB_WORK/logger.err' && grep -q 'fitting benches' '$LAB_WORK/fitter.err' &&
-          grep -q listening '$LAB_WORK/watch.out'" 30 || fail "the lab services did not start"
+lab_start_services -k "$KEY" -c "$LAB_WORK/credentials"
 grep -q "messages signed with key 0x.* (systemd credential lab-key)" "$LAB_WORK/logger.err" ||
   fail "the logger did not take the key from the credential"
 lab_profile 1 bench-1
@@ -56,18 +49,7 @@ replayed=$(sed -n 's/^sent \([0-9]*\) messages again.*/\1/p' "$LAB_WORK/inject.o
 rc=0
 lab_wait_exit bench-1.bench 150 || rc=$?
 ((rc == 0)) || fail "virtual bench bench-1 ended with code $rc"
-EXPECTED=$(lab_truth_runs "$LAB_WORK/bench-1.truth.json")
-lab_wait "(( \$(lab_fits_published) >= $EXPECTED ))" 60 ||
-  echo "note: the fitter published $(lab_fits_published) fits; the bench sent $EXPECTED runs"
-sleep 1.2
-lab_stop bench-1.bridge 5 || fail "bridge: exit code $? on SIGTERM"
-lab_stop fitter 10 || fail "fitter: exit code $? on SIGTERM"
-sleep 0.5
-lab_stop watch 5 || fail "watch: exit code $? on SIGTERM"
-lab_stop logger 15 || fail "logger: exit code $? on SIGTERM"
-LOG=$(lab_only_log "$LAB_WORK/log")
-[[ -n $LOG ]] || fail "no log written"
-echo "fitter: $(grep 'spindown-fitter: sources:' "$LAB_WORK/fitter.err" | sed 's/^spindown-fitter: //')"
+lab_end_session "$LAB_WORK/bench-1.truth.json" -- bench-1.bridge
 
 # 1. Every run fitted live (signed FITs only, with the key), and the refit with the key equals it.
 "$LAB_BIN/spindown" refit "$LOG" --live --json --key "$KEY" >"$LAB_WORK/live.json" 2>/dev/null || fail "refit --live --key"
