@@ -410,7 +410,7 @@ void RunDetector::clock_restart() {
   last_t_ = -std::numeric_limits<double>::infinity();
   last_v_ = std::numeric_limits<double>::quiet_NaN();
   state_ = State::idle;
-  lo_ = next_index_;
+  lo_ = search_lo_ = next_index_;
   need_quiet_ = false;
   short_.clear(next_index_, 0.0);
   long_.clear(next_index_, 0.0);
@@ -453,7 +453,7 @@ void RunDetector::went_silent(double silent_s) {
   }
 }
 
-void RunDetector::to_idle(std::size_t lo, bool need_quiet) {
+void RunDetector::to_idle(std::size_t lo, bool need_quiet, std::size_t search_from) {
   // After a stop, a new coast must start above the standstill: a slow coast's last creep
   // after a premature stop is not a new run.
   need_rise_ = state_ == State::tail && run_.stopped;
@@ -461,6 +461,7 @@ void RunDetector::to_idle(std::size_t lo, bool need_quiet) {
   rise_level_ = run_.zero_level + depart_band_;
   state_ = State::idle;
   lo_ = lo;
+  search_lo_ = std::max(std::min(search_from, lo), base_);
   need_quiet_ = need_quiet;
   rising_ = departing_ = 0;
   reset_window(short_, lo, next_index_);
@@ -475,7 +476,7 @@ void RunDetector::trim_idle() {
   const double keep_s = idle_keep_s;
   const double t_now = t(next_index_ - 1);
   // The first sample within keep_s only moves forward: amortized O(1) per sample.
-  time_cursor_ = std::max({time_cursor_, lo_, base_});
+  time_cursor_ = std::max({time_cursor_, search_lo_, base_});
   while (time_cursor_ + 1 < next_index_ && t_now - t(time_cursor_) > keep_s) ++time_cursor_;
   std::size_t keep_from = time_cursor_;
   // Keep enough samples for a slow loop's back-search, and what the windows still use.
@@ -680,7 +681,7 @@ void RunDetector::retract_stop(std::size_t i, Sample s) {
 bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
   const std::size_t b = i;
   const std::size_t w0 = w.first;
-  const std::size_t lower = std::max(lo_, base_);
+  const std::size_t lower = std::max(search_lo_, base_);
   double span = std::max(back_search_s, 2.0 * w.span_s);
   CutSplit sp;
   std::string lead;
@@ -702,7 +703,8 @@ bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
 
   // The coast begins at the peak, never before a rise: a motor's ramp or a hand's push straight
   // into the peak (a speed sensor's reading) is the powered phase, not the coast.
-  const bool spin_up = at_peak(sp, b);
+  // (An open pin's hum rising into the connection is no spin-up: its lead-in is rough, the rise's smooth.)
+  const bool spin_up = lead != "floating" && at_peak(sp, b);
   if (spin_up) lead = "spin-up";
   // A coast whose start was not recorded: the recording (or the stream after a clock restart)
   // begins on it, or resumes on it after a pause. Its cut is not known: the coast is partial and
@@ -710,13 +712,20 @@ bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
   std::string unseen;
   if (!spin_up && !sp.clipped) unseen = start_not_seen(sp);
   if (!unseen.empty()) lead = "none";
+  bounce_.clear();
+  if (!spin_up && unseen.empty()) take_bounce(sp, w);
 
   // Whether this is a cut at all.
   bool plausible = sp.v0 > 0;
   const double scale = std::abs(sp.v0);
   if (lead == "none") plausible = plausible && !unseen.empty();  // a stream that starts mid-coast, or a pause
   if (lead == "powered" && sp.pre_sd > 0.05 * scale) plausible = false;  // a rough "plateau"
-  if ((lead == "zeros" || lead == "floating") && sp.v0 < 1.5 * sp.pre_max) plausible = false;
+  // A coast from a motor at rest starts well above the zeros it leaves. A floating pin (the
+  // handout's step 6: A0 is connected only after the cut) reads anywhere in 0.5–2.5 V, above or
+  // below the back-EMF it is connected to: its coast needs no step, only the smooth decline the
+  // open pin's hum never keeps up (a swing of the hum taken for a coast is set aside when it rises
+  // again: swing_reason).
+  if (lead == "zeros" && sp.v0 < 1.5 * sp.pre_max) plausible = false;
   if (spin_up && sp.pre_declining) sp.pre_declining = false;  // the rise's own end, not a decline
   if (sp.pre_declining) plausible = false;  // a decline with no cut in reach
   // A cut without a step (a kink, or a stream that starts mid-coast) rests on the slope alone:
