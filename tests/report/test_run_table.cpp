@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "spindown/csv_fields.hpp"
 #include "spindown/run_table.hpp"
 
 namespace spindown {
@@ -47,26 +48,11 @@ RunFit run_fit(int number, bool stopped) {
   return f;
 }
 
-std::vector<std::string> split_csv_line(const std::string& line) {
-  std::vector<std::string> out;
-  std::string cell;
-  bool quoted = false;
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (c == '"' && quoted && i + 1 < line.size() && line[i + 1] == '"') {
-      cell += '"';
-      ++i;
-    } else if (c == '"') {
-      quoted = !quoted;
-    } else if (c == ',' && !quoted) {
-      out.push_back(cell);
-      cell.clear();
-    } else {
-      cell += c;
-    }
-  }
-  out.push_back(cell);
-  return out;
+std::vector<std::string> split_csv_line(const std::string& line, char delimiter = ',') {
+  CsvFieldSplitter splitter;
+  std::vector<std::string_view> cells;
+  splitter.split(line, delimiter, cells);
+  return {cells.begin(), cells.end()};
 }
 
 FileFit class_file() {
