@@ -13,10 +13,10 @@ void add_csv_locale_option(CLI::App* sub, std::string& locale) {
                   "decimal commas, as a German, French, Italian, Spanish or Dutch Excel opens a CSV)");
 }
 
-CsvStyle csv_style_from(const std::string& locale, bool to_file) {
+CsvStyle csv_style_from(const std::string& locale, bool byte_order_mark) {
   auto style = csv_style_for_locale(locale);
   if (!style) bad_usage(fmt::format("--csv-locale '{}' is not one of: en, de", locale));
-  style->byte_order_mark = to_file;
+  style->byte_order_mark = byte_order_mark;
   return *style;
 }
 

@@ -213,10 +213,10 @@ void setup_export(CLI::App& app) {
       "one row per run and model: bench,run,model,best,converged,t_cut_s,t_stop_s,stopped,samples,rmse,"
       "residual_unit,r2,aic,bic,t_stop_pred_s, then value and _stderr of c1,c2,c3,c4,omega0,A,B,C, then "
       "J_kg_m2,Kb_V_s_per_rad,bench_source,zero_level. SI: c1,c3 N*m*s/rad; c2,c4 N*m; omega0 rad/s.\n"
-      "A CSV written to a file starts with a UTF-8 byte-order mark (Excel then reads names right); "
-      "--csv-locale de writes ';' and decimal commas for a German (French, Italian…) Excel.\n"
+      "--csv-locale de writes ';' and decimal commas for a German (French, Italian…) Excel, and files that start "
+      "with a UTF-8 byte-order mark (--csv-locale en: the mark alone).\n"
       "MATLAB: readtable('OUT.csv'); Python: pandas.read_csv('OUT.csv') (with --csv-locale de: sep=';', "
-      "decimal=','); Python's csv module: open('OUT.csv', encoding='utf-8-sig').\n"
+      "decimal=',').\n"
       "Exit codes: 0 ok, 1 the log could not be read or written, 2 bad usage.");
   sub->add_option("FILE", opt->log, "LCM event log, or a text recording (Arduino/PuTTY log, CSV/TSV)")->required();
   sub->add_flag("--csv", opt->csv, "CSV output (the default; see --mcap)");
@@ -256,8 +256,11 @@ int run_export(const ExportCommandOptions& o) {
   OfflinePlan text_plan{read_options_from(o.input), bench_choice_from(o.input), {}, {}, {}};
   text_plan.naming = &naming;
 
-  const CsvStyle samples_style = csv_style_from(o.csv_locale, !o.out.empty() && o.out != "-");
-  const CsvStyle fits_style = csv_style_from(o.csv_locale, true);
+  // A byte-order mark only on files written for a spreadsheet (--csv-locale): the default CSV is for
+  // MATLAB and Python, whose csv module would read the mark into the first column's name.
+  const bool for_spreadsheet = !o.csv_locale.empty();
+  const CsvStyle samples_style = csv_style_from(o.csv_locale, for_spreadsheet && !o.out.empty() && o.out != "-");
+  const CsvStyle fits_style = csv_style_from(o.csv_locale, for_spreadsheet);
   Output samples;
   if (!samples.open(o.out)) {
     std::cerr << "spindown export: cannot write " << o.out << ": " << std::strerror(errno) << '\n';

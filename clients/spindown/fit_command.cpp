@@ -179,7 +179,7 @@ void setup_fit(CLI::App& app) {
 int run_fit(const FitCommandOptions& options) {
   const FitPlan plan = plan_from(options);
   const bool to_file = !options.output.empty() && options.output != "-";
-  const CsvStyle csv_style = csv_style_from(options.csv_locale, to_file);
+  const CsvStyle csv_style = csv_style_from(options.csv_locale, to_file);  // the table in a file: the mark
   if (!options.csv_locale.empty() && options.table != "csv") bad_usage("--csv-locale needs --table csv");
   std::ofstream file;
   if (to_file) {
