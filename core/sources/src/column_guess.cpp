@@ -168,7 +168,9 @@ std::optional<std::string> column_proposal(const ColumnGuess& g) {
                               g.time + 1, g.time_why, g.value + 1, g.value_why, g.time + 1, time_unit_name(g.time_unit),
                               g.value + 1);
   if (g.value_peak > 30)
-    s += fmt::format(" --value-unit rpm (or rad/s: readings up to {:g} are no back-EMF in volts)", g.value_peak);
+    s += fmt::format(" --value-unit rpm (readings up to {:g} are no back-EMF in volts; --value-unit rad/s if they "
+                     "are rad/s)",
+                     g.value_peak);
   return s;
 }
 
