@@ -94,7 +94,10 @@ TEST(ColumnNames, ParseUnitsForTheCommandLine) {
   EXPECT_EQ(parse_time_unit("Seconds"), TimeUnit::s);
   EXPECT_EQ(parse_time_unit("\xC2\xB5s"), TimeUnit::us);
   EXPECT_EQ(parse_time_unit("\xCE\xBCs"), TimeUnit::us);
+  EXPECT_EQ(parse_time_unit("micros"), TimeUnit::us);
   EXPECT_FALSE(parse_time_unit("min"));
+  EXPECT_EQ(time_unit_name(TimeUnit::us), "us");
+  EXPECT_DOUBLE_EQ(time_units_per_second(TimeUnit::ms), 1000);
   EXPECT_EQ(parse_value_unit("U/min")->quantity, Quantity::rpm);
   EXPECT_EQ(parse_value_unit("mV")->name, "mV");
   EXPECT_FALSE(parse_value_unit("A"));

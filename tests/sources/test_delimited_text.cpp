@@ -209,16 +209,6 @@ TEST(DelimitedText, LongLineAndManyBadRowsStayBounded) {
   for (const auto& d : r.diagnostics) EXPECT_LT(d.message.size(), 400u);
 }
 
-TEST(DelimitedText, TimeUnitNames) {
-  EXPECT_EQ(parse_time_unit("ms"), TimeUnit::ms);
-  EXPECT_EQ(parse_time_unit("Seconds"), TimeUnit::s);
-  EXPECT_EQ(parse_time_unit("µs"), TimeUnit::us);
-  EXPECT_EQ(parse_time_unit("micros"), TimeUnit::us);
-  EXPECT_FALSE(parse_time_unit("min"));
-  EXPECT_EQ(time_unit_name(TimeUnit::us), "us");
-  EXPECT_DOUBLE_EQ(time_units_per_second(TimeUnit::ms), 1000);
-}
-
 TEST(DelimitedText, OptionsValidate) {
   DelimitedTextOptions o;
   std::string why;

@@ -7,6 +7,7 @@
 
 #include "spindown/file_bytes.hpp"
 #include "spindown/lcm_channels.hpp"
+#include "spindown/ascii_lower.hpp"
 #include "spindown/csv_fields.hpp"
 #include "spindown/text_encoding.hpp"
 #include "spindown/text_support.hpp"
@@ -20,11 +21,6 @@ char header_delimiter(std::string_view header) {
   for (const char d : {'\t', ';', ','})
     if (header.find(d) != std::string_view::npos) return d;
   return ',';
-}
-
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return s;
 }
 
 }  // namespace
@@ -74,7 +70,7 @@ ClassRoster load_class_roster(const std::string& path) {
     const auto at = [&](std::string_view what) {
       return std::runtime_error(fmt::format("{}:{}: {}", path, number, what));
     };
-    if (columns == 0 && delim == 0 && line.size() == 5 && lower(line.substr(0, 4)) == "sep=") {
+    if (columns == 0 && delim == 0 && line.size() == 5 && ascii_lower(line.substr(0, 4)) == "sep=") {
       delim = line[4];  // Excel's hint for the delimiter ("sep=;")
       return;
     }
@@ -84,7 +80,7 @@ ClassRoster load_class_roster(const std::string& path) {
       if (std::all_of(names.begin(), names.end(), [](const std::string& x) { return x.empty(); })) return;
       columns = names.size();
       for (std::size_t i = 0; i < names.size(); ++i) {
-        const std::string n = lower(names[i]);
+        const std::string n = ascii_lower(names[i]);
         if (n == "file" || n == "filename" || n == "file name" || n == "datei" || n == "dateiname") col_file = i;
         if (n == "bench" || n == "bench_id" || n == "bench id" || n == "platz" || n == "pr\xc3\xbc" "fstand") col_bench = i;
         if (n == "student" || n == "name" || n == "students" || n == "studierende") col_student = i;

@@ -4,19 +4,13 @@
 #include <array>
 #include <numbers>
 
+#include "spindown/ascii_lower.hpp"
 #include "spindown/text_support.hpp"
 #include "spindown/trim.hpp"
 
 namespace spindown {
 
 namespace {
-
-std::string lower(std::string_view s) {
-  std::string out(s);
-  std::transform(out.begin(), out.end(), out.begin(),
-                 [](unsigned char c) { return static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c); });
-  return out;
-}
 
 // A unit as written, for matching: lower case, no blanks, µ/μ as u, ⁻¹ as ^-1, · as *, ° as deg,
 // outer brackets and a trailing full stop dropped.
@@ -145,7 +139,7 @@ std::optional<ValueUnit> parse_value_unit(std::string_view unit, std::string_vie
   if (one_of(deg_per_s, u)) return ValueUnit{Quantity::rad_per_s, std::numbers::pi / 180, "deg/s"};
   if (one_of(per_second, u)) {
     // An angular velocity's 1/s is rad/s; a speed's (n, Drehzahl) revolutions per second.
-    if (names(omega_names, lower(trim(column_base)))) return ValueUnit{Quantity::rad_per_s, 1, "rad/s"};
+    if (names(omega_names, ascii_lower(trim(column_base)))) return ValueUnit{Quantity::rad_per_s, 1, "rad/s"};
     return ValueUnit{Quantity::rpm, 60, "rev/s"};
   }
   return std::nullopt;
@@ -158,7 +152,7 @@ std::string_view value_units_read() {
 ColumnName describe_column(std::string_view field) {
   ColumnName c;
   c.name = text::escape_invalid_utf8(field);
-  const std::string l = lower(trim(field));
+  const std::string l = ascii_lower(trim(field));
   const auto split_at = [&](std::size_t base_end, std::size_t unit_begin, std::size_t unit_end) {
     c.base = clean_base(std::string_view(l).substr(0, base_end));
     c.unit = normal_unit(std::string_view(l).substr(unit_begin, unit_end - unit_begin));

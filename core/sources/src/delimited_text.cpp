@@ -12,19 +12,13 @@
 
 #include "spindown/column_guess.hpp"
 #include "spindown/csv_fields.hpp"
+#include "spindown/ascii_lower.hpp"
 #include "spindown/text_support.hpp"
 #include "spindown/trim.hpp"
 
 namespace spindown {
 
 namespace {
-
-std::string lower(std::string_view s) {
-  std::string out(s);
-  std::transform(out.begin(), out.end(), out.begin(),
-                 [](unsigned char c) { return static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c); });
-  return out;
-}
 
 // A field in single quotes ('time'), as some loggers write them: without them.
 std::string_view unquote_single(std::string_view s) {
@@ -87,10 +81,10 @@ int resolve_named(const std::string& spec, const std::vector<ColumnName>& cols, 
     *why = fmt::format("column '{}' is named but the file has no header row; give its 1-based index", spec);
     return -1;
   }
-  const std::string want = lower(trim(spec));
+  const std::string want = ascii_lower(trim(spec));
   int found = -1;
   for (std::size_t i = 0; i < cols.size(); ++i) {
-    if (lower(cols[i].name) == want || cols[i].base == want) {
+    if (ascii_lower(cols[i].name) == want || cols[i].base == want) {
       if (found >= 0) {
         *why = fmt::format("column name '{}' matches both column {} and column {}; give the index", spec, found + 1,
                            i + 1);
@@ -119,7 +113,7 @@ bool DelimitedTextOptions::is_valid(std::string* why) const {
     if (all_digits(*c) && (c->size() > 6 || std::stoul(*c) == 0))
       return fail(fmt::format("column index '{}' must be between 1 and 999999", *c));
   }
-  if (!time_column.empty() && lower(time_column) == lower(value_column))
+  if (!time_column.empty() && ascii_lower(time_column) == ascii_lower(value_column))
     return fail(fmt::format("time and value are both column '{}'", time_column));
   if (delimiter != 0 && delimiter != ',' && delimiter != ';' && delimiter != '\t' && delimiter != ' ')
     return fail(fmt::format("delimiter '{}' is not one of ',', ';', tab or blank", delimiter));
