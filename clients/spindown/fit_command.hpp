@@ -17,6 +17,8 @@ struct FitCommandOptions {
   std::vector<std::string> files;
   bool json = false;
   std::string table;     // "csv" | "json": one row per run across all files (run_table.hpp)
+  std::string output;    // -o: the output (text, JSON or table) to this file instead of stdout
+  std::string csv_locale;  // --csv-locale: the table's CSV style (csv_output.hpp)
   bool lab_units = false;
   bool details = false;  // 95 % intervals, correlations, reduced χ² in the text
   bool verbose = false;  // every diagnostic, notes included

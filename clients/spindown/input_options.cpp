@@ -86,7 +86,9 @@ std::function<void()> add_input_options(CLI::App* sub, InputOptions& opt) {
   sub->add_option("--time-column", opt.time_column, "Time column: header name or 1-based index")->group(text);
   sub->add_option("--value-column", opt.value_column, "Value column: header name or 1-based index")->group(text);
   sub->add_option("--time-unit", opt.time_unit, "Time unit: ms, s or us")->group(text);
-  sub->add_option("--value-unit", opt.value_unit, "Value unit: V, rpm or rad/s")->group(text);
+  sub->add_option("--value-unit", opt.value_unit,
+                  "Value unit: V, rpm or rad/s (also mV, U/min, 1/min, rev/s, Hz, deg/s, converted)")
+      ->group(text);
   sub->add_option("--delimiter", opt.delimiter, "Column delimiter: , ; tab space")->group(text);
 
   const char* klass = "A class's files";
@@ -173,8 +175,10 @@ ReadOptions read_options_from(const InputOptions& o) {
     if (!d.time_unit) bad_usage(fmt::format("--time-unit '{}' is not one of: s, ms, us", o.time_unit));
   }
   if (!o.value_unit.empty()) {
-    d.quantity = parse_quantity(o.value_unit);
-    if (!d.quantity) bad_usage(fmt::format("--value-unit '{}' is not one of: V, rpm, rad/s", o.value_unit));
+    const auto unit = parse_value_unit(o.value_unit);
+    if (!unit) bad_usage(fmt::format("--value-unit '{}' is not one of: {}", o.value_unit, value_units_read()));
+    d.quantity = unit->quantity;
+    d.value_scale = unit->scale;
   }
   if (!o.delimiter.empty()) d.delimiter = parse_delimiter(o.delimiter);
   std::string why;
