@@ -129,6 +129,27 @@ TEST_F(RetentionDir, DeletesOnlyOwnOldestFiles) {
                                             "other-2026-01-01-000000.lcm", "lab-2026-01-01-000000-b1.lcm"}));
 }
 
+// A disk about to fill (issue 31): its own files go, oldest first, one at a time until there is
+// room, whatever the budget; never the current file nor another's.
+TEST_F(RetentionDir, FreeingSpaceDeletesOwnOldestUntilThereIsRoom) {
+  make("lab-2026-01-01-000000.lcm", 1000, 400);
+  make("lab-2026-01-01-010000.lcm", 1000, 300);
+  make("lab-2026-01-01-020000.lcm", 1000, 200);
+  make("lab-2026-01-01-030000.lcm", 1000, 100);
+  make("notes.txt", 5000, 1000);
+  const std::string current = dir_.string() + "/lab-2026-01-01-030000.lcm";
+  int asked = 0;
+  LogPruneResult r = free_log_space(dir_.string(), "lab", "", current, [&] { return ++asked > 2; });
+  EXPECT_TRUE(r.errors.empty());
+  EXPECT_EQ(r.deleted.size(), 2u) << "room after two files";
+  EXPECT_EQ(names(), (std::set<std::string>{"lab-2026-01-01-020000.lcm", "lab-2026-01-01-030000.lcm", "notes.txt"}));
+  r = free_log_space(dir_.string(), "lab", "", current, [] { return false; });  // never enough
+  EXPECT_EQ(r.deleted.size(), 1u);
+  EXPECT_EQ(names(), (std::set<std::string>{"lab-2026-01-01-030000.lcm", "notes.txt"}));
+  r = free_log_space(dir_.string(), "lab", "", current, [] { return true; });  // room already
+  EXPECT_TRUE(r.deleted.empty());
+}
+
 TEST_F(RetentionDir, MissingDirectoryIsAnErrorNamingIt) {
   const LogPruneResult r = prune_log_files((dir_ / "gone").string(), "lab", "", "", {.keep_files = 2});
   ASSERT_EQ(r.errors.size(), 1u);
