@@ -288,7 +288,7 @@ TEST(LabTable, ARunNoFitterFollowsAnyMoreAgesOut) {
     table.on_run("b", run_msg("b", 1, run_t::STATE_COASTING), t0);
     EXPECT_TRUE(contains(table.render(t0 + 5 * sec), "1 coasting  ")) << table.render(t0 + 5 * sec);
     const std::string later = table.render(t0 + 12 * sec);
-    EXPECT_TRUE(contains(later, "1 coasting? (no fitter for 12 s)")) << later;
+    EXPECT_TRUE(contains(later, "1 not followed (no fitter for 12 s)")) << later;
   }
   {
     LabTable table(opt);
@@ -297,7 +297,7 @@ TEST(LabTable, ARunNoFitterFollowsAnyMoreAgesOut) {
     const std::string text = table.render(t0 + 60 * sec);
     EXPECT_TRUE(contains(text, "1 coasting  ")) << "a long coast, its fitter alive: " << text;
     table.on_status("fitter", status_msg("fitter", "fitter", "stopping", {}), t0 + 61 * sec);
-    EXPECT_TRUE(contains(table.render(t0 + 61 * sec), "1 coasting? (no fitter for 61 s)")) << table.render(t0 + 61 * sec);
+    EXPECT_TRUE(contains(table.render(t0 + 61 * sec), "1 not followed (no fitter for 61 s)")) << table.render(t0 + 61 * sec);
   }
 }
 

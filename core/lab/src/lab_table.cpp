@@ -43,8 +43,7 @@ std::string age_text(std::int64_t last_us, std::int64_t now_us, double stale_s) 
 std::string run_state_text(const LabBenchRow& r, bool unfollowed, std::int64_t now_us) {
   if (!r.has_run) return r.has_samples ? "-" : "no data";
   if (unfollowed)
-    return fmt::format("{} {}? (no fitter for {:.0f} s)", r.run, run_state_name(r.run_state),
-                       1e-6 * double(now_us - r.last_run_us));
+    return fmt::format("{} not followed (no fitter for {:.0f} s)", r.run, 1e-6 * double(now_us - r.last_run_us));
   return fmt::format("{} {}{}", r.run, run_state_name(r.run_state), r.run_partial ? " (partial)" : "");
 }
 

@@ -33,7 +33,7 @@ struct LabTableOptions {
   double gap_event_every_s = 10.0; // sequence-gap events at most this often per bench
   // A run shown coasting (or at a provisional stop) is no longer followed once no fitter has
   // sent a heartbeat for this long (or the last one said "stopping") and its last RUN is as old:
-  // the row says so instead of "coasting" for ever.
+  // the row says "not followed (no fitter for N s)" instead of "coasting" for ever.
   double fitter_lost_s = 10.0;
 };
 
