@@ -102,7 +102,7 @@ case_outage_cut() {
 
 # ---------------------------------------------------------------- frozen fitter
 # The fitter is frozen (SIGSTOP) for 5.5 s while bench-2's run 1 stops, bench-1's run 1 is cut
-# and bench-2's run 2 is cut; nothing is lost (the kernel queues every datagram for it: checked
+# and bench-2's run 2 is cut, and bench-3 coasts through it; nothing is lost (the kernel queues every datagram for it: checked
 # from the fitter's socket drops in /proc/net/udp). Fitter --silent 2. Speed 4.
 case_frozen() {
   local C=fz S=4
@@ -112,8 +112,11 @@ case_frozen() {
   bench $C bp bench-pc bench-1 --runs 1 --speed $S --seed 331 --wait-reader 10 --lead-in-s 34 \
         --coulomb 9e-5 --viscous 1.6e-7 --linger 1
   bench $C bp bench-pc bench-2 --runs 2 --idle 5 --speed $S --seed 332 --wait-reader 10 --linger 1
+  bench $C bp bench-pc bench-3 --runs 1 --speed $S --seed 333 --wait-reader 10 --lead-in-s 16 \
+        --coulomb 7e-5 --viscous 1.4e-7 --linger 1
   bridge_t0 $C bp bench-pc bench-2 "$(cat bench-2.tty)" "$LAB_URL" a; local b2=$LASTPID; local t2=$T0
   bridge_t0 $C bp bench-pc bench-1 "$(cat bench-1.tty)" "$LAB_URL" a; local b1=$LASTPID; local t1=$T0
+  bridge $C bp bench-pc bench-3 "$(cat bench-3.tty)" "$LAB_URL" a; local b3=$LASTPID
   local s2 c1 c2
   s2=$(truthval bench-2.truth.json "d['runs'][0]['cut_bench_s']+d['runs'][0]['t_stop_s']")
   c1=$(truthval bench-1.truth.json "d['runs'][0]['cut_bench_s']")
@@ -130,17 +133,17 @@ case_frozen() {
   echo "fitter socket drops while frozen: $drops (inodes $inodes)"
   sleep_until $t2 12
   kill -CONT $PID_F; echo "thawed at $(now)"
-  wait_exit $PID_VB_bench_1 40; wait_exit $PID_VB_bench_2 20
+  wait_exit $PID_VB_bench_1 40; wait_exit $PID_VB_bench_2 20; wait_exit $PID_VB_bench_3 20
   sleep 2
   drops=$(ip netns exec $ns cat /proc/net/udp | awk -v l=" $inodes " 'NR>1 && index(l, " " $10 " ") {d+=$13} END{print d+0}')
-  stop $PID_F; stop $PID_L; stop $b1; stop $b2
+  stop $PID_F; stop $PID_L; stop $b1; stop $b2; stop $b3
   local log; log=$(ls logs/*.lcm)
   if [ "$drops" != 0 ]; then
     result "FAIL frozen-fitter: runner premise broken: the kernel dropped $drops datagrams on the frozen fitter's socket (the truth assumes none; raise net.core.rmem_max)"
     return
   fi
   # nothing was lost: every run is whole, live (the frozen fitter) and in refit
-  result "$(judge_fits frozen-fitter "$log" bench-1=bench-1.truth.json=1= bench-2=bench-2.truth.json=1,2= "extra=(fitter socket drops: 0)")"
+  result "$(judge_fits frozen-fitter "$log" bench-1=bench-1.truth.json=1= bench-2=bench-2.truth.json=1,2= bench-3=bench-3.truth.json=1= "extra=(fitter socket drops: 0)")"
 }
 
 # ---------------------------------------------------------------- rotated session
@@ -168,10 +171,10 @@ case_rotated() {
   files=$(ls logs/*.lcm)                 # the shell's order
   rev=$(ls logs/*.lcm | sort -r)
   n=$(echo $files | wc -w)
-  "$BIN/spindown" refit --live --json $files > live.json 2> live.err
-  "$BIN/spindown" refit --json $files > refit-glob.json 2> refit-glob.err
-  "$BIN/spindown" refit --json $rev > refit-rev.json 2> refit-rev.err
-  "$BIN/spindown" refit --compare $files > compare.txt 2> compare.err; local crc=$?
+  timeout 60 "$BIN/spindown" refit --live --json $files > live.json 2> live.err
+  timeout 60 "$BIN/spindown" refit --json $files > refit-glob.json 2> refit-glob.err
+  timeout 60 "$BIN/spindown" refit --json $rev > refit-rev.json 2> refit-rev.err
+  timeout 60 "$BIN/spindown" refit --compare $files > compare.txt 2> compare.err; local crc=$?
   local v1 v2
   v1=$($PY "$HERE/judge.py" fits refit-rotated live.json refit-glob.json \
         bench-1=bench-1.truth.json=1,2,3= bench-2=bench-2.truth.json=1,2,3=)
@@ -223,7 +226,7 @@ case_sigterm() {
   sleep 2
   stop $f2; stop $PID_L; stop $b1; stop $b2
   local log; log=$(ls logs/*.lcm)
-  "$BIN/spindown" export "$log" --mcap session.mcap > export.out 2> export.err
+  timeout 60 "$BIN/spindown" export "$log" --mcap session.mcap > export.out 2> export.err
   local c1 c2
   c1=$(truthval bench-1.truth.json "d['runs'][0]['cut_device_us']/1e6")
   c2=$(truthval bench-2.truth.json "d['runs'][0]['cut_device_us']/1e6")
@@ -261,7 +264,7 @@ case_replay() {
   wait_exit $PID_VB_bench_1 20; sleep 1
   stop $ly; stop $by
   local ylog; ylog=$(ls logs/*.lcm)
-  "$BIN/spindown" export "$ylog" --csv -o y.csv --no-fits > /dev/null 2> export.err
+  timeout 60 "$BIN/spindown" export "$ylog" --csv -o y.csv --no-fits > /dev/null 2> export.err
   local c7 th n
   c7=$(truthval bench-1.truth.json "d['runs'][6]['cut_device_us']/1e6")
   th=$($PY "$HERE/tools.py" hosttime y.csv bench-1 "$(awk -v c=$c7 'BEGIN{print c-5}')")
@@ -329,7 +332,7 @@ case_twolabs_onepc() {
   bg $C lb lab-b-bench-pc B/b1.br.out B/b1.br.err "$BIN/spindown-bridge" --device "$(cat B/bench-1.tty)" --bench bench-1 --lcm-url "$UB"; br+=($LASTPID)
   bg $C lb lab-b-bench-pc B/b2.br.out B/b2.br.err "$BIN/spindown-bridge" --device "$(cat B/bench-2.tty)" --bench bench-2 --lcm-url "$UB"; br+=($LASTPID)
   sleep 2
-  ( on $C srv shared-pc "$BIN/spindown" doctor --json --lcm-url "$UA" --listen 3 --timeout 2 > doctor.json 2> doctor.err )
+  ( on $C srv shared-pc timeout 20 "$BIN/spindown" doctor --json --lcm-url "$UA" --listen 3 --timeout 2 > doctor.json 2> doctor.err )
   local p
   for p in $PID_VB_A_bench_1 $PID_VB_A_bench_2 $PID_VB_B_bench_1 $PID_VB_B_bench_2; do wait_exit $p 30; done
   sleep 2
@@ -380,7 +383,7 @@ case_twolabs_instance() {
   bridge $C ba lab-a-bench-pc a-1 "$(cat a-1.tty)" "$LAB_URL" a; local b1=$LASTPID
   bridge $C bb lab-b-bench-pc b-1 "$(cat b-1.tty)" "$LAB_URL" a; local b2=$LASTPID
   sleep 2
-  ( on $C ws teacher-pc "$BIN/spindown" watch --once --duration 3 --lcm-url "$LAB_URL" > watch.txt 2> watch.err )
+  ( on $C ws teacher-pc timeout 15 "$BIN/spindown" watch --once --duration 3 --lcm-url "$LAB_URL" > watch.txt 2> watch.err )
   wait_exit $PID_VB_a_1 40; wait_exit $PID_VB_b_1 20
   sleep 2
   grep -v ': stopped:' fitterA.err > fitterA.live.err; grep -v ': stopped:' fitterB.err > fitterB.live.err

@@ -84,8 +84,8 @@ runner_fail() { result "FAIL $1: runner: $2"; }
 # fit_jsons ID LOG...: the live FITs (refit --live --json) and the refit (refit --json) of LOGs
 fit_jsons() {
   local id=$1; shift
-  "$BIN/spindown" refit --live --json "$@" > "$id.live.json" 2> "$id.live.err"
-  "$BIN/spindown" refit --json "$@" > "$id.refit.json" 2> "$id.refit.err"
+  timeout 60 "$BIN/spindown" refit --live --json "$@" > "$id.live.json" 2> "$id.live.err"
+  timeout 60 "$BIN/spindown" refit --json "$@" > "$id.refit.json" 2> "$id.refit.err"
 }
 # judge_fits ID LOG SPEC... [opts]: judge.py fits over the log's live FITs and its refit
 judge_fits() {
