@@ -152,6 +152,42 @@ double window_overlap_s(const Run& ours, const Json& theirs) {
   return std::isfinite(lo) && std::isfinite(hi) && hi > lo ? hi - lo : 0.0;
 }
 
+// Why a refitted run and the live FIT paired with it differ, in words (what a lab sees: a run
+// joined mid-coast, a run split at a silence or a gap, a cut one side invented, samples the live
+// fitter never got); "" when nothing explains it beyond the numbers.
+std::string why_they_differ(const Run& ours, std::int64_t ours_samples, const Json& live) {
+  const bool live_partial = live.value("lead_in", "") == "none", ours_partial = ours.partial();
+  const double live_cut = number_in(live, "t_cut_s"), live_end = number_in(live, "t_end_s");
+  const std::string live_end_name = live.value("end", "");
+  const double tol = 1.5 * std::max(ours.period_s, 1e-3);
+  if (live_partial && !ours_partial)
+    return "partial: live joined this run mid-coast (the fitter started, took the bench in, or resumed after a "
+           "silence after its cut); the log holds the whole run";
+  if (ours_partial && !live_partial)
+    return "partial: the refit joined this run mid-coast (the log, or the first file of this session, starts after "
+           "its cut; give the refit the file before it too)";
+  if (!live_partial && !ours_partial && std::isfinite(live_cut) && std::abs(live_cut - ours.t_cut_s) > tol)
+    return live_cut > ours.t_cut_s
+               ? fmt::format("invented cut: live put a cut at {:.3f} s inside the coast the log shows cut at {:.3f} s "
+                             "(live missed samples there: an outage, a frozen or restarted fitter)",
+                             live_cut, ours.t_cut_s)
+               : fmt::format("invented cut: the refit put a cut at {:.3f} s inside the coast live saw cut at {:.3f} s",
+                             ours.t_cut_s, live_cut);
+  if (live_end_name != end_name(ours.end) && std::isfinite(live_end) && std::isfinite(ours.t_end_s) &&
+      std::abs(live_end - ours.t_end_s) > tol)
+    return live_end < ours.t_end_s
+               ? fmt::format("split: live closed this run at {:.3f} s ({}) and the rest of the coast was apart; the "
+                             "refit ends it at {:.3f} s ({})",
+                             live_end, live_end_name, ours.t_end_s, end_name(ours.end))
+               : fmt::format("split: the refit closed this run at {:.3f} s ({}); live went on to {:.3f} s ({})",
+                             ours.t_end_s, end_name(ours.end), live_end, live_end_name);
+  if (const auto it = live.find("samples"); it != live.end() && it->is_number() && it->get<std::int64_t>() != ours_samples)
+    return fmt::format("samples: live fitted {} samples, the refit {} (samples the live fitter did not get, or the "
+                       "logger did not)",
+                       it->get<std::int64_t>(), ours_samples);
+  return {};
+}
+
 }  // namespace
 
 void setup_refit(CLI::App& app) {
@@ -159,10 +195,14 @@ void setup_refit(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "refit", "Refit LCM logs exactly as spindown-fitter did live (same runs, same numbers); --compare checks it");
   sub->footer(
-      "Reads each log in its own order with its own timestamps (never file:// replay). Runs are listed by bench, "
-      "then run number; in JSON each run also has bench.id, first_seq and last_seq.\n"
+      "Reads each log in its own order with its own timestamps (never file:// replay). Several logs are read as "
+      "sessions in time order: a logger's rotated files are one session (a run across a file boundary is whole, as "
+      "live); a log overlapping another in time is a session of its own. Runs are listed by bench, then run "
+      "number; in JSON each run also has bench.id, first_seq and last_seq, and a session of several files "
+      "session_files.\n"
       "Exit codes: 0 ok, 1 a log or run could not be used or --compare found a difference, 2 bad usage.");
-  sub->add_option("LOG", opt->logs, "LCM event log(s) (spindown-logger, lcm-logger)")->required();
+  sub->add_option("LOG", opt->logs, "LCM event log(s) (spindown-logger, lcm-logger); rotated files in any order")
+      ->required();
   sub->add_flag("--json", opt->json, "Print one JSON object {\"files\":[{\"runs\":[…]}]} instead of tables");
   sub->add_option("--bench", opt->bench_regex, "Only benches whose id matches this regex (default all)");
   sub->add_option("--models", opt->models, "Models to fit: viscous,coulomb,combined (default all)")
@@ -215,7 +255,15 @@ int run_refit(const RefitCommandOptions& o) {
   const bool show_progress = !o.no_progress && ProgressReporter::is_terminal(STDERR_FILENO);
   const bool stream = !o.live && !o.compare;  // runs formatted as fitted, not kept (memory flat)
   bool first_file = true;
-  for (const auto& path : o.logs) {
+  // Logs given together are read as sessions in time order: a logger's rotated files are one
+  // session, so a run across a file boundary is whole, as it was live.
+  const std::vector<std::vector<std::string>> sessions =
+      o.logs.size() > 1 ? log_sessions(o.logs) : std::vector<std::vector<std::string>>{o.logs};
+  for (const auto& session : sessions) {
+    const std::string path =
+        session.size() == 1 ? session.front()
+                            : fmt::format("{} + {} more (one session, in time order)", session.front(),
+                                          session.size() - 1);
     // On a terminal only (never in pipes or files), throttled, erased before anything is printed.
     ProgressReporter progress(STDERR_FILENO, show_progress);
     // Each bench's runs, formatted as they are fitted; printed by bench (first appearance) once
@@ -238,8 +286,8 @@ int run_refit(const RefitCommandOptions& o) {
                    format_run_fit(run.fit, report));
       }
     };
-    LogRefit r = refit_log(
-        path, fopt, o.live || o.compare, {},
+    LogRefit r = refit_log_session(
+        session, fopt, o.live || o.compare, {},
         [&](std::int64_t done, std::int64_t total, std::size_t runs) {
           progress.update(done, total, "refit", fmt::format("{} run{} fitted  {}", runs, runs == 1 ? "" : "s", path));
         },
@@ -302,7 +350,17 @@ int run_refit(const RefitCommandOptions& o) {
                                              ours.fit.run.t_cut_s);
         if (best == live.size()) {
           ++missing_live;
-          std::cout << fmt::format("{}: {}: refit found it, no live FIT recorded\n", path, name);
+          std::string why;
+          for (std::size_t k = 0; k < live.size(); ++k)
+            if (live[k].first == ours.bench && window_overlap_s(ours.fit.run, live[k].second) > 0) {
+              why = fmt::format(" (split: it lies inside live run {} (cut at {:.3f} s), which the refit splits here)",
+                                live[k].second.value("run", 0), number_in(live[k].second, "t_cut_s"));
+              break;
+            }
+          if (why.empty() && ours.fit.run.end == Run::End::end_of_data)
+            why = " (split: the log ends during this run, and its live FIT, published when it ended, is in the log "
+                  "after it: refit the session's files together)";
+          std::cout << fmt::format("{}: {}: refit found it, no live FIT recorded{}\n", path, name, why);
           continue;
         }
         live_paired[best] = true;
@@ -316,20 +374,27 @@ int run_refit(const RefitCommandOptions& o) {
           continue;
         }
         ++differ;
-        const bool live_partial = b.value("lead_in", "") == "none", ours_partial = ours.fit.run.partial();
-        std::cout << fmt::format("{}: {}: differs: {}{}\n", path, name, d,
-                                 live_partial && !ours_partial
-                                     ? " (live joined this run mid-coast: the fitter started or took the bench "
-                                       "in after its cut; the log holds the whole run)"
-                                     : "");
+        const std::string why = why_they_differ(ours.fit.run, jr.value("samples", std::int64_t{0}), b);
+        std::cout << fmt::format("{}: {}: differs: {}{}\n", path, name, d, why.empty() ? "" : " (" + why + ")");
       }
       for (std::size_t k = 0; k < live.size(); ++k)
         if (!live_paired[k]) {
           ++missing_refit;
+          // Part of a refitted run already paired: live split that run in two.
+          std::string why;
+          for (const RefitRun& ours : r.runs)
+            if (ours.bench == live[k].first && window_overlap_s(ours.fit.run, live[k].second) > 0) {
+              const bool partial = live[k].second.value("lead_in", "") == "none";
+              why = fmt::format(" (split: it lies inside refit run {} (cut at {:.3f} s); live {}", ours.fit.run.number,
+                                ours.fit.run.t_cut_s,
+                                partial ? "published this part of it as a partial run of its own)"
+                                        : "gave this part of it a cut of its own: an invented cut)");
+              break;
+            }
           std::cout << fmt::format("{}: {} live run {} (cut at {:.3f} s): live FIT recorded, the refit did not find "
-                                   "this run\n",
+                                   "this run{}\n",
                                    path, live[k].first, live[k].second.value("run", 0),
-                                   number_in(live[k].second, "t_cut_s"));
+                                   number_in(live[k].second, "t_cut_s"), why);
         }
       std::cout << fmt::format("{}: {} runs refitted, {} live FIT messages: {} identical, {} different, {} only "
                                "refitted, {} only live\n",

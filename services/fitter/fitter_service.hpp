@@ -13,6 +13,7 @@
 #include "spindown/fitter_core.hpp"
 #include "spindown/lcm_loop.hpp"
 #include "spindown/message_queue.hpp"
+#include "spindown/publish_health.hpp"
 #include "spindown/service_notifier.hpp"
 #include "spindown/stop_signal.hpp"
 
@@ -49,6 +50,8 @@ class FitterService final : public FitterSink {
 
  private:
   void worker();
+  // Nothing received still waits: the service's queue, LCM's and the socket's are empty.
+  bool nothing_waiting() const;
   void publish_status(std::int64_t now_us, const char* state);
   // SPINDOWN.<bench>.EXPLAIN, after the FIT (the workflow takes tens of ms; FIT goes first).
   void publish_explain(const FitResult& result);
@@ -64,7 +67,9 @@ class FitterService final : public FitterSink {
 
   // Worker-side measurements for the heartbeat.
   double last_latency_s_ = 0, max_latency_s_ = 0, last_fit_s_ = 0;
-  std::int64_t publish_failures_ = 0;
+  PublishHealth publish_{{.program = "spindown-fitter"}};  // send errors, unheard heartbeats
+  std::int64_t stalls_ = 0;
+  bool draining_ = false;    // after a stall, until nothing received waits any more  // rounds that started long after the one before (a freeze)
   std::int64_t explains_ = 0, explain_failures_ = 0;
   std::int64_t last_samples_ = 0, last_rate_us_ = 0;
   double rate_hz_ = 0;

@@ -276,6 +276,31 @@ TEST(LabTable, AgeAndStaleMark) {
   EXPECT_TRUE(contains(table.render(t0 + 7 * sec), "  7.0 s !  ")) << table.render(t0 + 7 * sec);
 }
 
+// A run shown coasting whose fitter stopped heartbeating (killed, host gone) is no longer shown
+// as coasting for ever: after fitter_lost_s it says nobody follows it; a fitter still beating
+// keeps it coasting, and a fitter whose last word was "stopping" lets it go at once.
+TEST(LabTable, ARunNoFitterFollowsAnyMoreAgesOut) {
+  LabTableOptions opt;
+  opt.fitter_lost_s = 10;
+  {
+    LabTable table(opt);
+    table.on_status("fitter", status_msg("fitter", "fitter", "running", {}), t0);
+    table.on_run("b", run_msg("b", 1, run_t::STATE_COASTING), t0);
+    EXPECT_TRUE(contains(table.render(t0 + 5 * sec), "1 coasting  ")) << table.render(t0 + 5 * sec);
+    const std::string later = table.render(t0 + 12 * sec);
+    EXPECT_TRUE(contains(later, "1 not followed (no fitter for 12 s)")) << later;
+  }
+  {
+    LabTable table(opt);
+    table.on_run("b", run_msg("b", 1, run_t::STATE_COASTING), t0);
+    for (int i = 1; i <= 60; ++i) table.on_status("fitter", status_msg("fitter", "fitter", "running", {}), t0 + i * sec);
+    const std::string text = table.render(t0 + 60 * sec);
+    EXPECT_TRUE(contains(text, "1 coasting  ")) << "a long coast, its fitter alive: " << text;
+    table.on_status("fitter", status_msg("fitter", "fitter", "stopping", {}), t0 + 61 * sec);
+    EXPECT_TRUE(contains(table.render(t0 + 61 * sec), "1 not followed (no fitter for 61 s)")) << table.render(t0 + 61 * sec);
+  }
+}
+
 TEST(LabTable, BoundedRowsAndEvents) {
   LabTableOptions opt;
   opt.max_benches = 3;

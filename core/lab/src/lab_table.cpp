@@ -40,8 +40,10 @@ std::string age_text(std::int64_t last_us, std::int64_t now_us, double stale_s) 
   return seconds_text(age) + (age > stale_s ? " !" : "");
 }
 
-std::string run_state_text(const LabBenchRow& r) {
+std::string run_state_text(const LabBenchRow& r, bool unfollowed, std::int64_t now_us) {
   if (!r.has_run) return r.has_samples ? "-" : "no data";
+  if (unfollowed)
+    return fmt::format("{} not followed (no fitter for {:.0f} s)", r.run, 1e-6 * double(now_us - r.last_run_us));
   return fmt::format("{} {}{}", r.run, run_state_name(r.run_state), r.run_partial ? " (partial)" : "");
 }
 
@@ -247,6 +249,7 @@ void LabTable::on_run(std::string_view bench, const run_t& msg, std::int64_t now
   r.t_stop_s = msg.t_stop_s;
   r.run_samples = msg.samples;
   r.run_partial = msg.lead_in == "none";
+  r.last_run_us = std::max(r.last_run_us, now_us);
   if (!news) return;
   std::string text = fmt::format("{}: run {} {}", r.bench, msg.run, run_state_name(msg.state));
   switch (msg.state) {
@@ -341,6 +344,10 @@ void LabTable::on_status(std::string_view channel_id, const status_t& msg, std::
   s.uptime_s = msg.uptime_s;
   s.last_error = msg.last_error;
   s.last_message_us = std::max(s.last_message_us, now_us);
+  if (msg.service == "fitter" && now_us >= last_fitter_us_) {
+    last_fitter_us_ = now_us;
+    fitter_stopping_ = msg.state == "stopping";
+  }
   s.counters.clear();
   auto pick = [&](auto names) {
     for (std::string_view name : names)
@@ -365,6 +372,15 @@ void LabTable::on_bad_message(std::string text, std::int64_t) {
   changed_ = true;
 }
 
+bool LabTable::run_unfollowed(const LabBenchRow& r, std::int64_t now_us) const {
+  if (!r.has_run || (r.run_state != run_t::STATE_COASTING && r.run_state != run_t::STATE_STOPPED)) return false;
+  const auto lost_us = static_cast<std::int64_t>(opt_.fitter_lost_s * 1e6);
+  if (now_us - r.last_run_us < lost_us) return false;
+  // A stopped run is final once its FIT came (the fit's run is this run).
+  if (r.run_state == run_t::STATE_STOPPED && r.has_fit && r.fit_run == r.run) return false;
+  return fitter_stopping_ || now_us - last_fitter_us_ >= lost_us;
+}
+
 std::string LabTable::render(std::int64_t now_us, std::size_t width) const {
   std::string out;
   const std::time_t now_s = static_cast<std::time_t>(now_us / 1000000);
@@ -382,12 +398,14 @@ std::string LabTable::render(std::int64_t now_us, std::size_t width) const {
   if (width > 0 && width < compact_width) {
     rows.push_back({"BENCH", "RUN", "AGE", "BRIDGE", "GAPS", "LAST FIT"});
     for (const auto& [id, r] : benches_)
-      rows.push_back({id, run_state_text(r), age_text(r.last_message_us, now_us, opt_.stale_s), bridge_short(r),
+      rows.push_back({id, run_state_text(r, run_unfollowed(r, now_us), now_us),
+                      age_text(r.last_message_us, now_us, opt_.stale_s), bridge_short(r),
                       r.has_samples ? fmt::format("{}", r.seq_gaps) : "-", fit_short(r)});
   } else {
     rows.push_back({"BENCH", "RUN", "AGE", "BRIDGE (lines ok/bad, rate)", "SEQ GAPS", "RMSE", "LAST FIT (best model)"});
     for (const auto& [id, r] : benches_)
-      rows.push_back({id, run_state_text(r), age_text(r.last_message_us, now_us, opt_.stale_s), bridge_text(r),
+      rows.push_back({id, run_state_text(r, run_unfollowed(r, now_us), now_us),
+                      age_text(r.last_message_us, now_us, opt_.stale_s), bridge_text(r),
                       gaps_text(r), rmse_text(r), fit_text(r)});
   }
   out += format_columns(rows, width);

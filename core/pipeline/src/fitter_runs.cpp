@@ -170,6 +170,27 @@ void FitterCore::finish(std::int64_t now_utime) {
   }
 }
 
+void FitterCore::abandon_open_runs(std::int64_t now_utime, const std::string& why) {
+  std::vector<Bench*> order;
+  for (auto& [id, b] : benches_) order.push_back(b.get());
+  std::sort(order.begin(), order.end(), [](const Bench* a, const Bench* b) { return a->arrival < b->arrival; });
+  for (Bench* b : order) {
+    if (b->open_state == 0) continue;
+    Run run = b->open_run;
+    run.end_index = b->detector.samples_seen();  // every sample it had when the fitter stopped
+    ++counters_.runs_abandoned;
+    publish_run(*b, run, run_t::STATE_ABANDONED, why, now_utime);
+    b->open_state = 0;
+  }
+}
+
+bool FitterCore::silence_due(std::int64_t now_utime) const {
+  const auto silent_us = static_cast<std::int64_t>(opt_.silent_s * 1e6);
+  for (const auto& [id, b] : benches_)
+    if (b->open_state != 0 && now_utime - b->last_sample_utime >= silent_us) return true;
+  return false;
+}
+
 void FitterCore::poll(std::int64_t now_utime) {
   const auto silent_us = static_cast<std::int64_t>(opt_.silent_s * 1e6);
   for (auto& [id, b] : benches_) {

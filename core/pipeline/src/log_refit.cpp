@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <limits>
 #include <map>
+#include <sys/stat.h>
 
 #include "spindown/fit_message.hpp"
 
@@ -56,81 +57,160 @@ class RefitSink final : public FitterSink {
 LogRefit refit_log(const std::string& path, const FitterOptions& options, bool keep_live_fits,
                    const std::function<void(const LcmLogEvent&)>& each_event, const RefitProgressFn& progress,
                    const RefitRunFn& each_run) {
-  LogRefit out;
-  out.file.file = path;
-  // The core reads samples in place; a caller that sees each event may want the samples_t.
-  LcmLogReader reader(path, each_event ? LcmSamples::view_and_message : LcmSamples::view_only);
-  if (!reader.good()) {
-    out.file.failures.push_back(reader.open_error());
-    return out;
+  return refit_log_session({path}, options, keep_live_fits, each_event, progress, each_run);
+}
+
+namespace {
+
+// The first and last event times of a log (0, 0 when it holds none).
+std::pair<std::int64_t, std::int64_t> log_time_span(const std::string& path) {
+  LcmLogReader reader(path, LcmSamples::view_only);
+  std::int64_t first = 0, last = 0;
+  LcmLogEvent ev;
+  while (reader.good() && reader.next(ev)) {
+    if (ev.number <= 0) continue;
+    if (first == 0) first = ev.log_utime;
+    last = ev.log_utime;
   }
+  return {first, last};
+}
+
+}  // namespace
+
+std::vector<std::vector<std::string>> log_sessions(const std::vector<std::string>& paths) {
+  struct Span {
+    std::string path;
+    std::int64_t first, last;
+  };
+  std::vector<Span> spans;
+  for (const auto& p : paths) {
+    const auto [first, last] = log_time_span(p);
+    spans.push_back({p, first, last});
+  }
+  // Unreadable or empty logs keep their place at the end, each alone.
+  std::stable_sort(spans.begin(), spans.end(), [](const Span& a, const Span& b) {
+    if ((a.first == 0) != (b.first == 0)) return b.first == 0;
+    return a.first < b.first;
+  });
+  std::vector<std::vector<std::string>> sessions;
+  std::int64_t session_end = 0;
+  for (const Span& sp : spans) {
+    if (sp.first != 0 && !sessions.empty() && session_end != 0 && sp.first >= session_end) {
+      sessions.back().push_back(sp.path);
+    } else {
+      sessions.push_back({sp.path});
+    }
+    session_end = sp.last;
+  }
+  return sessions;
+}
+
+LogRefit refit_log_session(const std::vector<std::string>& paths, const FitterOptions& options, bool keep_live_fits,
+                           const std::function<void(const LcmLogEvent&)>& each_event, const RefitProgressFn& progress,
+                           const RefitRunFn& each_run) {
+  LogRefit out;
+  out.file.file = paths.empty() ? std::string() : paths.front();
+  out.session_files = paths;
+  const std::string& path = out.file.file;
   RefitSink sink(out, path, each_run);
   FitterCore core(options, sink);
   std::map<std::string, std::size_t, std::less<>> order;
-  std::vector<char> channel_done;  // by LcmLogEvent::channel_id: its bench's place is known
+  std::vector<char> channel_done;  // by session channel id: its bench's place is known
+  // Each reader numbers its own channels; the core's numbering is the session's, by name.
+  std::map<std::string, std::int32_t, std::less<>> session_ids;
   std::int64_t last_utime = 0, next_poll = std::numeric_limits<std::int64_t>::min();
   std::size_t file_problems = 0;
+  std::int64_t events_read = 0, bytes_before = 0, bytes_total = 0;
+  for (const auto& p : paths) {
+    struct stat st {};
+    if (::stat(p.c_str(), &st) == 0) bytes_total += st.st_size;
+  }
   LcmLogEvent ev;
-  // Progress every 256 events, counted down (one test per event, none for a caller without one).
-  constexpr std::size_t progress_every = 256;
-  std::size_t until_progress = progress ? progress_every : std::numeric_limits<std::size_t>::max();
-  while (reader.next(ev)) {
-    if (each_event) each_event(ev);
-    if (--until_progress == 0) {
-      until_progress = progress_every;
-      progress(ev.file_offset, reader.file_size(), out.runs_fitted);
+  std::size_t opened = 0;
+  for (const std::string& file : paths) {
+    // The core reads samples in place; a caller that sees each event may want the samples_t.
+    LcmLogReader reader(file, each_event ? LcmSamples::view_and_message : LcmSamples::view_only);
+    if (!reader.good()) {
+      out.file.failures.push_back(reader.open_error());
+      continue;
     }
-    if (ev.number > 0) last_utime = ev.log_utime;
-    // Host time passes as the log's events do: benches gone silent mid-coast are closed as live.
-    if (ev.log_utime >= next_poll) {
-      core.poll(ev.log_utime);
-      next_poll = ev.log_utime + FitterCore::poll_period_us;
-    }
-    // A bench's first SAMPLE/CONFIG fixes its place; checked once per channel, not per event.
-    const auto id = static_cast<std::size_t>(ev.channel_id);
-    if (ev.channel_id < 0 || id >= channel_done.size() || !channel_done[id]) {
-      if (!ev.bench.empty() && (ev.channel.ends_with(".SAMPLE") || ev.channel.ends_with(".CONFIG")) &&
-          !order.contains(ev.bench)) {
-        order.emplace(ev.bench, order.size());
-        out.bench_order.emplace_back(ev.bench);
+    ++opened;
+    std::vector<std::int32_t> id_map;  // reader's channel id -> the session's
+    // Progress every 256 events, counted down (one test per event, none for a caller without one).
+    constexpr std::size_t progress_every = 256;
+    std::size_t until_progress = progress ? progress_every : std::numeric_limits<std::size_t>::max();
+    while (reader.next(ev)) {
+      if (each_event) each_event(ev);
+      if (--until_progress == 0) {
+        until_progress = progress_every;
+        progress(bytes_before + ev.file_offset, std::max(bytes_total, bytes_before + reader.file_size()),
+                 out.runs_fitted);
+      }
+      if (ev.number > 0) last_utime = ev.log_utime;
+      // Host time passes as the log's events do: benches gone silent mid-coast are closed as live.
+      if (ev.log_utime >= next_poll) {
+        core.poll(ev.log_utime);
+        next_poll = ev.log_utime + FitterCore::poll_period_us;
       }
       if (ev.channel_id >= 0) {
-        if (id >= channel_done.size()) channel_done.resize(id + 1, 0);
-        channel_done[id] = 1;
+        const auto rid = static_cast<std::size_t>(ev.channel_id);
+        if (rid >= id_map.size()) id_map.resize(rid + 1, -1);
+        if (id_map[rid] < 0) {
+          const auto [it, added] =
+                session_ids.try_emplace(std::string(ev.channel), static_cast<std::int32_t>(session_ids.size()));
+          id_map[rid] = it->second;
+        }
+        ev.channel_id = id_map[rid];
+      }
+      // A bench's first SAMPLE/CONFIG fixes its place; checked once per channel, not per event.
+      const auto id = static_cast<std::size_t>(ev.channel_id);
+      if (ev.channel_id < 0 || id >= channel_done.size() || !channel_done[id]) {
+        if (!ev.bench.empty() && (ev.channel.ends_with(".SAMPLE") || ev.channel.ends_with(".CONFIG")) &&
+            !order.contains(ev.bench)) {
+          order.emplace(ev.bench, order.size());
+          out.bench_order.emplace_back(ev.bench);
+        }
+        if (ev.channel_id >= 0) {
+          if (id >= channel_done.size()) channel_done.resize(id + 1, 0);
+          channel_done[id] = 1;
+        }
+      }
+      switch (ev.kind) {
+        // Decoded (and checked) once, by the reader: the core takes the message as it is.
+        case LcmLogEvent::Kind::samples:
+          core.on_samples(ev.channel_id, ev.bench, ev.samples_view, ev.log_utime);
+          break;
+        case LcmLogEvent::Kind::config:
+          core.on_config(ev.bench, ev.config, ev.log_utime);
+          break;
+        case LcmLogEvent::Kind::problem:
+          if (ev.number > 0 && ev.data) {  // a message that does not decode: the core counts it
+            core.on_message(ev.channel, ev.data, ev.data_size, ev.log_utime);
+          } else if (++file_problems <= max_problems_listed) {
+            out.file.diagnostics.push_back({Diagnostic::Severity::warning, file, ev.number, ev.problem});
+          }
+          break;
+        case LcmLogEvent::Kind::other:
+          if (keep_live_fits && ev.channel.starts_with("SPINDOWN.") && ev.channel.ends_with(".FIT")) {
+            fit_t m;
+            try {
+              if (m.decode(ev.data, 0, ev.data_size) >= 0) {
+                out.live.push_back(std::move(m));
+                break;
+              }
+            } catch (const std::exception&) {
+            }
+            out.file.diagnostics.push_back({Diagnostic::Severity::warning, file, ev.number,
+                                            fmt::format("event {} on {}: not a decodable fit_t; skipped", ev.number,
+                                                        ev.channel)});
+          }
+          break;
       }
     }
-    switch (ev.kind) {
-      // Decoded (and checked) once, by the reader: the core takes the message as it is.
-      case LcmLogEvent::Kind::samples:
-        core.on_samples(ev.channel_id, ev.bench, ev.samples_view, ev.log_utime);
-        break;
-      case LcmLogEvent::Kind::config:
-        core.on_config(ev.bench, ev.config, ev.log_utime);
-        break;
-      case LcmLogEvent::Kind::problem:
-        if (ev.number > 0 && ev.data) {  // a message that does not decode: the core counts it
-          core.on_message(ev.channel, ev.data, ev.data_size, ev.log_utime);
-        } else if (++file_problems <= max_problems_listed) {
-          out.file.diagnostics.push_back({Diagnostic::Severity::warning, path, ev.number, ev.problem});
-        }
-        break;
-      case LcmLogEvent::Kind::other:
-        if (keep_live_fits && ev.channel.starts_with("SPINDOWN.") && ev.channel.ends_with(".FIT")) {
-          fit_t m;
-          try {
-            if (m.decode(ev.data, 0, ev.data_size) >= 0) {
-              out.live.push_back(std::move(m));
-              break;
-            }
-          } catch (const std::exception&) {
-          }
-          out.file.diagnostics.push_back({Diagnostic::Severity::warning, path, ev.number,
-                                          fmt::format("event {} on {}: not a decodable fit_t; skipped", ev.number,
-                                                      ev.channel)});
-        }
-        break;
-    }
+    events_read += reader.events_read();
+    bytes_before += reader.file_size();
   }
+  if (opened == 0) return out;
   core.finish(last_utime);
   out.counters = core.counters();
   const FitterCounters& c = out.counters;
@@ -150,7 +230,7 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
        fmt::format("{} events: {} sample messages, {} config messages, {} samples used; {} decode errors, {} sequence "
                    "gaps ({} samples lost), {} repeated messages, {} NaN values, {} samples with time going back, "
                    "{} clock restarts",
-                   reader.events_read(), c.sample_messages, c.config_messages, c.samples, c.decode_errors, c.seq_gaps,
+                   events_read, c.sample_messages, c.config_messages, c.samples, c.decode_errors, c.seq_gaps,
                    c.samples_lost, c.duplicates, c.nan_values, c.time_backwards, c.clock_restarts)});
 
   // Runs in the order `spindown fit` lists them: by bench (first appearance), then number.
@@ -179,6 +259,7 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
 
 Json refit_file_json(const LogRefit& refit, const ReportOptions& opt) {
   Json j = file_fit_json(refit.file, opt);
+  if (refit.session_files.size() > 1) j["session_files"] = refit.session_files;
   Json& runs = j["runs"];
   for (std::size_t i = 0; i < refit.runs.size() && i < runs.size(); ++i)
     tag_run_json(runs[i], {refit.runs[i].bench, refit.runs[i].first_seq, refit.runs[i].last_seq});

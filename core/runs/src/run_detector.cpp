@@ -394,6 +394,7 @@ std::size_t RunDetector::coast_loop(const double* t_s, const double* value, std:
 
 void RunDetector::clock_restart() {
   restarted_mid_coast_ = state_ == State::coasting;
+  after_silence_ = false;  // a new timeline: nothing on it continues the silenced coast
   if (state_ == State::coasting) {
     run_note_severity_ = Diagnostic::Severity::warning;  // the run is cut short: it changes the result
     close_unstopped(next_index_,
@@ -437,6 +438,12 @@ void RunDetector::finish() {
 void RunDetector::went_silent(double silent_s) {
   if (state_ == State::coasting && next_index_ > base_) coast_checks(next_index_ - 1, ring_[(next_index_ - 1) & mask_], true);
   if (state_ == State::coasting) {
+    // Where the coast was when the samples stopped: what resumes below it is the same coast.
+    after_silence_ = true;
+    silenced_run_ = run_.number;
+    silence_s_ = silent_s;
+    silence_level_ = next_index_ > base_ ? v(next_index_ - 1) : v0_;
+    silence_band_ = std::max({4.0 * coast_sd_, 3.0 * coast_step_, 0.02 * std::abs(v0_)});
     run_note_severity_ = Diagnostic::Severity::warning;
     close_unstopped(next_index_,
                     fmt::format("no samples for {:g} s: the bench went silent mid-coast; fitted to its last sample, "
@@ -450,6 +457,19 @@ void RunDetector::went_silent(double silent_s) {
   } else if (state_ == State::tail) {
     complete_run(next_index_);
     to_idle(next_index_, false);
+  }
+}
+
+void RunDetector::watch_after_silence(double v) {
+  // A rise above where the silence began: the motor was powered again (a new run's lead-in).
+  if (v > silence_level_ + silence_band_) {
+    after_silence_ = false;
+    return;
+  }
+  // A standstill: a second of readings, low beside that level, with no significant slope.
+  if (long_.n >= 8 && duration(long_) >= 0.8 * long_.span_s && long_.mean() < standstill_max_fraction * silence_level_) {
+    const double sd = long_.resid_sd(), slope = long_.slope();
+    if (!(slope < 0 && -slope * std::sqrt(long_.sxx()) > 2.0 * sd)) after_silence_ = false;
   }
 }
 
@@ -529,6 +549,8 @@ void RunDetector::idle_step(std::size_t i, Sample s, double prev_t) {
   advance(short_, i, s);
   advance(long_, i, s);
   advance(vlong_, i, s);
+  if (after_silence_) [[unlikely]]
+    watch_after_silence(s.v);
   if (need_quiet_) {
     // After a coast closed without a stop the decline may go on: wait for it to pause.
     const bool full = long_.n >= 8 && duration(long_) >= 0.8 * long_.span_s;
@@ -710,7 +732,11 @@ bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
   // begins on it, or resumes on it after a pause. Its cut is not known: the coast is partial and
   // taken from its first sample, never given an invented cut in the pause or a lead-in.
   std::string unseen;
-  if (!spin_up && !sp.clipped) unseen = start_not_seen(sp);
+  if (after_silence_) {
+    unseen = rest_after_silence(sp);
+  } else if (!spin_up && !sp.clipped) {
+    unseen = start_not_seen(sp);
+  }
   if (!unseen.empty()) lead = "none";
   bounce_.clear();
   if (!spin_up && unseen.empty()) take_bounce(sp, w);
@@ -743,6 +769,7 @@ bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
   run_note_severity_ = Diagnostic::Severity::note;
   fragment_ = restarted_mid_coast_ && sp.cut_index == stream_start_;
   restarted_mid_coast_ = false;
+  after_silence_ = false;
   if (!unseen.empty() && !fragment_) {
     run_note_ = unseen;
     run_note_severity_ = Diagnostic::Severity::warning;

@@ -410,6 +410,24 @@ std::string RunDetector::start_not_seen(CutSplit& sp) {
                      fmt_s(t(a)));
 }
 
+std::string RunDetector::rest_after_silence(CutSplit& sp) {
+  // The coast that went silent goes on: taken from the first sample after the silence (or the
+  // oldest still held), its cut long before and not in this stream.
+  const std::size_t a = std::max({resume_index_, base_, lo_});
+  if (a >= next_index_) return {};
+  const std::size_t c = sp.cut_index;
+  sp.v0 = sp.v0 + sp.post_slope * (t(a) - t(c));
+  sp.cut_index = a;
+  sp.pre_end = a;
+  sp.npre = 0;
+  sp.t_cut_s = t(a);
+  sp.clipped = false;
+  sp.pre_declining = false;
+  return fmt::format("the samples stopped for over {:g} s mid-coast and resumed on the same clock at {}: this is the "
+                     "rest of run {}'s coast, whose cut came before the silence, so it is partial (no cut)",
+                     silence_s_, fmt_s(t(a)), silenced_run_);
+}
+
 std::string RunDetector::classify_lead_in(const CutSplit& sp) const {
   if (sp.npre < 3) return "none";
   const double scale = std::abs(sp.v0);

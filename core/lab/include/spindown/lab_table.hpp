@@ -31,6 +31,10 @@ struct LabTableOptions {
   std::size_t max_services = 16;
   std::size_t max_events = 200;    // events not yet taken; older ones are dropped (and counted)
   double gap_event_every_s = 10.0; // sequence-gap events at most this often per bench
+  // A run shown coasting (or at a provisional stop) is no longer followed once no fitter has
+  // sent a heartbeat for this long (or the last one said "stopping") and its last RUN is as old:
+  // the row says "not followed (no fitter for N s)" instead of "coasting" for ever.
+  double fitter_lost_s = 10.0;
 };
 
 // What the table knows about one bench.
@@ -45,6 +49,7 @@ struct LabBenchRow {
   double t_cut_s = 0, t_stop_s = 0;
   std::int32_t run_samples = 0;
   bool run_partial = false;          // the cut was not seen (joined mid-coast)
+  std::int64_t last_run_us = 0;      // host time of the last RUN
 
   // From SPINDOWN.<bench>.FIT: the latest fit.
   bool has_fit = false;
@@ -104,6 +109,8 @@ class LabTable {
   // A message that could not be decoded (counted, the text kept for the footer).
   void on_bad_message(std::string text, std::int64_t now_us);
 
+  // Whether row's open run is no longer followed by a fitter at now_us (fitter_lost_s).
+  bool run_unfollowed(const LabBenchRow& row, std::int64_t now_us) const;
   // The table at now_us. width > 0 cuts lines to that many characters (a terminal's width).
   std::string render(std::int64_t now_us, std::size_t width = 0) const;
   // Events since the last call, oldest first, without time stamps ("bench-a: run 2 coasting…").
@@ -129,6 +136,8 @@ class LabTable {
   LabTableOptions opt_;
   std::map<std::string, LabBenchRow, std::less<>> benches_;
   std::map<std::string, LabServiceRow, std::less<>> services_;  // "service/instance"
+  std::int64_t last_fitter_us_ = 0;  // the newest heartbeat of any fitter
+  bool fitter_stopping_ = false;     // that heartbeat said "stopping"
   std::deque<std::string> events_;
   std::int64_t bad_messages_ = 0;
   std::string last_bad_message_;

@@ -91,6 +91,7 @@ struct FitterCounters {
   std::int64_t dropped_benches = 0;    // benches evicted (max_benches), never one with a run in progress
   std::int64_t benches_refused = 0;    // messages of new benches refused (table full or admission rate)
   std::int64_t partial_runs = 0;       // runs completed whose cut was not seen (joined mid-coast)
+  std::int64_t runs_abandoned = 0;     // runs still open when the fitter stopped (RUN abandoned)
   std::int64_t silent_benches = 0;     // runs closed because their bench went silent (silent_s)
   std::int64_t flood_drops = 0;        // samples dropped by the rate cap
   std::int64_t flood_messages = 0;     // messages dropped by the rate cap
@@ -149,10 +150,17 @@ class FitterCore {
   // End of the stream (refit, shutdown): open coasts are closed and fitted as `spindown fit`
   // does at the end of a file.
   void finish(std::int64_t now_utime);
+  // The service stops: every run still open is published abandoned with the note why (not
+  // fitted: a fitter started again takes the rest of its coast as partial), counted in
+  // runs_abandoned. The core takes no samples after it.
+  void abandon_open_runs(std::int64_t now_utime, const std::string& why);
   // The passing of host time (the service calls it a few times a second, refit at the log's
   // event times): a bench with a run in progress and no samples for silent_s has it closed.
   void poll(std::int64_t now_utime);
   static constexpr std::int64_t poll_period_us = 500'000;  // how often poll() is worth calling
+  // Whether poll(now_utime) would close a run: a bench with a run in progress and no samples
+  // for silent_s. The service then first makes sure nothing it received still waits.
+  bool silence_due(std::int64_t now_utime) const;
 
   const FitterCounters& counters() const { return counters_; }
   std::size_t bench_count() const { return benches_.size(); }

@@ -69,8 +69,10 @@ class RunDetector {
   // End of the stream: an open coast is closed (never stopped), a tail is cut short.
   void finish();
   // Live: no sample came for silent_s (host time). An open coast is closed there (End::silent,
-  // a warning), a tail is cut short; samples that come after are found afresh, a coast going on
-  // as a partial one. Nothing happens when idle.
+  // a warning), a tail is cut short; samples that come after are found afresh. A coast that goes
+  // on after the silence (the samples resume on the same clock: an outage, a frozen fitter) is
+  // that run's rest: partial, never given a cut, until the reading shows the coast is over (it
+  // rises above where the silence began, or holds still at a standstill). Nothing happens when idle.
   void went_silent(double silent_s);
 
   // Events since the last call, oldest first.
@@ -246,6 +248,9 @@ class RunDetector {
   bool creeps_in(double t_cut, double t_quarter, double t_stop) const;
   // The sample-to-sample noise of [from, to) (second differences; 0 for fewer than 3 samples).
   double rough_sd(std::size_t from, std::size_t to) const;
+  // The same for a coast found while after_silence_: the silenced coast's rest, from the first
+  // sample after the silence; empty only when nothing of it is held.
+  std::string rest_after_silence(CutSplit& sp);
   // The mean of samples k-1..k+1 within [lo, hi].
   double smoothed(std::size_t k, std::size_t lo, std::size_t hi) const;
   // Whether the coast found in sp follows a rise straight into its peak (a spin-up): a rise after
@@ -336,6 +341,12 @@ class RunDetector {
   bool creeping_ = false;
   double stop_approach_t_ = 0;  // found_standstill's approach t-value of the run's standstill
   bool restarted_mid_coast_ = false;  // the clock restarted while a coast was open: its rest is a fragment
+  // A coast closed by went_silent(): until the reading rises above silence_level_ +
+  // silence_band_ or holds still low, a coast found is that one's rest (partial, no cut).
+  bool after_silence_ = false;
+  int silenced_run_ = 0;
+  double silence_level_ = 0, silence_band_ = 0, silence_s_ = 0;
+  void watch_after_silence(double v);  // idle: releases after_silence_ when the coast is over
   bool fragment_ = false;             // the open run is such a rest: ignored when complete  // the coast was seen approaching standstill asymptotically
   double quiet_until_s_ = -std::numeric_limits<double>::infinity();  // after a rejected cut
 
