@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,10 +23,11 @@ struct RefitRun {
   RunFit fit;
   std::string bench_source;
   std::int64_t first_seq = 0, last_seq = 0;
+  std::optional<HealthVerdict> health;  // when FitterOptions::health has the bench (as the live FIT)
 };
 
 struct LogRefit {
-  FileFit file;                 // runs ordered by bench (first appearance), then run number
+  FileFit file;                 // runs ordered by bench (first appearance), then run number; their health
   std::vector<RefitRun> runs;   // the same runs, with their bench ids (empty when streamed)
   std::size_t runs_fitted = 0;  // runs fitted, kept or streamed
   std::vector<fit_t> live;      // SPINDOWN.<bench>.FIT messages recorded in the log (when asked)
