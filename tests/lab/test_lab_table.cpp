@@ -151,9 +151,11 @@ TEST(LabTable, FitShowsBestModelCoefficientsAndRmse) {
   EXPECT_TRUE(contains(row->coefficients, "±")) << row->coefficients;
   EXPECT_FALSE(contains(row->coefficients, "N·m")) << row->coefficients;  // units: once, under the table
   const std::string text = table.render(t0);
-  EXPECT_TRUE(contains(text, "run 2 combined: c3 = (1.822 ± 0.011)e-07, c4 = ")) << text;
-  EXPECT_TRUE(contains(text, "coefficients in N·m·s/rad (c1, c3) and N·m (c2, c4)")) << text;
-  EXPECT_TRUE(contains(text, "0.0123 V")) << text;
+  // The combined model's c3 and c4 in columns of their own, scaled by a power of ten said once.
+  EXPECT_TRUE(contains(text, "run 2 combined  1.822±0.011  1.139±0.002  0.0123 V")) << text;
+  EXPECT_TRUE(contains(text, "c3 (1e-7 N·m·s/rad)")) << text;
+  EXPECT_TRUE(contains(text, "c3 in 1e-7 N·m·s/rad, c4 in 1e-4 N·m: the combined model's, ± total standard error"))
+      << text;
   const auto events = table.take_events();
   ASSERT_EQ(events.size(), 1u);
   EXPECT_TRUE(contains(events[0], "bench-a: run 2 fit: best combined: c3 = (1.822 ± 0.011)e-07 N·m·s/rad, c4 = "))
@@ -179,7 +181,9 @@ TEST(LabTable, LabUnitsMatchTheLabReport) {
   opt.lab_units = true;
   LabTable table(opt);
   table.on_fit("b", fit_msg("b", 1), t0);
-  EXPECT_TRUE(contains(table.render(t0), "coefficients in g·cm²·s⁻¹ (c1, c3) and g·cm²·rad·s⁻² (c2, c4)"));
+  const std::string text = table.render(t0);
+  EXPECT_TRUE(contains(text, "c3 in g·cm²·s⁻¹, c4 in g·cm²·rad·s⁻²")) << text;
+  EXPECT_TRUE(contains(text, "1.822±0.011  1139.0±2.0")) << text;  // the lab's units, unscaled
 }
 
 TEST(LabTable, FitWithoutBestModelSaysSo) {
@@ -335,23 +339,45 @@ TEST(LabTable, ChangedFlagFollowsInput) {
 }
 
 }  // namespace
-// An 80-column terminal: short columns, and the last fit's model, RMSE and verdict come before
-// its coefficients, so what matters is never cut off.
+// An 80-column terminal: short headers and cells, then the columns worth least dropped in their
+// order, so that the run, c3 and c4 with their errors and the verdict always fit; at 120 columns
+// nothing is dropped or cut.
 TEST(LabTable, UsableInEightyColumns) {
   LabTable table;
-  fit_t m = fit_msg("bench-a", 2);
-  m.verdict = "service";
-  table.on_fit("bench-a", m, t0);
-  const std::string text = table.render(t0, 80);
-  std::istringstream lines(text);
-  std::string line, row;
-  while (std::getline(lines, line)) {
-    EXPECT_LE(display_width(line), 80u) << line;
-    if (line.starts_with("bench-a")) row = line;
+  for (const char* id : {"teaching-lab-bench-000", "teaching-lab-bench-001", "teaching-lab-bench-002"}) {
+    table.on_status(id, status_msg("bridge", id, "connected", {{"lines_good", 15200}, {"lines_bad", 3}}, {{"rate_hz", 49.6}}), t0);
+    table.on_samples(id, samples_msg(id, 0, 10), t0);
+    table.on_run(id, run_msg(id, 12, run_t::STATE_COASTING), t0);
+    fit_t m = fit_msg(id, 11);
+    m.verdict = "not_judged";
+    table.on_fit(id, m, t0);
   }
-  EXPECT_TRUE(contains(row, "2 combined 0.0123 V; service")) << text;
-  EXPECT_TRUE(contains(text, "BRIDGE")) << text;
-  EXPECT_FALSE(contains(text, "lines ok/bad")) << text;  // the wide header would leave no room for the fit
+  for (std::size_t width : {80u, 120u}) {
+    const std::string text = table.render(t0, width);
+    std::istringstream lines(text);
+    std::string line, header;
+    std::vector<std::string> rows;
+    while (std::getline(lines, line)) {
+      EXPECT_LE(display_width(line), width) << line;
+      if (line.starts_with("BENCH")) header = line;
+      if (line.starts_with("teaching-lab-bench-")) rows.push_back(line);
+    }
+    ASSERT_EQ(rows.size(), 3u) << text;
+    for (const auto& row : rows) {
+      EXPECT_TRUE(contains(row, "12 coast")) << text;
+      EXPECT_TRUE(contains(row, "1.822±0.011  1.139±0.002")) << text;
+      EXPECT_TRUE(row.ends_with("NOT JUDGED")) << text;
+    }
+    EXPECT_TRUE(contains(header, "c3") && contains(header, "c4") && contains(header, "HEALTH")) << text;
+    if (width == 80) {
+      EXPECT_FALSE(contains(header, "BRIDGE")) << text;  // the first to go
+      EXPECT_TRUE(contains(text, "not shown at this width: BRIDGE")) << text;
+    } else {
+      for (const char* column : {"BRIDGE", "GAPS", "AGE", "FIT", "RMSE"}) EXPECT_TRUE(contains(header, column)) << text;
+      EXPECT_FALSE(contains(text, "not shown")) << text;
+      EXPECT_TRUE(contains(rows[0], "50 Hz, 3 bad")) << text;
+    }
+  }
 }
 
 }  // namespace spindown

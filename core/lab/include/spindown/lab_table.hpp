@@ -55,6 +55,9 @@ struct LabBenchRow {
   std::string coefficients;          // the best model's friction coefficients ± error (no units)
   double rmse = 0;
   std::string residual_unit;
+  // The combined model's c3 and c4 with their total standard errors (J's and K_b's uncertainty
+  // included), in SI or the lab's units as the table shows them; NaN when it has none.
+  double c3 = 0, c3_error = 0, c4 = 0, c4_error = 0;
   std::string bench_source;          // "config" or why a default J/K_b was used
   std::string health;                // motor health verdict "ok"/"check"/"service" ("" when not assessed)
   std::string health_reason;         // its reason in words
@@ -104,7 +107,10 @@ class LabTable {
   // A message that could not be decoded (counted, the text kept for the footer).
   void on_bad_message(std::string text, std::int64_t now_us);
 
-  // The table at now_us. width > 0 cuts lines to that many characters (a terminal's width).
+  // The table at now_us. width > 0 fits it to that many columns (a terminal's width): one row per
+  // bench with its run, the last fit's model, the combined model's c3 and c4 with their errors and
+  // the health verdict always; headers and cells shortened first, then the columns worth least
+  // dropped one by one (bridge, sequence gaps, RMSE, age, last fit), and only then lines cut.
   std::string render(std::int64_t now_us, std::size_t width = 0) const;
   // Events since the last call, oldest first, without time stamps ("bench-a: run 2 coasting…").
   std::vector<std::string> take_events();
@@ -124,6 +130,7 @@ class LabTable {
 
  private:
   LabBenchRow& row(std::string_view bench, std::int64_t now_us);
+  std::string bench_table(std::int64_t now_us, std::size_t width) const;  // the rows and their units line
   void event(std::string text);
 
   LabTableOptions opt_;
