@@ -509,7 +509,7 @@ std::string LabTable::bench_table(std::int64_t now_us, std::size_t width) const 
   }
   std::string out = format_columns(rows, width);
   // What the cells mean: the coefficients' scale and units, the marks, what the width left out.
-  std::string units = fmt::format("c3 in {}{}, c4 in {}{}: the combined model's, ± total standard error",
+  std::string units = fmt::format("c3 in {}{}, c4 in {}{} (combined model, ± total error)",
                                   scale_text(e3), c3_unit, scale_text(e4), c4_unit);
   out += cut_to_width(units, width) + '\n';
   if (!dropped_note.empty())
