@@ -5,10 +5,13 @@
 #include <string>
 #include <vector>
 
+#include "lab_messages.hpp"
 #include "spindown/lab_table.hpp"
 
 namespace spindown {
 namespace {
+
+using test::fit_msg;
 
 constexpr std::int64_t t0 = 1'700'000'000'000'000;  // µs since the epoch
 constexpr std::int64_t sec = 1'000'000;
@@ -21,32 +24,6 @@ run_t run_msg(const std::string& bench, int run, std::int8_t state, double cut =
   m.t_cut_s = cut;
   m.t_stop_s = stop;
   m.samples = 388;
-  return m;
-}
-
-// A combined-model fit as spindown-fitter publishes it (flat arrays; model 2 is the best).
-fit_t fit_msg(const std::string& bench, int run, const std::string& best = "combined") {
-  fit_t m{};
-  m.bench = bench;
-  m.run = run;
-  m.residual_unit = "V";
-  m.bench_source = "config";
-  m.model = {"viscous", "coulomb", "combined"};
-  m.nmodels = 3;
-  m.rmse = {0.05, 0.02, 0.0123};
-  m.r2 = {0.9, 0.99, 0.999};
-  m.aic = m.bic = {1, 2, 3};
-  m.t_stop_pred_s = {1e9, 8, 7.7};
-  m.converged = {true, true, true};
-  m.model_samples = {388, 388, 388};
-  m.model_message = {"", "", ""};
-  m.param_model = {0, 1, 2, 2, 2, 2};
-  m.param_name = {"c1", "c2", "c3", "c4", "omega0", "A"};
-  m.param_value = {1.4e-6, 1.38e-4, 1.822e-7, 1.139e-4, 450, -5.06};
-  m.param_stderr = {1e-8, 1e-6, 1.1e-9, 2e-7, 0.5, 0.01};
-  m.param_unit = {"N*m*s/rad", "N*m", "N*m*s/rad", "N*m", "rad/s", "V"};
-  m.nparams = static_cast<std::int32_t>(m.param_name.size());
-  m.best = best;
   return m;
 }
 
@@ -319,17 +296,8 @@ TEST(LabTable, WidthCutsEveryLineAndColumnsAlign) {
   // no RMSE, its "-" sits under the header's RMSE, as bench-a's value does.
   // The code points of line from column col on (n of them).
   const auto at_column = [](const std::string& line, std::size_t col, std::size_t n) {
-    std::size_t points = 0, from = line.size(), to = line.size();
-    for (std::size_t i = 0; i < line.size(); ++i) {
-      if ((static_cast<unsigned char>(line[i]) & 0xC0) == 0x80) continue;
-      if (points == col) from = i;
-      if (points == col + n) {
-        to = i;
-        break;
-      }
-      ++points;
-    }
-    return from < line.size() ? line.substr(from, to - from) : std::string();
+    const std::size_t from = utf8_prefix_bytes(line, col);
+    return line.substr(from, utf8_prefix_bytes(std::string_view(line).substr(from), n));
   };
   const auto rmse_byte = header.find("RMSE");
   ASSERT_NE(rmse_byte, std::string::npos);

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "lab_messages.hpp"
 #include "spindown/watch_screen.hpp"
 
 namespace spindown {
@@ -12,23 +13,9 @@ namespace {
 
 constexpr std::int64_t t0 = 1'700'000'000'000'000;
 
+// The lab table test's fit with a verdict and a long reason.
 fit_t fit_msg(const std::string& bench, int run, const std::string& verdict) {
-  fit_t m{};
-  m.bench = bench;
-  m.run = run;
-  m.residual_unit = "V";
-  m.bench_source = "config";
-  m.model = {"viscous", "coulomb", "combined"};
-  m.nmodels = 3;
-  m.rmse = {0.05, 0.02, 0.0123};
-  m.converged = {true, true, true};
-  m.param_model = {0, 1, 2, 2};
-  m.param_name = {"c1", "c2", "c3", "c4"};
-  m.param_value = {1.4e-6, 1.38e-4, 1.822e-7, 1.139e-4};
-  m.param_stderr = {1e-8, 1e-6, 1.1e-9, 2e-7};
-  m.param_unit = {"N*m*s/rad", "N*m", "N*m*s/rad", "N*m"};
-  m.nparams = 4;
-  m.best = "combined";
+  fit_t m = test::fit_msg(bench, run);
   m.verdict = verdict;
   m.verdict_reason = "dry friction 2.2× the baseline (±0.0029): check bearings and alignment; stops 51 % sooner";
   return m;

@@ -141,17 +141,6 @@ std::string counters_text(const LabServiceRow& s) {
   return out.empty() ? "-" : out;
 }
 
-// Cuts a UTF-8 line to width code points (never inside a character).
-std::string cut_to_width(const std::string& line, std::size_t width) {
-  if (width == 0) return line;
-  std::size_t points = 0;
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    if ((static_cast<unsigned char>(line[i]) & 0xC0) == 0x80) continue;
-    if (points == width) return line.substr(0, i);
-    ++points;
-  }
-  return line;
-}
 
 // Columns padded to their widest cell; the last column is not padded.
 std::string format_columns(const std::vector<std::vector<std::string>>& rows, std::size_t width) {
@@ -186,11 +175,8 @@ std::size_t table_width(const std::vector<std::vector<std::string>>& rows) {
 
 }  // namespace
 
-std::size_t display_width(std::string_view utf8) {
-  std::size_t n = 0;
-  for (unsigned char c : utf8)
-    if ((c & 0xC0) != 0x80) ++n;
-  return n;
+std::string cut_to_width(const std::string& line, std::size_t width) {
+  return width == 0 ? line : line.substr(0, utf8_prefix_bytes(line, width));
 }
 
 namespace {

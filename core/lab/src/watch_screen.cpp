@@ -3,33 +3,10 @@
 #include <algorithm>
 #include <vector>
 
+#include "spindown/text_support.hpp"
+#include "spindown/utf8_text.hpp"
+
 namespace spindown {
-
-namespace {
-
-// Byte offset of the first code point past n code points of text (text.size() when it has fewer).
-std::size_t offset_of(std::string_view text, std::size_t n) {
-  std::size_t points = 0;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    if ((static_cast<unsigned char>(text[i]) & 0xC0) == 0x80) continue;
-    if (points == n) return i;
-    ++points;
-  }
-  return text.size();
-}
-
-std::vector<std::string_view> lines_of(std::string_view text) {
-  std::vector<std::string_view> out;
-  while (!text.empty()) {
-    const auto nl = text.find('\n');
-    out.push_back(text.substr(0, nl));
-    if (nl == std::string_view::npos) break;
-    text.remove_prefix(nl + 1);
-  }
-  return out;
-}
-
-}  // namespace
 
 std::string fold_to_width(std::string_view line, std::size_t width, std::size_t max_lines, std::size_t indent) {
   if (width == 0 || display_width(line) <= width) return std::string(line) + '\n';
@@ -45,12 +22,12 @@ std::string fold_to_width(std::string_view line, std::size_t width, std::size_t 
       break;
     }
     if (last) {
-      out.append(line.substr(0, offset_of(line, room - 1)));
+      out.append(line.substr(0, utf8_prefix_bytes(line, room - 1)));
       out += "…\n";
       break;
     }
     // Break at the last space that leaves something on this line, else mid-word.
-    std::size_t cut = offset_of(line, room);
+    std::size_t cut = utf8_prefix_bytes(line, room);
     const std::size_t space = line.substr(0, cut + 1).rfind(' ');
     if (space != std::string_view::npos && space > 0) cut = space;
     out.append(line.substr(0, cut));
@@ -69,12 +46,12 @@ std::string watch_screen(const LabTable& table, std::int64_t now_us, std::span<c
   const std::string text = table.render(now_us, width);
   std::string out;
   std::size_t used = 0;
-  for (std::string_view line : lines_of(text)) {
-    if (used == room) return out;
+  text::for_each_line(text, [&](std::int64_t, std::string_view line) {
+    if (used == room) return;
     out.append(line);
     out += '\n';
     ++used;
-  }
+  });
   if (recent_events.empty() || used + 2 > room) return out;
   // The newest events that fit, oldest first, each at most two lines.
   std::vector<std::string> folded;

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <fmt/format.h>
 
+#include "spindown/utf8_text.hpp"
+
 namespace spindown::svg {
 
 std::vector<double> nice_ticks(double lo, double hi, int target) {
@@ -93,14 +95,7 @@ std::string legend(double x, double y, const std::vector<std::pair<std::string, 
   for (std::size_t i = 0; i < items.size(); ++i) {
     std::string_view rest = items[i].first;
     while (!rest.empty()) {
-      std::size_t points = 0, cut = rest.size();
-      for (std::size_t b = 0; b < rest.size(); ++b) {
-        if ((static_cast<unsigned char>(rest[b]) & 0xC0) == 0x80) continue;
-        if (points++ == room) {
-          cut = b;
-          break;
-        }
-      }
+      std::size_t cut = utf8_prefix_bytes(rest, room);
       if (cut < rest.size()) {
         const std::size_t space = rest.substr(0, cut).rfind(' ');
         if (space != std::string_view::npos && space > 0) cut = space + 1;  // the space stays, at the line's end

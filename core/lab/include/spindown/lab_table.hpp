@@ -22,6 +22,8 @@
 #include <spindown/samples_t.hpp>
 #include <spindown/status_t.hpp>
 
+#include "spindown/utf8_text.hpp"  // display_width: the columns this table's text takes
+
 namespace spindown {
 
 struct LabTableOptions {
@@ -149,7 +151,7 @@ class LabTable {
 // usable best model.
 std::string fit_coefficients_text(const fit_t& msg, bool lab_units, bool with_units = true);
 
-// Code points of a UTF-8 string (the columns it takes for the text this table prints).
-std::size_t display_width(std::string_view utf8);
+// A line cut to width code points (never inside a character); width 0 leaves it whole.
+std::string cut_to_width(const std::string& line, std::size_t width);
 
 }  // namespace spindown
