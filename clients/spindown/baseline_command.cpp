@@ -179,7 +179,7 @@ int run_baseline(const BaselineCommandOptions& o) {
     if (naming.active()) {
       const BenchName name = naming.name(path, file_stem(path));
       if (name.bench != o.bench) {
-        std::cout << fmt::format("  {:<9} {}: bench {} ({})\n", "skipped", path, name.bench,
+        std::cout << fmt::format("  {:<8} {}: bench {} ({})\n", "skipped", path, name.bench,
                                  name.problem.empty() ? name.from : name.problem);
         continue;
       }
@@ -212,11 +212,11 @@ int run_baseline(const BaselineCommandOptions& o) {
   std::optional<RecordedAt> first_used, last_used;
   for (const auto& s : sink.seen) {
     if (!s.run) {
-      std::cout << fmt::format("  {:<9} {}: {}\n", "not used", s.source, s.why);
+      std::cout << fmt::format("  {:<8} {}: {}\n", "not used", s.source, s.why);
     } else if (const std::string* aside = set_aside_why(s.source)) {
       std::cout << fmt::format("  set aside {}: {}\n", s.source, *aside);
     } else {
-      std::cout << fmt::format("  {:<9} {}: c3 = {} N·m·s/rad, c4 = {} N·m\n", baseline ? "used" : "candidate", s.source,
+      std::cout << fmt::format("  {:<8} {}: c3 = {} N·m·s/rad, c4 = {} N·m\n", baseline ? "used" : "candidate", s.source,
                                format_value_error(s.run->c_viscous, s.run->c_viscous_stderr),
                                format_value_error(s.run->c_coulomb, s.run->c_coulomb_stderr));
       if (s.at) {

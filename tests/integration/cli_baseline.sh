@@ -169,7 +169,7 @@ grep -q "set aside $T/worn.tsv run 1: dry friction 2.5× the others' median" "$T
 grep -q "baseline of bench b3 from 3 of 4 runs" "$T/b3.out" || fail "the worn run is in the mean"
 # Listed once, as set aside: never "used" (issue 30), and in fit's names.
 if grep "worn.tsv" "$T/b3.out" | grep -vq "set aside"; then fail "the worn run is listed otherwise than set aside: $(grep worn.tsv "$T/b3.out")"; fi
-[ "$(grep -c "^  used      $T/good[123].tsv run 1: c3 = .* N·m·s/rad, c4 = .* N·m$" "$T/b3.out")" -eq 3 ] || fail "the good runs not listed as used in c3/c4"
+[ "$(grep -c "^  used     $T/good[123].tsv run 1: c3 = .* N·m·s/rad, c4 = .* N·m$" "$T/b3.out")" -eq 3 ] || fail "the good runs not listed as used in c3/c4"
 if grep -q "c_v\|c_c" "$T/b3.out"; then fail "baseline speaks of c_v/c_c, not fit's c3/c4"; fi
 # Dated by the recordings, not by today: PuTTY logs of 2023.09.14 give that date; text files that
 # tell no date are dated today, said on stderr.
