@@ -115,7 +115,10 @@ bool is_lcm_log(const std::string& path) {
 }
 
 // An LCM log: every SAMPLE message as recorded, and the log refitted as spindown-fitter fits live.
-LogRefit export_log(const ExportCommandOptions& o, const std::regex& wanted, const CsvStyle& style, std::FILE* f,
+// J and K_b as `spindown refit` takes them: the command line's and the bench files' [bench] win over
+// the CONFIG (each run's bench_source says so), else the CONFIG, else the lab's.
+LogRefit export_log(const ExportCommandOptions& o, const BenchFiles& files, const std::regex& wanted, const CsvStyle& style,
+                    std::FILE* f,
                     std::size_t& rows) {
   auto each = [&](const LcmLogEvent& ev) {
     if (ev.kind != LcmLogEvent::Kind::samples || !std::regex_match(ev.bench.begin(), ev.bench.end(), wanted)) return;
@@ -135,6 +138,8 @@ LogRefit export_log(const ExportCommandOptions& o, const std::regex& wanted, con
   FitterOptions fopt;
   fopt.bench_regex = o.bench_regex;
   fopt.max_rate_hz = 0;
+  fopt.named = bench_choice_from(o.input);
+  fopt.bench_files = files.files;
   return refit_log(o.log, fopt, false, each);
 }
 
@@ -181,7 +186,7 @@ LogRefit export_text(const ExportCommandOptions& o, OfflinePlan plan, const std:
       opt.bench = r.params;
       RunFit fit = fit_run(r.recording, run, opt);
       out.runs.push_back({csv_bench(r), fit, fmt::format("J: {}; K_b: {}", r.params.inertia_source, r.params.kb_source),
-                          0, 0});
+                          0, 0, std::nullopt});
       out.file.runs.push_back(std::move(fit));
     }
   } sink(wanted, style, f, rows);
@@ -229,7 +234,8 @@ void setup_export(CLI::App& app) {
                   "write MCAP (Foxglove, PlotJuggler) to this file instead of CSV: every sample, and the log's RUN "
                   "and FIT messages, as JSON (LCM logs only)")
       ->excludes("--csv")->excludes("--output")->excludes("--fits")->excludes("--no-fits")->excludes("--csv-locale");
-  auto note_given = add_input_options(sub, opt->input);  // a text recording's columns, units, bench, J and K_b
+  // A text recording's columns, units and bench; J and K_b and --bench-config for either, as fit takes them.
+  auto note_given = add_input_options(sub, opt->input);
   sub->callback([opt, note_given]() {
     note_given();
     const int code = run_export(*opt);
@@ -253,8 +259,10 @@ int run_export(const ExportCommandOptions& o) {
   // A text recording's options, checked before anything is written (bad usage: exit 2).
   const bool lcm_log = is_lcm_log(o.log);
   const BenchNaming naming = lcm_log ? BenchNaming() : naming_from(o.input);
+  const BenchFiles bench_files = bench_files_from(o.input, std::cerr);
   OfflinePlan text_plan{read_options_from(o.input), bench_choice_from(o.input), {}, {}, {}};
   text_plan.naming = &naming;
+  text_plan.bench_file = [&bench_files](const OfflineRecording& r) { return bench_files.for_bench(r.bench); };
 
   // A byte-order mark only on files written for a spreadsheet (--csv-locale): the default CSV is for
   // MATLAB and Python, whose csv module would read the mark into the first column's name.
@@ -273,7 +281,7 @@ int run_export(const ExportCommandOptions& o) {
   std::size_t rows = 0;
   bool ok = true;
   std::string why;
-  const LogRefit r = lcm_log ? export_log(o, wanted, samples_style, f, rows)
+  const LogRefit r = lcm_log ? export_log(o, bench_files, wanted, samples_style, f, rows)
                              : export_text(o, text_plan, wanted, samples_style, f, rows, ok);
   if (!samples.close(&why)) {
     std::cerr << "spindown export: " << why << '\n';

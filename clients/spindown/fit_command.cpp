@@ -45,15 +45,6 @@ struct FitPlan {
   BenchNaming naming;            // --roster, --bench-pattern: a text file's bench
 };
 
-// The bench file for a recording: its bench id's (LCM logs), or the only one given (text files).
-const BenchFile* bench_file_for(const FitPlan& plan, const std::string& bench) {
-  if (!bench.empty()) {
-    auto it = plan.bench_files.files.find(bench);
-    return it == plan.bench_files.files.end() ? nullptr : &it->second;
-  }
-  return plan.bench_files.files.size() == 1 ? &plan.bench_files.files.begin()->second : nullptr;
-}
-
 FitPlan plan_from(const FitCommandOptions& o) {
   FitPlan plan;
   plan.bench = bench_choice_from(o.input);
@@ -64,11 +55,7 @@ FitPlan plan_from(const FitCommandOptions& o) {
   if (!plan.fit.is_valid(&why)) bad_usage(why);
 
   plan.read = read_options_from(o.input);
-  try {
-    plan.bench_files = load_bench_files(o.bench_configs);
-  } catch (const std::exception& e) {
-    bad_usage(fmt::format("--bench-config: {}", e.what()));
-  }
+  plan.bench_files = bench_files_from(o.input, std::cerr);
 
   plan.report.lab_units = o.lab_units;
   plan.report.details = o.details;
@@ -129,7 +116,7 @@ FileFit fit_file(const std::string& path, const FitPlan& plan) {
   sink.out.file = path;
   OfflinePlan offline{plan.read, plan.bench, {}, {}, {}};
   offline.naming = &plan.naming;
-  offline.bench_file = [&plan](const OfflineRecording& r) { return bench_file_for(plan, r.bench); };
+  offline.bench_file = [&plan](const OfflineRecording& r) { return plan.bench_files.for_bench(r.bench); };
   walk_file(path, offline, sink);
   return std::move(sink.out);
 }
@@ -160,11 +147,6 @@ void setup_fit(CLI::App& app) {
                 "Also give each model's 95 % intervals, parameter correlations and reduced χ² (JSON always has them)");
   sub->add_flag("-v,--verbose", opt->verbose, "Show every diagnostic, notes included");
 
-  sub->add_option("--bench-config", opt->bench_configs,
-                  "Per-bench TOML file(s): [bench] J/K_b (flags win) and [motor]/[baseline]/[health] for the "
-                  "motor health verdict; a directory means every *.toml in it; repeat the flag for more")
-      ->allow_extra_args(false)
-      ->check(CLI::ExistingPath);
   sub->add_option("-j,--jobs", opt->jobs, "Files fitted at once (default 0: one per core); output keeps the order given")
       ->check(CLI::Range(0u, 1024u));
   auto note_given = add_input_options(sub, opt->input);

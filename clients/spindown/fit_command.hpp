@@ -23,10 +23,7 @@ struct FitCommandOptions {
   bool details = false;  // 95 % intervals, correlations, reduced χ² in the text
   bool verbose = false;  // every diagnostic, notes included
   std::vector<std::string> models;  // names; empty = all
-  InputOptions input;  // the bench and delimited-text columns
-  // Per-bench TOML files ([bench] J/K_b unless given as flags; [motor], [baseline], [health]
-  // for the motor health verdict printed after each run).
-  std::vector<std::string> bench_configs;
+  InputOptions input;  // the bench, --bench-config, delimited-text columns, a class's roster
   unsigned jobs = 0;  // files fitted at once; 0 = one per core
 };
 

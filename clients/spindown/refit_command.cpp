@@ -2,6 +2,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -18,6 +19,7 @@
 #include "file_problems.hpp"
 #include "spindown/bench.hpp"
 #include "spindown/fit_message.hpp"
+#include "spindown/health_report.hpp"
 #include "spindown/progress.hpp"
 
 namespace spindown::cli {
@@ -106,7 +108,11 @@ std::string first_difference(const Json& a, const Json& b, const std::string& pa
   return a == b ? std::string() : fmt::format("{}: {} vs {}", path, a.dump(), b.dump());
 }
 
-FitterOptions fitter_options(const RefitCommandOptions& o) {
+// The live fitter's options for the log. J and K_b: what the command line and the bench files name
+// wins over the CONFIG (FitterOptions::named), as in `spindown fit`; with --compare they are the
+// live fitter's instead (the flags its defaults for benches without CONFIG, the files its health
+// references), so that the comparison sets like beside like.
+FitterOptions fitter_options(const RefitCommandOptions& o, const BenchFiles& files) {
   FitterOptions f;
   f.bench_regex = o.bench_regex;
   f.ignore_config = o.ignore_config;
@@ -114,28 +120,35 @@ FitterOptions fitter_options(const RefitCommandOptions& o) {
   f.admit_rate_hz = o.admit_rate_hz;
   f.silent_s = o.silent_s;
   f.max_rate_hz = 0;  // a log is read as fast as the disk allows; live caps were applied live
-  if (o.inertia_given) {
-    f.default_bench.inertia_kg_m2 = o.inertia_kg_m2;
-    f.default_bench.inertia_source = "--inertia";
+  const BenchChoice named = bench_choice_from(o.input);
+  for (const auto& [bench, file] : files.files) f.health.emplace(bench, file.health);
+  if (o.compare) {
+    f.default_bench = named.given;
+  } else {
+    f.named = named;
+    f.bench_files = files.files;
   }
-  if (o.kb_given) {
-    f.default_bench.kb_v_s_per_rad = o.kb_v_s_per_rad;
-    f.default_bench.kb_source = "--kb";
-  } else if (o.speed_constant_given) {
-    f.default_bench.kb_v_s_per_rad = kb_from_speed_constant(o.speed_constant_rpm_per_v);
-    f.default_bench.kb_source = fmt::format("--speed-constant {} rpm/V", o.speed_constant_rpm_per_v);
-  }
-  if (!o.models.empty()) {
-    f.models.clear();
-    for (const auto& name : o.models) {
-      auto kind = parse_model(name);
-      if (!kind) throw CLI::ValidationError(fmt::format("--models: unknown model '{}' (viscous, coulomb, combined)", name));
-      f.models.push_back(*kind);
-    }
-  }
+  if (!o.models.empty()) f.models = models_from(o.models);
   std::string why;
   if (!f.is_valid(&why)) throw CLI::ValidationError(why);
   return f;
+}
+
+// Whether the command line or a bench file names J or K_b (what --compare leaves to the CONFIG).
+bool names_bench(const RefitCommandOptions& o, const BenchFiles& files) {
+  const InputOptions& i = o.input;
+  if (i.inertia_given || i.flywheel_given || i.kb_given || i.speed_constant_given) return true;
+  return std::any_of(files.files.begin(), files.files.end(),
+                     [](const auto& f) { return f.second.sets_inertia || f.second.sets_kb; });
+}
+
+// A health verdict's level in capitals ("CHECK"), or "none".
+std::string level_of(const Json& run) {
+  const auto h = run.find("health");
+  if (h == run.end() || !h->is_object()) return "none";
+  std::string level = h->value("level", "?");
+  for (char& c : level) c = c == '_' ? ' ' : static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return level;
 }
 
 // Seconds of device time two fitted windows share (a recorded FIT as JSON); 0 when apart. A
@@ -200,6 +213,12 @@ void setup_refit(CLI::App& app) {
       "live); a log overlapping another in time is a session of its own. Runs are listed by bench, then run "
       "number; in JSON each run also has bench.id, first_seq and last_seq, and a session of several files "
       "session_files.\n"
+      "J and K_b: the command line (--inertia…, --kb…), else the bench's --bench-config file ([bench]), else the "
+      "log's CONFIG, else the lab's: what the first two name wins over the CONFIG and each run says so (J/K_b: …); "
+      "without them a refit equals live. --bench-config's [motor]/[baseline]/[health] give each run a health "
+      "verdict, as spindown-fitter --bench-config does live. --compare refits with the J and K_b the live fitter "
+      "used (the CONFIG, else the flags as its defaults) and tells a verdict only one side has (the live fitter "
+      "had a bench file, this refit none, or the other way) from a difference in the numbers.\n"
       "Exit codes: 0 ok, 1 a log or run could not be used or --compare found a difference, 2 bad usage.");
   sub->add_option("LOG", opt->logs, "LCM event log(s) (spindown-logger, lcm-logger); rotated files in any order")
       ->required();
@@ -215,16 +234,6 @@ void setup_refit(CLI::App& app) {
   sub->add_flag("--compare", opt->compare,
                 "Refit and compare with the recorded FIT messages, timing fields aside (exit 1 on a difference)")
       ->excludes(live);
-  auto* j = sub->add_option("--inertia", opt->inertia_kg_m2, "J (kg·m²) for benches without CONFIG")
-                ->check(CLI::PositiveNumber)
-                ->group("Bench");
-  auto* kb = sub->add_option("--kb", opt->kb_v_s_per_rad, "K_b (V·s/rad) for benches without CONFIG")
-                 ->check(CLI::PositiveNumber)
-                 ->group("Bench");
-  auto* kv = sub->add_option("--speed-constant", opt->speed_constant_rpm_per_v, "K_b from a speed constant (rpm/V)")
-                 ->check(CLI::PositiveNumber)
-                 ->excludes(kb)
-                 ->group("Bench");
   sub->add_option("--max-benches", opt->max_benches,
                   "Benches held at once, as the live spindown-fitter --max-benches (evictions are replayed too)")
       ->check(CLI::PositiveNumber);
@@ -233,19 +242,24 @@ void setup_refit(CLI::App& app) {
   sub->add_option("--silent", opt->silent_s,
                   "Seconds without samples (log time) that close a bench's open run, as spindown-fitter --silent")
       ->check(CLI::PositiveNumber);
-  sub->add_flag("--ignore-config", opt->ignore_config, "Use --inertia/--kb (or the lab's) even where CONFIG says otherwise")
+  sub->add_flag("--ignore-config", opt->ignore_config,
+                "Never use the log's CONFIG: J and K_b from the flags, the bench file, else the lab's")
       ->group("Bench");
-  sub->callback([opt, j, kb, kv]() {
-    opt->inertia_given = j->count() > 0;
-    opt->kb_given = kb->count() > 0;
-    opt->speed_constant_given = kv->count() > 0;
+  auto note_given = add_input_options(sub, opt->input, {.bench_config = true, .text = false});
+  sub->callback([opt, note_given]() {
+    note_given();
     const int code = run_refit(*opt);
     if (code != exit_ok) throw CLI::RuntimeError(code);
   });
 }
 
 int run_refit(const RefitCommandOptions& o) {
-  const FitterOptions fopt = fitter_options(o);
+  const BenchFiles bench_files = bench_files_from(o.input, std::cerr);
+  const FitterOptions fopt = fitter_options(o, bench_files);
+  if (o.compare && names_bench(o, bench_files))
+    std::cerr << "spindown refit --compare: J and K_b as the live fitter chose them (the log's CONFIG, else the "
+                 "command line's as its defaults), so that like is compared with like; a bench file gives the "
+                 "health references only\n";
   ReportOptions report;
   report.lab_units = o.lab_units;
   report.max_diagnostics = o.verbose ? 0 : 8;
@@ -279,11 +293,11 @@ int run_refit(const RefitCommandOptions& o) {
         // The run as refit_file_json() lists it, written straight to text (no document).
         const RunTags tags{run.bench, run.first_seq, run.last_seq};
         run_text.assign(",\n        ");
-        append_run_fit_json_text(run_text, run.fit, report, 8, &tags);
+        append_run_fit_json_text(run_text, run.fit, report, 8, &tags, run.health ? &*run.health : nullptr);
         spool->add(run_text);
       } else {
         spool->add(fmt::format("\n-- bench {} (J/K_b: {})\n", run.bench, run.bench_source) +
-                   format_run_fit(run.fit, report));
+                   format_run_fit(run.fit, report) + (run.health ? format_health_verdict(*run.health) : std::string()));
       }
     };
     LogRefit r = refit_log_session(
@@ -335,6 +349,7 @@ int run_refit(const RefitCommandOptions& o) {
       // does not), the largest overlap first.
       const Json refit = refit_file_json(r, report);
       std::size_t same = 0, differ = 0, missing_live = 0, missing_refit = 0;
+      std::size_t verdict_live_only = 0, verdict_refit_only = 0, verdict_differ = 0;
       std::vector<bool> live_paired(live.size(), false);
       for (std::size_t i = 0; i < r.runs.size(); ++i) {
         const RefitRun& ours = r.runs[i];
@@ -364,13 +379,36 @@ int run_refit(const RefitCommandOptions& o) {
           continue;
         }
         live_paired[best] = true;
-        // The run number is the fitter's count since it started, not the run's identity.
+        // The run number is the fitter's count since it started, not the run's identity. The
+        // numbers first; a health verdict is compared on its own, since one side may have had a
+        // bench file and the other not.
         Json a = jr, b = live[best].second;
         a.erase("run");
         b.erase("run");
+        const std::string ours_level = level_of(a), live_level = level_of(b);
+        Json ours_health = a.contains("health") ? a["health"] : Json(), live_health = b.contains("health") ? b["health"] : Json();
+        a.erase("health");
+        b.erase("health");
         const std::string d = first_difference(a, b, "run");
         if (d.empty()) {
           ++same;
+          if (live_health.is_null() && ours_health.is_null()) continue;
+          if (ours_health.is_null()) {
+            ++verdict_live_only;
+            std::cout << fmt::format("{}: {}: identical numbers; health {} live, none here: the live fitter had a "
+                                     "bench file for bench {}, this refit has none (give it with --bench-config)\n",
+                                     path, name, live_level, ours.bench);
+          } else if (live_health.is_null()) {
+            ++verdict_refit_only;
+            std::cout << fmt::format("{}: {}: identical numbers; health {} here, none live: the live fitter had no "
+                                     "bench file for bench {}\n",
+                                     path, name, ours_level, ours.bench);
+          } else if (const std::string hd = first_difference(ours_health, live_health, "run.health"); !hd.empty()) {
+            ++verdict_differ;
+            std::cout << fmt::format("{}: {}: identical numbers, but health {} here against {} live ({}): this "
+                                     "bench file is not the one the live fitter had\n",
+                                     path, name, ours_level, live_level, hd);
+          }
           continue;
         }
         ++differ;
@@ -396,10 +434,19 @@ int run_refit(const RefitCommandOptions& o) {
                                    path, live[k].first, live[k].second.value("run", 0),
                                    number_in(live[k].second, "t_cut_s"), why);
         }
+      std::string verdicts;
+      if (verdict_live_only)
+        verdicts += fmt::format("; {} with a health verdict live only (the live fitter had a bench file, this refit "
+                                "none)",
+                                verdict_live_only);
+      if (verdict_refit_only)
+        verdicts += fmt::format("; {} with a health verdict here only (the live fitter had no bench file)",
+                                verdict_refit_only);
+      if (verdict_differ) verdicts += fmt::format("; {} with another health verdict (another bench file)", verdict_differ);
       std::cout << fmt::format("{}: {} runs refitted, {} live FIT messages: {} identical, {} different, {} only "
-                               "refitted, {} only live\n",
-                               path, r.runs.size(), live.size(), same, differ, missing_live, missing_refit);
-      if (differ || missing_live || missing_refit || live.empty()) ok = false;
+                               "refitted, {} only live{}\n",
+                               path, r.runs.size(), live.size(), same, differ, missing_live, missing_refit, verdicts);
+      if (differ || verdict_differ || missing_live || missing_refit || live.empty()) ok = false;
       continue;
     }
 

@@ -93,7 +93,10 @@ std::optional<int> parse_options(int argc, char** argv, spindown::FitterServiceO
   }
   std::string why;
   try {
-    for (auto& [bench, file] : spindown::load_bench_files(bench_configs).files) o.core.health.emplace(bench, file.health);
+    for (auto& [bench, file] : spindown::load_bench_files(bench_configs).files) {
+      for (const auto& w : file.warnings) fmt::print(stderr, "spindown-fitter: {}\n", w);
+      o.core.health.emplace(bench, file.health);
+    }
   } catch (const std::exception& e) {
     fmt::print(stderr, "spindown-fitter: --bench-config: {}\n", e.what());
     return 2;

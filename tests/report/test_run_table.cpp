@@ -132,6 +132,23 @@ TEST(RunTable, JsonRowsHaveTheCsvColumnsAndReadBack) {
   EXPECT_EQ(rows[3]["file"], "caf\xef\xbf\xbd.txt");
 }
 
+// --table json writes the CSV's numbers (10 significant digits) in their shortest form: a time
+// computed as 3491 × 0.001 is 3.491, and a fitted coefficient carries no 17-digit tail.
+TEST(RunTable, JsonNumbersAreTheCsvsInTheirShortestForm) {
+  FileFit f = class_file();
+  f.runs[0].run.t_cut_s = 3491 * 0.001;  // 3.4909999999999997 as a double
+  f.runs[0].models[2].params[0].value = 1.8053123456789012e-7;
+  std::string text = "[";
+  bool first = true;
+  append_run_table_json_rows(f, text, first);
+  EXPECT_NE(text.find("\"t_cut_s\": 3.491,"), std::string::npos) << text;
+  EXPECT_NE(text.find("\"c3\": 1.805312346e-07,"), std::string::npos) << text;
+  EXPECT_EQ(text.find("3.4909999999999997"), std::string::npos);
+  const std::string csv = run_table_csv_rows(f);
+  EXPECT_NE(csv.find(",3.491,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",1.805312346e-07,"), std::string::npos) << csv;
+}
+
 TEST(RunTable, AModelThatDidNotConvergeLeavesItsCellsEmpty) {
   FileFit f = class_file();
   f.runs[0].models[2].converged = false;

@@ -24,13 +24,13 @@ class RefitSink final : public FitterSink {
   void fit_ready(const FitResult& r) override {
     ++out_.runs_fitted;
     if (!each_run_) {
-      out_.runs.push_back({r.bench, r.fit, r.bench_source, r.first_seq, r.last_seq});
+      out_.runs.push_back({r.bench, r.fit, r.bench_source, r.first_seq, r.last_seq, r.health});
       return;
     }
     if (r.fit.best.empty())
       out_.file.failures.push_back(fmt::format("SPINDOWN.{}.SAMPLE: run {}: no model converged", r.bench,
                                                r.fit.run.number));
-    each_run_(RefitRun{r.bench, r.fit, r.bench_source, r.first_seq, r.last_seq});
+    each_run_(RefitRun{r.bench, r.fit, r.bench_source, r.first_seq, r.last_seq, r.health});
   }
   void problem(const std::string& text) override {
     if (++problems_ <= max_problems_listed)
@@ -245,8 +245,10 @@ LogRefit refit_log_session(const std::vector<std::string>& paths, const FitterOp
   out.file.samples = static_cast<std::size_t>(c.samples);
   out.file.lines_read = static_cast<std::size_t>(c.sample_messages);
   out.file.lines_skipped = static_cast<std::size_t>(c.decode_errors + c.duplicates + c.quantity_errors);
+  const bool any_health = std::any_of(out.runs.begin(), out.runs.end(), [](const RefitRun& r) { return r.health.has_value(); });
   for (const RefitRun& r : out.runs) {
     out.file.runs.push_back(r.fit);
+    if (any_health) out.file.health.push_back(r.health);
     if (r.fit.best.empty())
       out.file.failures.push_back(fmt::format("SPINDOWN.{}.SAMPLE: run {}: no model converged", r.bench,
                                               r.fit.run.number));

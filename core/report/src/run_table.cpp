@@ -133,7 +133,7 @@ void append_run_table_json_rows(const FileFit& file, std::string& out, bool& fir
       else if (const auto* n = std::get_if<long long>(&c.value))
         w.integer(*n);
       else
-        w.number(std::get<double>(c.value));  // shortest digits that read back; NaN/inf: null
+        w.number(csv_number_value(std::get<double>(c.value)));  // the CSV's 10 digits, shortest; NaN/inf: null
     }
     w.end_object();
   }

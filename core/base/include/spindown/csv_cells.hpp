@@ -8,6 +8,7 @@
 // Italian, Spanish… opens a CSV by a double click). A file written for a spreadsheet starts with
 // a UTF-8 byte-order mark, without which Excel reads UTF-8 as Windows-1252 ("1.0Ã—", "SchÃ¤fer");
 // readtable and pandas.read_csv skip it, Python's csv module needs encoding="utf-8-sig".
+#include <charconv>
 #include <cmath>
 #include <fmt/format.h>
 #include <optional>
@@ -49,6 +50,17 @@ inline std::string csv_number(double x, const CsvStyle& style = {}) {
   if (std::isnan(x)) return "NaN";
   if (std::isinf(x)) return x > 0 ? "Inf" : "-Inf";
   return csv_decimal(fmt::format("{:.10g}", x), style);
+}
+
+// The number a csv_number cell reads back as (x itself when not finite): what `fit --table json`
+// writes, in the shortest digits that read back as it, so the JSON and CSV tables hold the same
+// numbers and no 3.4909999999999997 (a time computed as 3491 × 0.001) shows its last bits.
+inline double csv_number_value(double x) {
+  if (!std::isfinite(x)) return x;
+  const std::string text = fmt::format("{:.10g}", x);
+  double y = x;
+  std::from_chars(text.data(), text.data() + text.size(), y);  // locale-free, as fmt wrote it
+  return y;
 }
 
 inline std::string csv_field(std::string_view s, const CsvStyle& style = {}) {

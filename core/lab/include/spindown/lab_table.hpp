@@ -22,6 +22,8 @@
 #include <spindown/samples_t.hpp>
 #include <spindown/status_t.hpp>
 
+#include "spindown/utf8_text.hpp"  // display_width: the columns this table's text takes
+
 namespace spindown {
 
 struct LabTableOptions {
@@ -60,6 +62,9 @@ struct LabBenchRow {
   std::string coefficients;          // the best model's friction coefficients ± error (no units)
   double rmse = 0;
   std::string residual_unit;
+  // The combined model's c3 and c4 with their total standard errors (J's and K_b's uncertainty
+  // included), in SI or the lab's units as the table shows them; NaN when it has none.
+  double c3 = 0, c3_error = 0, c4 = 0, c4_error = 0;
   std::string bench_source;          // "config" or why a default J/K_b was used
   std::string health;                // motor health verdict "ok"/"check"/"service" ("" when not assessed)
   std::string health_reason;         // its reason in words
@@ -111,7 +116,10 @@ class LabTable {
 
   // Whether row's open run is no longer followed by a fitter at now_us (fitter_lost_s).
   bool run_unfollowed(const LabBenchRow& row, std::int64_t now_us) const;
-  // The table at now_us. width > 0 cuts lines to that many characters (a terminal's width).
+  // The table at now_us. width > 0 fits it to that many columns (a terminal's width): one row per
+  // bench with its run, the last fit's model, the combined model's c3 and c4 with their errors and
+  // the health verdict always; headers and cells shortened first, then the columns worth least
+  // dropped one by one (bridge, sequence gaps, RMSE, age, last fit), and only then lines cut.
   std::string render(std::int64_t now_us, std::size_t width = 0) const;
   // Events since the last call, oldest first, without time stamps ("bench-a: run 2 coasting…").
   std::vector<std::string> take_events();
@@ -131,6 +139,7 @@ class LabTable {
 
  private:
   LabBenchRow& row(std::string_view bench, std::int64_t now_us);
+  std::string bench_table(std::int64_t now_us, std::size_t width) const;  // the rows and their units line
   void event(std::string text);
 
   LabTableOptions opt_;
@@ -151,7 +160,7 @@ class LabTable {
 // usable best model.
 std::string fit_coefficients_text(const fit_t& msg, bool lab_units, bool with_units = true);
 
-// Code points of a UTF-8 string (the columns it takes for the text this table prints).
-std::size_t display_width(std::string_view utf8);
+// A line cut to width code points (never inside a character); width 0 leaves it whole.
+std::string cut_to_width(const std::string& line, std::size_t width);
 
 }  // namespace spindown

@@ -30,6 +30,7 @@
 #include <spindown/status_t.hpp>
 
 #include "spindown/bench.hpp"
+#include "spindown/bench_file.hpp"
 #include "spindown/fit.hpp"
 #include "spindown/message_decode.hpp"
 #include "spindown/motor_health.hpp"
@@ -46,6 +47,13 @@ struct FitterOptions {
   std::vector<ModelKind> models{all_models[0], all_models[1], all_models[2]};
   BenchParams default_bench;             // J, K_b for a bench without (usable) CONFIG
   bool ignore_config = false;            // always use default_bench (like `spindown fit --inertia`)
+  // J and K_b named for a refit (spindown refit and export of a log: --inertia/--kb/… and a
+  // --bench-config file's [bench], by bench id): what they name wins over the CONFIG, each
+  // parameter on its own, by the offline rule (choose_bench_params: command line, else the bench's
+  // file, else the CONFIG, else default_bench), and bench_source says where each came from. The
+  // live fitter names none: CONFIG, else default_bench.
+  BenchChoice named{default_bench};      // its given: default_bench with the command line's values
+  std::map<std::string, BenchFile, std::less<>> bench_files;
   std::string bench_regex = ".*";        // benches handled (full match on the id)
   // Benches held at once. A new bench takes a free place, or the place of the least recently
   // active bench with no run in progress; new benches are admitted at most admit_rate_hz per

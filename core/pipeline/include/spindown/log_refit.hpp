@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,11 +23,12 @@ struct RefitRun {
   RunFit fit;
   std::string bench_source;
   std::int64_t first_seq = 0, last_seq = 0;
+  std::optional<HealthVerdict> health;  // when FitterOptions::health has the bench (as the live FIT)
 };
 
 struct LogRefit {
-  FileFit file;                 // runs ordered by bench (first appearance), then run number; file:
-                                // the session's first log
+  FileFit file;                 // runs ordered by bench (first appearance), then run number, with their
+                                // health; file: the session's first log
   std::vector<std::string> session_files;  // the logs read as this one session, in time order
   std::vector<RefitRun> runs;   // the same runs, with their bench ids (empty when streamed)
   std::size_t runs_fitted = 0;  // runs fitted, kept or streamed
