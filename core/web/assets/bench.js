@@ -179,9 +179,12 @@
     }
     showExplain(run ? run.explain : null);
     showRuns(d.earlier || [], run);
-    showResiduals();
-    if (newRun) rebuildPlot();
-    dirty = true;
+    // The plots in a task of their own: the numbers, curves' legend and markers show at once.
+    setTimeout(() => {
+      showResiduals();
+      if (newRun) rebuildPlot();
+      dirty = true;
+    }, 0);
   }
 
   function showExplain(x) {

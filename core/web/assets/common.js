@@ -67,7 +67,7 @@ const spindown = (() => {
     if (bridge.state) parts.push(bridge.state);
     if (bridge.rate_hz) parts.push(`${bridge.rate_hz} Hz`);
     if (bridge.reconnects) parts.push(`replugged ${bridge.reconnects}×`);
-    if (bridge.error) parts.push(bridge.error);
+    if (bridge.error) parts.push(bridge.error.length > 70 ? bridge.error.slice(0, 69) + "…" : bridge.error);
     return parts.join(" · ");
   }
 
