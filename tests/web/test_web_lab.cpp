@@ -8,6 +8,7 @@
 #include <sstream>
 #include <string>
 
+#include "spindown/fit_view.hpp"
 #include "spindown/web_lab.hpp"
 #include "web_test_support.hpp"
 
@@ -277,6 +278,14 @@ TEST(WebLab, APageFirstViewIsItsSnapshot) {
   EXPECT_EQ(bj["page"], "bench");
   EXPECT_EQ(bj["detail"]["run"]["number"], 1);
   EXPECT_GT(bj["samples"]["b1"]["p"].size(), 1000u);
+}
+
+// The plots' points are short in JSON (0.1 ms, 7 significant digits), read back as the decimal.
+TEST(WebLab, APlotPointIsShortAndReadsBackAsTheDecimal) {
+  EXPECT_EQ(plot_point(12.345678901, 2.8300000000004).dump(), "[12.3457,2.83]");
+  EXPECT_EQ(plot_point(0.1 + 0.2, -1.234567891e-7).dump(), "[0.3,-1.234568e-07]");
+  EXPECT_EQ(plot_point(1.0, 0.0).dump(), "[1.0,0.0]");
+  EXPECT_EQ(plot_point(std::nan(""), 1.0)[0], nullptr);
 }
 
 }  // namespace

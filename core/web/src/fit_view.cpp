@@ -77,7 +77,7 @@ Json curve_json(const RunFit& fit, const ModelFit& m, double tau_end, std::size_
   points = std::max<std::size_t>(points, 2);
   for (std::size_t i = 0; i < points; ++i) {
     const double tau = tau_end * double(i) / double(points - 1);
-    pts.push_back(Json::array({tau, number(model_reading(fit, m, tau))}));
+    pts.push_back(plot_point(tau, model_reading(fit, m, tau)));
   }
   return pts;
 }
@@ -87,7 +87,21 @@ const ModelFit* named_model(const RunFit& fit, std::string_view name) {
   return kind ? fit.model(*kind) : nullptr;
 }
 
+// v rounded to digits significant digits, the nearest double to that decimal (a division by an
+// exact power of ten), so the shortest text that reads back is short too.
+double round_significant(double v, int digits) {
+  if (v == 0 || !std::isfinite(v)) return v;
+  const int shift = digits - 1 - static_cast<int>(std::floor(std::log10(std::fabs(v))));
+  if (shift <= 0 || shift > 22) return v;
+  const double p = std::pow(10.0, shift);
+  return std::round(v * p) / p;
+}
+
 }  // namespace
+
+Json plot_point(double x, double y) {
+  return Json::array({std::isfinite(x) ? Json(std::round(x * 1e4) / 1e4) : Json(nullptr), number(round_significant(y, 7))});
+}
 
 std::string health_text(const fit_t& msg) {
   if (msg.verdict == "ok" || msg.verdict == "check" || msg.verdict == "service") return msg.verdict;
@@ -160,7 +174,7 @@ std::optional<Json> fit_curves_json(const fit_t& msg, const RunTrace* trace, std
     Json pts = Json::array();
     for (std::size_t k = 0; k < in.size(); k += stride) {
       const double tau = in[k]->t_s - fit->run.t_cut_s;
-      pts.push_back(Json::array({tau, number(in[k]->value - model_reading(*fit, *best, tau))}));
+      pts.push_back(plot_point(tau, in[k]->value - model_reading(*fit, *best, tau)));
     }
     Json r;
     r["model"] = fit->best;

@@ -234,7 +234,7 @@ void WebLab::on_refused(std::string text, std::int64_t) {
 
 // ---- JSON ------------------------------------------------------------------------------------------
 
-Json WebLab::run_summary_json(const Bench& b, const WebRun& r) const {
+Json WebLab::run_summary_json(const Bench& b, const WebRun& r, bool counts) const {
   Json j;
   j["number"] = r.number;
   j["key"] = r.key;
@@ -244,8 +244,10 @@ Json WebLab::run_summary_json(const Bench& b, const WebRun& r) const {
   j["note"] = r.note;
   j["t_cut_s"] = number(r.t_cut_s);
   j["t_stop_s"] = number(r.t_stop_s);
-  j["samples"] = r.trace.received();
-  j["truncated"] = r.trace.truncated();
+  if (counts) {  // not in a tile's pushed summary: it would change with every sample
+    j["samples"] = r.trace.received();
+    j["truncated"] = r.trace.truncated();
+  }
   j["csv"] = fmt::format("/bench/{}/runs/{}.csv", b.id, r.number);
   j["fit"] = r.fit;
   return j;
@@ -271,7 +273,7 @@ Json WebLab::summary_json(const Bench& b, std::int64_t now_us, bool counters) co
     bridge["samples_missing"] = row ? row->samples_missing : 0;
   }
   j["bridge"] = std::move(bridge);
-  j["run"] = b.runs.empty() ? Json(nullptr) : run_summary_json(b, b.runs.back());
+  j["run"] = b.runs.empty() ? Json(nullptr) : run_summary_json(b, b.runs.back(), counters);
   j["last_fit"] = b.last_fit;
   j["last_fit_curve"] = b.last_fit_curve;
   if (counters) {
@@ -298,7 +300,7 @@ Json WebLab::points_json(const Bench& b, std::size_t first, std::size_t step, bo
     Json p = Json::array();
     for (std::size_t i = first; i < r.trace.display_size(); i += step) {
       const TracePoint& t = r.trace.display_point(i);
-      p.push_back(Json::array({t.t_s - x0, t.value}));
+      p.push_back(plot_point(t.t_s - x0, t.value));
     }
     j["key"] = r.key;
     j["reset"] = reset;
@@ -390,7 +392,7 @@ std::optional<Json> WebLab::run_json(std::string_view id, std::int32_t number) c
     j["x0"] = x0;
     Json p = Json::array();
     for (std::size_t i = 0; i < it->trace.display_size(); ++i)
-      p.push_back(Json::array({it->trace.display_point(i).t_s - x0, it->trace.display_point(i).value}));
+      p.push_back(plot_point(it->trace.display_point(i).t_s - x0, it->trace.display_point(i).value));
     j["points"] = std::move(p);
     j["curves"] = it->curves;
     return j;

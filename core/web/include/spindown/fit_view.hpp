@@ -16,6 +16,10 @@
 
 namespace spindown {
 
+// A point of a plot, [x, y] to the plots' resolution (x to 0.1 ms, y to 7 significant digits,
+// each the decimal's nearest double): shorter JSON for the pages; the CSV keeps every digit.
+Json plot_point(double x, double y);
+
 // "ok", "check", "service" or "not judged" (no reference, or no bench file: verdict "").
 std::string health_text(const fit_t& msg);
 

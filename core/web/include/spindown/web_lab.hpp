@@ -152,7 +152,7 @@ class WebLab {
   void close_run(Bench& b, WebRun& r);
 
   Json summary_json(const Bench& b, std::int64_t now_us, bool counters) const;
-  Json run_summary_json(const Bench& b, const WebRun& r) const;
+  Json run_summary_json(const Bench& b, const WebRun& r, bool counts = true) const;
   Json detail_json(const Bench& b) const;
   Json points_json(const Bench& b, std::size_t first, std::size_t step, bool reset) const;
   Json lab_json(std::int64_t now_us) const;
