@@ -571,4 +571,10 @@ const LabServiceRow* LabTable::service(std::string_view service, std::string_vie
   return it == services_.end() ? nullptr : &it->second;
 }
 
+std::vector<const LabServiceRow*> LabTable::services() const {
+  std::vector<const LabServiceRow*> out;
+  for (const auto& [key, s] : services_) out.push_back(&s);
+  return out;
+}
+
 }  // namespace spindown

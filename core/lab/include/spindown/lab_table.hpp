@@ -133,6 +133,7 @@ class LabTable {
   std::size_t bench_count() const { return benches_.size(); }
   const LabServiceRow* service(std::string_view service, std::string_view instance) const;
   std::size_t service_count() const { return services_.size(); }
+  std::vector<const LabServiceRow*> services() const;  // sorted by service, then instance
   std::int64_t bad_messages() const { return bad_messages_; }
   std::int64_t forgotten_rows() const { return forgotten_rows_; }
   std::int64_t dropped_events() const { return dropped_events_; }
