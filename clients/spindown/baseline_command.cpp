@@ -23,6 +23,7 @@
 #include "spindown/lcm_log_reader.hpp"
 #include "spindown/offline_pipeline.hpp"
 #include "spindown/read_recording.hpp"
+#include "spindown/recording_time.hpp"
 #include "spindown/runs.hpp"
 
 namespace spindown::cli {
@@ -92,8 +93,10 @@ void setup_baseline(CLI::App& app) {
   sub->add_option("--update", opt->update, "Replace [baseline] in this existing bench file")
       ->check(CLI::ExistingFile)
       ->excludes(out);
-  sub->add_option("--date", opt->date, "Date recorded in the baseline (default today, UTC)");
-  auto note_given = add_input_options(sub, opt->input);
+  sub->add_option("--date", opt->date,
+                  "Date recorded in the baseline (default: the recordings' date, from a PuTTY header or an LCM "
+                  "log's times: the last run used; today only when no file tells)");
+  auto note_given = add_input_options(sub, opt->input, {.bench_config = false, .text = true});
   sub->callback([opt, note_given]() {
     note_given();
     const int code = run_baseline(*opt);
@@ -117,6 +120,7 @@ int run_baseline(const BaselineCommandOptions& o) {
   if (!o.update.empty()) {
     try {
       update_file = load_bench_file(o.update);
+      print_bench_file_warnings(*update_file, std::cerr);
       if (update_file->bench != o.bench)
         std::cerr << fmt::format("{}: warning: the file describes bench '{}', the baseline is for --bench {}\n",
                                  o.update, update_file->bench, o.bench);
@@ -125,11 +129,18 @@ int run_baseline(const BaselineCommandOptions& o) {
     }
   }
   // The offline path (offline_pipeline.hpp) over the files, for this bench's recordings only.
+  // Each run is listed once the baseline is made: used, set aside (and why) or not used (and why).
+  struct Seen {
+    std::string source;
+    std::optional<BaselineRun> run;  // a whole coast with a combined fit
+    std::string why;                 // else why not
+    std::optional<RecordedAt> at;    // when its cut was, as the file tells
+  };
   struct Sink : OfflineSink {
     const FitOptions& fit_opt;
-    std::vector<BaselineRun> good;
-    std::size_t runs_seen = 0;
+    std::vector<Seen> seen;
     bool all_read = true, bench_found = false;
+    std::optional<RecordedAt> start;  // the current file's
     explicit Sink(const FitOptions& f) : fit_opt(f) {}
     void recording(const OfflineRecording&) override { bench_found = true; }
     void diagnostics(const OfflineRecording&, From from, std::span<const Diagnostic> diags) override {
@@ -147,20 +158,14 @@ int run_baseline(const BaselineCommandOptions& o) {
       std::cerr << fmt::format("{}: {}\n", r->path, why);
     }
     void run(const OfflineRecording& r, const Run& run) override {
-      ++runs_seen;
       FitOptions this_fit = fit_opt;
       this_fit.bench = r.params;
       const RunFit fit = fit_run(r.recording, run, this_fit);
-      const std::string source = fmt::format("{} run {}", r.path, run.number);
-      std::string why;
-      if (auto b = baseline_run(fit, source, &why)) {
-        std::cout << fmt::format("  used     {}: c_v = {} N·m·s/rad, c_c = {} N·m\n", source,
-                                 format_value_error(b->c_viscous, b->c_viscous_stderr),
-                                 format_value_error(b->c_coulomb, b->c_coulomb_stderr));
-        good.push_back(*b);
-      } else {
-        std::cout << fmt::format("  not used {}: {}\n", source, why);
-      }
+      Seen s{fmt::format("{} run {}", r.path, run.number), std::nullopt, {}, std::nullopt};
+      s.run = baseline_run(fit, s.source, &s.why);
+      if (start && !r.recording.t_s.empty())
+        s.at = RecordedAt{start->unix_s + (run.t_cut_s - r.recording.t_s.front()), start->local};
+      seen.push_back(std::move(s));
     }
     std::string current;
   } sink(fit_opt);
@@ -174,37 +179,75 @@ int run_baseline(const BaselineCommandOptions& o) {
     if (naming.active()) {
       const BenchName name = naming.name(path, file_stem(path));
       if (name.bench != o.bench) {
-        std::cout << fmt::format("  skipped  {}: bench {} ({})\n", path, name.bench,
+        std::cout << fmt::format("  {:<8} {}: bench {} ({})\n", "skipped", path, name.bench,
                                  name.problem.empty() ? name.from : name.problem);
         continue;
       }
     }
     sink.bench_found = false;
     sink.current = path;
+    sink.start = recording_start(path, FileFormat::automatic, plan.read);
     walk_file(path, plan, sink);
     if (!sink.bench_found) {
       std::cerr << fmt::format("{}: error: no samples of bench '{}' in this file\n", path, o.bench);
       sink.all_read = false;
     }
   }
-  std::vector<BaselineRun>& good = sink.good;
-  const std::size_t runs_seen = sink.runs_seen;
+  std::vector<BaselineRun> good;
+  for (const auto& s : sink.seen)
+    if (s.run) good.push_back(*s.run);
+  const std::size_t runs_seen = sink.seen.size();
   const bool all_read = sink.all_read;
 
   std::string source = fmt::format("bench {}:", o.bench);
   for (const auto& f : o.files) source += " " + std::filesystem::path(f).filename().string();
   std::vector<SetAsideRun> set_aside;
-  const auto baseline = make_baseline(good, o.date.empty() ? today_utc() : o.date, source, &why, &set_aside);
-  for (const auto& r : set_aside) std::cout << fmt::format("  set aside {}: {}\n", r.source, r.why);
+  auto baseline = make_baseline(good, o.date, source, &why, &set_aside);
+  const auto set_aside_why = [&set_aside](const std::string& source) -> const std::string* {
+    for (const auto& r : set_aside)
+      if (r.source == source) return &r.why;
+    return nullptr;
+  };
+  // Every run once, in the order read: what the baseline is made of, and what not.
+  std::optional<RecordedAt> first_used, last_used;
+  for (const auto& s : sink.seen) {
+    if (!s.run) {
+      std::cout << fmt::format("  {:<8} {}: {}\n", "not used", s.source, s.why);
+    } else if (const std::string* aside = set_aside_why(s.source)) {
+      std::cout << fmt::format("  set aside {}: {}\n", s.source, *aside);
+    } else {
+      std::cout << fmt::format("  {:<8} {}: c3 = {} N·m·s/rad, c4 = {} N·m\n", baseline ? "used" : "candidate", s.source,
+                               format_value_error(s.run->c_viscous, s.run->c_viscous_stderr),
+                               format_value_error(s.run->c_coulomb, s.run->c_coulomb_stderr));
+      if (s.at) {
+        if (!first_used || s.at->unix_s < first_used->unix_s) first_used = s.at;
+        if (!last_used || s.at->unix_s > last_used->unix_s) last_used = s.at;
+      }
+    }
+  }
   if (!baseline) {
     std::cerr << fmt::format("spindown baseline: error: {} ({} run{} seen)\n", why, runs_seen,
                              runs_seen == 1 ? "" : "s");
     return exit_unusable;
   }
+  // Dated by the recordings (the last run used, as its file tells it), never by the day this runs.
+  if (o.date.empty()) {
+    if (last_used) {
+      baseline->date = recorded_date_text(*last_used);
+      if (recorded_date_text(*first_used) != baseline->date)
+        std::cout << fmt::format("  the runs used were recorded {} to {}: the baseline is dated by the last\n",
+                                 recorded_date_text(*first_used), baseline->date);
+    } else {
+      baseline->date = today_utc();
+      std::cerr << fmt::format("spindown baseline: warning: no recording date in these files (no PuTTY header, not an "
+                               "LCM log): the baseline is dated today, {}; give the recordings' date with --date\n",
+                               baseline->date);
+    }
+  }
   std::cout << fmt::format(
-      "baseline of bench {} from {} of {} run{}: c_v = {} N·m·s/rad (spread {:.2g}), c_c = {} N·m (spread {:.2g}), "
-      "J = {:.6g} kg·m²\n",
-      o.bench, baseline->runs, runs_seen, runs_seen == 1 ? "" : "s",
+      "baseline of bench {} from {} of {} run{} (recorded {}): c3 = {} N·m·s/rad (spread {:.2g}), c4 = {} N·m "
+      "(spread {:.2g}), J = {:.6g} kg·m²\n",
+      o.bench, baseline->runs, runs_seen, runs_seen == 1 ? "" : "s", baseline->date,
       format_value_error(baseline->c_viscous, baseline->c_viscous_stderr), baseline->c_viscous_spread,
       format_value_error(baseline->c_coulomb, baseline->c_coulomb_stderr), baseline->c_coulomb_spread,
       baseline->inertia_kg_m2);

@@ -30,6 +30,7 @@ struct ExplainPlan {
   ReadOptions read;
   ExplainOptions explain;
   BenchChoice bench;             // the command line's J and K_b (choose_bench_params)
+  BenchFiles bench_files;        // --bench-config, by bench id: [bench] J and K_b
   BenchNaming naming;            // --roster, --bench-pattern: a text file's bench
 };
 
@@ -44,6 +45,7 @@ ExplainPlan plan_from(const ExplainCommandOptions& o) {
 
   plan.read = read_options_from(o.input);
   plan.naming = naming_from(o.input);
+  plan.bench_files = bench_files_from(o.input, std::cerr);
   return plan;
 }
 
@@ -74,6 +76,7 @@ FileExplain explain_file(const std::string& path, const ExplainPlan& plan) {
   sink.out.file = path;
   OfflinePlan offline{plan.read, plan.bench, {}, {}, {}};
   offline.naming = &plan.naming;
+  offline.bench_file = [&plan](const OfflineRecording& r) { return plan.bench_files.for_bench(r.bench); };
   walk_file(path, offline, sink);
   return std::move(sink.out);
 }

@@ -12,6 +12,7 @@
 #include <memory>
 #include <regex>
 
+#include "csv_output.hpp"
 #include "exit_codes.hpp"
 #include "export_mcap.hpp"
 #include "refit_command.hpp"
@@ -68,35 +69,41 @@ std::string fits_path_for(const std::string& out) {
   return out + ".fits.csv";
 }
 
-void write_fits(std::FILE* f, const LogRefit& r) {
+// A number with six decimals in the style's decimal mark (times in seconds to the microsecond).
+std::string csv_fixed6(double x, const CsvStyle& style) { return csv_decimal(fmt::format("{:.6f}", x), style); }
+
+void write_fits(std::FILE* f, const LogRefit& r, const CsvStyle& style) {
   static const char* const param_names[] = {"c1", "c2", "c3", "c4", "omega0", "A", "B", "C"};
-  std::fputs("bench,run,model,best,converged,t_cut_s,t_stop_s,stopped,samples,rmse,residual_unit,r2,aic,bic,"
-             "t_stop_pred_s",
-             f);
-  for (const char* p : param_names) fmt::print(f, ",{},{}_stderr", p, p);
-  std::fputs(",J_kg_m2,Kb_V_s_per_rad,bench_source,zero_level\n", f);
+  const char d = style.delimiter;
+  std::fputs(std::string(csv_file_start(style)).c_str(), f);
+  for (const char* name : {"bench", "run", "model", "best", "converged", "t_cut_s", "t_stop_s", "stopped", "samples",
+                           "rmse", "residual_unit", "r2", "aic", "bic", "t_stop_pred_s"})
+    fmt::print(f, "{}{}", std::string_view(name) == "bench" ? "" : std::string(1, d), name);
+  for (const char* p : param_names) fmt::print(f, "{0}{1}{0}{1}_stderr", d, p);
+  fmt::print(f, "{0}J_kg_m2{0}Kb_V_s_per_rad{0}bench_source{0}zero_level\n", d);
   for (const RefitRun& run : r.runs) {
     const RunFit& fit = run.fit;
     const Run& rn = fit.run;
     for (const ModelFit& m : fit.models) {
       const std::string name(model_name(m.kind));
-      fmt::print(f, "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}", csv_field(run.bench), rn.number, name,
-                 name == fit.best ? 1 : 0, m.converged ? 1 : 0, csv_number(rn.t_cut_s),
-                 rn.stopped ? csv_number(rn.t_stop_s) : std::string("NaN"), rn.stopped ? 1 : 0,
-                 rn.end_index - rn.cut_index, csv_number(m.rmse), quantity_unit(fit.quantity), csv_number(m.r2),
-                 csv_number(m.aic), csv_number(m.bic), csv_number(m.t_stop_pred_s));
+      fmt::print(f, "{1}{0}{2}{0}{3}{0}{4}{0}{5}{0}{6}{0}{7}{0}{8}{0}{9}{0}{10}{0}{11}{0}{12}{0}{13}{0}{14}{0}{15}", d,
+                 csv_field(run.bench, style), rn.number, name, name == fit.best ? 1 : 0, m.converged ? 1 : 0,
+                 csv_number(rn.t_cut_s, style), rn.stopped ? csv_number(rn.t_stop_s, style) : std::string("NaN"),
+                 rn.stopped ? 1 : 0, rn.end_index - rn.cut_index, csv_number(m.rmse, style),
+                 quantity_unit(fit.quantity), csv_number(m.r2, style), csv_number(m.aic, style),
+                 csv_number(m.bic, style), csv_number(m.t_stop_pred_s, style));
       for (const char* p : param_names) {
         if (const Parameter* q = m.param(p))
-          fmt::print(f, ",{},{}", csv_number(q->value), csv_number(q->std_error));
+          fmt::print(f, "{0}{1}{0}{2}", d, csv_number(q->value, style), csv_number(q->std_error, style));
         else
-          std::fputs(",,", f);
+          fmt::print(f, "{0}{0}", d);
       }
-      fmt::print(f, ",{},{},{},{}\n", csv_number(fit.bench.inertia_kg_m2), csv_number(fit.bench.kb_v_s_per_rad),
-                 csv_field(run.bench_source), csv_number(rn.zero_level));
+      fmt::print(f, "{0}{1}{0}{2}{0}{3}{0}{4}\n", d, csv_number(fit.bench.inertia_kg_m2, style),
+                 csv_number(fit.bench.kb_v_s_per_rad, style), csv_field(run.bench_source, style),
+                 csv_number(rn.zero_level, style));
     }
   }
 }
-
 
 // What the file's first bytes say it is (a missing file: not a log; the text path says why).
 bool is_lcm_log(const std::string& path) {
@@ -108,10 +115,16 @@ bool is_lcm_log(const std::string& path) {
 }
 
 // An LCM log: every SAMPLE message as recorded, and the log refitted as spindown-fitter fits live.
-LogRefit export_log(const ExportCommandOptions& o, const std::regex& wanted, std::FILE* f, std::size_t& rows) {
+// J and K_b as `spindown refit` takes them: the command line's and the bench files' [bench] win over
+// the CONFIG (each run's bench_source says so), else the CONFIG, else the lab's.
+LogRefit export_log(const ExportCommandOptions& o, const BenchFiles& files, const std::regex& wanted, const CsvStyle& style,
+                    std::FILE* f,
+                    std::size_t& rows) {
   FitterOptions fopt;
   fopt.bench_regex = o.bench_regex;
   fopt.max_rate_hz = 0;
+  fopt.named = bench_choice_from(o.input);
+  fopt.bench_files = files.files;
   fopt.gate = gate_options_from(o.input.lab);
   // The samples of this lab (and with --key, signed ones); the refit's core names the rest.
   MessageGate gate(fopt.gate);
@@ -126,9 +139,10 @@ LogRefit export_log(const ExportCommandOptions& o, const std::regex& wanted, std
     for (std::int32_t i = 0; i < m.n; ++i) {
       const std::int32_t adc = i < std::int32_t(m.raw_adc.size()) ? m.raw_adc[i] : -1;
       const double host = i < std::int32_t(m.host_time_us.size()) ? 1e-6 * double(m.host_time_us[i]) : NAN;
-      fmt::print(f, "{},{},{:.6f},{},{},{},{},{}\n", csv_field(std::string(ev.bench)), m.seq + i,
-                 1e-6 * double(m.device_time_us[i]), std::isfinite(host) ? fmt::format("{:.6f}", host) : std::string("NaN"),
-                 csv_number(m.value[i]), csv_field(unit), adc >= 0 ? std::to_string(adc) : std::string(), m.clock_epoch);
+      fmt::print(f, "{1}{0}{2}{0}{3}{0}{4}{0}{5}{0}{6}{0}{7}{0}{8}\n", style.delimiter,
+                 csv_field(std::string(ev.bench), style), m.seq + i, csv_fixed6(1e-6 * double(m.device_time_us[i]), style),
+                 std::isfinite(host) ? csv_fixed6(host, style) : std::string("NaN"), csv_number(m.value[i], style),
+                 csv_field(unit, style), adc >= 0 ? std::to_string(adc) : std::string(), m.clock_epoch);
       ++rows;
     }
   };
@@ -142,26 +156,29 @@ std::string csv_bench(const OfflineRecording& r) { return r.bench.empty() ? file
 // time and raw ADC unknown; clock_epoch: Arduino resets before it), and its runs fitted as
 // `spindown fit` fits them (J and K_b by the same rule). Its bench: --roster, --bench-pattern, else
 // the file's name.
-LogRefit export_text(const ExportCommandOptions& o, OfflinePlan plan, const std::regex& wanted, std::FILE* f,
-                     std::size_t& rows, bool& ok) {
+LogRefit export_text(const ExportCommandOptions& o, OfflinePlan plan, const std::regex& wanted,
+                     const CsvStyle& style, std::FILE* f, std::size_t& rows, bool& ok) {
   struct Sink : OfflineSink {
     const std::regex& wanted;
+    const CsvStyle& style;
     std::FILE* f;
     std::size_t& rows;
     LogRefit out;
     FitOptions fit_opt;
     bool export_fits = true;
-    Sink(const std::regex& w, std::FILE* file, std::size_t& n) : wanted(w), f(file), rows(n) {}
+    Sink(const std::regex& w, const CsvStyle& s, std::FILE* file, std::size_t& n)
+        : wanted(w), style(s), f(file), rows(n) {}
     void recording(const OfflineRecording& r) override {
       const Recording& rec = r.recording;
       out.file.samples += rec.size();
       out.file.lines_read += rec.lines_read;
       out.file.lines_skipped += rec.lines_skipped;
-      const std::string bench = csv_field(csv_bench(r)), unit = csv_field(quantity_unit(rec.quantity));
+      const std::string bench = csv_field(csv_bench(r), style), unit = csv_field(quantity_unit(rec.quantity), style);
       std::size_t epoch = 0;
       for (std::size_t i = 0; i < rec.size(); ++i) {
         while (epoch < rec.clock_restarts.size() && rec.clock_restarts[epoch] <= i) ++epoch;
-        fmt::print(f, "{},{},{:.6f},NaN,{},{},,{}\n", bench, i, rec.t_s[i], csv_number(rec.value[i]), unit, epoch);
+        fmt::print(f, "{1}{0}{2}{0}{3}{0}NaN{0}{4}{0}{5}{0}{0}{6}\n", style.delimiter, bench, i, csv_fixed6(rec.t_s[i], style),
+                   csv_number(rec.value[i], style), unit, epoch);
       }
       rows += rec.size();
     }
@@ -175,10 +192,10 @@ LogRefit export_text(const ExportCommandOptions& o, OfflinePlan plan, const std:
       opt.bench = r.params;
       RunFit fit = fit_run(r.recording, run, opt);
       out.runs.push_back({csv_bench(r), fit, fmt::format("J: {}; K_b: {}", r.params.inertia_source, r.params.kb_source),
-                          0, 0});
+                          0, 0, std::nullopt});
       out.file.runs.push_back(std::move(fit));
     }
-  } sink(wanted, f, rows);
+  } sink(wanted, style, f, rows);
   sink.export_fits = !o.no_fits;
   sink.fit_opt.bench = plan.bench.given;
   plan.wanted = [&wanted](const OfflineRecording& r) { return std::regex_match(csv_bench(r), wanted); };
@@ -207,7 +224,10 @@ void setup_export(CLI::App& app) {
       "one row per run and model: bench,run,model,best,converged,t_cut_s,t_stop_s,stopped,samples,rmse,"
       "residual_unit,r2,aic,bic,t_stop_pred_s, then value and _stderr of c1,c2,c3,c4,omega0,A,B,C, then "
       "J_kg_m2,Kb_V_s_per_rad,bench_source,zero_level. SI: c1,c3 N*m*s/rad; c2,c4 N*m; omega0 rad/s.\n"
-      "MATLAB: readtable('OUT.csv'); Python: pandas.read_csv('OUT.csv').\n"
+      "--csv-locale de writes ';' and decimal commas for a German (French, Italian…) Excel, and files that start "
+      "with a UTF-8 byte-order mark (--csv-locale en: the mark alone).\n"
+      "MATLAB: readtable('OUT.csv'); Python: pandas.read_csv('OUT.csv') (with --csv-locale de: sep=';', "
+      "decimal=',').\n"
       "Exit codes: 0 ok, 1 the log could not be read or written, 2 bad usage.");
   sub->add_option("FILE", opt->log, "LCM event log, or a text recording (Arduino/PuTTY log, CSV/TSV)")->required();
   sub->add_flag("--csv", opt->csv, "CSV output (the default; see --mcap)");
@@ -215,11 +235,13 @@ void setup_export(CLI::App& app) {
   auto* fits = sub->add_option("--fits", opt->fits, "fits CSV file (default: OUT with .fits.csv when -o is given)");
   sub->add_flag("--no-fits", opt->no_fits, "do not refit, samples only")->excludes(fits);
   sub->add_option("--bench", opt->bench_regex, "only benches whose id matches this regex");
+  add_csv_locale_option(sub, opt->csv_locale);
   sub->add_option("--mcap", opt->mcap,
                   "write MCAP (Foxglove, PlotJuggler) to this file instead of CSV: every sample, and the log's RUN "
                   "and FIT messages, as JSON (LCM logs only)")
-      ->excludes("--csv")->excludes("--output")->excludes("--fits")->excludes("--no-fits");
-  auto note_given = add_input_options(sub, opt->input);  // a text recording's columns, units, bench, J and K_b
+      ->excludes("--csv")->excludes("--output")->excludes("--fits")->excludes("--no-fits")->excludes("--csv-locale");
+  // A text recording's columns, units and bench; J and K_b and --bench-config for either, as fit takes them.
+  auto note_given = add_input_options(sub, opt->input);
   sub->callback([opt, note_given]() {
     note_given();
     const int code = run_export(*opt);
@@ -243,20 +265,30 @@ int run_export(const ExportCommandOptions& o) {
   // A text recording's options, checked before anything is written (bad usage: exit 2).
   const bool lcm_log = is_lcm_log(o.log);
   const BenchNaming naming = lcm_log ? BenchNaming() : naming_from(o.input);
+  const BenchFiles bench_files = bench_files_from(o.input, std::cerr);
   OfflinePlan text_plan{read_options_from(o.input), bench_choice_from(o.input), {}, {}, {}};
   text_plan.naming = &naming;
+  text_plan.bench_file = [&bench_files](const OfflineRecording& r) { return bench_files.for_bench(r.bench); };
 
+  // A byte-order mark only on files written for a spreadsheet (--csv-locale): the default CSV is for
+  // MATLAB and Python, whose csv module would read the mark into the first column's name.
+  const bool for_spreadsheet = !o.csv_locale.empty();
+  const CsvStyle samples_style = csv_style_from(o.csv_locale, for_spreadsheet && !o.out.empty() && o.out != "-");
+  const CsvStyle fits_style = csv_style_from(o.csv_locale, for_spreadsheet);
   Output samples;
   if (!samples.open(o.out)) {
     std::cerr << "spindown export: cannot write " << o.out << ": " << std::strerror(errno) << '\n';
     return exit_unusable;
   }
   std::FILE* f = samples.f;
-  std::fputs("bench,seq,device_time_s,host_time_s,value,unit,raw_adc,clock_epoch\n", f);
+  std::fputs(std::string(csv_file_start(samples_style)).c_str(), f);
+  fmt::print(f, "bench{0}seq{0}device_time_s{0}host_time_s{0}value{0}unit{0}raw_adc{0}clock_epoch\n",
+             samples_style.delimiter);
   std::size_t rows = 0;
   bool ok = true;
   std::string why;
-  const LogRefit r = lcm_log ? export_log(o, wanted, f, rows) : export_text(o, text_plan, wanted, f, rows, ok);
+  const LogRefit r = lcm_log ? export_log(o, bench_files, wanted, samples_style, f, rows)
+                             : export_text(o, text_plan, wanted, samples_style, f, rows, ok);
   if (!samples.close(&why)) {
     std::cerr << "spindown export: " << why << '\n';
     ok = false;
@@ -278,7 +310,7 @@ int run_export(const ExportCommandOptions& o) {
       std::cerr << "spindown export: cannot write " << fits_path << ": " << std::strerror(errno) << '\n';
       return exit_unusable;
     }
-    write_fits(fits.f, r);
+    write_fits(fits.f, r, fits_style);
     if (!fits.close(&why)) {
       std::cerr << "spindown export: " << why << '\n';
       ok = false;

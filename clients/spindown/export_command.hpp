@@ -21,6 +21,9 @@
 // constants (viscous y = A·e^(−B·t): A in V, B in 1/s; Coulomb y = A·t + B: A in V/s, B in V;
 // combined y = A + B·e^(C·t): A, B in V, C in 1/s). Empty cells: not part of that model.
 //
+// --csv-locale de writes ';' between cells and decimal commas for a European Excel, and its files
+// start with a UTF-8 byte-order mark (csv_output.hpp); the default CSV has none.
+//
 // `spindown export LOG --mcap FILE`: the same samples, with the log's RUN and FIT messages, as
 // MCAP for Foxglove and PlotJuggler instead (export_mcap.hpp).
 #include <string>
@@ -42,6 +45,7 @@ struct ExportCommandOptions {
   std::string bench_regex = ".*";
   InputOptions input;  // a text recording: columns, units, --roster/--bench-pattern, J and K_b
   std::string mcap;      // MCAP file instead of CSV (export_mcap.hpp)
+  std::string csv_locale;  // --csv-locale: en or de (csv_output.hpp); its files get a byte-order mark
 };
 
 void setup_export(CLI::App& app);

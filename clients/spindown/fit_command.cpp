@@ -2,7 +2,10 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <fstream>
 #include <cstdio>
 #include <exception>
 #include <fmt/format.h>
@@ -14,6 +17,7 @@
 #include <string>
 #include <unistd.h>
 
+#include "csv_output.hpp"
 #include "exit_codes.hpp"
 #include "file_problems.hpp"
 #include "spindown/bench.hpp"
@@ -41,15 +45,6 @@ struct FitPlan {
   BenchNaming naming;            // --roster, --bench-pattern: a text file's bench
 };
 
-// The bench file for a recording: its bench id's (LCM logs), or the only one given (text files).
-const BenchFile* bench_file_for(const FitPlan& plan, const std::string& bench) {
-  if (!bench.empty()) {
-    auto it = plan.bench_files.files.find(bench);
-    return it == plan.bench_files.files.end() ? nullptr : &it->second;
-  }
-  return plan.bench_files.files.size() == 1 ? &plan.bench_files.files.begin()->second : nullptr;
-}
-
 FitPlan plan_from(const FitCommandOptions& o) {
   FitPlan plan;
   plan.bench = bench_choice_from(o.input);
@@ -60,11 +55,7 @@ FitPlan plan_from(const FitCommandOptions& o) {
   if (!plan.fit.is_valid(&why)) bad_usage(why);
 
   plan.read = read_options_from(o.input);
-  try {
-    plan.bench_files = load_bench_files(o.bench_configs);
-  } catch (const std::exception& e) {
-    bad_usage(fmt::format("--bench-config: {}", e.what()));
-  }
+  plan.bench_files = bench_files_from(o.input, std::cerr);
 
   plan.report.lab_units = o.lab_units;
   plan.report.details = o.details;
@@ -125,7 +116,7 @@ FileFit fit_file(const std::string& path, const FitPlan& plan) {
   sink.out.file = path;
   OfflinePlan offline{plan.read, plan.bench, {}, {}, {}};
   offline.naming = &plan.naming;
-  offline.bench_file = [&plan](const OfflineRecording& r) { return bench_file_for(plan, r.bench); };
+  offline.bench_file = [&plan](const OfflineRecording& r) { return plan.bench_files.for_bench(r.bench); };
   walk_file(path, offline, sink);
   return std::move(sink.out);
 }
@@ -144,6 +135,10 @@ void setup_fit(CLI::App& app) {
                   "c1…c4 ± errors, doubts, health), as csv or json (an array of the same rows)")
       ->check(CLI::IsMember({"csv", "json"}))
       ->excludes(json);
+  sub->add_option("-o,--output", opt->output,
+                  "Write the output (the tables, --json or --table) to this file instead of stdout; a --table csv "
+                  "file starts with a UTF-8 byte-order mark, so that Excel shows names and units right");
+  add_csv_locale_option(sub, opt->csv_locale);
   sub->add_option("--models", opt->models, "Models to fit, comma-separated: viscous,coulomb,combined (default all)")
       ->delimiter(',')
       ->allow_extra_args(false);  // one value per flag: `--models combined a.tsv b.tsv` leaves the files alone
@@ -152,11 +147,6 @@ void setup_fit(CLI::App& app) {
                 "Also give each model's 95 % intervals, parameter correlations and reduced χ² (JSON always has them)");
   sub->add_flag("-v,--verbose", opt->verbose, "Show every diagnostic, notes included");
 
-  sub->add_option("--bench-config", opt->bench_configs,
-                  "Per-bench TOML file(s): [bench] J/K_b (flags win) and [motor]/[baseline]/[health] for the "
-                  "motor health verdict; a directory means every *.toml in it; repeat the flag for more")
-      ->allow_extra_args(false)
-      ->check(CLI::ExistingPath);
   sub->add_option("-j,--jobs", opt->jobs, "Files fitted at once (default 0: one per core); output keeps the order given")
       ->check(CLI::Range(0u, 1024u));
   auto note_given = add_input_options(sub, opt->input);
@@ -170,6 +160,18 @@ void setup_fit(CLI::App& app) {
 
 int run_fit(const FitCommandOptions& options) {
   const FitPlan plan = plan_from(options);
+  const bool to_file = !options.output.empty() && options.output != "-";
+  const CsvStyle csv_style = csv_style_from(options.csv_locale, to_file);  // the table in a file: the mark
+  if (!options.csv_locale.empty() && options.table != "csv") bad_usage("--csv-locale needs --table csv");
+  std::ofstream file;
+  if (to_file) {
+    file.open(options.output, std::ios::binary | std::ios::trunc);
+    if (!file) {
+      std::cerr << fmt::format("spindown fit: cannot write {}: {}\n", options.output, std::strerror(errno));
+      return exit_unusable;
+    }
+  }
+  std::ostream& out = to_file ? static_cast<std::ostream&>(file) : std::cout;
   bool all_usable = true;
   // --json: one document, assembled from each file's text as it comes. On a terminal it is
   // printed once every file is done, so that stderr's problems never land inside it; into a
@@ -178,13 +180,13 @@ int run_fit(const FitCommandOptions& options) {
   // grown by doubling).
   std::string json;
   FitReportJsonText json_files;
-  const bool json_in_pieces = options.json && !isatty(STDOUT_FILENO);
+  const bool json_in_pieces = options.json && (to_file || !isatty(STDOUT_FILENO));
   constexpr std::size_t json_piece_bytes = 256 * 1024;
   // --table: one row per run across the files, in the order given.
   const bool csv_table = options.table == "csv", json_table = options.table == "json";
   bool first_row = true;
-  if (csv_table) std::cout << run_table_csv_header();
-  if (json_table) std::cout << '[';
+  if (csv_table) out << run_table_csv_header(csv_style);
+  if (json_table) out << '[';
   struct Done {
     FileFit file;
     std::string text;  // the file's tables, JSON entry or table rows, formatted by the worker too
@@ -196,7 +198,7 @@ int run_fit(const FitCommandOptions& options) {
         Done d{fit_file(options.files[i], plan), {}};
         // Bytes that are not UTF-8 (a Latin-1 file name or config string) are replaced, never abort the output.
         if (csv_table)
-          d.text = run_table_csv_rows(d.file);
+          d.text = run_table_csv_rows(d.file, csv_style);
         else if (!json_table)
           d.text = options.json ? file_fit_json_text(d.file, plan.report) : format_file_fit(d.file, plan.report);
         return d;
@@ -208,22 +210,29 @@ int run_fit(const FitCommandOptions& options) {
         if (json_table) {
           std::string rows;
           append_run_table_json_rows(d.file, rows, first_row);
-          std::cout << rows;
+          out << rows;
         } else if (options.json) {
           json_files.add(d.text, json);
           if (json_in_pieces && json.size() >= json_piece_bytes) {
-            std::cout << json;
+            out << json;
             json.clear();
           }
         } else {
-          std::cout << d.text << (csv_table ? "" : "\n");
-          std::cout.flush();
+          out << d.text << (csv_table ? "" : "\n");
+          out.flush();
         }
       });
-  if (json_table) std::cout << (first_row ? "]" : "\n]") << std::endl;
+  if (json_table) out << (first_row ? "]" : "\n]") << std::endl;
   if (options.json) {
     json_files.finish(json);
-    std::cout << json << std::endl;
+    out << json << std::endl;
+  }
+  if (to_file) {
+    file.close();
+    if (!file) {
+      std::cerr << fmt::format("spindown fit: writing {} failed\n", options.output);
+      return exit_unusable;
+    }
   }
   return all_usable ? exit_ok : exit_unusable;
 }

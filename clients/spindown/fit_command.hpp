@@ -17,14 +17,13 @@ struct FitCommandOptions {
   std::vector<std::string> files;
   bool json = false;
   std::string table;     // "csv" | "json": one row per run across all files (run_table.hpp)
+  std::string output;    // -o: the output (text, JSON or table) to this file instead of stdout
+  std::string csv_locale;  // --csv-locale: the table's CSV style (csv_output.hpp)
   bool lab_units = false;
   bool details = false;  // 95 % intervals, correlations, reduced χ² in the text
   bool verbose = false;  // every diagnostic, notes included
   std::vector<std::string> models;  // names; empty = all
-  InputOptions input;  // the bench and delimited-text columns
-  // Per-bench TOML files ([bench] J/K_b unless given as flags; [motor], [baseline], [health]
-  // for the motor health verdict printed after each run).
-  std::vector<std::string> bench_configs;
+  InputOptions input;  // the bench, --bench-config, delimited-text columns, a class's roster
   unsigned jobs = 0;  // files fitted at once; 0 = one per core
 };
 

@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <exception>
+#include <ostream>
 #include <stdexcept>
 #include <fmt/format.h>
 
@@ -40,7 +41,7 @@ char parse_delimiter(const std::string& s) {
 
 void bad_usage(const std::string& why) { throw CLI::ValidationError(why); }
 
-std::function<void()> add_input_options(CLI::App* sub, InputOptions& opt) {
+std::function<void()> add_input_options(CLI::App* sub, InputOptions& opt, InputParts parts) {
   const CLI::Validator positive = number_check(false);
   const CLI::Validator non_negative = number_check(true);
   auto* inertia = sub->add_option("--inertia", opt.inertia_kg_m2, "Moment of inertia J (kg·m²). J and K_b, each on its own: this command line, else the bench's "
@@ -82,22 +83,34 @@ std::function<void()> add_input_options(CLI::App* sub, InputOptions& opt) {
       ->check(CLI::Range(0.0, 100.0))
       ->group("Bench");
 
-  const char* text = "Delimited text";
-  sub->add_option("--time-column", opt.time_column, "Time column: header name or 1-based index")->group(text);
-  sub->add_option("--value-column", opt.value_column, "Value column: header name or 1-based index")->group(text);
-  sub->add_option("--time-unit", opt.time_unit, "Time unit: ms, s or us")->group(text);
-  sub->add_option("--value-unit", opt.value_unit, "Value unit: V, rpm or rad/s")->group(text);
-  sub->add_option("--delimiter", opt.delimiter, "Column delimiter: , ; tab space")->group(text);
+  if (parts.bench_config)
+    sub->add_option("--bench-config", opt.bench_configs,
+                    "Per-bench TOML file(s): [bench] J/K_b (flags win) and [motor]/[baseline]/[health] for the "
+                    "motor health verdict; a directory means every *.toml in it; repeat the flag for more. An LCM "
+                    "log's bench takes the file of its bench id, a text file the roster's or --bench-pattern's "
+                    "bench, else the only file given")
+        ->allow_extra_args(false)
+        ->check(CLI::ExistingPath)
+        ->group("Bench");
 
-  const char* klass = "A class's files";
-  sub->add_option("--roster", opt.roster,
-                  "CSV/TSV with columns file,bench[,student]: which bench (and student) each text file is from")
-      ->check(CLI::ExistingFile)
-      ->group(klass);
-  sub->add_option("--bench-pattern", opt.bench_pattern,
-                  "Regex on a text file's name: group 1 is its bench, group 2 its student, "
-                  "e.g. '(bench[0-9]+)_([a-z]+)'")
-      ->group(klass);
+  if (parts.text) {
+    const char* text = "Delimited text";
+    sub->add_option("--time-column", opt.time_column, "Time column: header name or 1-based index")->group(text);
+    sub->add_option("--value-column", opt.value_column, "Value column: header name or 1-based index")->group(text);
+    sub->add_option("--time-unit", opt.time_unit, "Time unit: ms, s or us")->group(text);
+    sub->add_option("--value-unit", opt.value_unit, "Value unit: V, rpm or rad/s")->group(text);
+    sub->add_option("--delimiter", opt.delimiter, "Column delimiter: , ; tab space")->group(text);
+
+    const char* klass = "A class's files";
+    sub->add_option("--roster", opt.roster,
+                    "CSV/TSV with columns file,bench[,student]: which bench (and student) each text file is from")
+        ->check(CLI::ExistingFile)
+        ->group(klass);
+    sub->add_option("--bench-pattern", opt.bench_pattern,
+                    "Regex on a text file's name: group 1 is its bench, group 2 its student, "
+                    "e.g. '(bench[0-9]+)_([a-z]+)'")
+        ->group(klass);
+  }
 
   add_lab_options(sub, opt.lab, "LCM logs");
 
@@ -109,6 +122,21 @@ std::function<void()> add_input_options(CLI::App* sub, InputOptions& opt) {
     opt.kb_given = kb->count() > 0;
     opt.speed_constant_given = kv->count() > 0;
   };
+}
+
+void print_bench_file_warnings(const BenchFile& file, std::ostream& err) {
+  for (const auto& w : file.warnings) err << w << '\n';
+}
+
+BenchFiles bench_files_from(const InputOptions& o, std::ostream& err) {
+  BenchFiles files;
+  try {
+    files = load_bench_files(o.bench_configs);
+  } catch (const std::exception& e) {
+    bad_usage(fmt::format("--bench-config: {}", e.what()));
+  }
+  for (const auto& [bench, file] : files.files) print_bench_file_warnings(file, err);
+  return files;
 }
 
 BenchNaming naming_from(const InputOptions& o, const std::string& fixed_bench) {
@@ -175,8 +203,10 @@ ReadOptions read_options_from(const InputOptions& o) {
     if (!d.time_unit) bad_usage(fmt::format("--time-unit '{}' is not one of: s, ms, us", o.time_unit));
   }
   if (!o.value_unit.empty()) {
-    d.quantity = parse_quantity(o.value_unit);
-    if (!d.quantity) bad_usage(fmt::format("--value-unit '{}' is not one of: V, rpm, rad/s", o.value_unit));
+    const auto unit = parse_value_unit(o.value_unit);
+    if (!unit) bad_usage(fmt::format("--value-unit '{}' is not one of: {}", o.value_unit, value_units_read()));
+    d.quantity = unit->quantity;
+    d.value_scale = unit->scale;
   }
   if (!o.delimiter.empty()) d.delimiter = parse_delimiter(o.delimiter);
   read.lcm.gate = gate_options_from(o.lab);

@@ -3,6 +3,7 @@
 // geometry + rotor inertia; K_b directly or from a speed constant), the columns and units of
 // delimited text, and which bench a class's text file is from (a roster or a file-name pattern). One definition, so both commands accept and check them alike.
 #include <functional>
+#include <iosfwd>
 #include <string>
 #include <vector>
 
@@ -36,13 +37,33 @@ struct InputOptions {
   // A class's text files: which bench (and student) each is from.
   std::string roster, bench_pattern;
 
+  // --bench-config: per-bench TOML files or directories ([bench] J/K_b unless given as flags;
+  // [motor], [baseline], [health] for the motor health verdict).
+  std::vector<std::string> bench_configs;
+
   // LCM logs: whose messages are read (--lab, --key).
   LabOptions lab;
 };
 
-// Adds the bench ("Bench" group) and delimited-text options to sub, bound to opt. Call the
-// returned function in the subcommand's callback: it records which bench flags were given.
-std::function<void()> add_input_options(CLI::App* sub, InputOptions& opt);
+// Which groups a command takes: every command that reads recordings takes the bench group;
+// --bench-config unless it names its bench file otherwise (baseline's --update); the text
+// groups (columns and units, a class's roster) unless it reads LCM logs only (refit).
+struct InputParts {
+  bool bench_config = true;
+  bool text = true;
+};
+
+// Adds the bench ("Bench" group), --bench-config and the delimited-text and class options to sub,
+// bound to opt, the same flags and words for every command. Call the returned function in the
+// subcommand's callback: it records which bench flags were given.
+std::function<void()> add_input_options(CLI::App* sub, InputOptions& opt, InputParts parts = {});
+
+// The --bench-config files, each read once (load_bench_files). What a file says that is doubtful
+// (BenchFile::warnings) goes to err, once per file; a file that cannot be used is bad usage
+// (CLI::ValidationError, exit 2).
+BenchFiles bench_files_from(const InputOptions& opt, std::ostream& err);
+// One bench file's warnings on err (a file given otherwise, as baseline's --update).
+void print_bench_file_warnings(const BenchFile& file, std::ostream& err);
 
 // The bench the options describe (lab defaults where not given). Bad usage throws
 // CLI::ValidationError (exit code 2).

@@ -2,6 +2,7 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <exception>
@@ -18,6 +19,7 @@
 #include "file_problems.hpp"
 #include "spindown/bench.hpp"
 #include "spindown/fit_message.hpp"
+#include "spindown/health_report.hpp"
 #include "spindown/progress.hpp"
 
 namespace spindown::cli {
@@ -106,7 +108,11 @@ std::string first_difference(const Json& a, const Json& b, const std::string& pa
   return a == b ? std::string() : fmt::format("{}: {} vs {}", path, a.dump(), b.dump());
 }
 
-FitterOptions fitter_options(const RefitCommandOptions& o) {
+// The live fitter's options for the log. J and K_b: what the command line and the bench files name
+// wins over the CONFIG (FitterOptions::named), as in `spindown fit`; with --compare they are the
+// live fitter's instead (the flags its defaults for benches without CONFIG, the files its health
+// references), so that the comparison sets like beside like.
+FitterOptions fitter_options(const RefitCommandOptions& o, const BenchFiles& files) {
   FitterOptions f;
   f.bench_regex = o.bench_regex;
   f.ignore_config = o.ignore_config;
@@ -114,31 +120,38 @@ FitterOptions fitter_options(const RefitCommandOptions& o) {
   f.admit_rate_hz = o.admit_rate_hz;
   f.silent_s = o.silent_s;
   f.max_rate_hz = 0;  // a log is read as fast as the disk allows; live caps were applied live
-  f.gate = gate_options_from(o.lab);
+  f.gate = gate_options_from(o.input.lab);
   f.gate.replay_window_s = o.replay_window_s;
   f.stream.takeover_s = o.takeover_s;
-  if (o.inertia_given) {
-    f.default_bench.inertia_kg_m2 = o.inertia_kg_m2;
-    f.default_bench.inertia_source = "--inertia";
+  const BenchChoice named = bench_choice_from(o.input);
+  for (const auto& [bench, file] : files.files) f.health.emplace(bench, file.health);
+  if (o.compare) {
+    f.default_bench = named.given;
+  } else {
+    f.named = named;
+    f.bench_files = files.files;
   }
-  if (o.kb_given) {
-    f.default_bench.kb_v_s_per_rad = o.kb_v_s_per_rad;
-    f.default_bench.kb_source = "--kb";
-  } else if (o.speed_constant_given) {
-    f.default_bench.kb_v_s_per_rad = kb_from_speed_constant(o.speed_constant_rpm_per_v);
-    f.default_bench.kb_source = fmt::format("--speed-constant {} rpm/V", o.speed_constant_rpm_per_v);
-  }
-  if (!o.models.empty()) {
-    f.models.clear();
-    for (const auto& name : o.models) {
-      auto kind = parse_model(name);
-      if (!kind) throw CLI::ValidationError(fmt::format("--models: unknown model '{}' (viscous, coulomb, combined)", name));
-      f.models.push_back(*kind);
-    }
-  }
+  if (!o.models.empty()) f.models = models_from(o.models);
   std::string why;
   if (!f.is_valid(&why)) throw CLI::ValidationError(why);
   return f;
+}
+
+// Whether the command line or a bench file names J or K_b (what --compare leaves to the CONFIG).
+bool names_bench(const RefitCommandOptions& o, const BenchFiles& files) {
+  const InputOptions& i = o.input;
+  if (i.inertia_given || i.flywheel_given || i.kb_given || i.speed_constant_given) return true;
+  return std::any_of(files.files.begin(), files.files.end(),
+                     [](const auto& f) { return f.second.sets_inertia || f.second.sets_kb; });
+}
+
+// A health verdict's level in capitals ("CHECK"), or "none".
+std::string level_of(const Json& run) {
+  const auto h = run.find("health");
+  if (h == run.end() || !h->is_object()) return "none";
+  std::string level = h->value("level", "?");
+  for (char& c : level) c = c == '_' ? ' ' : static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return level;
 }
 
 // Seconds of device time two fitted windows share (a recorded FIT as JSON); 0 when apart. A
@@ -155,6 +168,42 @@ double window_overlap_s(const Run& ours, const Json& theirs) {
   return std::isfinite(lo) && std::isfinite(hi) && hi > lo ? hi - lo : 0.0;
 }
 
+// Why a refitted run and the live FIT paired with it differ, in words (what a lab sees: a run
+// joined mid-coast, a run split at a silence or a gap, a cut one side invented, samples the live
+// fitter never got); "" when nothing explains it beyond the numbers.
+std::string why_they_differ(const Run& ours, std::int64_t ours_samples, const Json& live) {
+  const bool live_partial = live.value("lead_in", "") == "none", ours_partial = ours.partial();
+  const double live_cut = number_in(live, "t_cut_s"), live_end = number_in(live, "t_end_s");
+  const std::string live_end_name = live.value("end", "");
+  const double tol = 1.5 * std::max(ours.period_s, 1e-3);
+  if (live_partial && !ours_partial)
+    return "partial: live joined this run mid-coast (the fitter started, took the bench in, or resumed after a "
+           "silence after its cut); the log holds the whole run";
+  if (ours_partial && !live_partial)
+    return "partial: the refit joined this run mid-coast (the log, or the first file of this session, starts after "
+           "its cut; give the refit the file before it too)";
+  if (!live_partial && !ours_partial && std::isfinite(live_cut) && std::abs(live_cut - ours.t_cut_s) > tol)
+    return live_cut > ours.t_cut_s
+               ? fmt::format("invented cut: live put a cut at {:.3f} s inside the coast the log shows cut at {:.3f} s "
+                             "(live missed samples there: an outage, a frozen or restarted fitter)",
+                             live_cut, ours.t_cut_s)
+               : fmt::format("invented cut: the refit put a cut at {:.3f} s inside the coast live saw cut at {:.3f} s",
+                             ours.t_cut_s, live_cut);
+  if (live_end_name != end_name(ours.end) && std::isfinite(live_end) && std::isfinite(ours.t_end_s) &&
+      std::abs(live_end - ours.t_end_s) > tol)
+    return live_end < ours.t_end_s
+               ? fmt::format("split: live closed this run at {:.3f} s ({}) and the rest of the coast was apart; the "
+                             "refit ends it at {:.3f} s ({})",
+                             live_end, live_end_name, ours.t_end_s, end_name(ours.end))
+               : fmt::format("split: the refit closed this run at {:.3f} s ({}); live went on to {:.3f} s ({})",
+                             ours.t_end_s, end_name(ours.end), live_end, live_end_name);
+  if (const auto it = live.find("samples"); it != live.end() && it->is_number() && it->get<std::int64_t>() != ours_samples)
+    return fmt::format("samples: live fitted {} samples, the refit {} (samples the live fitter did not get, or the "
+                       "logger did not)",
+                       it->get<std::int64_t>(), ours_samples);
+  return {};
+}
+
 }  // namespace
 
 void setup_refit(CLI::App& app) {
@@ -162,10 +211,20 @@ void setup_refit(CLI::App& app) {
   CLI::App* sub = app.add_subcommand(
       "refit", "Refit LCM logs exactly as spindown-fitter did live (same runs, same numbers); --compare checks it");
   sub->footer(
-      "Reads each log in its own order with its own timestamps (never file:// replay). Runs are listed by bench, "
-      "then run number; in JSON each run also has bench.id, first_seq and last_seq.\n"
+      "Reads each log in its own order with its own timestamps (never file:// replay). Several logs are read as "
+      "sessions in time order: a logger's rotated files are one session (a run across a file boundary is whole, as "
+      "live); a log overlapping another in time is a session of its own. Runs are listed by bench, then run "
+      "number; in JSON each run also has bench.id, first_seq and last_seq, and a session of several files "
+      "session_files.\n"
+      "J and K_b: the command line (--inertia…, --kb…), else the bench's --bench-config file ([bench]), else the "
+      "log's CONFIG, else the lab's: what the first two name wins over the CONFIG and each run says so (J/K_b: …); "
+      "without them a refit equals live. --bench-config's [motor]/[baseline]/[health] give each run a health "
+      "verdict, as spindown-fitter --bench-config does live. --compare refits with the J and K_b the live fitter "
+      "used (the CONFIG, else the flags as its defaults) and tells a verdict only one side has (the live fitter "
+      "had a bench file, this refit none, or the other way) from a difference in the numbers.\n"
       "Exit codes: 0 ok, 1 a log or run could not be used or --compare found a difference, 2 bad usage.");
-  sub->add_option("LOG", opt->logs, "LCM event log(s) (spindown-logger, lcm-logger)")->required();
+  sub->add_option("LOG", opt->logs, "LCM event log(s) (spindown-logger, lcm-logger); rotated files in any order")
+      ->required();
   sub->add_flag("--json", opt->json, "Print one JSON object {\"files\":[{\"runs\":[…]}]} instead of tables");
   sub->add_option("--bench", opt->bench_regex, "Only benches whose id matches this regex (default all)");
   sub->add_option("--models", opt->models, "Models to fit: viscous,coulomb,combined (default all)")
@@ -178,16 +237,6 @@ void setup_refit(CLI::App& app) {
   sub->add_flag("--compare", opt->compare,
                 "Refit and compare with the recorded FIT messages, timing fields aside (exit 1 on a difference)")
       ->excludes(live);
-  auto* j = sub->add_option("--inertia", opt->inertia_kg_m2, "J (kg·m²) for benches without CONFIG")
-                ->check(CLI::PositiveNumber)
-                ->group("Bench");
-  auto* kb = sub->add_option("--kb", opt->kb_v_s_per_rad, "K_b (V·s/rad) for benches without CONFIG")
-                 ->check(CLI::PositiveNumber)
-                 ->group("Bench");
-  auto* kv = sub->add_option("--speed-constant", opt->speed_constant_rpm_per_v, "K_b from a speed constant (rpm/V)")
-                 ->check(CLI::PositiveNumber)
-                 ->excludes(kb)
-                 ->group("Bench");
   sub->add_option("--max-benches", opt->max_benches,
                   "Benches held at once, as the live spindown-fitter --max-benches (evictions are replayed too)")
       ->check(CLI::PositiveNumber);
@@ -196,23 +245,27 @@ void setup_refit(CLI::App& app) {
   sub->add_option("--silent", opt->silent_s,
                   "Seconds without samples (log time) that close a bench's open run, as spindown-fitter --silent")
       ->check(CLI::PositiveNumber);
-  add_lab_options(sub, opt->lab, "");
   sub->add_option("--replay-window", opt->replay_window_s, "With --key: as spindown-fitter --replay-window")
       ->check(CLI::PositiveNumber);
   sub->add_option("--takeover", opt->takeover_s, "As spindown-fitter --takeover")->check(CLI::NonNegativeNumber);
-  sub->add_flag("--ignore-config", opt->ignore_config, "Use --inertia/--kb (or the lab's) even where CONFIG says otherwise")
+  sub->add_flag("--ignore-config", opt->ignore_config,
+                "Never use the log's CONFIG: J and K_b from the flags, the bench file, else the lab's")
       ->group("Bench");
-  sub->callback([opt, j, kb, kv]() {
-    opt->inertia_given = j->count() > 0;
-    opt->kb_given = kb->count() > 0;
-    opt->speed_constant_given = kv->count() > 0;
+  auto note_given = add_input_options(sub, opt->input, {.bench_config = true, .text = false});
+  sub->callback([opt, note_given]() {
+    note_given();
     const int code = run_refit(*opt);
     if (code != exit_ok) throw CLI::RuntimeError(code);
   });
 }
 
 int run_refit(const RefitCommandOptions& o) {
-  const FitterOptions fopt = fitter_options(o);
+  const BenchFiles bench_files = bench_files_from(o.input, std::cerr);
+  const FitterOptions fopt = fitter_options(o, bench_files);
+  if (o.compare && names_bench(o, bench_files))
+    std::cerr << "spindown refit --compare: J and K_b as the live fitter chose them (the log's CONFIG, else the "
+                 "command line's as its defaults), so that like is compared with like; a bench file gives the "
+                 "health references only\n";
   ReportOptions report;
   report.lab_units = o.lab_units;
   report.max_diagnostics = o.verbose ? 0 : 8;
@@ -222,7 +275,15 @@ int run_refit(const RefitCommandOptions& o) {
   const bool show_progress = !o.no_progress && ProgressReporter::is_terminal(STDERR_FILENO);
   const bool stream = !o.live && !o.compare;  // runs formatted as fitted, not kept (memory flat)
   bool first_file = true;
-  for (const auto& path : o.logs) {
+  // Logs given together are read as sessions in time order: a logger's rotated files are one
+  // session, so a run across a file boundary is whole, as it was live.
+  const std::vector<std::vector<std::string>> sessions =
+      o.logs.size() > 1 ? log_sessions(o.logs) : std::vector<std::vector<std::string>>{o.logs};
+  for (const auto& session : sessions) {
+    const std::string path =
+        session.size() == 1 ? session.front()
+                            : fmt::format("{} + {} more (one session, in time order)", session.front(),
+                                          session.size() - 1);
     // On a terminal only (never in pipes or files), throttled, erased before anything is printed.
     ProgressReporter progress(STDERR_FILENO, show_progress);
     // Each bench's runs, formatted as they are fitted; printed by bench (first appearance) once
@@ -238,15 +299,15 @@ int run_refit(const RefitCommandOptions& o) {
         // The run as refit_file_json() lists it, written straight to text (no document).
         const RunTags tags{run.bench, run.first_seq, run.last_seq};
         run_text.assign(",\n        ");
-        append_run_fit_json_text(run_text, run.fit, report, 8, &tags);
+        append_run_fit_json_text(run_text, run.fit, report, 8, &tags, run.health ? &*run.health : nullptr);
         spool->add(run_text);
       } else {
         spool->add(fmt::format("\n-- bench {} (J/K_b: {})\n", run.bench, run.bench_source) +
-                   format_run_fit(run.fit, report));
+                   format_run_fit(run.fit, report) + (run.health ? format_health_verdict(*run.health) : std::string()));
       }
     };
-    LogRefit r = refit_log(
-        path, fopt, o.live || o.compare, {},
+    LogRefit r = refit_log_session(
+        session, fopt, o.live || o.compare, {},
         [&](std::int64_t done, std::int64_t total, std::size_t runs) {
           progress.update(done, total, "refit", fmt::format("{} run{} fitted  {}", runs, runs == 1 ? "" : "s", path));
         },
@@ -294,6 +355,7 @@ int run_refit(const RefitCommandOptions& o) {
       // does not), the largest overlap first.
       const Json refit = refit_file_json(r, report);
       std::size_t same = 0, differ = 0, missing_live = 0, missing_refit = 0;
+      std::size_t verdict_live_only = 0, verdict_refit_only = 0, verdict_differ = 0;
       std::vector<bool> live_paired(live.size(), false);
       for (std::size_t i = 0; i < r.runs.size(); ++i) {
         const RefitRun& ours = r.runs[i];
@@ -309,39 +371,88 @@ int run_refit(const RefitCommandOptions& o) {
                                              ours.fit.run.t_cut_s);
         if (best == live.size()) {
           ++missing_live;
-          std::cout << fmt::format("{}: {}: refit found it, no live FIT recorded\n", path, name);
+          std::string why;
+          for (std::size_t k = 0; k < live.size(); ++k)
+            if (live[k].first == ours.bench && window_overlap_s(ours.fit.run, live[k].second) > 0) {
+              why = fmt::format(" (split: it lies inside live run {} (cut at {:.3f} s), which the refit splits here)",
+                                live[k].second.value("run", 0), number_in(live[k].second, "t_cut_s"));
+              break;
+            }
+          if (why.empty() && ours.fit.run.end == Run::End::end_of_data)
+            why = " (split: the log ends during this run, and its live FIT, published when it ended, is in the log "
+                  "after it: refit the session's files together)";
+          std::cout << fmt::format("{}: {}: refit found it, no live FIT recorded{}\n", path, name, why);
           continue;
         }
         live_paired[best] = true;
-        // The run number is the fitter's count since it started, not the run's identity.
+        // The run number is the fitter's count since it started, not the run's identity. The
+        // numbers first; a health verdict is compared on its own, since one side may have had a
+        // bench file and the other not.
         Json a = jr, b = live[best].second;
         a.erase("run");
         b.erase("run");
+        const std::string ours_level = level_of(a), live_level = level_of(b);
+        Json ours_health = a.contains("health") ? a["health"] : Json(), live_health = b.contains("health") ? b["health"] : Json();
+        a.erase("health");
+        b.erase("health");
         const std::string d = first_difference(a, b, "run");
         if (d.empty()) {
           ++same;
+          if (live_health.is_null() && ours_health.is_null()) continue;
+          if (ours_health.is_null()) {
+            ++verdict_live_only;
+            std::cout << fmt::format("{}: {}: identical numbers; health {} live, none here: the live fitter had a "
+                                     "bench file for bench {}, this refit has none (give it with --bench-config)\n",
+                                     path, name, live_level, ours.bench);
+          } else if (live_health.is_null()) {
+            ++verdict_refit_only;
+            std::cout << fmt::format("{}: {}: identical numbers; health {} here, none live: the live fitter had no "
+                                     "bench file for bench {}\n",
+                                     path, name, ours_level, ours.bench);
+          } else if (const std::string hd = first_difference(ours_health, live_health, "run.health"); !hd.empty()) {
+            ++verdict_differ;
+            std::cout << fmt::format("{}: {}: identical numbers, but health {} here against {} live ({}): this "
+                                     "bench file is not the one the live fitter had\n",
+                                     path, name, ours_level, live_level, hd);
+          }
           continue;
         }
         ++differ;
-        const bool live_partial = b.value("lead_in", "") == "none", ours_partial = ours.fit.run.partial();
-        std::cout << fmt::format("{}: {}: differs: {}{}\n", path, name, d,
-                                 live_partial && !ours_partial
-                                     ? " (live joined this run mid-coast: the fitter started or took the bench "
-                                       "in after its cut; the log holds the whole run)"
-                                     : "");
+        const std::string why = why_they_differ(ours.fit.run, jr.value("samples", std::int64_t{0}), b);
+        std::cout << fmt::format("{}: {}: differs: {}{}\n", path, name, d, why.empty() ? "" : " (" + why + ")");
       }
       for (std::size_t k = 0; k < live.size(); ++k)
         if (!live_paired[k]) {
           ++missing_refit;
+          // Part of a refitted run already paired: live split that run in two.
+          std::string why;
+          for (const RefitRun& ours : r.runs)
+            if (ours.bench == live[k].first && window_overlap_s(ours.fit.run, live[k].second) > 0) {
+              const bool partial = live[k].second.value("lead_in", "") == "none";
+              why = fmt::format(" (split: it lies inside refit run {} (cut at {:.3f} s); live {}", ours.fit.run.number,
+                                ours.fit.run.t_cut_s,
+                                partial ? "published this part of it as a partial run of its own)"
+                                        : "gave this part of it a cut of its own: an invented cut)");
+              break;
+            }
           std::cout << fmt::format("{}: {} live run {} (cut at {:.3f} s): live FIT recorded, the refit did not find "
-                                   "this run\n",
+                                   "this run{}\n",
                                    path, live[k].first, live[k].second.value("run", 0),
-                                   number_in(live[k].second, "t_cut_s"));
+                                   number_in(live[k].second, "t_cut_s"), why);
         }
+      std::string verdicts;
+      if (verdict_live_only)
+        verdicts += fmt::format("; {} with a health verdict live only (the live fitter had a bench file, this refit "
+                                "none)",
+                                verdict_live_only);
+      if (verdict_refit_only)
+        verdicts += fmt::format("; {} with a health verdict here only (the live fitter had no bench file)",
+                                verdict_refit_only);
+      if (verdict_differ) verdicts += fmt::format("; {} with another health verdict (another bench file)", verdict_differ);
       std::cout << fmt::format("{}: {} runs refitted, {} live FIT messages: {} identical, {} different, {} only "
-                               "refitted, {} only live\n",
-                               path, r.runs.size(), live.size(), same, differ, missing_live, missing_refit);
-      if (differ || missing_live || missing_refit || live.empty()) ok = false;
+                               "refitted, {} only live{}\n",
+                               path, r.runs.size(), live.size(), same, differ, missing_live, missing_refit, verdicts);
+      if (differ || verdict_differ || missing_live || missing_refit || live.empty()) ok = false;
       continue;
     }
 

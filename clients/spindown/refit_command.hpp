@@ -16,12 +16,11 @@
 
 #include <spindown/fit_t.hpp>
 
+#include "input_options.hpp"
 #include "spindown/fit_report.hpp"
 #include "spindown/fitter_core.hpp"
 #include "spindown/lcm_log_reader.hpp"
 #include "spindown/log_refit.hpp"
-
-#include "lab_options.hpp"
 
 namespace CLI {
 class App;
@@ -39,13 +38,15 @@ struct RefitCommandOptions {
   bool no_progress = false;  // no progress line on a terminal
   std::string bench_regex = ".*";
   std::vector<std::string> models;
-  double inertia_kg_m2 = 0, kb_v_s_per_rad = 0, speed_constant_rpm_per_v = 0;
-  bool inertia_given = false, kb_given = false, speed_constant_given = false;
+  // J and K_b (--inertia/--flywheel-*, --kb/--speed-constant, their errors) and --bench-config, as
+  // `spindown fit` takes them: what they name wins over the log's CONFIG (said in each run's
+  // bench_source). With --compare they are the live fitter's: the flags its defaults for benches
+  // without CONFIG, the bench files its health references, so that like is compared with like.
+  InputOptions input;
   bool ignore_config = false;
   std::size_t max_benches = FitterOptions{}.max_benches;  // as spindown-fitter --max-benches
   double admit_rate_hz = FitterOptions{}.admit_rate_hz;   // as spindown-fitter --admit-rate
   double silent_s = FitterOptions{}.silent_s;             // as spindown-fitter --silent
-  LabOptions lab;                                         // as spindown-fitter --lab, --key
   double replay_window_s = FitterOptions{}.gate.replay_window_s;  // as spindown-fitter --replay-window
   double takeover_s = FitterOptions{}.stream.takeover_s;          // as spindown-fitter --takeover
 };

@@ -33,12 +33,9 @@ SessionReportOptions plan_from(const ReportCommandOptions& o) {
   if (plan.explain.base.empty()) bad_usage(fmt::format("--base: {}", why));
   if (!plan.explain.is_valid(&why)) bad_usage(fmt::format("--base: {}", why));
   plan.naming = naming_from(o.input, o.text_bench);
-  try {  // one loader for fit, report and the fitter: files or directories, duplicate benches refused
-    for (const auto& [bench, file] : load_bench_files(o.bench_configs).files)
-      plan.references.emplace(bench, bench_reference(file));
-  } catch (const std::exception& e) {
-    bad_usage(fmt::format("--bench-config: {}", e.what()));
-  }
+  // One loader for fit, report and the fitter: files or directories, duplicate benches refused.
+  for (const auto& [bench, file] : bench_files_from(o.input, std::cerr).files)
+    plan.references.emplace(bench, bench_reference(file));
   return plan;
 }
 
@@ -65,11 +62,6 @@ void setup_report(CLI::App& app) {
   sub->add_option("FILE", opt->files, "Arduino/PuTTY log, delimited text (CSV/TSV) or LCM log")->required();
   sub->add_option("-o,--output", opt->output, "The HTML page to write")->required();
   sub->add_option("--bench", opt->text_bench, "Bench id for the text files (default: each file's name)");
-  sub->add_option("--bench-config", opt->bench_configs,
-                  "Per-bench TOML file(s) with [motor]/[baseline]/[health]; a directory means every *.toml in it; "
-                  "repeat the flag for more")
-      ->allow_extra_args(false)
-      ->check(CLI::ExistingPath);
   sub->add_option("--base", opt->base, "The explain workflow's starting model (default viscous)");
   sub->add_option("--models", opt->models, "Models to fit: viscous,coulomb,combined (default all)")
       ->delimiter(',')

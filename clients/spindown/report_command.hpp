@@ -18,7 +18,6 @@ struct ReportCommandOptions {
   std::vector<std::string> files;
   std::string output;                     // the HTML file
   std::string text_bench;                 // --bench: bench id of text files
-  std::vector<std::string> bench_configs; // per-bench TOML files
   std::string base = "viscous";           // the explain workflow's starting belief
   std::vector<std::string> models;
   bool no_explain = false;
@@ -26,7 +25,7 @@ struct ReportCommandOptions {
   bool verbose = false;
   std::string title = "spindown report";
 
-  InputOptions input;  // the bench and delimited-text columns, as for `spindown fit`
+  InputOptions input;  // the bench, --bench-config and delimited-text columns, as for `spindown fit`
 };
 
 void setup_report(CLI::App& app);

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <memory>
 #include <regex>
+#include <vector>
 #include <sys/ioctl.h>
 #include <unistd.h>
 
@@ -19,6 +20,7 @@
 #include "spindown/lcm_loop.hpp"
 #include "spindown/lcm_url.hpp"
 #include "spindown/stop_signal.hpp"
+#include "spindown/watch_screen.hpp"
 
 namespace spindown::cli {
 
@@ -31,10 +33,15 @@ std::string clock_text(std::int64_t utime) {
   return fmt::format("{:02}:{:02}:{:02}.{}", local.tm_hour, local.tm_min, local.tm_sec, (utime / 100000) % 10);
 }
 
-std::size_t terminal_width() {
+// The terminal's size now (it may have been resized): columns and rows, 0 when unknown.
+WatchScreenOptions terminal_size() {
+  WatchScreenOptions size;
   winsize ws{};
-  if (::ioctl(STDOUT_FILENO, TIOCGWINSZ, &ws) == 0 && ws.ws_col > 0) return ws.ws_col;
-  return 0;
+  if (::ioctl(STDOUT_FILENO, TIOCGWINSZ, &ws) == 0) {
+    size.width = ws.ws_col;
+    size.height = ws.ws_row;
+  }
+  return size;
 }
 
 // The table hears SPINDOWN.<bench>.<KIND> as Msg: table_call(bench id, message, receive time).
@@ -102,7 +109,11 @@ void setup_watch(CLI::App& app) {
   CLI::App* sub = app.add_subcommand("watch", "Live table of the lab's benches: run state, last fit, bridge health");
   sub->footer(
       "Listens to SPINDOWN.<bench>.SAMPLE|CONFIG|RUN|FIT|STATUS and the services' STATUS. On a terminal the table is "
-      "redrawn in place; with --plain or when stdout is not a terminal, events (runs, fits, bridge changes, "
+      "redrawn in place to the terminal's size: title, header and every bench row first (the run, the last fit's "
+      "model, the combined model's c3 and c4 ± error, the health verdict), then the services and as many recent "
+      "events as fit, each folded within the width; a narrow terminal shortens the cells, then drops BRIDGE, SEQ "
+      "GAPS, RMSE, AGE and LAST FIT in that order. With --plain or when stdout is not a terminal, events (runs, fits, "
+      "bridge changes, "
       "sequence gaps) are printed as lines and the table every --interval when something changed, and once more at "
       "the end. AGE marked '!' is older than 5 s. SEQ GAPS are samples_t.seq gaps as this listener saw them.\n"
       "Exit codes: 0 stopped by SIGINT/SIGTERM or after --duration, 1 LCM could not start, 2 bad usage.");
@@ -154,15 +165,13 @@ int run_watch(const WatchCommandOptions& o) {
   const bool redraw = tty && !o.plain && !o.once;
   const double duration = o.duration_s > 0 ? o.duration_s : (o.once ? 3.0 : 0.0);
   const double interval = o.interval_s > 0 ? o.interval_s : (redraw ? 1.0 : 10.0);
-  std::deque<std::string> recent;  // events shown under a redrawn table
+  std::deque<std::string> recent;  // events shown under a redrawn table (as many as fit)
   constexpr std::size_t recent_shown = 12;
   const auto redraw_screen = [&](std::int64_t t) {
-    std::string screen = "\x1b[H\x1b[2J" + table.render(t, terminal_width());
-    if (!recent.empty()) {
-      screen += "\nrecent events:\n";
-      for (const auto& line : recent) screen += "  " + line + '\n';
-    }
-    print(screen);
+    const std::vector<std::string> events(recent.begin(), recent.end());
+    WatchScreenOptions size = terminal_size();
+    size.max_events = recent_shown;
+    print("\x1b[H\x1b[2J" + watch_screen(table, t, events, size));
   };
 
   if (!redraw && !o.once)

@@ -95,6 +95,7 @@ std::optional<int> parse_options(int argc, char** argv, BridgeOptions& o) {
       fmt::print(stderr, "spindown-bridge: {}\n", e.what());
       return 2;
     }
+    for (const auto& w : s.warnings) fmt::print(stderr, "spindown-bridge: {}\n", w);
     if (!cli.bench.empty()) s.bench = cli.bench;
     if (!cli.device.empty()) s.device = cli.device;
     if (baud_opt->count() > 0) s.baud = cli.baud;

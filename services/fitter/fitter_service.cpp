@@ -47,7 +47,7 @@ FitterService::~FitterService() {
 
 void FitterService::run_changed(const run_t& run) {
   const std::string channel = channel_name(run.bench, ChannelKind::run);
-  if (loop_.publish(channel, run) != 0) ++publish_failures_;
+  publish_.sent(loop_.publish(channel, run), channel, wall_us());
   if (opt_.verbose)
     fmt::print(stderr, "spindown-fitter: {} run {} {}: {}\n", run.bench, run.run, run_state_name(run.state), run.note);
 }
@@ -64,7 +64,8 @@ void FitterService::fit_ready(const FitResult& r) {
   about.bridge_host = r.bridge_host;
   about.bridge_session = r.bridge_session;
   const fit_t msg = to_fit_message(r.fit, about, now);
-  if (loop_.publish(channel_name(r.bench, ChannelKind::fit), msg) != 0) ++publish_failures_;
+  const std::string channel = channel_name(r.bench, ChannelKind::fit);
+  publish_.sent(loop_.publish(channel, msg), channel, now);
   last_latency_s_ = about.latency_s;
   max_latency_s_ = std::max(max_latency_s_, about.latency_s);
   last_fit_s_ = r.fit_seconds;
@@ -94,7 +95,8 @@ void FitterService::publish_explain(const FitResult& r) {
   const ExplainResult ex = explain_run(r.t_s, r.value, r.fit.quantity, run, eo);
   if (!ex.ok) ++explain_failures_;
   const explain_t msg = to_explain_message(ex, r.bench, wall_us());
-  if (loop_.publish(channel_name(r.bench, ChannelKind::explain), msg) != 0) ++publish_failures_;
+  const std::string channel = channel_name(r.bench, ChannelKind::explain);
+  publish_.sent(loop_.publish(channel, msg), channel, wall_us());
   ++explains_;
   if (opt_.verbose)
     fmt::print(stderr, "spindown-fitter: {} run {} explained: {} -> {} (RMSE {:.4g} -> {:.4g})\n", r.bench,
@@ -141,7 +143,11 @@ void FitterService::publish_status(std::int64_t now_us, const char* state) {
   s.counter_name.emplace_back("oversize_drops");
   s.counter_value.push_back(q.oversize_drops);
   s.counter_name.emplace_back("publish_failures");
-  s.counter_value.push_back(publish_failures_);
+  s.counter_value.push_back(publish_.failures());
+  s.counter_name.emplace_back("heartbeats_unheard");
+  s.counter_value.push_back(publish_.unheard_heartbeats());
+  s.counter_name.emplace_back("stalls");
+  s.counter_value.push_back(stalls_);
   s.counter_name.emplace_back("explains");
   s.counter_value.push_back(explains_);
   s.counter_name.emplace_back("explain_failures");
@@ -167,6 +173,10 @@ void FitterService::publish_status(std::int64_t now_us, const char* state) {
     s.last_error = fmt::format("{} messages dropped: larger than the receive queue's limit of {} bytes (last: {} "
                                "bytes on {}; a forged LCM fragment header claims any size)",
                                q.oversize_drops, opt_.max_queue_bytes, q.last_oversize_bytes, q.last_oversize_channel);
+  if (s.last_error.empty() && publish_.failures() + publish_.unheard_heartbeats() > 0) {
+    s.last_error = publish_.last_error();
+    s.last_error_utime = publish_.last_error_utime();
+  }
   if (s.last_error.empty() && q.full_drops > 0)
     s.last_error = fmt::format("{} messages dropped: receive queue full", q.full_drops);
   // Another fitter with this name alive now: said in every heartbeat while it lasts.
@@ -175,19 +185,47 @@ void FitterService::publish_status(std::int64_t now_us, const char* state) {
   s.ncounters = static_cast<std::int32_t>(s.counter_name.size());
   if (instances_.alive(now_us).size() > 1 && !collision_.empty()) s.last_error = collision_;
   s.start_utime = stamp_.identity().start_utime;
-  if (loop_.publish(channel_name(opt_.instance, ChannelKind::status), s) != 0) ++publish_failures_;
+  const std::string channel = channel_name(opt_.instance, ChannelKind::status);
+  publish_.heartbeat_sent(loop_.publish(channel, s), channel, s.utime, wall_us(), !draining_);
+}
+
+bool FitterService::nothing_waiting() const {
+  return queue_.counts().depth == 0 && !loop_.messages_waiting() && own_udp_queued_bytes() <= 0;
 }
 
 void FitterService::worker() {
+  using std::chrono::steady_clock;
   const auto period = std::chrono::microseconds(static_cast<std::int64_t>(opt_.status_period_s * 1e6));
-  auto next_status = std::chrono::steady_clock::now();
+  auto next_status = steady_clock::now();
   constexpr auto poll_wait = std::chrono::microseconds(FitterCore::poll_period_us);
+  // A round that starts this long after the one before was a stall (SIGSTOP, a suspended VM, a
+  // starved machine): what arrived meanwhile waits in LCM's queue and in the socket, and LCM
+  // stamps it with the time it reads it, after the stall. No bench is judged silent until that
+  // backlog has been handled (nothing waits any more), so a frozen fitter never takes its own
+  // backlog for silence.
+  constexpr auto stall_after = poll_wait + std::chrono::seconds(1);
+  constexpr std::int64_t drain_at_most_us = 5'000'000;  // then live traffic is flowing anyway
   std::deque<QueuedMessage> batch;
   std::int64_t next_poll = 0;
+  auto last_round = steady_clock::now(), next_drain_check = last_round;
+  std::int64_t drain_from_us = 0, drained_messages = 0;
   for (;;) {
     worker_alive_ns_.store(monotonic_ns(), std::memory_order_relaxed);
     // Closed (the service stops): this batch is the last.
-    const bool open = queue_.take_all(batch, std::min(next_status, std::chrono::steady_clock::now() + poll_wait));
+    const bool open = queue_.take_all(batch, std::min(next_status, steady_clock::now() + poll_wait));
+    const auto round = steady_clock::now();
+    if (round - last_round > stall_after) {
+      ++stalls_;
+      const double stalled_s = std::chrono::duration<double>(round - last_round).count();
+      fmt::print(stderr,
+                 "spindown-fitter: no message handled for {:.1f} s (the fitter was stopped, suspended, starved or "
+                 "busy): no bench is judged silent until what arrived meanwhile has been handled\n",
+                 stalled_s);
+      draining_ = true;
+      drain_from_us = wall_us();
+      drained_messages = 0;
+    }
+    last_round = round;
     for (const QueuedMessage& m : batch) {
       if (m.channel == status_channel_)
         own_channel_status(m);
@@ -195,17 +233,27 @@ void FitterService::worker() {
         core_.on_message(m.channel, m.data.data(), static_cast<std::int64_t>(m.data.size()), m.recv_utime);
     }
     // Benches gone silent mid-coast, by the time of the traffic just handled (as refit does with
-    // a log), so a backlog in the queue is never taken for silence; the clock when none came.
-    const std::int64_t now = batch.empty() ? wall_us() : batch.back().recv_utime;
+    // a log); by the clock only when none came and nothing received still waits.
+    const bool idle = batch.empty();
+    const std::int64_t now = idle ? wall_us() : batch.back().recv_utime;
+    drained_messages += static_cast<std::int64_t>(batch.size());
     batch.clear();
-    if (now >= next_poll) {
+    if (draining_ && round >= next_drain_check) {
+      next_drain_check = round + std::chrono::milliseconds(100);
+      if (nothing_waiting() || now - drain_from_us > drain_at_most_us) {
+        draining_ = false;
+        fmt::print(stderr, "spindown-fitter: the backlog is handled ({} messages); silence is judged again\n",
+                   drained_messages);
+      }
+    }
+    if (!draining_ && now >= next_poll && (!idle || !core_.silence_due(now) || nothing_waiting())) {
       core_.poll(now);
       next_poll = now + FitterCore::poll_period_us;
     }
-    if (std::chrono::steady_clock::now() >= next_status) {
+    if (steady_clock::now() >= next_status) {
       publish_status(wall_us(), "running");
       next_status += period;
-      if (next_status < std::chrono::steady_clock::now()) next_status = std::chrono::steady_clock::now() + period;
+      if (next_status < steady_clock::now()) next_status = steady_clock::now() + period;
     }
     if (!open) break;
   }
@@ -242,6 +290,12 @@ int FitterService::run(const StopSignals& stop) {
     fmt::print(stderr, "spindown-fitter: cannot subscribe (bad --bench regex?)\n");
     return 2;
   }
+  // Its own heartbeats, back through the network stack: the check that what it publishes
+  // goes where the lab listens (PublishHealth).
+  const std::int32_t pid = static_cast<std::int32_t>(::getpid());
+  loop_.subscribe<status_t>(channel_name(opt_.instance, ChannelKind::status), [this, pid](const status_t& st) {
+    if (st.service == "fitter" && st.pid == pid && st.host == host_) publish_.echoed(st.utime);
+  });
   worker_alive_ns_.store(monotonic_ns());
   worker_ = std::thread([this] { worker(); });
   feed_watchdog_from_loop(loop_, notify_, [this](std::int64_t now_ns) {
@@ -254,19 +308,22 @@ int FitterService::run(const StopSignals& stop) {
   loop_.unsubscribe_all();
   queue_.close();
   worker_.join();
-  // Runs still open are left open (a restarted fitter finds them again from new samples);
-  // only the counters go out.
+  // Runs still open are closed as abandoned (not fitted: a restarted fitter takes the rest of
+  // the coast as partial), so no client shows them coasting for ever; then the last heartbeat.
+  core_.abandon_open_runs(wall_us(), "fitter stopping: the run was not finished; a fitter started again takes the "
+                                     "rest of its coast as a partial run");
   publish_status(wall_us(), "stopping");
   const FitterCounters& c = core_.counters();
   const MessageQueueCounts q = queue_.counts();
   fmt::print(stderr,
              "spindown-fitter: stopped: {} benches, {} samples, {} runs, {} fits, {} decode errors, {} sequence gaps, "
              "{} duplicates, {} NaN values, {} time backwards, {} benches evicted, {} benches refused, {} partial runs, "
-             "{} silent benches, {} flood drops, {} queue drops, {} oversize drops, {} datagrams dropped by the kernel "
-             "on the fitter's socket\n",
+             "{} silent benches, {} runs abandoned, {} flood drops, {} queue drops, {} oversize drops, {} publish "
+             "failures, {} datagrams dropped by the kernel on the fitter's socket\n",
              core_.bench_count(), c.samples, c.runs, c.fits, c.decode_errors, c.seq_gaps, c.duplicates, c.nan_values,
-             c.time_backwards, c.dropped_benches, c.benches_refused, c.partial_runs, c.silent_benches, c.flood_drops,
-             q.full_drops, q.oversize_drops, own_udp_drop_count());
+             c.time_backwards, c.dropped_benches, c.benches_refused, c.partial_runs, c.silent_benches,
+             c.runs_abandoned, c.flood_drops, q.full_drops, q.oversize_drops, publish_.failures(),
+             own_udp_drop_count());
   fmt::print(stderr,
              "spindown-fitter: sources: {} new sources, {} two sources at once ({} samples refused), {} far jumps "
              "dropped ({} samples); not used: {} of another lab, {} unsigned, {} badly signed, {} replayed; {} "

@@ -17,6 +17,7 @@
 #include "spindown/lcm_loop.hpp"
 #include "spindown/message_queue.hpp"
 #include "spindown/message_stamp.hpp"
+#include "spindown/publish_health.hpp"
 #include "spindown/service_instances.hpp"
 #include "spindown/service_notifier.hpp"
 #include "spindown/stop_signal.hpp"
@@ -57,6 +58,8 @@ class FitterService final : public FitterSink {
 
  private:
   void worker();
+  // Nothing received still waits: the service's queue, LCM's and the socket's are empty.
+  bool nothing_waiting() const;
   void publish_status(std::int64_t now_us, const char* state);
   // A STATUS on this instance's own channel: another fitter with the same name is named.
   void own_channel_status(const QueuedMessage& m);
@@ -84,7 +87,9 @@ class FitterService final : public FitterSink {
 
   // Worker-side measurements for the heartbeat.
   double last_latency_s_ = 0, max_latency_s_ = 0, last_fit_s_ = 0;
-  std::int64_t publish_failures_ = 0;
+  PublishHealth publish_{{.program = "spindown-fitter"}};  // send errors, unheard heartbeats
+  std::int64_t stalls_ = 0;
+  bool draining_ = false;    // after a stall, until nothing received waits any more  // rounds that started long after the one before (a freeze)
   std::int64_t explains_ = 0, explain_failures_ = 0;
   std::int64_t last_samples_ = 0, last_rate_us_ = 0;
   double rate_hz_ = 0;

@@ -62,8 +62,10 @@ std::optional<int> parse_options(int argc, char** argv, spindown::FitterServiceO
   app.add_option("--admit-rate", o.core.admit_rate_hz,
                  "new benches admitted per second past the first --max-benches (a flood of bench ids is refused)")
       ->check(CLI::PositiveNumber);
-  app.add_option("--silent", o.core.silent_s, "seconds without samples that close a bench's open run (fitted to its "
-                 "last sample)")
+  app.add_option("--silent", o.core.silent_s,
+                 "seconds without samples that close a bench's open run (fitted to its last sample; what resumes "
+                 "of that coast is partial, never given a cut); judged only when nothing received still waits, so "
+                 "a fitter that was stopped or starved first handles its backlog")
       ->check(CLI::PositiveNumber);
   app.add_option("--max-rate", o.core.max_rate_hz, "samples/s per bench before messages are dropped (0: no cap)");
   app.add_option("--max-coast", o.core.runs.max_coast_s, "seconds before a coast that never stops is closed");
@@ -104,7 +106,10 @@ std::optional<int> parse_options(int argc, char** argv, spindown::FitterServiceO
   }
   std::string why;
   try {
-    for (auto& [bench, file] : spindown::load_bench_files(bench_configs).files) o.core.health.emplace(bench, file.health);
+    for (auto& [bench, file] : spindown::load_bench_files(bench_configs).files) {
+      for (const auto& w : file.warnings) fmt::print(stderr, "spindown-fitter: {}\n", w);
+      o.core.health.emplace(bench, file.health);
+    }
   } catch (const std::exception& e) {
     fmt::print(stderr, "spindown-fitter: --bench-config: {}\n", e.what());
     return 2;

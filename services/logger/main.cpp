@@ -177,8 +177,12 @@ int report_stop(const spindown::EventLogWriter& writer, bool quiet) {
                c.samples_missing, spindown::own_udp_drop_count());
     for (const auto& f : writer.files()) fmt::print(stderr, "spindown-logger: wrote {}\n", f);
     if (c.files_deleted > 0)
-      fmt::print(stderr, "spindown-logger: retention deleted {} files ({} bytes): {}\n", c.files_deleted,
-                 c.bytes_deleted, fmt::join(writer.deleted_files(), ", "));
+      fmt::print(stderr, "spindown-logger: retention deleted {} files ({} bytes{}): {}\n", c.files_deleted,
+                 c.bytes_deleted,
+                 c.files_deleted_for_space > 0
+                     ? fmt::format("; {} of them to make room on a disk about to fill", c.files_deleted_for_space)
+                     : std::string(),
+                 fmt::join(writer.deleted_files(), ", "));
   }
   if (c.write_errors > 0) {
     fmt::print(stderr, "spindown-logger: {} write errors, {} events lost; last: {}\n", c.write_errors, c.events_lost,

@@ -81,6 +81,26 @@ TEST(FitMessage, TheUncertaintyOfJAndKbTravelsWithEachParameter) {
   EXPECT_NE(run_fit_json(fit).dump().find("\"total_stderr\""), std::string::npos);
 }
 
+// A received fit draws the fitter's curves: each model's ω(τ) from the message equals the fit's
+// own, before the stop, at it and after (spindown-web draws them from the message).
+TEST(FitMessage, EachModelsSpeedLawSurvivesTheMessage) {
+  const RunFit fit = sample_fit();
+  std::string why;
+  const auto back = from_fit_message(to_fit_message(fit, {"b", "config", 0, 0, 0, std::nullopt, "", 0}, 1), &why);
+  ASSERT_TRUE(back) << why;
+  ASSERT_EQ(back->models.size(), fit.models.size());
+  for (std::size_t i = 0; i < fit.models.size(); ++i) {
+    const ModelFit& a = fit.models[i];
+    const ModelFit& b = back->models[i];
+    ASSERT_TRUE(a.converged) << model_name(a.kind);
+    EXPECT_GT(a.omega_at(1.0), 0) << model_name(a.kind);
+    for (double tau : {0.0, 1.0, 5.0, 0.5 * a.t_stop_pred_s, 20.0, 40.0}) {
+      if (!std::isfinite(tau)) continue;
+      EXPECT_NEAR(b.omega_at(tau), a.omega_at(tau), 1e-9 * a.omega0 + 1e-12) << model_name(a.kind) << " τ " << tau;
+    }
+  }
+}
+
 TEST(FitMessage, InconsistentArraysAreRefused) {
   fit_t msg = to_fit_message(sample_fit(), {"b", "config", 0, 0, 0, std::nullopt, "", 0}, 0);
   fit_t bad = msg;

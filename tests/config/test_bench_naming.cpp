@@ -55,6 +55,64 @@ TEST_F(BenchNamingTest, SpreadsheetExportsAreRead) {
   EXPECT_EQ(n.student, "Anna");
 }
 
+TEST_F(BenchNamingTest, AGermanExcelsCsvIsReadWithItsNames) {
+  // Excel (German) "CSV (Trennzeichen-getrennt)": Windows-1252, ';', CR LF, every row padded to the
+  // sheet's used range, its empty rows as ';;;;' — after the data and between.
+  const std::string roster = write("roster.csv",
+                                   "file;bench;student;;\r\n"
+                                   "mueller.txt;bench1;M\xFCller, J\xFCrgen;;\r\n"
+                                   ";;;;\r\n"
+                                   "schaefer.txt;bench3;Bj\xF6rn Sch\xE4" "fer;;\r\n"
+                                   "weiss.txt;bench2;Anna Wei\xDF;;\r\n"
+                                   ";;;;\r\n;;;;\r\n;;;;\r\n");
+  const ClassRoster r = load_class_roster(roster);
+  ASSERT_EQ(r.entries.size(), 3u);
+  const BenchNaming naming(roster, "");
+  EXPECT_EQ(naming.name("mueller.txt").student, "M\xC3\xBCller, J\xC3\xBCrgen");
+  EXPECT_EQ(naming.name("schaefer.txt").student, "Bj\xC3\xB6rn Sch\xC3\xA4" "fer");
+  EXPECT_EQ(naming.name("weiss.txt").student, "Anna Wei\xC3\x9F");
+  EXPECT_EQ(naming.name("weiss.txt").bench, "bench2");
+  EXPECT_EQ(naming.name("weiss.txt").from, "roster " + roster + ":5");
+}
+
+TEST_F(BenchNamingTest, ExcelsUnicodeTextAndItsSeparatorHintAreRead) {
+  // "Unicode Text (*.txt)": UTF-16 LE with a byte-order mark, tabs, CR LF.
+  std::string utf16("\xFF\xFE", 2);
+  for (char16_t c : std::u16string(u"Datei\tPr\u00FCfstand\tName\r\nweiss.txt\tbench2\tAnna Wei\u00DF\r\n")) {
+    utf16 += static_cast<char>(c & 0xFF);
+    utf16 += static_cast<char>(c >> 8);
+  }
+  const BenchName n = BenchNaming(write("roster.txt", utf16), "").name("weiss.txt");
+  EXPECT_EQ(n.bench, "bench2");
+  EXPECT_EQ(n.student, "Anna Wei\xC3\x9F");
+  // "sep=," first: Excel's hint for the delimiter, though the header has a ';' in a name.
+  const BenchName s =
+      BenchNaming(write("sep.csv", "sep=,\nfile,bench,student,note;x\na.txt,b1,\"Kim; Lee\",\n"), "").name("a.txt");
+  EXPECT_EQ(s.student, "Kim; Lee");
+}
+
+TEST_F(BenchNamingTest, AWorkbookOrUndecodableBytesAreRefusedWithWhatToDo) {
+  auto message = [&](const std::string& name, const std::string& bytes) {
+    try {
+      load_class_roster(write(name, bytes));
+    } catch (const std::runtime_error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  // The first bytes of an .xlsx as Excel writes it: a zip whose first entry is [Content_Types].xml.
+  const std::string xlsx = std::string("PK\x03\x04\x14\x00\x06\x00\x08\x00\x00\x00\x21\x00", 14) +
+                           std::string(12, '\x01') + std::string("\x13\x00\x00\x00", 4) + "[Content_Types].xml";
+  const std::string w = message("roster.xlsx", xlsx);
+  EXPECT_NE(w.find("an Excel workbook (.xlsx)"), std::string::npos) << w;
+  EXPECT_NE(w.find("save it as CSV (UTF-8)"), std::string::npos) << w;
+  EXPECT_EQ(w.find("binary"), std::string::npos) << w;
+  // UTF-8 and Windows-1252 in one file: no one encoding reads every name right.
+  const std::string mixed = message("mixed.csv", "file,bench,student\na.txt,b1,J\xC3\xBCrgen\nb.txt,b2,J\xFCrgen\n");
+  EXPECT_NE(mixed.find("CSV UTF-8"), std::string::npos) << mixed;
+  EXPECT_NE(message("nul.csv", std::string(200, '\0')).find("binary data"), std::string::npos);
+}
+
 TEST_F(BenchNamingTest, FileNotInRosterIsSaidAndKeepsItsOwnName) {
   const std::string roster = write("roster.csv", "file,bench\nalice.txt,bench1\n");
   const BenchName n = BenchNaming(roster, "").name("carol.txt", "carol");

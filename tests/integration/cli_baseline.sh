@@ -167,6 +167,22 @@ EOF
   >"$T/b3.out" 2>&1 || fail "baseline with a worn run among the good ones"
 grep -q "set aside $T/worn.tsv run 1: dry friction 2.5× the others' median" "$T/b3.out" || fail "worn run not set aside"
 grep -q "baseline of bench b3 from 3 of 4 runs" "$T/b3.out" || fail "the worn run is in the mean"
+# Listed once, as set aside: never "used" (issue 30), and in fit's names.
+if grep "worn.tsv" "$T/b3.out" | grep -vq "set aside"; then fail "the worn run is listed otherwise than set aside: $(grep worn.tsv "$T/b3.out")"; fi
+[ "$(grep -c "^  used     $T/good[123].tsv run 1: c3 = .* N·m·s/rad, c4 = .* N·m$" "$T/b3.out")" -eq 3 ] || fail "the good runs not listed as used in c3/c4"
+if grep -q "c_v\|c_c" "$T/b3.out"; then fail "baseline speaks of c_v/c_c, not fit's c3/c4"; fi
+# Dated by the recordings, not by today: PuTTY logs of 2023.09.14 give that date; text files that
+# tell no date are dated today, said on stderr.
+for i in 1 2 3; do
+  "$B/spindown" simulate --runs 1 --seed $((40 + i)) --putty-header -o "$T/putty$i.txt" >/dev/null 2>&1 || fail "simulate a PuTTY log"
+done
+head -1 "$T/putty1.txt" | grep -q "PuTTY log 2023.09.14" || fail "simulate's PuTTY header changed: $(head -1 "$T/putty1.txt")"
+"$B/spindown" baseline --bench b5 -o "$T/b5.toml" "$T"/putty[123].txt >"$T/b5.out" 2>"$T/b5.err" || fail "baseline of PuTTY logs"
+grep -q '^date = "2023-09-14"$' "$T/b5.toml" || fail "the baseline is not dated by the PuTTY logs: $(grep date "$T/b5.toml")"
+grep -q "(recorded 2023-09-14)" "$T/b5.out" || fail "the date is not said"
+"$B/spindown" baseline --bench b6 -o "$T/b6.toml" "$T/good1.tsv" "$T/good2.tsv" "$T/good3.tsv" >"$T/b6.out" 2>"$T/b6.err" || fail "baseline of undated files"
+grep -q "no recording date in these files .* dated today, $(date -u +%Y-%m-%d); give the recordings' date with --date" "$T/b6.err" ||
+  fail "an undated baseline is not said: $(cat "$T/b6.err")"
 if "$B/spindown" baseline --bench b4 -o "$T/b4.toml" "$T/good1.tsv" "$T/worn.tsv" >"$T/b4.out" 2>&1; then
   fail "two runs that disagree made a baseline"
 fi

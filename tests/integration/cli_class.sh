@@ -34,11 +34,12 @@ week3/dan.txt,bench4,Dan
 R
 
 # ---- one row per run, CSV ----------------------------------------------------------------------------
-"$bin" fit --roster roster.csv --bench-config benches --table csv week3/*.txt >class.csv 2>class.err ||
+"$bin" fit --roster roster.csv --bench-config benches --table csv -o class.csv week3/*.txt 2>class.err ||
   fail "fit --table csv exited $?: $(cat class.err)"
 python3 - class.csv week3 <<'PY' || fail "the class table is wrong"
 import csv, json, sys
-rows = list(csv.DictReader(open(sys.argv[1])))
+assert open(sys.argv[1], "rb").read(3) == b"\xef\xbb\xbf", "a CSV file for Excel starts with a byte-order mark"
+rows = list(csv.DictReader(open(sys.argv[1], encoding="utf-8-sig")))
 assert len(rows) == 8, f"{len(rows)} rows, want 8 (4 files x 2 runs)"
 who = {"alice": ("bench1", "Alice"), "bob": ("bench2", "Bob"), "carol": ("bench3", "Carol, C."), "dan": ("bench4", "Dan")}
 for r in rows:
@@ -108,9 +109,9 @@ PY
 "$bin" export week3/carol.txt --roster roster.csv -o carol.csv 2>export.err || fail "export exited $?: $(cat export.err)"
 python3 - carol.csv carol.fits.csv class.csv <<'PY' || fail "the export is wrong"
 import csv, sys
-samples = list(csv.DictReader(open(sys.argv[1])))
-fits = list(csv.DictReader(open(sys.argv[2])))
-table = [r for r in csv.DictReader(open(sys.argv[3])) if r["bench"] == "bench3"]
+samples = list(csv.DictReader(open(sys.argv[1], encoding="utf-8-sig")))
+fits = list(csv.DictReader(open(sys.argv[2], encoding="utf-8-sig")))
+table = [r for r in csv.DictReader(open(sys.argv[3], encoding="utf-8-sig")) if r["bench"] == "bench3"]
 lines = sum(1 for l in open("week3/carol.txt") if l.strip())
 assert len(samples) == lines, f"{len(samples)} samples exported from {lines} lines"
 assert {s["bench"] for s in samples} == {"bench3"}

@@ -3,7 +3,9 @@
 # windage effect named from the lab's belief, fit's vocabulary (the base model is fit's model of the
 # same name: c1, ω0, the reading noise σ, --lab-units), Coulomb friction not mistaken for a sensor
 # offset below zero on a recording cut off before its stop (rpm), bad usage (exit 2), an unusable
-# file (exit 1, the other files still explained).
+# file (exit 1, the other files still explained); --bench-config as fit takes it (explain, export),
+# a bench file whose K_b and datasheet disagree named; the viscous term of a Coulomb-only motor said
+# to be unneeded.
 set -euo pipefail
 bin="${SPINDOWN_BIN_DIR:?}/spindown"
 data="${SPINDOWN_SAMPLE_DATA:?}"
@@ -134,4 +136,57 @@ code=0
 timeout 60 "$bin" explain "$data/seed-3v-run1.tsv" --svg "$work/no/such/dir/fig.svg" > /dev/null 2> "$work/svg.err" || code=$?
 [ $code -eq 1 ] || fail "unwritable --svg gave exit $code"
 grep -q "cannot write the figure: No such file or directory" "$work/svg.err" || fail "unwritable --svg: $(cat "$work/svg.err")"
+# A bench with its own flywheel (J twice the lab's, by geometry in its bench file): explain and export
+# take --bench-config as fit does, so all three give the truth's c3 (the default J would halve it).
+cat > "$work/bench5.toml" <<'TOML'
+bench_id = "bench5"
+[bench]
+flywheel_radius_m = 0.02
+flywheel_height_m = 0.03
+flywheel_density_kg_m3 = 2700
+rotor_inertia_kg_m2 = 1.09e-6
+speed_constant_rpm_per_v = 1180
+[motor]
+speed_constant_rpm_per_v = 1416
+TOML
+J5=$(python3 -c 'import math; print(2700*math.pi*0.02**2*0.03*0.02**2/2 + 1.09e-6)')
+timeout 60 "$bin" simulate --runs 1 --seed 5 --inertia "$J5" --viscous 2.6e-7 --coulomb 1.25e-4 \
+  -o "$work/bench5_ida.txt" > /dev/null 2>&1 || fail "simulate the flywheel bench"
+bench_opts=(--bench-config "$work/bench5.toml" --bench-pattern '(bench[0-9]+)_([a-z]+)')
+timeout 60 "$bin" fit --json "${bench_opts[@]}" "$work/bench5_ida.txt" > "$work/b5fit.json" 2> "$work/b5fit.err" || fail "fit --bench-config"
+timeout 60 "$bin" explain --json --base combined "${bench_opts[@]}" "$work/bench5_ida.txt" > "$work/b5explain.json" 2> "$work/b5explain.err" ||
+  fail "explain --bench-config: $(cat "$work/b5explain.err")"
+timeout 60 "$bin" export "$work/bench5_ida.txt" -o "$work/b5.csv" "${bench_opts[@]}" 2> "$work/b5export.err" ||
+  fail "export --bench-config: $(cat "$work/b5export.err")"
+python3 - "$work" "$J5" <<'PY'
+import csv, json, sys
+work, J = sys.argv[1], float(sys.argv[2])
+fit = json.load(open(work + "/b5fit.json"))["files"][0]["runs"][0]
+fit_c3 = next(m for m in fit["models"] if m["name"] == "combined")["params"]["c3"]["value"]
+ex = json.load(open(work + "/b5explain.json"))["files"][0]["runs"][0]
+ex_c3 = ex["base_params"]["c3"]["value"]
+rows = [r for r in csv.DictReader(open(work + "/b5.fits.csv")) if r["model"] == "combined"]
+exp_c3 = float(rows[0]["c3"])
+assert abs(fit["bench"]["J"] / J - 1) < 1e-9 and abs(ex["inertia_kg_m2"] / J - 1) < 1e-9, (fit["bench"], ex["inertia_kg_m2"])
+assert abs(float(rows[0]["J_kg_m2"]) / J - 1) < 1e-9, rows[0]["J_kg_m2"]
+for name, c3 in (("fit", fit_c3), ("explain", ex_c3), ("export", exp_c3)):
+    assert abs(c3 / 2.6e-7 - 1) < 0.05, (name, c3)
+assert abs(ex_c3 / fit_c3 - 1) < 1e-3 and abs(exp_c3 / fit_c3 - 1) < 1e-6, (fit_c3, ex_c3, exp_c3)
+print("bench file honoured: c3 fit %.4g, explain %.4g, export %.4g (truth 2.6e-07, J %.4g)" % (fit_c3, ex_c3, exp_c3, J))
+PY
+# The file's [bench] K_b (1180 rpm/V) and [motor] speed constant (1416 rpm/V) disagree: every
+# command that reads it says so, and which one it uses.
+for f in b5fit b5explain b5export; do
+  grep -q "bench5.toml: warning: \[bench\] speed_constant_rpm_per_v = 1180 rpm/V .* and \[motor\] speed_constant_rpm_per_v = 1416 rpm/V .* disagree by 20 %.*the fits use \[bench\]'s K_b" "$work/$f.err" ||
+    fail "$f: no warning naming the K_b disagreement: $(cat "$work/$f.err")"
+done
+
+# A motor with Coulomb friction alone: explain says the viscous term is not needed, from the lab's
+# belief (viscous) and from fit's combined model.
+timeout 60 "$bin" simulate --runs 1 --seed 9 --viscous 0 --coulomb 1.2e-4 -o "$work/coulomb.txt" > /dev/null 2>&1
+timeout 60 "$bin" explain "$work/coulomb.txt" > "$work/coulomb.out" 2>&1 || fail "explain a Coulomb-only motor"
+grep -q "removed viscous: not needed once coulomb is in" "$work/coulomb.out" || fail "viscous not said to be unneeded: $(cat "$work/coulomb.out")"
+grep -q "final model: coulomb" "$work/coulomb.out" || fail "Coulomb-only motor's final model"
+timeout 60 "$bin" explain --base combined "$work/coulomb.txt" > "$work/coulomb2.out" 2>&1 || fail "explain --base combined"
+grep -q "step 1: viscous not needed" "$work/coulomb2.out" || fail "from combined, viscous not said to be unneeded: $(cat "$work/coulomb2.out")"
 echo "cli_explain: ok"

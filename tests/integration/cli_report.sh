@@ -179,7 +179,38 @@ check_page "$T/both.html" || fail "mixed page"
 "$B/spindown" refit "$LOG" >"$T/refit.out" 2>"$T/refit.err" || fail "refit exited $?"
 no_progress "$T/refit.err"
 
-# --- 4. exit codes -------------------------------------------------------------------------
+# --- 4. a semester as an instructor prints it (issue 30) ------------------------------------
+# Four weekly PuTTY logs of one bench whose dry friction rises 8 % a week: far apart beyond their
+# errors, but in a line in time: wear, said as drift, not "check which runs belong to this motor".
+# PuTTY's header time is the PC's local time, never called UTC; each run's figure shows the whole
+# recording with the fitted window shaded; the page prints compactly.
+for w in 0 1 2 3; do
+  "$B/spindown" simulate --runs 1 --seed $((60 + w)) --putty-header --coulomb "$(python3 -c "print(1.1389e-4 * (1 + 0.08 * $w))")" \
+    -o "$T/week$w.raw" >/dev/null 2>&1 || fail "simulate week $w"
+  sed "1s/PuTTY log 2023.09.14/PuTTY log 2023.09.$(printf %02d $((1 + 7 * w)))/" "$T/week$w.raw" >"$T/bench9_week$w.txt"
+done
+"$B/spindown" report "$T"/bench9_week[0-3].txt --bench-pattern '(bench[0-9]+)_([a-z0-9]+)' --no-explain -o "$T/semester.html" \
+  >"$T/semester.out" 2>"$T/semester.err" || fail "semester report exited $?"
+check_page "$T/semester.html" || fail "semester page"
+python3 - "$T/semester.html" <<'EOF' || fail "the semester page"
+import html, re, sys
+raw = open(sys.argv[1], encoding="utf-8").read()
+text = html.unescape(re.sub(r"<[^>]+>", " ", raw))
+assert re.search(r"dry friction rose \d+ % ± \d+ % over 21 days \(4 runs, 4 sessions\): drifting: friction rising "
+                 r"steadily over 4 sessions: wear", text), re.findall(r"dry friction[^.]{0,200}", text)[:2]
+assert "check which runs belong" not in text
+assert "2023-09-01 10:2" in text and "local time" in text
+assert not re.search(r"10:2\d:\d\d UTC", text), re.findall(r"\d\d:\d\d:\d\d UTC", text)
+assert raw.count('<rect class="fitted-window"') == 4 and raw.count("recording outside the fitted window") == 4
+css = raw[raw.index("@media print{"):raw.index("</style>")]
+assert "section.bench" in css and "display:none" in css, css
+assert raw.count('<table class="runs">') == 1 and len(re.findall(r"<tr><td>bench9</td>", raw)) == 4
+print("semester: wear said as drift; PuTTY time local; 4 figures with the fitted window shaded; print stylesheet")
+EOF
+# An LCM log's times are UTC and say so.
+grep -Eq '[0-9]{2}:[0-9]{2}:[0-9]{2} UTC' "$T/log.html" || fail "the LCM log's times are not labelled UTC"
+
+# --- 5. exit codes -------------------------------------------------------------------------
 set +e
 "$B/spindown" report "$D/seed-3v-run1.tsv" >/dev/null 2>"$T/usage.err"; rc=$?
 [ $rc -eq 2 ] || fail "no -o: want exit 2, got $rc"

@@ -3,9 +3,10 @@
 #  1. a live log (spindown-fitter + spindown-logger on a private LCM URL, spindown-run-publisher
 #     publishing runs for 3 benches), so it holds SAMPLE, RUN and FIT messages;
 #  2. spindown export --csv (samples and refitted fits) and --mcap of that log;
-#  3. @mcap/core (the MCAP project's TypeScript reader, installed from the npm registry into the
-#     build directory) reads the MCAP indexed and streamed, checks the CRCs, decodes every message
-#     (tests/integration/mcap_read.js);
+#  3. @mcap/core (the MCAP project's TypeScript reader, which deploy/setup --tests installs from
+#     the npm registry into /usr/local/lib/spindown-tests/node, or $SPINDOWN_TEST_NODE_DIR; this
+#     test installs nothing) reads the MCAP indexed and streamed, checks the CRCs, decodes every
+#     message (tests/integration/mcap_read.js);
 #  4. every sample equals its CSV row, field by field and in order; there is one FIT per run of
 #     the fits CSV with the same parameters; RUN messages follow every run to "stopped";
 #  5. --bench keeps one bench; a file that is not an LCM log and a missing file fail naming it.
@@ -13,14 +14,12 @@
 source "$(dirname "${BASH_SOURCE[0]}")/netns_common.bash"
 SRC=${SPINDOWN_SOURCE_DIR:?}
 
-# The reader, once per build directory (not committed; npm's own cache makes a rerun cheap).
-NODE_DIR="$B/../mcap-reader"
-if [ ! -f "$NODE_DIR/node_modules/@mcap/core/package.json" ]; then
-  command -v npm >/dev/null || fail "npm is not installed (deploy/setup --tests installs it)"
-  mkdir -p "$NODE_DIR"
-  npm install --prefix "$NODE_DIR" --no-audit --no-fund --no-save @mcap/core@2.2.2 >"$T/npm.out" 2>&1 ||
-    { cat "$T/npm.out" >&2; fail "npm install @mcap/core"; }
-fi
+# The reader, where deploy/setup --tests put it (never installed from here: no registry while
+# a test runs).
+NODE_DIR=${SPINDOWN_TEST_NODE_DIR:-/usr/local/lib/spindown-tests/node}
+command -v node >/dev/null || fail "node is not installed: run deploy/setup --tests"
+[ -f "$NODE_DIR/node_modules/@mcap/core/package.json" ] ||
+  fail "@mcap/core is not installed in $NODE_DIR: run deploy/setup --tests (it installs it from the npm registry)"
 read_mcap() { NODE_PATH="$NODE_DIR/node_modules" node "$SRC/tests/integration/mcap_read.js" "$@"; }
 
 # ---- 1. a live log --------------------------------------------------------------------------

@@ -104,6 +104,22 @@ with open("garbage_between.lcmlog", "wb") as f:
         f.write(event(k, ch, d))
         if k == 12: f.write(b"\0" * 300 + b"noise")
 open("empty.lcmlog", "wb").close()
+# What Windows hands in: a workbook instead of text, a German Excel's CSV (Windows-1252, ';',
+# decimal commas, its empty rows), a log closed with DOS's Ctrl-Z.
+import io, zipfile
+book = io.BytesIO()
+with zipfile.ZipFile(book, "w", zipfile.ZIP_DEFLATED) as z:
+    z.writestr("[Content_Types].xml", '<?xml version="1.0"?><Types/>')
+    z.writestr("xl/workbook.xml", '<?xml version="1.0"?><workbook/>')
+    z.writestr("xl/worksheets/sheet1.xml", "<worksheet>" + "".join(f"<row><c><v>{t}</v></c></row>" for t, _ in rows) + "</worksheet>")
+open("workbook.xlsx", "wb").write(book.getvalue())
+with open("excel_de.csv", "wb") as f:
+    f.write("Zeit [\u00b5s];Spannung [V];Bemerkung\r\n".encode("cp1252"))
+    for t, v in rows: f.write(f"{t * 1000};{fmt(v).replace('.', ',')};\r\n".encode("cp1252"))
+    f.write(b";;\r\n" * 5)
+with open("ctrl_z.tsv", "wb") as f:
+    for t, v in rows: f.write(f"{t}\t{fmt(v)}\r\n".encode())
+    f.write(b"\x1a")
 PY
 mkdir a_directory
 mkfifo fifo_no_writer
@@ -124,6 +140,9 @@ cases=(
   "device clock jumping 3 s mid-coast, readings going on|fit|clock_jump.tsv|0|device clock jumped"
   "a day without samples mid-coast|fit|day_gap.tsv|0|cut short there"
   "non-UTF-8 bytes (Latin-1 line, invalid sequences)|fit|latin1.tsv|0|not a number"
+  "an Excel workbook (.xlsx) instead of text|fit|workbook.xlsx|1|an Excel workbook"
+  "a German Excel's CSV (Windows-1252, ';', decimal commas, ';;' rows)|fit|excel_de.csv|0|best: "
+  "a trailing Ctrl-Z (DOS end of file)|fit|ctrl_z.tsv|0|best: "
   "a directory|fit|a_directory|1|it is a directory"
   "a missing file|fit|missing.tsv|1|No such file"
   "a FIFO with no writer|fit|fifo_no_writer|1|the file is empty"
@@ -294,8 +313,9 @@ Regenerate it with `tests/integration/hostile_inputs.sh --write-doc` (uses `buil
 
 Exit codes: 0 every file was used (warnings say what was skipped), 1 a file (or run) could not
 be used, 2 bad usage. "Kept" is from `--json`: samples read and runs fitted. Lines or messages
-that are not used are counted and reported, never silently dropped; a text file's diagnostics
-beyond the first 20 problem lines are summarised as a count.
+that are not used are counted and reported, never silently dropped (text in Windows-1252, as the
+Latin-1 file below is, is decoded to UTF-8 first; text that mixes UTF-8 with other bytes shows them
+as `\xNN`); a text file's diagnostics beyond the first 20 problem lines are summarised as a count.
 
 | Input | Command | Exit | Message (first matching line) | Kept |
 |---|---|---|---|---|

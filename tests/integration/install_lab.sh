@@ -23,6 +23,8 @@ for step in "install -m 0755 $bin/spindown-bridge /usr/local/bin/spindown-bridge
             "/etc/sysusers.d/spindown.conf" "systemd-sysusers" \
             "/etc/systemd/system/spindown-bridge@.service" "/etc/systemd/system/spindown-fitter.service" \
             "/etc/systemd/system/spindown-logger.service" "/etc/udev/rules.d/99-spindown.rules" \
+            "/etc/systemd/system/spindown-web.service" "/etc/spindown/web.env" \
+            "install -m 0755 $bin/spindown-web /usr/local/bin/spindown-web" \
             "/etc/spindown/lcm.env" "/etc/sysctl.d/60-spindown.conf" "sysctl -q -p /etc/sysctl.d/60-spindown.conf" \
             "/usr/local/bin/spindown-lcm-spy" "/usr/local/bin/spindown-lcm-logplayer-gui" \
             "dry run: nothing was changed"; do
@@ -48,17 +50,19 @@ rc=0
 "$install" --root "$root" --no-build --bin-dir "$bin" --enable >"$tmp/first.out" 2>&1 || rc=$?
 cat "$tmp/first.out"
 check "install into --root exits 0" "((rc == 0))"
-for p in spindown spindown-bridge spindown-fitter spindown-logger; do
+for p in spindown spindown-bridge spindown-fitter spindown-logger spindown-web; do
   check "/usr/local/bin/$p installed, executable, same as the build" "[[ -x '$root/usr/local/bin/$p' ]] && cmp -s '$bin/$p' '$root/usr/local/bin/$p'"
 done
 for f in etc/systemd/system/spindown-bridge@.service etc/systemd/system/spindown-fitter.service \
-         etc/systemd/system/spindown-logger.service etc/sysusers.d/spindown.conf etc/udev/rules.d/99-spindown.rules \
+         etc/systemd/system/spindown-logger.service etc/systemd/system/spindown-web.service \
+         etc/spindown/web.env etc/sysusers.d/spindown.conf etc/udev/rules.d/99-spindown.rules \
          etc/spindown/lcm.env etc/sysctl.d/60-spindown.conf usr/local/share/doc/spindown/README.md; do
   check "$f installed" "[[ -s '$root/$f' ]]"
 done
 check "user spindown created (offline sysusers)" "grep -q '^spindown:' '$root/etc/passwd'"
 check "spindown is in dialout" "grep -Eq '^dialout:[^:]*:[0-9]+:(.*,)?spindown(,|$)' '$root/etc/group'"
-for u in spindown-fitter.service spindown-logger.service spindown-bridge@bench-1.service spindown-bridge@bench-2.service; do
+for u in spindown-fitter.service spindown-logger.service spindown-web.service spindown-bridge@bench-1.service \
+         spindown-bridge@bench-2.service; do
   check "$u enabled" "[[ -L '$root/etc/systemd/system/multi-user.target.wants/$u' ]]"
 done
 
@@ -75,4 +79,5 @@ changed=$(cd "$root" && find . -type f -newer "$tmp/marker" ! -name '.pwd.lock' 
 check "second run modified no file (found: $changed)" "[[ -z '$changed' ]]"
 check "edited lcm.env kept" "grep -q 'edited by the technician' '$root/etc/spindown/lcm.env'"
 check "second run says lcm.env is the technician's" "grep -q '/etc/spindown/lcm.env (exists; yours' '$tmp/second.out'"
+check "the install names the pages' URL" "grep -q 'The pages: http://127.0.0.1:8080/' '$tmp/second.out'"
 exit $fail

@@ -57,7 +57,9 @@ for b in "${BENCHES[@]}"; do
     grep -q "  $b: run $r fit: best " "$LAB_WORK/watch.out" || fail "watch did not show $b run $r's fit"
   done
   grep -q "  $b: bridge connected" "$LAB_WORK/watch.out" || fail "watch did not show $b's bridge connecting"
-  watch_last_table | grep -Eq "^  $b  +$RUNS stopped .* [0-9]+/0 .* run $RUNS [a-z]+: c[0-9] = " ||
+  # The row: its last run stopped, the bridge's lines, the last fit's model, the combined model's
+  # c3 and c4 with their errors.
+  watch_last_table | grep -Eq "^  $b  +$RUNS stopped .* [0-9]+/0 .* run $RUNS [a-z]+ .*[0-9]±[0-9.]+ +[0-9.()e-]+±[0-9]" ||
     fail "watch's last table has no row for $b with its last run stopped and fitted"
 done
 watch_last_table | grep -q "^  fitter fitter  " || fail "watch's last table has no fitter row"

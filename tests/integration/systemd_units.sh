@@ -17,7 +17,7 @@ fi
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 fail=0
-for p in spindown-bridge spindown-fitter spindown-logger; do
+for p in spindown-bridge spindown-fitter spindown-logger spindown-web; do
   [[ -x $bin/$p ]] || { echo "FAIL: $bin/$p is not built"; exit 1; }
 done
 cp "$src"/deploy/systemd/*.service "$tmp/"
@@ -33,11 +33,11 @@ verify() {  # UNIT...
     echo "ok: systemd-analyze verify $*"
   fi
 }
-verify spindown-fitter.service spindown-logger.service spindown-bridge@bench-1.service
+verify spindown-fitter.service spindown-logger.service spindown-bridge@bench-1.service spindown-web.service
 verify spindown-bridge@lab_3.service
 
 # systemd's own exposure score (0 = locked down … 10 = exposed): the hardening stays in place.
-for u in spindown-fitter.service spindown-logger.service spindown-bridge@bench-1.service; do
+for u in spindown-fitter.service spindown-logger.service spindown-bridge@bench-1.service spindown-web.service; do
   score=$(cd "$tmp" && SYSTEMD_UNIT_PATH="$tmp:" "$analyze" security --offline=yes --no-pager "$u" 2>/dev/null |
           sed -n 's/.*Overall exposure level for [^:]*: \([0-9.]*\).*/\1/p')
   if [[ -n $score ]] && python3 -c "import sys; sys.exit(0 if float('$score') <= 2.5 else 1)"; then
@@ -70,6 +70,18 @@ for u in spindown-bridge@.service spindown-fitter.service spindown-logger.servic
   done
 done
 expect spindown-bridge@.service "DeviceAllow=/dev/spindown/%i rw"
+# spindown-web: the same, serving TCP (IPv4 or IPv6) on the admin's address (web.env, default this PC
+# only), with one capability (ports below 1024).
+for line in User=spindown NoNewPrivileges=yes ProtectSystem=strict ProtectHome=yes PrivateTmp=yes PrivateDevices=yes \
+  DevicePolicy=closed "RestrictAddressFamilies=AF_INET AF_INET6 AF_UNIX" CapabilityBoundingSet=CAP_NET_BIND_SERVICE \
+  SystemCallFilter=@system-service Restart=on-failure EnvironmentFile=/etc/spindown/lcm.env \
+  EnvironmentFile=-/etc/spindown/web.env Environment=SPINDOWN_WEB_LISTEN=127.0.0.1:8080 \
+  Type=notify NotifyAccess=main WatchdogSec=30 \
+  "ExecStart=/usr/local/bin/spindown-web --listen \${SPINDOWN_WEB_LISTEN} --bench-config /etc/spindown/benches"; do
+  expect spindown-web.service "$line"
+done
+grep -qx 'SPINDOWN_WEB_LISTEN=127.0.0.1:8080' "$src/deploy/systemd/web.env" ||
+  { echo "FAIL: web.env does not default to this PC only"; fail=1; }
 expect spindown-bridge@.service "SupplementaryGroups=dialout"
 expect spindown-bridge@.service "ExecStart=/usr/local/bin/spindown-bridge --config /etc/spindown/benches/%i.toml --bench %i"
 expect spindown-fitter.service "ExecStart=/usr/local/bin/spindown-fitter --bench-config /etc/spindown/benches"

@@ -5,10 +5,13 @@
 #include <string>
 #include <vector>
 
+#include "lab_messages.hpp"
 #include "spindown/lab_table.hpp"
 
 namespace spindown {
 namespace {
+
+using test::fit_msg;
 
 constexpr std::int64_t t0 = 1'700'000'000'000'000;  // µs since the epoch
 constexpr std::int64_t sec = 1'000'000;
@@ -21,32 +24,6 @@ run_t run_msg(const std::string& bench, int run, std::int8_t state, double cut =
   m.t_cut_s = cut;
   m.t_stop_s = stop;
   m.samples = 388;
-  return m;
-}
-
-// A combined-model fit as spindown-fitter publishes it (flat arrays; model 2 is the best).
-fit_t fit_msg(const std::string& bench, int run, const std::string& best = "combined") {
-  fit_t m{};
-  m.bench = bench;
-  m.run = run;
-  m.residual_unit = "V";
-  m.bench_source = "config";
-  m.model = {"viscous", "coulomb", "combined"};
-  m.nmodels = 3;
-  m.rmse = {0.05, 0.02, 0.0123};
-  m.r2 = {0.9, 0.99, 0.999};
-  m.aic = m.bic = {1, 2, 3};
-  m.t_stop_pred_s = {1e9, 8, 7.7};
-  m.converged = {true, true, true};
-  m.model_samples = {388, 388, 388};
-  m.model_message = {"", "", ""};
-  m.param_model = {0, 1, 2, 2, 2, 2};
-  m.param_name = {"c1", "c2", "c3", "c4", "omega0", "A"};
-  m.param_value = {1.4e-6, 1.38e-4, 1.822e-7, 1.139e-4, 450, -5.06};
-  m.param_stderr = {1e-8, 1e-6, 1.1e-9, 2e-7, 0.5, 0.01};
-  m.param_unit = {"N*m*s/rad", "N*m", "N*m*s/rad", "N*m", "rad/s", "V"};
-  m.nparams = static_cast<std::int32_t>(m.param_name.size());
-  m.best = best;
   return m;
 }
 
@@ -151,9 +128,12 @@ TEST(LabTable, FitShowsBestModelCoefficientsAndRmse) {
   EXPECT_TRUE(contains(row->coefficients, "±")) << row->coefficients;
   EXPECT_FALSE(contains(row->coefficients, "N·m")) << row->coefficients;  // units: once, under the table
   const std::string text = table.render(t0);
-  EXPECT_TRUE(contains(text, "run 2 combined: c3 = (1.822 ± 0.011)e-07, c4 = ")) << text;
-  EXPECT_TRUE(contains(text, "coefficients in N·m·s/rad (c1, c3) and N·m (c2, c4)")) << text;
-  EXPECT_TRUE(contains(text, "0.0123 V")) << text;
+  // The combined model's c3 and c4 in columns of their own, scaled by a power of ten said once.
+  for (const char* cell : {"run 2 combined ", " 1.822±0.011 ", " 1.1390±0.0020 ", " 0.0123 V "})
+    EXPECT_TRUE(contains(text, cell)) << cell << "\n" << text;
+  EXPECT_TRUE(contains(text, "c3 (1e-7 N·m·s/rad)")) << text;
+  EXPECT_TRUE(contains(text, "c3 in 1e-7 N·m·s/rad, c4 in 1e-4 N·m (combined model, ± total error)"))
+      << text;
   const auto events = table.take_events();
   ASSERT_EQ(events.size(), 1u);
   EXPECT_TRUE(contains(events[0], "bench-a: run 2 fit: best combined: c3 = (1.822 ± 0.011)e-07 N·m·s/rad, c4 = "))
@@ -179,7 +159,9 @@ TEST(LabTable, LabUnitsMatchTheLabReport) {
   opt.lab_units = true;
   LabTable table(opt);
   table.on_fit("b", fit_msg("b", 1), t0);
-  EXPECT_TRUE(contains(table.render(t0), "coefficients in g·cm²·s⁻¹ (c1, c3) and g·cm²·rad·s⁻² (c2, c4)"));
+  const std::string page = table.render(t0);
+  EXPECT_TRUE(contains(page, "c3 in g·cm²·s⁻¹, c4 in g·cm²·rad·s⁻²")) << page;
+  EXPECT_TRUE(contains(page, " 1.822±0.011 ") && contains(page, " 1139.0±2.0 ")) << page;  // the lab's units, unscaled
 }
 
 TEST(LabTable, FitWithoutBestModelSaysSo) {
@@ -349,6 +331,31 @@ TEST(LabTable, AgeAndStaleMark) {
   EXPECT_TRUE(contains(table.render(t0 + 7 * sec), "  7.0 s !  ")) << table.render(t0 + 7 * sec);
 }
 
+// A run shown coasting whose fitter stopped heartbeating (killed, host gone) is no longer shown
+// as coasting for ever: after fitter_lost_s it says nobody follows it; a fitter still beating
+// keeps it coasting, and a fitter whose last word was "stopping" lets it go at once.
+TEST(LabTable, ARunNoFitterFollowsAnyMoreAgesOut) {
+  LabTableOptions opt;
+  opt.fitter_lost_s = 10;
+  {
+    LabTable table(opt);
+    table.on_status("fitter", status_msg("fitter", "fitter", "running", {}), t0);
+    table.on_run("b", run_msg("b", 1, run_t::STATE_COASTING), t0);
+    EXPECT_TRUE(contains(table.render(t0 + 5 * sec), "1 coasting  ")) << table.render(t0 + 5 * sec);
+    const std::string later = table.render(t0 + 12 * sec);
+    EXPECT_TRUE(contains(later, "1 not followed (no fitter for 12 s)")) << later;
+  }
+  {
+    LabTable table(opt);
+    table.on_run("b", run_msg("b", 1, run_t::STATE_COASTING), t0);
+    for (int i = 1; i <= 60; ++i) table.on_status("fitter", status_msg("fitter", "fitter", "running", {}), t0 + i * sec);
+    const std::string text = table.render(t0 + 60 * sec);
+    EXPECT_TRUE(contains(text, "1 coasting  ")) << "a long coast, its fitter alive: " << text;
+    table.on_status("fitter", status_msg("fitter", "fitter", "stopping", {}), t0 + 61 * sec);
+    EXPECT_TRUE(contains(table.render(t0 + 61 * sec), "1 not followed (no fitter for 61 s)")) << table.render(t0 + 61 * sec);
+  }
+}
+
 TEST(LabTable, BoundedRowsAndEvents) {
   LabTableOptions opt;
   opt.max_benches = 3;
@@ -385,10 +392,16 @@ TEST(LabTable, WidthCutsEveryLineAndColumnsAlign) {
   std::getline(lines, second);
   // Columns line up in code points, whatever bytes "±" and "·" take: row "b" (sorted first) has
   // no RMSE, its "-" sits under the header's RMSE, as bench-a's value does.
-  const auto rmse_col = header.find("RMSE");
-  ASSERT_NE(rmse_col, std::string::npos);
-  EXPECT_EQ(first.substr(rmse_col, 2), "- ") << full;
-  EXPECT_EQ(second.substr(rmse_col, 8), "0.0123 V") << full;
+  // The code points of line from column col on (n of them).
+  const auto at_column = [](const std::string& line, std::size_t col, std::size_t n) {
+    const std::size_t from = utf8_prefix_bytes(line, col);
+    return line.substr(from, utf8_prefix_bytes(std::string_view(line).substr(from), n));
+  };
+  const auto rmse_byte = header.find("RMSE");
+  ASSERT_NE(rmse_byte, std::string::npos);
+  const std::size_t rmse_col = display_width(header.substr(0, rmse_byte));
+  EXPECT_EQ(at_column(first, rmse_col, 2), "- ") << full;
+  EXPECT_EQ(at_column(second, rmse_col, 8), "0.0123 V") << full;
   EXPECT_TRUE(second.starts_with("bench-a")) << full;
   const std::string cut = table.render(t0, 40);
   std::istringstream cut_lines(cut);
@@ -408,23 +421,45 @@ TEST(LabTable, ChangedFlagFollowsInput) {
 }
 
 }  // namespace
-// An 80-column terminal: short columns, and the last fit's model, RMSE and verdict come before
-// its coefficients, so what matters is never cut off.
+// An 80-column terminal: short headers and cells, then the columns worth least dropped in their
+// order, so that the run, c3 and c4 with their errors and the verdict always fit; at 120 columns
+// nothing is dropped or cut.
 TEST(LabTable, UsableInEightyColumns) {
   LabTable table;
-  fit_t m = fit_msg("bench-a", 2);
-  m.verdict = "service";
-  table.on_fit("bench-a", m, t0);
-  const std::string text = table.render(t0, 80);
-  std::istringstream lines(text);
-  std::string line, row;
-  while (std::getline(lines, line)) {
-    EXPECT_LE(display_width(line), 80u) << line;
-    if (line.starts_with("bench-a")) row = line;
+  for (const char* id : {"teaching-lab-bench-000", "teaching-lab-bench-001", "teaching-lab-bench-002"}) {
+    table.on_status(id, status_msg("bridge", id, "connected", {{"lines_good", 15200}, {"lines_bad", 3}}, {{"rate_hz", 49.6}}), t0);
+    table.on_samples(id, samples_msg(id, 0, 10), t0);
+    table.on_run(id, run_msg(id, 12, run_t::STATE_COASTING), t0);
+    fit_t m = fit_msg(id, 11);
+    m.verdict = "not_judged";
+    table.on_fit(id, m, t0);
   }
-  EXPECT_TRUE(contains(row, "2 combined 0.0123 V; service")) << text;
-  EXPECT_TRUE(contains(text, "BRIDGE")) << text;
-  EXPECT_FALSE(contains(text, "lines ok/bad")) << text;  // the wide header would leave no room for the fit
+  for (std::size_t width : {80u, 120u}) {
+    const std::string text = table.render(t0, width);
+    std::istringstream lines(text);
+    std::string line, header;
+    std::vector<std::string> rows;
+    while (std::getline(lines, line)) {
+      EXPECT_LE(display_width(line), width) << line;
+      if (line.starts_with("BENCH")) header = line;
+      if (line.starts_with("teaching-lab-bench-")) rows.push_back(line);
+    }
+    ASSERT_EQ(rows.size(), 3u) << text;
+    for (const auto& row : rows) {
+      EXPECT_TRUE(contains(row, "12 coast")) << text;
+      EXPECT_TRUE(contains(row, "1.822±0.011  1.1390±0.0020")) << text;
+      EXPECT_TRUE(row.ends_with("NOT JUDGED")) << text;
+    }
+    EXPECT_TRUE(contains(header, "c3") && contains(header, "c4") && contains(header, "HEALTH")) << text;
+    if (width == 80) {
+      EXPECT_FALSE(contains(header, "BRIDGE")) << text;  // the first to go
+      EXPECT_TRUE(contains(text, "not shown at this width: BRIDGE")) << text;
+    } else {
+      for (const char* column : {"BRIDGE", "GAPS", "AGE", "FIT", "RMSE"}) EXPECT_TRUE(contains(header, column)) << text;
+      EXPECT_FALSE(contains(text, "not shown")) << text;
+      EXPECT_TRUE(contains(rows[0], "50 Hz, 3 bad")) << text;
+    }
+  }
 }
 
 }  // namespace spindown

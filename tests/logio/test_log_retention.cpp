@@ -102,6 +102,9 @@ class RetentionDir : public ::testing::Test {
     std::ofstream(p) << std::string(bytes, 'x');
     fs::last_write_time(p, fs::file_time_type::clock::now() - std::chrono::seconds(age_s));
   }
+  void make_four_own_logs() {
+    for (int h = 0; h < 4; ++h) make("lab-2026-01-01-0" + std::to_string(h) + "0000.lcm", 1000, 400 - 100 * h);
+  }
   std::set<std::string> names() const {
     std::set<std::string> out;
     for (const auto& e : fs::directory_iterator(dir_)) out.insert(e.path().filename().string());
@@ -111,10 +114,7 @@ class RetentionDir : public ::testing::Test {
 };
 
 TEST_F(RetentionDir, DeletesOnlyOwnOldestFiles) {
-  make("lab-2026-01-01-000000.lcm", 1000, 400);
-  make("lab-2026-01-01-010000.lcm", 1000, 300);
-  make("lab-2026-01-01-020000.lcm", 1000, 200);
-  make("lab-2026-01-01-030000.lcm", 1000, 100);
+  make_four_own_logs();  // an hour apart, 1000 bytes each
   make("notes.txt", 5000, 1000);
   make("other-2026-01-01-000000.lcm", 5000, 1000);
   make("lab-2026-01-01-000000-b1.lcm", 5000, 1000);
@@ -127,6 +127,24 @@ TEST_F(RetentionDir, DeletesOnlyOwnOldestFiles) {
   EXPECT_EQ(r.bytes_kept, 2000);
   EXPECT_EQ(names(), (std::set<std::string>{"lab-2026-01-01-020000.lcm", "lab-2026-01-01-030000.lcm", "notes.txt",
                                             "other-2026-01-01-000000.lcm", "lab-2026-01-01-000000-b1.lcm"}));
+}
+
+// A disk about to fill (issue 31): its own files go, oldest first, one at a time until there is
+// room, whatever the budget; never the current file nor another's.
+TEST_F(RetentionDir, FreeingSpaceDeletesOwnOldestUntilThereIsRoom) {
+  make_four_own_logs();  // an hour apart, 1000 bytes each
+  make("notes.txt", 5000, 1000);
+  const std::string current = dir_.string() + "/lab-2026-01-01-030000.lcm";
+  int asked = 0;
+  LogPruneResult r = free_log_space(dir_.string(), "lab", "", current, [&] { return ++asked > 2; });
+  EXPECT_TRUE(r.errors.empty());
+  EXPECT_EQ(r.deleted.size(), 2u) << "room after two files";
+  EXPECT_EQ(names(), (std::set<std::string>{"lab-2026-01-01-020000.lcm", "lab-2026-01-01-030000.lcm", "notes.txt"}));
+  r = free_log_space(dir_.string(), "lab", "", current, [] { return false; });  // never enough
+  EXPECT_EQ(r.deleted.size(), 1u);
+  EXPECT_EQ(names(), (std::set<std::string>{"lab-2026-01-01-030000.lcm", "notes.txt"}));
+  r = free_log_space(dir_.string(), "lab", "", current, [] { return true; });  // room already
+  EXPECT_TRUE(r.deleted.empty());
 }
 
 TEST_F(RetentionDir, MissingDirectoryIsAnErrorNamingIt) {

@@ -121,7 +121,7 @@ TEST(BridgeLogic, SpindownV1SamplesCarryRawCountsAndDetectLoss) {
   EXPECT_EQ(f[0].t_us, 1'000'000);
   EXPECT_EQ(f[2].t_us, 1'020'000);
   EXPECT_EQ(f[0].adc, 512);
-  EXPECT_DOUBLE_EQ(f[0].value, 512 * 5.0 / 1023);
+  EXPECT_DOUBLE_EQ(f[0].value, 512 * 5.0 / 1024);
   EXPECT_EQ(f[2].seq, 2);  // bridge seq stays gapless: it numbers what it publishes
   EXPECT_EQ(b.counters().device_seq_gaps, 2);
   EXPECT_NE(b.last_error().find("from 1 to 4"), std::string::npos) << b.last_error();
@@ -130,7 +130,7 @@ TEST(BridgeLogic, SpindownV1SamplesCarryRawCountsAndDetectLoss) {
   EXPECT_EQ(c.protocol, "spindown-v1");
   EXPECT_EQ(c.firmware, "spindown-coast 1.0.0");
   EXPECT_DOUBLE_EQ(c.sample_period_s, 0.005);
-  EXPECT_DOUBLE_EQ(c.adc_volts_per_count, 5.0 / 1023);
+  EXPECT_DOUBLE_EQ(c.adc_volts_per_count, 5.0 / 1024);
 }
 
 TEST(BridgeLogic, ResetStartsANewEpochInItsOwnMessage) {

@@ -19,6 +19,7 @@
 #include "spindown/lab_units.hpp"
 #include "spindown/read_recording.hpp"
 #include "spindown/runs.hpp"
+#include "spindown/svg_plot.hpp"
 #include "spindown/synthetic_run.hpp"
 
 using namespace spindown;
@@ -400,6 +401,73 @@ TEST(Explain, TheFigureShowsEveryStepWithItsRmse) {
   // The RMSEs fall step by step.
   EXPECT_GT(r.base.rmse, r.steps[0].rmse_after);
   EXPECT_GT(r.steps[0].rmse_after, r.steps[1].rmse_after);
+}
+
+// The legend keeps every step: an effect a later step removed is marked so, and the later step
+// says what it removed.
+TEST(Explain, TheLegendMarksAnEffectALaterStepRemoved) {
+  FileExplain file;
+  file.file = "stribeck-example.tsv";
+  file.runs.push_back(explain_file_run("stribeck-example.tsv"));
+  ExplainResult& r = file.runs[0];
+  ASSERT_EQ(r.steps.size(), 2u);
+  r.steps[1].removed = {r.steps[0].added};  // as when windage made an earlier Stribeck unneeded
+  const std::string svg = explain_svg(std::span<const FileExplain>(&file, 1));
+  EXPECT_NE(svg.find(fmt::format("step 1: + {} -&gt; ", r.steps[0].added)), std::string::npos) << svg;
+  EXPECT_NE(svg.find(fmt::format("[{} removed at step 2]", r.steps[0].added)), std::string::npos) << svg;
+  EXPECT_NE(svg.find(fmt::format("step 2: + {}, - {} (removed: not needed)", r.steps[1].added, r.steps[0].added)),
+            std::string::npos)
+      << svg;
+  // No legend line runs past the figure: a long label wraps inside its box (tspan lines).
+  std::string long_label(300, 'x');
+  for (std::size_t i = 10; i < long_label.size(); i += 11) long_label[i] = ' ';
+  const std::string box = svg::legend(400, 10, {{long_label, "stroke=\"#000\""}}, 540);
+  std::size_t lines = 1;
+  for (auto at = box.find("<tspan"); at != std::string::npos; at = box.find("<tspan", at + 1)) ++lines;
+  EXPECT_EQ(lines, 5u) << box;  // 300 characters, broken at spaces into lines of at most 73
+  EXPECT_NE(box.find("height=\"98\""), std::string::npos) << box;  // the box holds all five
+}
+
+// A motor with Coulomb friction alone: explain says the viscous term is not needed, whether it
+// starts from the lab's belief (viscous: Coulomb added, viscous removed) or from fit's combined
+// model (nothing to add, viscous removed as a step of its own).
+TEST(Explain, SaysTheViscousTermIsNotNeededOnACoulombOnlyMotor) {
+  for (std::uint64_t seed : {31u, 32u, 33u}) {
+    SyntheticRunSpec spec;
+    spec.friction = {0.0, 1.2e-4};
+    spec.seed = seed;
+    const SyntheticRun run = make_synthetic_run(spec);
+    Recording rec;
+    for (std::size_t i = 0; i < run.t_ms.size(); ++i) rec.push(run.t_ms[i] / 1000.0, run.volts[i]);
+    const Segmentation seg = find_runs(rec);
+    ASSERT_EQ(seg.runs.size(), 1u);
+    ExplainOptions from_viscous;
+    const ExplainResult a = explain_run(rec, seg.runs[0], from_viscous);
+    ASSERT_TRUE(a.ok) << a.message;
+    ASSERT_FALSE(a.steps.empty());
+    EXPECT_EQ(a.steps[0].added, "coulomb");
+    EXPECT_EQ(a.steps[0].removed, std::vector<std::string>{"viscous"}) << a.steps[0].why;
+    EXPECT_EQ(a.final_fit.fit_model(), "coulomb");
+    EXPECT_NE(format_explain(a, {}, {}).find("removed viscous: not needed"), std::string::npos);
+
+    ExplainOptions from_combined;
+    std::string why;
+    from_combined.base = parse_effect_list("combined", &why);
+    const ExplainResult b = explain_run(rec, seg.runs[0], from_combined);
+    ASSERT_TRUE(b.ok) << b.message;
+    ASSERT_EQ(b.steps.size(), 1u) << b.conclusion;
+    EXPECT_EQ(b.steps[0].added, "");
+    EXPECT_EQ(b.steps[0].removed, std::vector<std::string>{"viscous"});
+    EXPECT_EQ(b.final_fit.fit_model(), "coulomb");
+    const std::string text = format_explain(b, {}, {});
+    EXPECT_NE(text.find("step 1: viscous not needed"), std::string::npos) << text;
+    EXPECT_NE(b.conclusion.find("viscous removed: not needed"), std::string::npos) << b.conclusion;
+  }
+  // The lab's motor needs its viscous term: nothing of its belief is removed.
+  const auto recs = read_recordings(std::string(SPINDOWN_SAMPLE_DATA) + "/seed-3v-run1.tsv");
+  ASSERT_EQ(recs.size(), 1u);
+  const ExplainResult lab = explain_run(recs[0], find_runs(recs[0]).runs.at(0), ExplainOptions{});
+  for (const auto& s : lab.steps) EXPECT_TRUE(s.removed.empty()) << s.why;
 }
 
 // A file of several benches (an LCM log): every run names its bench in text, JSON and the SVG.

@@ -60,6 +60,59 @@ TEST(FitterCore, OneFitPerRunWithTheBenchsConfigAndTheDefaultFlagged) {
   EXPECT_EQ(stopped, 4);
 }
 
+// A refit names J or K_b (spindown refit/export: --inertia…, a --bench-config file's [bench]):
+// what it names wins over the CONFIG, each parameter on its own, and bench_source says so; the
+// bench file's health references give each fit a verdict; nothing named is the live rule.
+TEST(FitterCore, WhatARefitNamesWinsOverTheConfigAndIsSaid) {
+  const Stream s = make_stream(1, 7);
+  const auto run_with = [&](const FitterOptions& o) {
+    CollectingSink sink;
+    FitterCore core(o, sink);
+    core.on_config("b1", config("b1", 2.0e-5), 1);
+    std::int64_t utime = 10;
+    feed(core, "b1", s, 5, utime);
+    core.finish(utime);
+    const auto fits = sink.of("b1");
+    EXPECT_EQ(fits.size(), 1u);
+    return fits.empty() ? FitResult{} : *fits[0];
+  };
+  FitterOptions live;
+  const FitResult plain = run_with(live);
+  EXPECT_EQ(plain.bench_source, "config");
+  EXPECT_DOUBLE_EQ(plain.fit.bench.inertia_kg_m2, 2.0e-5);
+  EXPECT_FALSE(plain.health.has_value());
+
+  FitterOptions flag;
+  flag.named.given.inertia_kg_m2 = 3.0e-5;
+  flag.named.given.inertia_source = "--inertia";
+  flag.named.inertia_given = true;
+  const FitResult by_flag = run_with(flag);
+  EXPECT_DOUBLE_EQ(by_flag.fit.bench.inertia_kg_m2, 3.0e-5);
+  EXPECT_DOUBLE_EQ(by_flag.fit.bench.kb_v_s_per_rad, config("b1", 2.0e-5).kb_v_s_per_rad);  // K_b: still the CONFIG's
+  EXPECT_EQ(by_flag.bench_source, "J: the command line (over the log's CONFIG: 2e-05 kg·m²); K_b: CONFIG");
+  const double c4_plain = plain.fit.model(ModelKind::combined)->param("c4")->value;
+  EXPECT_NEAR(by_flag.fit.model(ModelKind::combined)->param("c4")->value / c4_plain, 1.5, 1e-6);
+
+  FitterOptions file;
+  BenchFile b1;
+  b1.path = "benches/b1.toml";
+  b1.bench = "b1";
+  b1.params.kb_v_s_per_rad = 0.009;
+  b1.params.kb_source = "config file";
+  b1.sets_kb = true;
+  b1.health.baseline = HealthBaseline{1.8e-7, 2e-9, 1.14e-4, 4e-7, 0, 0, 3, "2024-09-14", 0, "test"};
+  file.bench_files.emplace("b1", b1);
+  file.health.emplace("b1", b1.health);
+  file.bench_files.emplace("other", BenchFile{});  // another bench's file changes nothing here
+  const FitResult by_file = run_with(file);
+  EXPECT_DOUBLE_EQ(by_file.fit.bench.inertia_kg_m2, 2.0e-5);  // J: the CONFIG's
+  EXPECT_DOUBLE_EQ(by_file.fit.bench.kb_v_s_per_rad, 0.009);
+  EXPECT_NE(by_file.bench_source.find("K_b: bench file benches/b1.toml (over the log's CONFIG:"), std::string::npos)
+      << by_file.bench_source;
+  ASSERT_TRUE(by_file.health.has_value());
+  EXPECT_TRUE(by_file.health->has_reference);
+}
+
 TEST(FitterCore, SameNumbersAsFindRunsAndFitRun) {
   const Stream s = make_stream(2, 11);
   Recording rec;

@@ -159,6 +159,64 @@ TEST(FitterFaults, ASilentBenchHasItsRunClosedAfterTheTimeout) {
   EXPECT_EQ(sink.fits.size(), 1u);
 }
 
+// A network outage mid-coast (issue 31): the bench goes on sampling, but nothing reaches the
+// fitter for 12 s (--silent 10), then the samples resume on the same source and clock. Wherever
+// the outage falls in the coast (early, late, when little of the coast is left), the run is
+// closed "silent" with its true cut, what comes after on the same coast is never given a cut (at
+// most a partial run), and run 2 is whole.
+TEST(FitterFaults, AnOutageMidCoastNeverInventsACut) {
+  int cases = 0, partial_after = 0, second_hidden = 0;
+  for (std::uint64_t seed : {51u, 53u, 55u, 57u}) {
+    const TwoRuns tr = two_runs(seed);
+    for (double at : {0.3, 0.55, 0.75, 0.9}) {
+      SCOPED_TRACE(fmt::format("seed {}, outage {:.0f} % into the coast", seed, 100 * at));
+      CollectingSink sink;
+      FitterOptions o;
+      o.silent_s = 10;
+      FitterCore core(o, sink);
+      std::int64_t seq = 0, utime = 0;
+      const std::size_t from =
+          tr.first.cut_index + static_cast<std::size_t>(at * double(tr.first.stop_index - tr.first.cut_index));
+      feed_range(core, "a", tr.s, 0, from, seq, utime);
+      // 12 s of samples lost: the host's clock goes on and the fitter polls as it does live.
+      const std::int64_t outage_us = 12'000'000;
+      std::size_t to = from;
+      while (to < tr.s.t_us.size() && tr.s.t_us[to] < tr.s.t_us[from] + outage_us) ++to;
+      seq += std::int64_t(to - from);
+      for (std::int64_t t = 0; t < outage_us; t += FitterCore::poll_period_us) core.poll(utime + t);
+      utime += outage_us;
+      feed_range(core, "a", tr.s, to, tr.s.t_us.size(), seq, utime);
+      core.finish(utime);
+
+      const auto a = sink.of("a");
+      ASSERT_GE(a.size(), 2u);
+      EXPECT_EQ(a.front()->fit.run.end, Run::End::silent);
+      for (const FitResult* f : a) {
+        const spindown::Run& r = f->fit.run;
+        if (r.partial()) continue;
+        const bool true_cut = std::abs(r.t_cut_s - tr.first.t_cut_s) <= 1.5 * tr.first.period_s ||
+                              std::abs(r.t_cut_s - tr.second.t_cut_s) <= 1.5 * tr.second.period_s;
+        EXPECT_TRUE(true_cut) << "run " << r.number << " given an invented cut at " << r.t_cut_s << " s (lead-in "
+                              << r.lead_in << "; true cuts " << tr.first.t_cut_s << ", " << tr.second.t_cut_s << ")";
+      }
+      // Run 2 is whole, unless the outage hid its cut too: then it is partial, never given one.
+      if (double(tr.s.t_us[to]) / 1e6 < tr.second.t_cut_s) {
+        EXPECT_FALSE(a.back()->fit.run.partial());
+        EXPECT_NEAR(a.back()->fit.run.t_cut_s, tr.second.t_cut_s, 1.5 * tr.second.period_s);
+      } else {
+        EXPECT_TRUE(a.back()->fit.run.partial());
+        ++second_hidden;
+      }
+      partial_after += a.size() == 3 && a[1]->fit.run.partial();
+      ++cases;
+    }
+  }
+  EXPECT_EQ(cases, 16);
+  std::printf("outage mid-coast: %d cases, %d with the rest of the coast published partial, %d where run 2's cut fell "
+              "in the outage (run 2 partial)\n",
+              cases, partial_after, second_hidden);
+}
+
 // An Arduino reset (or a USB unplug and replug) a third into run 1's coast: the device clock
 // and the sequence numbers start again. Run 1 ends there with the reason; the rest of that coast
 // is never a run of its own; run 2 is whole.

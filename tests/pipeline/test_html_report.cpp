@@ -246,6 +246,86 @@ TEST(PuttyLogTime, ReadsTheHeader) {
   EXPECT_FALSE(putty_log_time("=~= PuTTY log 2023.13.14 10:21:33 =~=").has_value());
 }
 
+// A PuTTY header's time is the recording PC's local time: never labelled UTC; an LCM log's is.
+TEST(RecordedAt, LocalTimeIsNotCalledUtc) {
+  const RecordedAt local{1726322602.0, true}, utc{1726322602.0, false};  // 2024-09-14 14:03:22
+  EXPECT_EQ(recorded_at_text(local), "2024-09-14 14:03:22 local time");
+  EXPECT_EQ(recorded_at_text(utc), "2024-09-14 14:03:22 UTC");
+  EXPECT_EQ(recorded_date_text(local), "2024-09-14");
+  SessionReportOptions opt;
+  opt.explain_runs = false;
+  SessionReport report;
+  add_run(report, synthetic(1.0, 3, "p.tsv"), "putty.log", "bench-1", opt, 1726322602.0);
+  report.files[0].start_local = report.runs[0].cut_local = true;
+  summarize_session(report);
+  const std::string page = render_html_report(report);
+  EXPECT_EQ(page.find(" UTC"), std::string::npos) << "a local time labelled UTC";
+  EXPECT_NE(page.find("2024-09-14 14:03:22 local time"), std::string::npos);
+}
+
+// The run's figure shows the recording around the run, the fitted window shaded: what came
+// before the cut (here a stretch of coast the run's window left out) is in the figure.
+TEST(RunFigure, TheWholeRecordingWithTheFittedWindowShaded) {
+  const Recording rec = synthetic(1.0, 5, "r.tsv");
+  const Segmentation seg = find_runs(rec);
+  ASSERT_EQ(seg.runs.size(), 1u);
+  SessionReportOptions opt;
+  opt.explain_runs = false;
+  ReportRun r = make_report_run(rec, seg.runs[0], "b", BenchParams{}, opt);
+  set_run_context(r, rec, seg.runs);
+  ASSERT_FALSE(r.context_tau.empty());
+  EXPECT_DOUBLE_EQ(r.context_tau.front(), rec.t_s.front() - seg.runs[0].t_cut_s);  // from the recording's start
+  EXPECT_DOUBLE_EQ(r.context_tau.back(), rec.t_s.back() - seg.runs[0].t_cut_s);    // to its end
+  EXPECT_LT(r.context_tau.front(), -1.0);  // the lead-in before the cut
+  const std::string svg = run_figure_svg(r);
+  EXPECT_NE(svg.find("class=\"fitted-window\""), std::string::npos);
+  EXPECT_NE(svg.find("fitted window:"), std::string::npos);
+  EXPECT_NE(svg.find("recording outside the fitted window"), std::string::npos);
+  EXPECT_NE(svg.find("class=\"cut\""), std::string::npos);
+  // Thinned to at most max_points, the lowest and highest of each stretch kept.
+  set_run_context(r, rec, seg.runs, 100);
+  EXPECT_LE(r.context_tau.size(), 100u);
+  EXPECT_DOUBLE_EQ(*std::max_element(r.context_y.begin(), r.context_y.end()),
+                   *std::max_element(rec.value.begin(), rec.value.end()));
+  // Another run after this one bounds the figure at its cut.
+  spindown::Run later = seg.runs[0];
+  later.cut_index = rec.size() - 10;
+  const std::vector<spindown::Run> two{seg.runs[0], later};
+  set_run_context(r, rec, two);
+  EXPECT_DOUBLE_EQ(r.context_tau.back(), rec.t_s[rec.size() - 11] - seg.runs[0].t_cut_s);
+}
+
+// A semester prints on a few pages: a print stylesheet leaves the per-run figures to the screen
+// and keeps a one-line-per-run table.
+TEST(HtmlReport, PrintsCompactly) {
+  SessionReportOptions opt;
+  opt.explain_runs = false;
+  SessionReport report;
+  add_run(report, synthetic(1.0, 7, "a.tsv"), "a.tsv", "bench-1", opt);
+  add_run(report, synthetic(1.0, 8, "b.tsv"), "b.tsv", "bench-1", opt);
+  summarize_session(report);
+  const std::string page = render_html_report(report);
+  const auto print = page.find("@media print{");
+  ASSERT_NE(print, std::string::npos);
+  const std::string css = page.substr(print, page.find("</style>") - print);
+  EXPECT_NE(css.find("section.bench"), std::string::npos) << css;
+  EXPECT_NE(css.find("svg.run-plot{display:none}"), std::string::npos) << css;
+  EXPECT_NE(page.find("<table class=\"runs\">"), std::string::npos);
+  EXPECT_EQ(count(page, "<tr><td>bench-1</td>"), 2u);  // one line per run
+}
+
+// Runs far apart beyond their errors that line up in time are wear, not runs of another motor.
+TEST(CoefficientTrend, RunsThatLineUpInTimeAreWear) {
+  std::vector<double> x, v, se;
+  for (int week = 0; week < 6; ++week)
+    x.push_back(7.0 * week), v.push_back(1.14e-4 * (1 + 0.05 * week)), se.push_back(3e-7);
+  const auto t = coefficient_trend("c4", "N*m", "day", x, v, se);
+  EXPECT_GT(t.scatter, 5) << "far apart about their mean";
+  EXPECT_TRUE(t.drifting) << t.words;
+  EXPECT_NE(t.words.find("friction rising steadily over 6 sessions: wear"), std::string::npos) << t.words;
+  EXPECT_EQ(t.words.find("check which runs belong"), std::string::npos) << t.words;
+}
+
 TEST(SvgPlot, EscapesAndTicks) {
   EXPECT_EQ(svg::escape("a<b & \"c\">"), "a&lt;b &amp; &quot;c&quot;&gt;");
   EXPECT_EQ(html_escape("it's <x>"), "it&#39;s &lt;x&gt;");

@@ -86,6 +86,62 @@ TEST(LogRefit, SameRunsAndNumbersAsTheCoreFedDirectly) {
   EXPECT_EQ(st.runs_fitted, 2u);
 }
 
+// A logger's rotated files (issue 31): the same log cut into three files mid-coast, given in any
+// order, are one session in time order: the same runs and numbers as the whole log; each file
+// alone only has fragments. Files that overlap in time (another logger's copy) are sessions of
+// their own.
+TEST(LogRefit, RotatedFilesAreOneSessionInTimeOrder) {
+  const Stream s = make_stream(2, 17);
+  TempLog whole;
+  write_log(whole.path, s, nullptr);
+  const LogRefit all = refit_log(whole.path, FitterOptions{}, false);
+  ASSERT_EQ(all.runs.size(), 2u);
+
+  // The events again, cut at a third and two thirds: both cuts fall inside a coast.
+  std::vector<lcm::LogEvent> events;
+  std::vector<std::vector<unsigned char>> data;
+  {
+    lcm::LogFile in(whole.path, "r");
+    while (const lcm::LogEvent* e = in.readNextEvent()) {
+      data.emplace_back(static_cast<const unsigned char*>(e->data), static_cast<const unsigned char*>(e->data) + e->datalen);
+      events.push_back(*e);
+    }
+  }
+  const std::size_t n = events.size();
+  const std::string base = ::testing::TempDir() + "spindown_rotated_" + std::to_string(::getpid());
+  const std::vector<std::string> parts{base + "-1.lcm", base + "-2.lcm", base + "-3.lcm"};
+  const std::size_t cut1 = 1 + all.runs[0].fit.run.cut_index / 5 + 20, cut2 = 1 + all.runs[1].fit.run.cut_index / 5 + 20;
+  ASSERT_LT(cut1, cut2);
+  ASSERT_LT(cut2, n);
+  for (int k = 0; k < 3; ++k) {
+    lcm::LogFile out(parts[k], "w");
+    const std::size_t from = k == 0 ? 0 : k == 1 ? cut1 : cut2, to = k == 0 ? cut1 : k == 1 ? cut2 : n;
+    for (std::size_t i = from; i < to; ++i) {
+      lcm::LogEvent e = events[i];
+      e.data = data[i].data();
+      ASSERT_EQ(out.writeEvent(&e), 0);
+    }
+  }
+  const auto sessions = log_sessions({parts[2], parts[0], parts[1]});
+  ASSERT_EQ(sessions.size(), 1u);
+  EXPECT_EQ(sessions[0], parts);
+  const LogRefit r = refit_log_session(sessions[0], FitterOptions{}, false);
+  ASSERT_EQ(r.runs.size(), 2u);
+  EXPECT_EQ(r.session_files, parts);
+  for (std::size_t k = 0; k < 2; ++k)
+    EXPECT_EQ(run_fit_json(r.runs[k].fit).dump(), run_fit_json(all.runs[k].fit).dump()) << "run " << k + 1;
+  std::size_t whole_alone = 0;
+  for (const auto& p : parts)
+    for (const auto& run : refit_log(p, FitterOptions{}, false).runs)
+      whole_alone += !run.fit.run.partial() && run.fit.run.stopped;
+  EXPECT_EQ(whole_alone, 0u) << "each file alone holds no run whole";
+
+  // The whole log beside its own parts: two loggers' copies of one traffic never mix.
+  const auto apart = log_sessions({whole.path, parts[1]});
+  EXPECT_EQ(apart.size(), 2u);
+  for (const auto& p : parts) std::remove(p.c_str());
+}
+
 TEST(LogRefit, AMissingLogIsAFailureNamingIt) {
   const LogRefit r = refit_log("/nonexistent/spindown.lcm", FitterOptions{}, false);
   ASSERT_FALSE(r.file.failures.empty());

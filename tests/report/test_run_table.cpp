@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "spindown/csv_fields.hpp"
 #include "spindown/run_table.hpp"
 
 namespace spindown {
@@ -47,26 +48,11 @@ RunFit run_fit(int number, bool stopped) {
   return f;
 }
 
-std::vector<std::string> split_csv_line(const std::string& line) {
-  std::vector<std::string> out;
-  std::string cell;
-  bool quoted = false;
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (c == '"' && quoted && i + 1 < line.size() && line[i + 1] == '"') {
-      cell += '"';
-      ++i;
-    } else if (c == '"') {
-      quoted = !quoted;
-    } else if (c == ',' && !quoted) {
-      out.push_back(cell);
-      cell.clear();
-    } else {
-      cell += c;
-    }
-  }
-  out.push_back(cell);
-  return out;
+std::vector<std::string> split_csv_line(const std::string& line, char delimiter = ',') {
+  CsvFieldSplitter splitter;
+  std::vector<std::string_view> cells;
+  splitter.split(line, delimiter, cells);
+  return {cells.begin(), cells.end()};
 }
 
 FileFit class_file() {
@@ -146,6 +132,23 @@ TEST(RunTable, JsonRowsHaveTheCsvColumnsAndReadBack) {
   EXPECT_EQ(rows[3]["file"], "caf\xef\xbf\xbd.txt");
 }
 
+// --table json writes the CSV's numbers (10 significant digits) in their shortest form: a time
+// computed as 3491 × 0.001 is 3.491, and a fitted coefficient carries no 17-digit tail.
+TEST(RunTable, JsonNumbersAreTheCsvsInTheirShortestForm) {
+  FileFit f = class_file();
+  f.runs[0].run.t_cut_s = 3491 * 0.001;  // 3.4909999999999997 as a double
+  f.runs[0].models[2].params[0].value = 1.8053123456789012e-7;
+  std::string text = "[";
+  bool first = true;
+  append_run_table_json_rows(f, text, first);
+  EXPECT_NE(text.find("\"t_cut_s\": 3.491,"), std::string::npos) << text;
+  EXPECT_NE(text.find("\"c3\": 1.805312346e-07,"), std::string::npos) << text;
+  EXPECT_EQ(text.find("3.4909999999999997"), std::string::npos);
+  const std::string csv = run_table_csv_rows(f);
+  EXPECT_NE(csv.find(",3.491,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",1.805312346e-07,"), std::string::npos) << csv;
+}
+
 TEST(RunTable, AModelThatDidNotConvergeLeavesItsCellsEmpty) {
   FileFit f = class_file();
   f.runs[0].models[2].converged = false;
@@ -160,6 +163,31 @@ TEST(RunTable, AModelThatDidNotConvergeLeavesItsCellsEmpty) {
     }
   }
   EXPECT_DOUBLE_EQ(std::stod(cells[std::find(names.begin(), names.end(), "omega0") - names.begin()]), 340.1);
+}
+
+TEST(RunTable, AGermanExcelsCsvWithAByteOrderMark) {
+  FileFit f = class_file();
+  f.student = "Bj\xC3\xB6rn Sch\xC3\xA4" "fer";
+  f.health[0]->reason = "dry friction 1.0\xC3\x97 the baseline; check";
+  const CsvStyle de = *csv_style_for_locale("de");
+  CsvStyle de_file = de;
+  de_file.byte_order_mark = true;
+  const std::string header = run_table_csv_header(de_file);
+  ASSERT_EQ(header.substr(0, 3), "\xEF\xBB\xBF");  // Excel reads the file as UTF-8, names and "×" right
+  const std::vector<std::string> names = split_csv_line(header.substr(3, header.size() - 4), ';');
+  const std::string rows = run_table_csv_rows(f, de);
+  const std::vector<std::string> cells = split_csv_line(rows.substr(0, rows.find('\n')), ';');
+  ASSERT_EQ(cells.size(), names.size());
+  auto at = [&](const std::string& col) { return cells[std::find(names.begin(), names.end(), col) - names.begin()]; };
+  EXPECT_EQ(at("c3"), "1,8e-07");  // a decimal comma
+  EXPECT_EQ(at("t_cut_s"), "8,25");
+  EXPECT_EQ(at("run"), "1");
+  EXPECT_EQ(at("student"), "Bj\xC3\xB6rn Sch\xC3\xA4" "fer");
+  EXPECT_EQ(at("health_reason"), "dry friction 1.0\xC3\x97 the baseline; check");  // quoted: it holds a ';'
+  EXPECT_NE(rows.find("\"dry friction 1.0\xC3\x97 the baseline; check\""), std::string::npos);
+  // The default: no mark on stdout, ',' and points.
+  EXPECT_EQ(run_table_csv_header().substr(0, 5), "file,");
+  EXPECT_FALSE(csv_style_for_locale("xx"));
 }
 
 }  // namespace

@@ -38,9 +38,11 @@ Recording multi_run_recording(std::vector<Truth>* truths, double noise = 0.004) 
     spec.ripple = 0.01;
     spec.period_s = k == 3 ? 0.030 : 0.020;
     spec.seed = 300 + k;
+    spec.bounce_samples = 0;  // contact bounce at the floating pin's connection: scored in test_detection_truth
     const SyntheticRun s = make_synthetic_run(spec);
     for (std::size_t i = 0; i < s.t_ms.size(); ++i) rec.push(s.t_ms[i] / 1000.0, s.volts[i]);
-    if (truths) truths->push_back({s.t_cut_ms / 1000.0, s.t_cut_ms / 1000.0 + s.t_stop_s});
+    // The coast begins in the readings at the cut, or where the floating pin was connected.
+    if (truths) truths->push_back({s.t_connect_ms / 1000.0, s.t_cut_ms / 1000.0 + s.t_stop_s});
     t0_ms = s.t_ms.back() + 20;
   }
   return rec;

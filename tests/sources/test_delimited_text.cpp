@@ -209,16 +209,6 @@ TEST(DelimitedText, LongLineAndManyBadRowsStayBounded) {
   for (const auto& d : r.diagnostics) EXPECT_LT(d.message.size(), 400u);
 }
 
-TEST(DelimitedText, TimeUnitNames) {
-  EXPECT_EQ(parse_time_unit("ms"), TimeUnit::ms);
-  EXPECT_EQ(parse_time_unit("Seconds"), TimeUnit::s);
-  EXPECT_EQ(parse_time_unit("µs"), TimeUnit::us);
-  EXPECT_EQ(parse_time_unit("micros"), TimeUnit::us);
-  EXPECT_FALSE(parse_time_unit("min"));
-  EXPECT_EQ(time_unit_name(TimeUnit::us), "us");
-  EXPECT_DOUBLE_EQ(time_units_per_second(TimeUnit::ms), 1000);
-}
-
 TEST(DelimitedText, OptionsValidate) {
   DelimitedTextOptions o;
   std::string why;
@@ -236,4 +226,129 @@ TEST(DelimitedText, OptionsValidate) {
   o = {};
   o.quantity = Quantity::rpm;
   EXPECT_TRUE(o.names_columns());
+}
+
+TEST(DelimitedText, UnitsInTheHeaderInAnyDelimiterAndSpelling) {
+  struct Case {
+    const char* header;
+    const char* sep;
+    Quantity quantity;
+    double scale;    // the value written is the reading divided by this
+    double t_scale;  // the time written is seconds times this
+  };
+  const Case cases[] = {
+      {"millis\trpm", "\t", Quantity::rpm, 1, 1000},
+      {"time_ms\tspeed_rpm", "\t", Quantity::rpm, 1, 1000},
+      {"t[ms];n[1/min]", ";", Quantity::rpm, 1, 1000},
+      {"Zeit (s)\tDrehzahl (U/min)", "\t", Quantity::rpm, 1, 1},
+      {"time,omega (rad/s)", ",", Quantity::rad_per_s, 1, 1000},
+      {"ms speed(RPM)", " ", Quantity::rpm, 1, 1000},
+      {"Time [s],Voltage [mV]", ",", Quantity::back_emf_volts, 1e-3, 1},
+      {"t / s;n / (1/s)", ";", Quantity::rpm, 60, 1},
+      {"Zeit in ms;Drehzahl in U/min", ";", Quantity::rpm, 1, 1000},
+  };
+  for (const Case& c : cases) {
+    std::string text = std::string(c.header) + "\r\n";
+    for (int i = 0; i < 60; ++i) {
+      const double t = 0.02 * i, reading = 300.0 - 2 * i;
+      text += (c.t_scale == 1 ? fmt::format("{:.3f}", t) : fmt::format("{}", std::lround(t * c.t_scale))) + c.sep +
+              fmt::format("{:.12g}", reading / c.scale) + "\r\n";
+    }
+    const Recording r = read_delimited_text(text, "units.txt");
+    SCOPED_TRACE(c.header);
+    SCOPED_TRACE(all_diagnostics(r));
+    ASSERT_EQ(r.size(), 60u);
+    EXPECT_EQ(r.quantity, c.quantity);
+    EXPECT_NEAR(r.t_s[10], 0.2, 1e-12);
+    EXPECT_NEAR(r.value[10], 280.0, 1e-6);
+  }
+}
+
+TEST(DelimitedText, AUnitRowUnderTheNames) {
+  std::string text = "Zeit;Drehzahl\r\n[ms];[U/min]\r\n";
+  for (int i = 0; i < 20; ++i) text += fmt::format("{};{}\r\n", 20 * i, 3000 - 10 * i);
+  const Recording r = read_delimited_text(text, "units-row.csv");
+  SCOPED_TRACE(all_diagnostics(r));
+  ASSERT_EQ(r.size(), 20u);
+  EXPECT_EQ(r.quantity, Quantity::rpm);
+  EXPECT_DOUBLE_EQ(r.t_s[1], 0.02);
+  EXPECT_TRUE(mentions(r, "1 units row"));
+}
+
+TEST(DelimitedText, AHeaderUnitSpindownCannotReadNamesTheOption) {
+  const Recording kmh = read_delimited_text("t [s],Speed [km/h]\n0,1\n1,2\n", "kmh.csv");
+  ASSERT_TRUE(kmh.has_errors());
+  EXPECT_TRUE(mentions(kmh, "its unit 'km/h' is not one spindown reads")) << all_diagnostics(kmh);
+  EXPECT_TRUE(mentions(kmh, "--value-unit rpm")) << all_diagnostics(kmh);
+  const Recording speed = read_delimited_text("time,speed\n0,1\n1,2\n", "speed.csv");
+  EXPECT_TRUE(mentions(speed, "cannot tell the unit of value column 'speed'")) << all_diagnostics(speed);
+  EXPECT_TRUE(mentions(speed, "--value-unit rpm")) << all_diagnostics(speed);
+  const Recording minutes = read_delimited_text("t [min],U [V]\n0,1\n1,2\n", "min.csv");
+  EXPECT_TRUE(mentions(minutes, "its unit 'min' is not one spindown reads (s, ms, us)")) << all_diagnostics(minutes);
+  // Given on the command line, the unit is used.
+  DelimitedTextOptions o;
+  o.quantity = Quantity::rpm;
+  EXPECT_EQ(read_delimited_text("t [s],Speed [km/h]\n0,1\n1,2\n", "kmh.csv", o).size(), 2u);
+}
+
+TEST(DelimitedText, AQuotedHeaderWithACommaIsOneColumn) {
+  std::string text = "\"Time, s\",\"RR_Wheel,Speed\",\"FL_Wheel,Speed\",\"Current, A\"\r\n";
+  for (int i = 0; i < 30; ++i) text += fmt::format("{:.2f},{},{},0.5\r\n", 0.02 * i, 500 - i, 900 - i);
+  DelimitedTextOptions o;
+  o.value_column = "FL_Wheel,Speed";
+  o.quantity = Quantity::rpm;
+  const Recording r = read_delimited_text(text, "wheels.csv", o);
+  SCOPED_TRACE(all_diagnostics(r));
+  ASSERT_EQ(r.size(), 30u);
+  EXPECT_DOUBLE_EQ(r.value[0], 900);  // column 3, not shifted by the commas in the names
+  EXPECT_TRUE(mentions(r, "value = column 3 'FL_Wheel,Speed'"));
+  EXPECT_TRUE(mentions(r, "time = column 1 'Time, s' in s (from the header)"));
+  // Not named: the two wheels are both speeds, and the error names them whole.
+  const Recording both = read_delimited_text(text, "wheels.csv");
+  EXPECT_TRUE(mentions(both, "'RR_Wheel,Speed' and 'FL_Wheel,Speed' could each be the value"))
+      << all_diagnostics(both);
+}
+
+TEST(DelimitedText, NoHeaderProposesTheTimeAndTheSpeedColumns) {
+  // A logger's CSV: time (s), speed (rpm), current (A), temperature; no names.
+  std::string text;
+  double w = 0;
+  for (int i = 0; i < 1000; ++i) {
+    const double t = 0.02 * i;
+    if (t >= 1 && t < 6) w = 2800 * (1 - std::exp(-(t - 1) / 0.5));
+    else if (t >= 6) w = std::max(0.0, w - 0.02 * (150 + 0.05 * w));
+    const double current = t >= 1 && t < 6 ? 0.35 + 2.5 * std::exp(-(t - 1) / 0.3) : 0.0;
+    text += fmt::format("{:.2f},{:.1f},{:.3f},{:.2f}\n", t, w, current, 24 + 0.01 * t);
+  }
+  const Recording r = read_delimited_text(text, "logger.csv");
+  ASSERT_TRUE(r.has_errors());
+  EXPECT_TRUE(mentions(r, "the file has no header row")) << all_diagnostics(r);
+  EXPECT_TRUE(mentions(r, "--time-column 1 --time-unit s --value-column 2 --value-unit rpm")) << all_diagnostics(r);
+  EXPECT_FALSE(mentions(r, "4 '4'")) << all_diagnostics(r);  // no longer a list of every column
+}
+
+TEST(DelimitedText, ASpreadsheetsEmptyRowsAndDecimalCommasInTabText) {
+  // Excel's "Unicode text" (decoded): tab-separated, decimal commas, rows of separators at the end.
+  std::string text = "Zeit [s]\tU [V]\r\n";
+  for (int i = 0; i < 20; ++i) text += fmt::format("0,{:02d}\t2,{:02d}\r\n", 2 * i, 90 - i);
+  text += "\t\r\n\t\r\n;;;;\r\n";
+  const Recording r = read_delimited_text(text, "excel.txt");
+  SCOPED_TRACE(all_diagnostics(r));
+  ASSERT_EQ(r.size(), 20u);
+  EXPECT_DOUBLE_EQ(r.value[3], 2.87);
+  EXPECT_EQ(warnings(r), 0u);
+  EXPECT_TRUE(mentions(r, "3 blank"));
+}
+
+TEST(DelimitedText, HeaderThatNeedsTheDelimitedReader) {
+  EXPECT_TRUE(header_needs_delimited_reader("millis\trpm"));
+  EXPECT_TRUE(header_needs_delimited_reader("time_ms\tspeed_rpm"));
+  EXPECT_TRUE(header_needs_delimited_reader("Drehzahl [U/min]\tZeit [s]"));
+  EXPECT_TRUE(header_needs_delimited_reader("millis\tVoltage [mV]"));
+  EXPECT_TRUE(header_needs_delimited_reader("time\tspeed"));
+  EXPECT_TRUE(header_needs_delimited_reader("t [s]\tvolts"));
+  EXPECT_FALSE(header_needs_delimited_reader("millis\tvolts"));
+  EXPECT_FALSE(header_needs_delimited_reader("time\tV"));
+  EXPECT_FALSE(header_needs_delimited_reader("5234\t2.45"));
+  EXPECT_FALSE(header_needs_delimited_reader("rpm"));
 }

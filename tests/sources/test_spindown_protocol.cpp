@@ -59,7 +59,7 @@ TEST(SpindownProtocol, BannerRoundTrips) {
   EXPECT_DOUBLE_EQ(l.banner.adc_ref_v, 4.096);
   EXPECT_EQ(l.banner.period_us, 5000u);
   EXPECT_EQ(l.banner.baud, 115200);
-  EXPECT_DOUBLE_EQ(l.banner.volts_per_count(), 4.096 / 1023);
+  EXPECT_DOUBLE_EQ(l.banner.volts_per_count(), 4.096 / 1024);
 }
 
 TEST(SpindownProtocol, NoteIsNotABanner) {

@@ -90,7 +90,7 @@ TEST(SpindownText, CaptureOfACoastRoundTripsExactly) {
     ASSERT_EQ(r.t_s[i], static_cast<double>(micros[i]) / 1e6) << i;  // as the fitter converts device_time_us
     ASSERT_EQ(r.value[i], banner.volts(run.adc[i])) << i;            // as the bridge converts
   }
-  EXPECT_NEAR(r.value[0], banner.adc_ref_v * run.adc[0] / 1023.0, 1e-12);
+  EXPECT_NEAR(r.value[0], banner.adc_ref_v * run.adc[0] / 1024.0, 1e-12);
   EXPECT_TRUE(r.clock_restarts.empty());
   EXPECT_EQ(lost, 0);
   EXPECT_EQ(r.lines_read, run.t_ms.size() + 1);
@@ -305,7 +305,7 @@ TEST(SpindownText, SamplesBeforeAnyBannerUseTheDefaultsWithAWarning) {
             std::string::npos)
       << warnings[0]->message;
   EXPECT_EQ(r.value[0], SpindownBanner{}.volts(1000));
-  EXPECT_DOUBLE_EQ(r.value[0], 1000 * 5.0 / 1023);
+  EXPECT_DOUBLE_EQ(r.value[0], 1000 * 5.0 / 1024);
   EXPECT_EQ(r.value[50], coast_banner(4.096).volts(1000));
   EXPECT_TRUE(r.clock_restarts.empty());
 }

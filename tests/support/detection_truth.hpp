@@ -23,6 +23,10 @@ namespace spindown::truth {
 // One coast as the physics made it, on the recording's clock.
 struct TruthRun {
   double t_cut_s = 0;  // the power cut; for a coast whose start was not recorded, its first sample
+  // With the handout's floating pin: t_cut_s is the pin's connection, and the first sample after its
+  // contact bounce is t_cut_late_s — a bounce sample can read anything, so a cut anywhere between
+  // the two is right. Otherwise equal to t_cut_s.
+  double t_cut_late_s = 0;
   double t_end_s = 0;  // the stop, the sensor's last pulse, or the last sample of a coast that goes on
   enum class End { stopped, signal_lost, goes_on } end = End::stopped;
   bool partial = false;  // the cut was not recorded (starts mid-coast, after a pause)
@@ -33,7 +37,8 @@ struct Case {
   Recording rec;
   std::vector<TruthRun> runs;
   double period_s = 0.02;
-  std::vector<double> glitch_t_s;  // samples that are not the motor's
+  std::vector<double> glitch_t_s;  // samples that are not the motor's: dropouts, glitches
+  std::vector<double> bounce_t_s;  // contact bounce where the handout's floating pin was connected
 };
 
 inline void append(Recording& rec, const SyntheticRun& s) {
@@ -43,13 +48,17 @@ inline void append(Recording& rec, const SyntheticRun& s) {
 // The run's truth from what the simulator made.
 inline TruthRun truth_of(const SyntheticRun& s) {
   TruthRun t;
-  t.t_cut_s = s.t_cut_ms / 1000.0;
-  const auto first_after = std::upper_bound(s.t_ms.begin(), s.t_ms.end(), s.t_cut_ms);
+  // The coast begins in the readings at the cut, or where the handout's floating pin was connected.
+  t.t_cut_s = s.t_connect_ms / 1000.0;
+  const auto first_after = std::upper_bound(s.t_ms.begin(), s.t_ms.end(), s.t_connect_ms);
   if (first_after == s.t_ms.begin() || (first_after != s.t_ms.end() && first_after[-1] < s.t_cut_ms - 1000.0)) {
     // No sample within a second before the cut: the coast's start was not recorded.
     t.partial = true;
     t.t_cut_s = first_after != s.t_ms.end() ? *first_after / 1000.0 : t.t_cut_s;
   }
+  t.t_cut_late_s = t.t_cut_s;
+  if (!s.bounce_index.empty() && s.bounce_index.back() + 1 < s.t_ms.size())
+    t.t_cut_late_s = s.t_ms[s.bounce_index.back() + 1] / 1000.0;
   if (s.t_signal_lost_ms >= 0) {
     t.end = TruthRun::End::signal_lost;
     t.t_end_s = s.t_signal_lost_ms / 1000.0;
@@ -62,14 +71,19 @@ inline TruthRun truth_of(const SyntheticRun& s) {
   return t;
 }
 
+// A run the simulator made, appended to c: its samples, its truth, its samples that are not the motor's.
+inline void add_run(Case& c, const SyntheticRun& s) {
+  append(c.rec, s);
+  c.runs.push_back(truth_of(s));
+  for (std::size_t i : s.glitch_index) c.glitch_t_s.push_back(s.t_ms[i] / 1000.0);
+  for (std::size_t i : s.bounce_index) c.bounce_t_s.push_back(s.t_ms[i] / 1000.0);
+}
+
 inline Case single(std::string pattern, const SyntheticRunSpec& spec) {
   Case c;
   c.pattern = std::move(pattern);
-  const SyntheticRun s = make_synthetic_run(spec);
-  append(c.rec, s);
-  c.runs.push_back(truth_of(s));
+  add_run(c, make_synthetic_run(spec));
   c.period_s = spec.period_s;
-  for (std::size_t i : s.glitch_index) c.glitch_t_s.push_back(s.t_ms[i] / 1000.0);
   return c;
 }
 
@@ -88,6 +102,13 @@ inline std::vector<Case> make_cases(int per_pattern) {
       SyntheticRunSpec s = base;
       s.lead_in = LeadIn(k % 3);
       cases.push_back(single("lab", s));
+    }
+    {  // the handout's step 6: A0 floats (mains hum, 0.5-2.5 V) until it is connected after the cut
+      SyntheticRunSpec s = base;
+      s.lead_in = LeadIn::floating;
+      s.lead_in_s = 3.0 + 2.0 * (k % 6);
+      s.e0_v = 2.6 + 0.1 * (k % 9);
+      cases.push_back(single("floating pin", s));
     }
     {  // a motor ramp straight into the peak, read by a speed sensor
       SyntheticRunSpec s = base;
@@ -154,9 +175,7 @@ inline std::vector<Case> make_cases(int per_pattern) {
       append(c.rec, nudge);
       SyntheticRunSpec real = base;
       real.t0_ms = nudge.t_ms.back() + 20;
-      const SyntheticRun sim = make_synthetic_run(real);
-      append(c.rec, sim);
-      c.runs.push_back(truth_of(sim));
+      add_run(c, make_synthetic_run(real));
       cases.push_back(std::move(c));
     }
     {  // an Arduino reset mid-coast: the device clock restarts, the coast goes on
@@ -205,8 +224,7 @@ inline std::vector<Case> make_cases(int per_pattern) {
         s.e0_v = base.e0_v + 0.3 * r;
         s.t0_ms = t0_ms;
         const SyntheticRun sim = make_synthetic_run(s);
-        append(c.rec, sim);
-        c.runs.push_back(truth_of(sim));
+        add_run(c, sim);
         t0_ms = sim.t_ms.back() + 20;
       }
       cases.push_back(std::move(c));
@@ -231,6 +249,7 @@ struct PatternScore {
   int false_lost = 0;       // "signal lost" where the motor was seen to stop
   int missed_lost = 0;      // a stop where the sensor gave up
   int bad_samples = 0, rejected = 0, wrongly_rejected = 0;  // dropouts/glitches made, left out; good samples left out
+  int bounces = 0, bounces_out = 0;  // contact bounce samples made, left out of every fit
   std::vector<double> cut_err, end_err;  // |detected - truth| in sample periods
   static double quantile(std::vector<double> x, double q) {
     if (x.empty()) return 0.0;
@@ -259,9 +278,18 @@ inline std::string detail(const Case& c, const Segmentation& seg) {
   for (const TruthRun& tr : c.runs)
     out += fmt::format("  truth    cut {:.3f} end {:.3f} ({}){}\n", tr.t_cut_s, tr.t_end_s, int(tr.end),
                        tr.partial ? " partial" : "");
-  for (const Run& r : seg.runs)
-    out += fmt::format("  detected cut {:.3f} end {:.3f} ({}) lead-in {}\n", r.t_cut_s, detected_end_s(r, c.rec),
+  for (const Run& r : seg.runs) {
+    out += fmt::format("  detected cut {:.3f} end {:.3f} ({}) lead-in {}", r.t_cut_s, detected_end_s(r, c.rec),
                        end_name(r.end), r.lead_in);
+    for (std::size_t k : r.outliers) out += fmt::format(" out@{:.3f}", c.rec.t_s[k]);
+    out += "\n";
+  }
+  if (!c.glitch_t_s.empty() || !c.bounce_t_s.empty()) {
+    out += "  bad samples at";
+    for (double t : c.glitch_t_s) out += fmt::format(" {:.3f}", t);
+    for (double t : c.bounce_t_s) out += fmt::format(" {:.3f}(bounce)", t);
+    out += "\n";
+  }
   for (const Diagnostic& d : seg.diagnostics) out += "  " + d.message + "\n";
   return out;
 }
@@ -287,7 +315,7 @@ inline void score_case(const Case& c, const Segmentation& seg, PatternScore& ps)
     used[std::size_t(best)] = true;
     ++ps.found;
     const Run& r = seg.runs[std::size_t(best)];
-    ps.cut_err.push_back(std::abs(r.t_cut_s - tr.t_cut_s) / c.period_s);
+    ps.cut_err.push_back(std::max({0.0, tr.t_cut_s - r.t_cut_s, r.t_cut_s - tr.t_cut_late_s}) / c.period_s);
     if (tr.end != TruthRun::End::goes_on)
       ps.end_err.push_back(std::abs(detected_end_s(r, c.rec) - tr.t_end_s) / c.period_s);
     else if (r.stopped)
@@ -296,19 +324,33 @@ inline void score_case(const Case& c, const Segmentation& seg, PatternScore& ps)
     if (tr.end == TruthRun::End::stopped && r.end == Run::End::signal_lost) ++ps.false_lost;
     if (tr.end == TruthRun::End::signal_lost && r.end != Run::End::signal_lost) ++ps.missed_lost;
   }
+  // A bad sample is left out when no run fits it: outside every run's window, or one of its outliers.
+  const auto left_out = [&](double tb) {
+    for (const Run& r : seg.runs)
+      for (std::size_t k = r.cut_index; k < r.end_index && k < c.rec.size(); ++k)
+        if (c.rec.t_s[k] == tb && !std::binary_search(r.outliers.begin(), r.outliers.end(), k)) return false;
+    return true;
+  };
   ps.bad_samples += int(c.glitch_t_s.size());
-  for (const Run& r : seg.runs)
-    for (std::size_t k : r.outliers) {
-      const bool bad = std::find(c.glitch_t_s.begin(), c.glitch_t_s.end(), c.rec.t_s[k]) != c.glitch_t_s.end();
-      ++(bad ? ps.rejected : ps.wrongly_rejected);
-    }
+  for (double tb : c.glitch_t_s) ps.rejected += left_out(tb);
+  ps.bounces += int(c.bounce_t_s.size());
+  for (double tb : c.bounce_t_s) ps.bounces_out += left_out(tb);
+  const auto bad = [&](double tk) {
+    return std::find(c.glitch_t_s.begin(), c.glitch_t_s.end(), tk) != c.glitch_t_s.end() ||
+           std::find(c.bounce_t_s.begin(), c.bounce_t_s.end(), tk) != c.bounce_t_s.end();
+  };
+  for (std::size_t j = 0; j < seg.runs.size(); ++j)  // good samples left out of a real run's fit
+    for (std::size_t k : seg.runs[j].outliers) ps.wrongly_rejected += used[j] && !bad(c.rec.t_s[k]);
   for (std::size_t j = 0; j < used.size(); ++j) {
     if (used[j]) continue;
     ++ps.invented;
+    // Said: a warning that calls it a fragment, or one that says it may be no coast at all.
     const std::string said = fmt::format("run {} (cut at", seg.runs[j].number);
+    const std::string said_too = fmt::format("run {}: ", seg.runs[j].number);
     for (const Diagnostic& d : seg.diagnostics)
-      if (d.severity == Diagnostic::Severity::warning && d.message.rfind(said, 0) == 0 &&
-          d.message.find("looks like a fragment") != std::string::npos) {
+      if (d.severity == Diagnostic::Severity::warning &&
+          ((d.message.rfind(said, 0) == 0 && d.message.find("looks like a fragment") != std::string::npos) ||
+           (d.message.rfind(said_too, 0) == 0 && d.message.find("no coast") != std::string::npos))) {
         ++ps.invented_said;
         break;
       }
@@ -318,10 +360,22 @@ inline void score_case(const Case& c, const Segmentation& seg, PatternScore& ps)
 // Scores every case; prints each one of the pattern named by SPINDOWN_TRUTH_DETAIL (if set).
 inline std::map<std::string, PatternScore> score_all(const std::vector<Case>& cases, const RunOptions& opt = {}) {
   std::map<std::string, PatternScore> out;
+  // SPINDOWN_TRUTH_DETAIL=pattern prints that pattern's runs; with SPINDOWN_TRUTH_DUMP=dir its
+  // recordings are also written there (millis<TAB>volts), to look at with spindown fit.
   const char* show = std::getenv("SPINDOWN_TRUTH_DETAIL");
+  const char* dump = std::getenv("SPINDOWN_TRUTH_DUMP");
+  int shown = 0;
   for (const Case& c : cases) {
     const Segmentation seg = find_runs(c.rec, opt);
-    if (show && c.pattern == show) std::fputs(detail(c, seg).c_str(), stdout);
+    if (show && c.pattern == show) {
+      std::fputs(detail(c, seg).c_str(), stdout);
+      if (dump)
+        if (std::FILE* f = std::fopen(fmt::format("{}/case{:02d}.tsv", dump, shown).c_str(), "w")) {
+          for (std::size_t i = 0; i < c.rec.size(); ++i) std::fprintf(f, "%.0f\t%.17g\n", c.rec.t_s[i] * 1000.0, c.rec.value[i]);
+          std::fclose(f);
+        }
+      ++shown;
+    }
     score_case(c, seg, out[c.pattern]);
   }
   return out;
@@ -330,7 +384,7 @@ inline std::map<std::string, PatternScore> score_all(const std::vector<Case>& ca
 inline std::string score_table(const std::map<std::string, PatternScore>& scores) {
   std::string out = fmt::format("{:<24} {:>4} {:>5} {:>6} {:>11} {:>9} {:>9} {:>9} {:>9} {:>6} {:>7} {:>6} {:>6} {:>8}\n", "pattern",
                                 "recs", "runs", "missed", "invented", "cut p50", "cut p90", "end p50", "end p90",
-                                "f.stop", "partial", "f.lost", "m.lost", "outliers");
+                                "f.stop", "partial", "f.lost", "m.lost", "outliers");  // outliers: left out/made+good left out, bounce
   for (const auto& [name, s] : scores)
     out += fmt::format("{:<24} {:>4} {:>5} {:>6} {:>11} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f} {:>6} {:>7} {:>6} {:>6} {:>8}\n", name,
                        s.recordings, s.truth_runs, s.missed,
@@ -339,7 +393,8 @@ inline std::string score_table(const std::map<std::string, PatternScore>& scores
                        PatternScore::quantile(s.cut_err, 0.5),
                        PatternScore::quantile(s.cut_err, 0.9), PatternScore::quantile(s.end_err, 0.5),
                        PatternScore::quantile(s.end_err, 0.9), s.false_stops, s.partial_wrong, s.false_lost, s.missed_lost,
-                       fmt::format("{}/{}+{}", s.rejected, s.bad_samples, s.wrongly_rejected));
+                       fmt::format("{}/{}+{}{}", s.rejected, s.bad_samples, s.wrongly_rejected,
+                                   s.bounces ? fmt::format(" b{}/{}", s.bounces_out, s.bounces) : std::string()));
   return out;
 }
 

@@ -1,9 +1,9 @@
 #include "spindown/quantity.hpp"
 
-#include <algorithm>
-#include <cctype>
 #include <numbers>
 #include <string>
+
+#include "spindown/ascii_lower.hpp"
 
 namespace spindown {
 
@@ -17,8 +17,7 @@ std::string_view quantity_unit(Quantity q) {
 }
 
 std::optional<Quantity> parse_quantity(std::string_view unit) {
-  std::string u(unit);
-  std::transform(u.begin(), u.end(), u.begin(), [](unsigned char c) { return std::tolower(c); });
+  const std::string u = ascii_lower(unit);
   if (u == "v" || u == "volt" || u == "volts") return Quantity::back_emf_volts;
   if (u == "rpm" || u == "1/min") return Quantity::rpm;
   if (u == "rad/s" || u == "rad_s" || u == "rads" || u == "rad/sec") return Quantity::rad_per_s;

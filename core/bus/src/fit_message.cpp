@@ -187,6 +187,16 @@ std::optional<RunFit> from_fit_message(const fit_t& m, std::string* why) {
     f.params.push_back({m.param_name[k], m.param_value[k], m.param_stderr[k], m.param_unit[k], m.param_bench_error[k]});
     if (m.param_name[k] == "omega0") f.omega0 = m.param_value[k];
   }
+  // Each model's speed law (ModelFit::omega_at: c/J of its viscous and Coulomb terms).
+  const double inertia = fit.bench.inertia_kg_m2;
+  for (ModelFit& f : fit.models) {
+    const auto per_j = [&](std::string_view name) {
+      const Parameter* p = f.param(name);
+      return p && inertia > 0 ? p->value / inertia : 0.0;
+    };
+    f.rate = per_j(f.kind == ModelKind::combined ? "c3" : "c1");
+    f.decel = per_j(f.kind == ModelKind::combined ? "c4" : "c2");
+  }
   fit.best = m.best;
   fit.best_reason = m.best_reason;
   const auto nd = static_cast<std::size_t>(std::max(m.ndoubts, 0));

@@ -47,6 +47,7 @@ bool LcmLoop::subscribe_raw(const std::string& channel_regex, std::function<void
   if (!sub->lcm) return false;
   lcm_subscription_set_queue_capacity(sub->lcm, options.queue_capacity);
   subscriptions_.push_back(std::move(sub));
+  receive_fd_.store(lcm_.getFileno(), std::memory_order_relaxed);
   return true;
 }
 
@@ -112,6 +113,13 @@ void LcmLoop::run_timers() {
 }
 
 bool LcmLoop::can_receive() { return lcm_.good() && lcm_.getFileno() >= 0; }
+
+bool LcmLoop::messages_waiting() const {
+  const int fd = receive_fd_.load(std::memory_order_relaxed);
+  if (fd < 0) return false;
+  pollfd p{fd, POLLIN, 0};
+  return ::poll(&p, 1, 0) > 0 && (p.revents & POLLIN);
+}
 
 LcmLoopEnd LcmLoop::run(const LcmRunOptions& o) {
   const auto deadline = o.timeout_s > 0 ? steady_after(o.timeout_s) : Clock::time_point::max();

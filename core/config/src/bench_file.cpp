@@ -54,12 +54,21 @@ BenchFile load_bench_file(const std::string& path) {
   BridgeSettings s;
   load_bridge_settings(path, s);  // [bench] exactly as spindown-bridge reads it
   f.params = s.params;
+  f.warnings = std::move(s.warnings);
   const toml::table root = parse_toml_file(path);
   f.sets_inertia = root.at_path("bench.inertia_kg_m2").node() || root.at_path("bench.flywheel_radius_m").node();
   f.sets_kb = root.at_path("bench.kb_v_s_per_rad").node() || root.at_path("bench.speed_constant_rpm_per_v").node();
   f.sets_inertia_error = root.at_path("bench.inertia_error_pct").node() != nullptr;
   f.sets_kb_error = root.at_path("bench.kb_error_pct").node() != nullptr;
   return f;
+}
+
+const BenchFile* BenchFiles::for_bench(std::string_view bench) const {
+  if (!bench.empty()) {
+    const auto it = files.find(bench);
+    return it == files.end() ? nullptr : &it->second;
+  }
+  return files.size() == 1 ? &files.begin()->second : nullptr;
 }
 
 BenchFiles load_bench_files(const std::vector<std::string>& paths) {

@@ -7,7 +7,9 @@
 
 #include "spindown/file_bytes.hpp"
 #include "spindown/lcm_channels.hpp"
-#include "spindown/text_repairs.hpp"
+#include "spindown/ascii_lower.hpp"
+#include "spindown/csv_fields.hpp"
+#include "spindown/text_encoding.hpp"
 #include "spindown/text_support.hpp"
 #include "spindown/trim.hpp"
 
@@ -15,45 +17,10 @@ namespace spindown {
 
 namespace {
 
-// One row's fields; a field in double quotes may hold the delimiter ("Smith, Anna") and "" for a quote.
-std::vector<std::string> split_row(std::string_view line, char delim) {
-  std::vector<std::string> out;
-  std::string field;
-  bool quoted = false;
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    const char c = line[i];
-    if (quoted) {
-      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-        field += '"';
-        ++i;
-      } else if (c == '"') {
-        quoted = false;
-      } else {
-        field += c;
-      }
-    } else if (c == '"' && trim(field).empty()) {
-      field.clear();
-      quoted = true;
-    } else if (c == delim) {
-      out.emplace_back(trim(field));
-      field.clear();
-    } else {
-      field += c;
-    }
-  }
-  out.emplace_back(trim(field));
-  return out;
-}
-
 char header_delimiter(std::string_view header) {
   for (const char d : {'\t', ';', ','})
     if (header.find(d) != std::string_view::npos) return d;
   return ',';
-}
-
-std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return s;
 }
 
 }  // namespace
@@ -69,34 +36,62 @@ ClassRoster load_class_roster(const std::string& path) {
   std::string why;
   std::optional<std::string> bytes = read_file_bytes(path, &why, std::size_t{16} << 20);
   if (!bytes) throw std::runtime_error(why);
-  if (bytes->starts_with("\xEF\xBB\xBF")) bytes->erase(0, 3);  // a spreadsheet's byte-order mark
-  if (needs_text_repair(*bytes)) repair_text(*bytes);        // UTF-16 from a Windows editor
+  constexpr std::string_view save_as = "save it from the spreadsheet as CSV UTF-8 (File > Save As > \"CSV UTF-8\")";
+  if (const auto office = office_document(*bytes))
+    throw std::runtime_error(fmt::format("{}: a roster must be text: {}", path, *office));
+  // What a spreadsheet writes: UTF-8 with a byte-order mark, UTF-16 ("Unicode text"), Windows-1252
+  // (a German Excel's "CSV (Trennzeichen-getrennt)").
+  const EncodingGuess encoding = guess_text_encoding(*bytes);
+  const bool wide = encoding.encoding == TextEncoding::utf16le || encoding.encoding == TextEncoding::utf16be;
+  std::size_t control = 0, looked_at = 0;
+  if (!wide && text::looks_binary(*bytes, &control, &looked_at))
+    throw std::runtime_error(fmt::format("{}: not a roster: binary data ({} of the first {} bytes are control "
+                                         "characters or NUL); {}",
+                                         path, control, looked_at, save_as));
+  if (encoding.encoding == TextEncoding::mixed)
+    throw std::runtime_error(fmt::format("{}: {} byte{} neither UTF-8 nor of one other encoding, so names "
+                                         "cannot be read right; {}",
+                                         path, encoding.not_utf8, encoding.not_utf8 == 1 ? " is" : "s are", save_as));
+  if (needs_decoding(encoding)) *bytes = decode_text(*bytes, encoding);
   ClassRoster roster;
   roster.path = path;
-  char delim = ',';
+  char delim = 0;
   std::optional<std::size_t> col_file, col_bench, col_student;
   std::size_t columns = 0;
+  CsvFieldSplitter splitter;
+  std::vector<std::string_view> views;
+  const auto split_row = [&](std::string_view line) {
+    splitter.split(line, delim, views);
+    return std::vector<std::string>(views.begin(), views.end());
+  };
   text::for_each_line(*bytes, [&](std::int64_t number, std::string_view raw) {
     const std::string line(trim(raw));
     if (line.empty() || line.front() == '#') return;
     const auto at = [&](std::string_view what) {
       return std::runtime_error(fmt::format("{}:{}: {}", path, number, what));
     };
+    if (columns == 0 && delim == 0 && line.size() == 5 && ascii_lower(line.substr(0, 4)) == "sep=") {
+      delim = line[4];  // Excel's hint for the delimiter ("sep=;")
+      return;
+    }
     if (columns == 0) {  // the header
-      delim = header_delimiter(line);
-      const std::vector<std::string> names = split_row(line, delim);
+      if (delim == 0) delim = header_delimiter(line);
+      const std::vector<std::string> names = split_row(line);
+      if (std::all_of(names.begin(), names.end(), [](const std::string& x) { return x.empty(); })) return;
       columns = names.size();
       for (std::size_t i = 0; i < names.size(); ++i) {
-        const std::string n = lower(names[i]);
-        if (n == "file" || n == "filename" || n == "file name") col_file = i;
-        if (n == "bench" || n == "bench_id" || n == "bench id") col_bench = i;
-        if (n == "student" || n == "name" || n == "students") col_student = i;
+        const std::string n = ascii_lower(names[i]);
+        if (n == "file" || n == "filename" || n == "file name" || n == "datei" || n == "dateiname") col_file = i;
+        if (n == "bench" || n == "bench_id" || n == "bench id" || n == "platz" || n == "pr\xc3\xbc" "fstand") col_bench = i;
+        if (n == "student" || n == "name" || n == "students" || n == "studierende") col_student = i;
       }
       if (!col_file || !col_bench)
         throw at(fmt::format("the header '{}' needs a 'file' and a 'bench' column (e.g. file,bench,student)", line));
       return;
     }
-    const std::vector<std::string> f = split_row(line, delim);
+    const std::vector<std::string> f = split_row(line);
+    // A spreadsheet's empty rows (";;;;", ",,,"): nothing in them.
+    if (std::all_of(f.begin(), f.end(), [](const std::string& x) { return x.empty(); })) return;
     if (f.size() <= std::max(*col_file, *col_bench))
       throw at(fmt::format("{} field{} where the header has {}: '{}'", f.size(), f.size() == 1 ? "" : "s", columns, line));
     RosterEntry e{f[*col_file], f[*col_bench], col_student && *col_student < f.size() ? f[*col_student] : "",

@@ -1,6 +1,8 @@
 #include "spindown/bridge_settings.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
 #include <fmt/format.h>
 #include <stdexcept>
 #include <toml++/toml.h>
@@ -73,9 +75,24 @@ struct Reader {
 
 }  // namespace
 
+std::string kb_disagreement(const std::string& path, double bench_kb, const std::string& bench_kb_key, double kb_rel_error,
+                            double motor_constant, const std::string& motor_key) {
+  if (!(bench_kb > 0) || !(motor_constant > 0)) return {};
+  const double apart = std::max(bench_kb / motor_constant, motor_constant / bench_kb) - 1;
+  const double allowed = std::max(kb_disagreement_floor, 2 * kb_rel_error);
+  if (!(apart > allowed)) return {};
+  return fmt::format(
+      "{}: warning: {} and {} disagree by {:.0f} % (one motor's constants agree within {:.0f} %{}): the fits use "
+      "[bench]'s K_b (c2, c4 and ω0 scale with 1/K_b; a bridge reading this file puts it in its CONFIG), [motor]'s "
+      "only for the datasheet's expected friction in the health verdict; check which belongs to this bench's motor",
+      path, bench_kb_key, motor_key, 100 * apart, 100 * allowed,
+      allowed > kb_disagreement_floor ? ", twice the file's kb_error_pct" : "");
+}
+
 void load_bridge_settings(const std::string& path, BridgeSettings& s) {
   const toml::table root = parse_toml_file(path);
   const Reader r{path, root};
+  s.warnings.clear();  // this file's
   long long i = 0;
   double d = 0;
   std::string t;
@@ -111,12 +128,42 @@ void load_bridge_settings(const std::string& path, BridgeSettings& s) {
     s.params.kb_source = fmt::format("speed constant {} rpm/V", d);
   }
   r.text("bench.kb_source", s.params.kb_source);
+  std::string bench_kb_key;
+  if (r.at("bench.kb_v_s_per_rad"))
+    bench_kb_key = fmt::format("[bench] kb_v_s_per_rad = {:.6g} V·s/rad", s.params.kb_v_s_per_rad);
+  else if (r.at("bench.speed_constant_rpm_per_v"))
+    bench_kb_key = fmt::format("[bench] speed_constant_rpm_per_v = {:.6g} rpm/V (K_b {:.6g} V·s/rad)",
+                               r.at("bench.speed_constant_rpm_per_v")->value<double>().value_or(0),
+                               s.params.kb_v_s_per_rad);
   // Their standard uncertainties in percent (geometry and density; the datasheet's tolerance).
   for (const auto& [key, field] : {std::pair{"bench.inertia_error_pct", &BenchParams::inertia_rel_error},
                                    std::pair{"bench.kb_error_pct", &BenchParams::kb_rel_error}}) {
     if (!r.number(key, d)) continue;
     if (!(d >= 0 && d < 100)) r.fail(key, fmt::format("{} is not a percentage in 0-100", d));
     s.params.*field = d / 100;
+  }
+  // [bench] K_b beside the datasheet's [motor] constants (that section is the health file's: only
+  // numbers are looked at here, its own checks are load_motor_health_config's).
+  if (!bench_kb_key.empty()) {
+    const auto motor_number = [&](const char* key) {
+      const toml::node* n = r.at(key);
+      const std::optional<double> v = n ? n->value<double>() : std::nullopt;
+      return v && std::isfinite(*v) && *v > 0 ? *v : 0.0;
+    };
+    if (const double kn = motor_number("motor.speed_constant_rpm_per_v"); kn > 0) {
+      std::string w = kb_disagreement(path, s.params.kb_v_s_per_rad, bench_kb_key, s.params.kb_rel_error,
+                                      kb_from_speed_constant(kn),
+                                      fmt::format("[motor] speed_constant_rpm_per_v = {:.6g} rpm/V (K_b {:.6g} V·s/rad)",
+                                                  kn, kb_from_speed_constant(kn)));
+      if (!w.empty()) s.warnings.push_back(std::move(w));
+    }
+    if (const double km = motor_number("motor.torque_constant_nm_per_a"); km > 0) {
+      std::string w = kb_disagreement(path, s.params.kb_v_s_per_rad, bench_kb_key, s.params.kb_rel_error, km,
+                                      fmt::format("[motor] torque_constant_nm_per_a = {:.6g} N·m/A (the same as K_b in "
+                                                  "V·s/rad)",
+                                                  km));
+      if (!w.empty()) s.warnings.push_back(std::move(w));
+    }
   }
   if (r.text("bench.quantity", t)) {
     const auto q = parse_quantity(t);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <limits>
 
 #include "spindown/effect_simulator.hpp"
@@ -322,6 +323,39 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
   constexpr double max_left = 0.5;
   // ... and move the model by at least half a reading step somewhere (else it fits rounding).
   EffectFit current = out.base;
+  // Backward check after a step: an effect added at an earlier step may only have stood in for the
+  // one just found (greedy order), and a term of the belief may not be needed at all once the
+  // missing effect is in (viscous friction on a motor whose coast is Coulomb's alone). Each is
+  // dropped, and said, when the model does as well without it; a friction term always stays.
+  const auto drop_unneeded = [&](EffectFit& model, ExplainStep& st, double n_eff) {
+    bool any = false;
+    for (bool dropped = true; dropped;) {
+      dropped = false;
+      for (const Effect* e : model.effects) {
+        if (e->name == st.added) continue;
+        std::vector<const Effect*> reduced;
+        for (const Effect* k2 : model.effects)
+          if (k2 != e) reduced.push_back(k2);
+        if (std::none_of(reduced.begin(), reduced.end(), [](const Effect* k2) { return k2->kind == EffectKind::torque; }))
+          continue;
+        EffectFit r = fit_effects(reduced, data, &model);
+        if (!std::isfinite(r.sse) || r.sse <= 0) continue;
+        const double cost = n_eff * std::log(r.sse / model.sse) - e->size() * std::log(n_eff);
+        if (cost >= opt.min_delta_bic) continue;
+        st.removed.emplace_back(e->name);
+        const bool belief = contains(opt.base, e);
+        st.why += fmt::format("; {} removed: not needed{} — the model without it fits as well (dBIC {:.1f} < {:.0f}){}",
+                              e->name, belief ? " (a term of the starting model)" : "", cost, opt.min_delta_bic,
+                              st.added.empty() ? std::string() : fmt::format(", {} covers it", st.added));
+        model = std::move(r);
+        st.fit = model;
+        st.rmse_after = model.rmse;
+        dropped = any = true;
+        break;
+      }
+    }
+    return any;
+  };
   for (int step = 0;; ++step) {
     const std::vector<double> res = residual_of(out.y, current);
     const ResidualBins bins = bin_residuals(res, m, noise);
@@ -504,30 +538,25 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
                          best->effect, best->delta_bic, n_eff, current.rmse, best->fit.rmse, out.unit,
                          current.rmse / best->fit.rmse, 100 * best->systematic_after);
     current = st.fit;
-    // Backward check: an effect added at an earlier step may only have stood in for the one
-    // just found (greedy order); drop it when the model does as well without it.
-    for (bool dropped = true; dropped;) {
-      dropped = false;
-      for (const Effect* e : current.effects) {
-        if (contains(opt.base, e) || e->name == st.added) continue;
-        std::vector<const Effect*> reduced;
-        for (const Effect* k2 : current.effects)
-          if (k2 != e) reduced.push_back(k2);
-        EffectFit r = fit_effects(reduced, data, &current);
-        if (!std::isfinite(r.sse) || r.sse <= 0) continue;
-        const double cost = n_eff * std::log(r.sse / current.sse) - e->size() * std::log(n_eff);
-        if (cost < opt.min_delta_bic) {
-          st.removed.emplace_back(e->name);
-          st.why += fmt::format("; {} removed (dBIC {:.1f} without it: {} covers it)", e->name, cost, st.added);
-          current = std::move(r);
-          st.fit = current;
-          st.rmse_after = current.rmse;
-          dropped = true;
-          break;
-        }
-      }
-    }
+    drop_unneeded(current, st, n_eff);
     out.steps.push_back(std::move(st));
+  }
+  // The belief itself: a term of it the data do not need (viscous friction on a motor whose coast
+  // is Coulomb's alone) is said and removed, as a step of its own when nothing was added.
+  if (out.steps.empty() && current.effects.size() > 1) {
+    ExplainStep st;
+    st.rmse_before = current.rmse;
+    st.fit = current;
+    st.rmse_after = current.rmse;
+    const ResidualBins bins = bin_residuals(residual_of(out.y, current), m, noise);
+    st.bin_noise = bins.bin_se;
+    const double inflation = static_cast<double>(m) * bins.bin_se * bins.bin_se / (noise * noise);
+    const double n_eff = std::clamp(static_cast<double>(n) / std::max(inflation, 1.0), 2.0, static_cast<double>(n));
+    if (drop_unneeded(current, st, n_eff)) {
+      st.why = st.why.substr(std::min<std::size_t>(2, st.why.size()));  // no step added before it: no "; "
+      out.conclusion += fmt::format("; then {} removed: not needed", fmt::join(st.removed, " and "));
+      out.steps.push_back(std::move(st));
+    }
   }
   out.final_fit = current;
   out.top_speed = current.omega0;

@@ -221,7 +221,7 @@ std::optional<HealthBaseline> make_baseline(std::span<const BaselineRun> all_run
   b.inertia_kg_m2 = J / double(runs.size());
   b.source = std::move(source);
   if (!(b.c_coulomb >= 0 && b.c_viscous >= 0))
-    return fail(why, fmt::format("mean coefficients are negative (c_v {:.4g}, c_c {:.4g}): not a usable baseline",
+    return fail(why, fmt::format("mean coefficients are negative (c3 {:.4g}, c4 {:.4g}): not a usable baseline",
                                  b.c_viscous, b.c_coulomb)),
            std::nullopt;
   return b;
@@ -229,8 +229,9 @@ std::optional<HealthBaseline> make_baseline(std::span<const BaselineRun> all_run
 
 std::string baseline_toml_section(const HealthBaseline& b) {
   std::string out = "[baseline]\n";
-  out += fmt::format("# written by `spindown baseline`: combined-model friction of {} good run{}, weighted mean ± "
-                     "standard error; spread = run-to-run standard deviation\n",
+  out += fmt::format("# written by `spindown baseline`: combined-model friction of {} good run{} (c_viscous = fit's "
+                     "c3, c_coulomb = fit's c4), weighted mean ± standard error; spread = run-to-run standard "
+                     "deviation\n",
                      b.runs, b.runs == 1 ? "" : "s");
   out += fmt::format("c_viscous_n_m_s = {}\n", toml_number(b.c_viscous));
   out += fmt::format("c_viscous_stderr = {}\n", toml_number(b.c_viscous_stderr));

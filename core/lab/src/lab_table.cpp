@@ -1,6 +1,8 @@
 #include "spindown/lab_table.hpp"
 
 #include <algorithm>
+#include <cctype>
+#include <functional>
 #include <array>
 #include <cmath>
 #include <ctime>
@@ -40,20 +42,11 @@ std::string age_text(std::int64_t last_us, std::int64_t now_us, double stale_s) 
   return seconds_text(age) + (age > stale_s ? " !" : "");
 }
 
-std::string run_state_text(const LabBenchRow& r) {
+std::string run_state_text(const LabBenchRow& r, bool unfollowed, std::int64_t now_us) {
   if (!r.has_run) return r.has_samples ? "-" : "no data";
+  if (unfollowed)
+    return fmt::format("{} not followed (no fitter for {:.0f} s)", r.run, 1e-6 * double(now_us - r.last_run_us));
   return fmt::format("{} {}{}", r.run, run_state_name(r.run_state), r.run_partial ? " (partial)" : "");
-}
-
-std::string fit_text(const LabBenchRow& r) {
-  if (!r.has_fit) return "-";
-  if (r.best.empty()) return fmt::format("run {}: no model converged", r.fit_run);
-  std::string s = fmt::format("run {}{} {}", r.fit_run, r.fit_partial ? " (partial)" : "", r.best);
-  if (!r.fit_doubt.empty()) s += " NOT VERIFIED";
-  if (!r.coefficients.empty()) s += ": " + r.coefficients;
-  if (r.bench_source != "config" && !r.bench_source.empty()) s += " (default J/K_b)";
-  if (!r.health.empty()) s += "; health " + r.health;
-  return s;
 }
 
 std::string rmse_text(const LabBenchRow& r) {
@@ -66,31 +59,83 @@ std::string bridge_text(const LabBenchRow& r) {
   return fmt::format("{} {}/{} {:.0f} Hz", r.bridge_state, r.lines_good, r.lines_bad, r.rate_hz);
 }
 
+// The bridge in a few characters: its rate and bad lines while connected (the normal state, not
+// said), else its state.
+std::string bridge_short(const LabBenchRow& r) {
+  if (!r.has_bridge) return "-";
+  if (r.bridge_state != "connected") return r.bridge_state;
+  return r.lines_bad ? fmt::format("{:.0f} Hz, {} bad", r.rate_hz, r.lines_bad) : fmt::format("{:.0f} Hz", r.rate_hz);
+}
+
 std::string gaps_text(const LabBenchRow& r) {
   if (!r.has_samples) return "-";
   if (r.seq_gaps == 0) return "0";
   return fmt::format("{} ({} lost)", r.seq_gaps, r.samples_missing);
 }
 
-// An 80-column terminal: the same facts, the verdict before the coefficients.
-constexpr std::size_t compact_width = 110;
+std::string_view state_short(std::int8_t state) {
+  switch (state) {
+    case run_t::STATE_POWERED: return "power";
+    case run_t::STATE_COASTING: return "coast";
+    case run_t::STATE_STOPPED: return "stop";
+    case run_t::STATE_ABANDONED: return "aband";
+    default: return "?";
+  }
+}
 
-std::string bridge_short(const LabBenchRow& r) {
-  if (!r.has_bridge) return "-";
-  return r.lines_bad ? fmt::format("{} {:.0f} Hz, {} bad", r.bridge_state, r.rate_hz, r.lines_bad)
-                     : fmt::format("{} {:.0f} Hz", r.bridge_state, r.rate_hz);
+std::string run_short(const LabBenchRow& r, bool unfollowed) {
+  if (!r.has_run) return r.has_samples ? "-" : "no data";
+  if (unfollowed) return fmt::format("{} not followed", r.run);
+  return fmt::format("{} {}{}", r.run, state_short(r.run_state), r.run_partial ? " (p)" : "");
+}
+
+// The last fit: its run and best model (and whether J/K_b were defaults).
+std::string fit_text(const LabBenchRow& r) {
+  if (!r.has_fit) return "-";
+  if (r.best.empty()) return fmt::format("run {}: no model converged", r.fit_run);
+  std::string s = fmt::format("run {}{} {}", r.fit_run, r.fit_partial ? " (partial)" : "", r.best);
+  if (!r.fit_doubt.empty()) s += " NOT VERIFIED";
+  if (r.bench_source != "config" && !r.bench_source.empty()) s += " (default J/K_b)";
+  return s;
 }
 
 std::string fit_short(const LabBenchRow& r) {
   if (!r.has_fit) return "-";
-  if (r.best.empty()) return fmt::format("run {}: no model converged", r.fit_run);
-  std::string s = fmt::format("{}{} {}", r.fit_run, r.fit_partial ? " (partial)" : "", r.best);
-  if (!r.fit_doubt.empty()) s += " NOT VERIFIED";
-  if (const std::string rmse = rmse_text(r); rmse != "-") s += " " + rmse;
-  if (!r.health.empty()) s += "; " + r.health;
-  if (!r.coefficients.empty()) s += "; " + r.coefficients;
-  return s;
+  const std::string model = r.best.empty() ? "none" : r.best.substr(0, 4);
+  return fmt::format("{}{} {}{}{}", r.fit_run, r.fit_partial ? "p" : "", model,
+                     r.bench_source != "config" && !r.bench_source.empty() ? "*" : "",
+                     r.fit_doubt.empty() ? "" : " NOT VERIFIED");
 }
+
+std::string health_text(const LabBenchRow& r) {
+  if (!r.has_fit || r.health.empty()) return "-";
+  std::string h = r.health;
+  for (char& c : h) c = c == '_' ? ' ' : static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return h;
+}
+
+// A power of ten for a column of coefficients, so that its cells read 1.822±0.011 (the scale said
+// once, under the table): the largest value's, 0 when there is none. Lab units are left unscaled.
+int column_exponent(const std::map<std::string, LabBenchRow, std::less<>>& rows, double LabBenchRow::*value,
+                    bool lab_units) {
+  double top = 0;
+  for (const auto& [id, r] : rows)
+    if (r.has_fit && std::isfinite(r.*value)) top = std::max(top, std::abs(r.*value));
+  if (!(top > 0) || lab_units) return 0;
+  return static_cast<int>(std::floor(std::log10(top)));
+}
+
+std::string coefficient_cell(double value, double error, int exponent) {
+  if (!std::isfinite(value)) return "-";
+  const double scale = std::pow(10.0, -exponent);
+  std::string text = format_value_error(value * scale, std::isfinite(error) ? error * scale : 0.0);
+  std::string out;
+  for (std::size_t i = 0; i < text.size(); ++i)
+    if (text[i] != ' ') out += text[i];  // "1.822 ± 0.011" -> "1.822±0.011"
+  return out;
+}
+
+std::string scale_text(int exponent) { return exponent == 0 ? std::string() : fmt::format("1e{} ", exponent); }
 
 std::string counters_text(const LabServiceRow& s) {
   std::string out;
@@ -101,17 +146,6 @@ std::string counters_text(const LabServiceRow& s) {
   return out.empty() ? "-" : out;
 }
 
-// Cuts a UTF-8 line to width code points (never inside a character).
-std::string cut_to_width(const std::string& line, std::size_t width) {
-  if (width == 0) return line;
-  std::size_t points = 0;
-  for (std::size_t i = 0; i < line.size(); ++i) {
-    if ((static_cast<unsigned char>(line[i]) & 0xC0) == 0x80) continue;
-    if (points == width) return line.substr(0, i);
-    ++points;
-  }
-  return line;
-}
 
 // Columns padded to their widest cell; the last column is not padded.
 std::string format_columns(const std::vector<std::vector<std::string>>& rows, std::size_t width) {
@@ -132,14 +166,61 @@ std::string format_columns(const std::vector<std::vector<std::string>>& rows, st
   return out;
 }
 
+// The width format_columns gives rows: each column as wide as its widest cell, two spaces between.
+std::size_t table_width(const std::vector<std::vector<std::string>>& rows) {
+  std::vector<std::size_t> widths;
+  for (const auto& row : rows) {
+    if (widths.size() < row.size()) widths.resize(row.size(), 0);
+    for (std::size_t i = 0; i < row.size(); ++i) widths[i] = std::max(widths[i], display_width(row[i]));
+  }
+  std::size_t total = 0;
+  for (std::size_t i = 0; i < widths.size(); ++i) total += widths[i] + (i + 1 < widths.size() ? 2 : 0);
+  return total;
+}
+
 }  // namespace
 
-std::size_t display_width(std::string_view utf8) {
-  std::size_t n = 0;
-  for (unsigned char c : utf8)
-    if ((c & 0xC0) != 0x80) ++n;
-  return n;
+std::string cut_to_width(const std::string& line, std::size_t width) {
+  return width == 0 ? line : line.substr(0, utf8_prefix_bytes(line, width));
 }
+
+namespace {
+
+// Parameter k of a fit message: its value and total standard error (J's and K_b's uncertainty
+// included when given, as a lab report quotes it), in the lab's units when asked; and the unit.
+struct ParamValue {
+  double value, error;
+  std::string_view unit;
+};
+ParamValue param_value(const fit_t& msg, std::size_t k, bool lab_units) {
+  ParamValue p{msg.param_value[k], msg.param_stderr[k], pretty_unit(msg.param_unit[k])};
+  if (k < msg.param_bench_error.size() && msg.param_bench_error[k] > 0) p.error = std::hypot(p.error, msg.param_bench_error[k]);
+  if (lab_units)
+    if (auto lab = lab_unit_for(msg.param_unit[k])) {
+      p.value *= lab->per_si;
+      p.error *= lab->per_si;
+      p.unit = lab->pretty;
+    }
+  return p;
+}
+
+// The parameter of that name of the named model (NaN when the message has none).
+ParamValue model_param(const fit_t& msg, std::string_view model, std::string_view name, bool lab_units) {
+  constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+  const auto models = static_cast<std::size_t>(std::max(0, msg.nmodels));
+  for (std::size_t m = 0; m < models && m < msg.model.size(); ++m) {
+    if (msg.model[m] != model || (m < msg.converged.size() && !msg.converged[m])) continue;
+    const auto params = static_cast<std::size_t>(std::max(0, msg.nparams));
+    for (std::size_t k = 0; k < params && k < msg.param_name.size() && k < msg.param_model.size() &&
+                            k < msg.param_value.size() && k < msg.param_stderr.size() && k < msg.param_unit.size();
+         ++k)
+      if (msg.param_model[k] == static_cast<std::int32_t>(m) && msg.param_name[k] == name)
+        return param_value(msg, k, lab_units);
+  }
+  return {nan, nan, {}};
+}
+
+}  // namespace
 
 std::string fit_coefficients_text(const fit_t& msg, bool lab_units, bool with_units) {
   if (msg.best.empty()) return {};
@@ -154,19 +235,10 @@ std::string fit_coefficients_text(const fit_t& msg, bool lab_units, bool with_un
                           k < msg.param_value.size() && k < msg.param_stderr.size() && k < msg.param_unit.size();
        ++k) {
     if (msg.param_model[k] != static_cast<std::int32_t>(best) || !is_friction_coefficient(msg.param_name[k])) continue;
-    double value = msg.param_value[k], err = msg.param_stderr[k];
-    // With J's and K_b's own uncertainty given, the total (what a lab report quotes).
-    if (k < msg.param_bench_error.size() && msg.param_bench_error[k] > 0) err = std::hypot(err, msg.param_bench_error[k]);
-    std::string_view unit = pretty_unit(msg.param_unit[k]);
-    if (lab_units)
-      if (auto lab = lab_unit_for(msg.param_unit[k])) {
-        value *= lab->per_si;
-        err *= lab->per_si;
-        unit = lab->pretty;
-      }
+    const ParamValue p = param_value(msg, k, lab_units);
     if (!out.empty()) out += ", ";
-    out += fmt::format("{} = {}", msg.param_name[k], format_value_error(value, err));
-    if (with_units) out += fmt::format(" {}", unit);
+    out += fmt::format("{} = {}", msg.param_name[k], format_value_error(p.value, p.error));
+    if (with_units) out += fmt::format(" {}", p.unit);
   }
   return out;
 }
@@ -271,6 +343,7 @@ void LabTable::on_run(std::string_view bench, const run_t& msg, std::int64_t now
   r.t_stop_s = msg.t_stop_s;
   r.run_samples = msg.samples;
   r.run_partial = msg.lead_in == "none";
+  r.last_run_us = std::max(r.last_run_us, now_us);
   if (!news) return;
   std::string text = fmt::format("{}: run {} {}", r.bench, msg.run, run_state_name(msg.state));
   switch (msg.state) {
@@ -302,6 +375,8 @@ void LabTable::on_fit(std::string_view bench, const fit_t& msg, std::int64_t now
   r.fit_partial = msg.lead_in == "none";
   r.best = msg.best;
   r.coefficients = fit_coefficients_text(msg, opt_.lab_units, false);
+  const ParamValue c3 = model_param(msg, "combined", "c3", opt_.lab_units), c4 = model_param(msg, "combined", "c4", opt_.lab_units);
+  r.c3 = c3.value, r.c3_error = c3.error, r.c4 = c4.value, r.c4_error = c4.error;
   const std::string with_units = fit_coefficients_text(msg, opt_.lab_units, true);
   r.rmse = std::numeric_limits<double>::quiet_NaN();
   for (std::size_t i = 0; i < msg.model.size() && i < msg.rmse.size(); ++i)
@@ -390,6 +465,10 @@ void LabTable::on_status(std::string_view channel_id, const status_t& msg, std::
   s.uptime_s = msg.uptime_s;
   s.last_error = msg.last_error;
   s.last_message_us = std::max(s.last_message_us, now_us);
+  if (msg.service == "fitter" && now_us >= last_fitter_us_) {
+    last_fitter_us_ = now_us;
+    fitter_stopping_ = msg.state == "stopping";
+  }
   s.counters.clear();
   auto pick = [&](auto names) {
     for (std::string_view name : names)
@@ -425,6 +504,93 @@ void LabTable::on_bad_message(std::string text, std::int64_t) {
   changed_ = true;
 }
 
+bool LabTable::run_unfollowed(const LabBenchRow& r, std::int64_t now_us) const {
+  if (!r.has_run || (r.run_state != run_t::STATE_COASTING && r.run_state != run_t::STATE_STOPPED)) return false;
+  const auto lost_us = static_cast<std::int64_t>(opt_.fitter_lost_s * 1e6);
+  if (now_us - r.last_run_us < lost_us) return false;
+  // A stopped run is final once its FIT came (the fit's run is this run).
+  if (r.run_state == run_t::STATE_STOPPED && r.has_fit && r.fit_run == r.run) return false;
+  return fitter_stopping_ || now_us - last_fitter_us_ >= lost_us;
+}
+
+bool LabTable::two_sources_now(const LabBenchRow& r, std::int64_t now_us) const {
+  return !r.two_sources.empty() && now_us - r.other_source_us <= static_cast<std::int64_t>(opt_.stale_s * 1e6);
+}
+
+std::string LabTable::bench_table(std::int64_t now_us, std::size_t width) const {
+  if (benches_.empty()) return {};
+  const int e3 = column_exponent(benches_, &LabBenchRow::c3, opt_.lab_units);
+  const int e4 = column_exponent(benches_, &LabBenchRow::c4, opt_.lab_units);
+  // The columns in their order: header, short header, the order they are dropped in when the
+  // width asks (0: never; the run, the coefficients and the verdict are what a row is for), and
+  // the cell (full or short).
+  struct Column {
+    std::string head, short_head;
+    int drop;
+    std::function<std::string(const LabBenchRow&, bool)> cell;
+  };
+  const std::string c3_unit = opt_.lab_units ? "g·cm²·s⁻¹" : "N·m·s/rad", c4_unit = opt_.lab_units ? "g·cm²·rad·s⁻²" : "N·m";
+  const std::vector<Column> columns{
+      {"BENCH", "BENCH", 0, [](const LabBenchRow& r, bool) { return r.bench; }},
+      {"RUN", "RUN", 0,
+       [&](const LabBenchRow& r, bool brief) {
+         const bool unfollowed = run_unfollowed(r, now_us);
+         return brief ? run_short(r, unfollowed) : run_state_text(r, unfollowed, now_us);
+       }},
+      {"AGE", "AGE", 4,
+       [&](const LabBenchRow& r, bool) { return age_text(r.last_message_us, now_us, opt_.stale_s); }},
+      {"BRIDGE (lines ok/bad, rate)", "BRIDGE", 1,
+       [&](const LabBenchRow& r, bool brief) {
+         const bool two = two_sources_now(r, now_us);
+         return brief ? bridge_short(r) + (two ? " 2 SOURCES" : "") : bridge_text(r) + (two ? " TWO SOURCES" : "");
+       }},
+      {"SEQ GAPS", "GAPS", 2,
+       [](const LabBenchRow& r, bool brief) {
+         return brief && r.has_samples ? fmt::format("{}", r.seq_gaps) : gaps_text(r);
+       }},
+      {"LAST FIT (best model)", "FIT", 5, [](const LabBenchRow& r, bool brief) { return brief ? fit_short(r) : fit_text(r); }},
+      {fmt::format("c3 ({}{})", scale_text(e3), c3_unit), "c3", 0,
+       [e3](const LabBenchRow& r, bool) { return r.has_fit ? coefficient_cell(r.c3, r.c3_error, e3) : "-"; }},
+      {fmt::format("c4 ({}{})", scale_text(e4), c4_unit), "c4", 0,
+       [e4](const LabBenchRow& r, bool) { return r.has_fit ? coefficient_cell(r.c4, r.c4_error, e4) : "-"; }},
+      {"RMSE", "RMSE", 3, [](const LabBenchRow& r, bool) { return rmse_text(r); }},
+      {"HEALTH", "HEALTH", 0, [](const LabBenchRow& r, bool) { return health_text(r); }},
+  };
+  // Full headers and cells; short headers; short cells; then columns dropped one by one.
+  const auto table = [&](bool short_heads, bool short_cells, int dropped) {
+    std::vector<std::vector<std::string>> rows(1);
+    for (const auto& c : columns)
+      if (c.drop == 0 || c.drop > dropped) rows[0].push_back(short_heads ? c.short_head : c.head);
+    for (const auto& [id, r] : benches_) {
+      rows.emplace_back();
+      for (const auto& c : columns)
+        if (c.drop == 0 || c.drop > dropped) rows.back().push_back(c.cell(r, short_cells));
+    }
+    return rows;
+  };
+  const auto fits = [&](const std::vector<std::vector<std::string>>& rows) {
+    return width == 0 || table_width(rows) <= width;
+  };
+  std::vector<std::vector<std::string>> rows = table(false, false, 0);
+  const int most_dropped = 5;
+  std::string dropped_note;
+  if (!fits(rows)) rows = table(true, false, 0);
+  if (!fits(rows)) rows = table(true, true, 0);
+  for (int d = 1; d <= most_dropped && !fits(rows); ++d) {
+    rows = table(true, true, d);
+    for (const auto& c : columns)
+      if (c.drop == d) dropped_note += (dropped_note.empty() ? "" : ", ") + c.short_head;
+  }
+  std::string out = format_columns(rows, width);
+  // What the cells mean: the coefficients' scale and units, the marks, what the width left out.
+  std::string units = fmt::format("c3 in {}{}, c4 in {}{} (combined model, ± total error)",
+                                  scale_text(e3), c3_unit, scale_text(e4), c4_unit);
+  out += cut_to_width(units, width) + '\n';
+  if (!dropped_note.empty())
+    out += cut_to_width(fmt::format("not shown at this width: {} (wider, or --plain)", dropped_note), width) + '\n';
+  return out;
+}
+
 std::string LabTable::render(std::int64_t now_us, std::size_t width) const {
   std::string out;
   const std::time_t now_s = static_cast<std::time_t>(now_us / 1000000);
@@ -440,39 +606,15 @@ std::string LabTable::render(std::int64_t now_us, std::size_t width) const {
                         "lab's own messages",
                         width) +
            '\n';
-  // A second source on a bench's SAMPLE channel heard lately: said in its row and under the table.
-  const auto two_sources_now = [&](const LabBenchRow& r) {
-    return !r.two_sources.empty() && now_us - r.other_source_us <= static_cast<std::int64_t>(opt_.stale_s * 1e6);
-  };
-  std::vector<std::vector<std::string>> rows;
-  // Health first, the long fit last: a narrow terminal cuts only the end of the coefficients.
-  // Below compact_width columns (an 80-column terminal) the columns are short and the last fit
-  // gives its model, RMSE and verdict before the coefficients.
-  if (width > 0 && width < compact_width) {
-    rows.push_back({"BENCH", "RUN", "AGE", "BRIDGE", "GAPS", "LAST FIT"});
-    for (const auto& [id, r] : benches_)
-      rows.push_back({id, run_state_text(r), age_text(r.last_message_us, now_us, opt_.stale_s),
-                      bridge_short(r) + (two_sources_now(r) ? " 2 SOURCES" : ""),
-                      r.has_samples ? fmt::format("{}", r.seq_gaps) : "-", fit_short(r)});
-  } else {
-    rows.push_back({"BENCH", "RUN", "AGE", "BRIDGE (lines ok/bad, rate)", "SEQ GAPS", "RMSE", "LAST FIT (best model)"});
-    for (const auto& [id, r] : benches_)
-      rows.push_back({id, run_state_text(r), age_text(r.last_message_us, now_us, opt_.stale_s),
-                      bridge_text(r) + (two_sources_now(r) ? " TWO SOURCES" : ""), gaps_text(r), rmse_text(r),
-                      fit_text(r)});
-  }
-  out += format_columns(rows, width);
+  out += bench_table(now_us, width);
+  // A second source on a bench's SAMPLE channel heard lately, and a fit watch cannot vouch for:
+  // marked in the row and said under the table.
   for (const auto& [id, r] : benches_) {
-    if (two_sources_now(r)) out += cut_to_width("  " + r.two_sources, width) + '\n';
+    if (two_sources_now(r, now_us)) out += cut_to_width("  " + r.two_sources, width) + '\n';
     if (!r.fit_doubt.empty())
       out += cut_to_width(fmt::format("  {}: run {} fit NOT VERIFIED: {}", id, r.fit_run, r.fit_doubt), width) + '\n';
   }
   if (benches_.empty()) out += "(no bench heard yet)\n";
-  if (!benches_.empty())
-    out += cut_to_width(opt_.lab_units ? "coefficients in g·cm²·s⁻¹ (c1, c3) and g·cm²·rad·s⁻² (c2, c4)"
-                                       : "coefficients in N·m·s/rad (c1, c3) and N·m (c2, c4)",
-                        width) +
-           '\n';
   if (!services_.empty()) {
     std::vector<std::vector<std::string>> srows;
     srows.push_back({"SERVICE", "STATE", "HOST/PID", "COUNTERS", "AGE"});
@@ -520,6 +662,12 @@ std::vector<std::string> LabTable::bench_ids() const {
 const LabServiceRow* LabTable::service(std::string_view service, std::string_view instance) const {
   auto it = services_.find(fmt::format("{}/{}", service, instance));
   return it == services_.end() ? nullptr : &it->second;
+}
+
+std::vector<const LabServiceRow*> LabTable::services() const {
+  std::vector<const LabServiceRow*> out;
+  for (const auto& [key, s] : services_) out.push_back(&s);
+  return out;
 }
 
 }  // namespace spindown

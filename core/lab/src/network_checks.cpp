@@ -258,6 +258,9 @@ UdpSocketDrops parse_udp_socket_drops(std::string_view text, const std::vector<s
     if (std::find(inodes.begin(), inodes.end(), inode) == inodes.end()) continue;
     ++out.sockets;
     out.drops += std::atoll(w[12].c_str());
+    // "tx_queue:rx_queue", both hexadecimal.
+    if (const auto colon = w[4].find(':'); colon != std::string_view::npos)
+      out.queued_bytes += std::strtoll(std::string(w[4].substr(colon + 1)).c_str(), nullptr, 16);
   }
   return out;
 }
@@ -284,6 +287,7 @@ std::optional<UdpSocketDrops> own_udp_socket_drops() {
     const UdpSocketDrops d = parse_udp_socket_drops(text.str(), inodes);
     total.sockets += d.sockets;
     total.drops += d.drops;
+    total.queued_bytes += d.queued_bytes;
   }
   if (!read_any) return std::nullopt;
   return total;
@@ -292,6 +296,11 @@ std::optional<UdpSocketDrops> own_udp_socket_drops() {
 std::int64_t own_udp_drop_count() {
   const auto d = own_udp_socket_drops();
   return d ? d->drops : -1;
+}
+
+std::int64_t own_udp_queued_bytes() {
+  const auto d = own_udp_socket_drops();
+  return d ? d->queued_bytes : -1;
 }
 
 DoctorCheck check_receive_buffer(std::optional<long> rmem_max, std::optional<long> rcvbuf_errors) {

@@ -133,6 +133,10 @@ void EventLogWriter::prune(std::int64_t now_us) {
   // The file being written counts with what has reached the kernel; its buffer is small beside
   // any sane budget.
   LogPruneResult r = prune_log_files(o_.dir, o_.prefix, o_.bench, path_, o_.retention);
+  count_deletions(r, now_us);
+}
+
+void EventLogWriter::count_deletions(LogPruneResult& r, std::int64_t now_us) {
   for (auto& f : r.deleted) deleted_.push_back(std::move(f.path));
   counters_.files_deleted += static_cast<std::int64_t>(r.deleted.size());
   counters_.bytes_deleted += r.bytes_deleted;
@@ -143,6 +147,22 @@ void EventLogWriter::prune(std::int64_t now_us) {
     last_error_ = r.errors.back();
     last_error_utime_ = now_us;
   }
+}
+
+bool EventLogWriter::make_room(std::int64_t bytes, std::int64_t now_us) {
+  if (!log_ || !o_.retention.enabled()) return true;
+  // The flush, a status event or two, and the filesystem's own rounding.
+  const double needed = double(bytes) + 64.0 * 1024;
+  const int fd = fileno(log_->f);
+  auto enough = [&] {
+    struct statvfs fs {};
+    return ::fstatvfs(fd, &fs) != 0 || double(fs.f_bavail) * double(fs.f_frsize) >= needed;
+  };
+  LogPruneResult r = free_log_space(o_.dir, o_.prefix, o_.bench, path_, enough);
+  if (r.deleted.empty() && r.errors.empty()) return enough();
+  counters_.files_deleted_for_space += static_cast<std::int64_t>(r.deleted.size());
+  count_deletions(r, now_us);
+  return enough();
 }
 
 bool EventLogWriter::rotation_due(std::int64_t now_us, std::int64_t next_event_bytes) const {
@@ -217,6 +237,7 @@ bool EventLogWriter::raw_write(std::int64_t utime, std::string_view channel, con
 bool EventLogWriter::fflush_pending(std::int64_t now_us) {
   if (!log_) return false;
   if (pending_bytes_ == 0) return true;
+  make_room(pending_bytes_, now_us);  // retention frees its old files before an event is lost
   if (std::fflush(log_->f) != 0) {
     fail(now_us, "writing " + path_, errno);
     return false;
@@ -254,6 +275,7 @@ void EventLogWriter::tick(std::int64_t now_us) {
 
 void EventLogWriter::resume_if_due(std::int64_t now_us) {
   if (!disk_full_ || !log_ || now_us < next_reopen_us_) return;
+  make_room(std::int64_t(o_.buffer_bytes), now_us);  // with retention on, its old files make the room
   // Space is back when a buffer's worth is free: the last page of the file may still take a
   // small event while the disk is full, and writing on into it would only fill it again.
   struct statvfs fs {};
@@ -419,6 +441,7 @@ status_t EventLogWriter::make_status(std::int64_t now_us) const {
       {"benches_untracked", counters_.benches_untracked},
       {"disk_full_episodes", counters_.disk_full_episodes},
       {"files_deleted", counters_.files_deleted},
+      {"files_deleted_for_space", counters_.files_deleted_for_space},
       {"bytes_deleted", counters_.bytes_deleted},
       {"retention_errors", counters_.retention_errors},
   };

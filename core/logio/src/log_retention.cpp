@@ -23,13 +23,22 @@ bool LogRetentionOptions::is_valid(std::string* why) const {
   return true;
 }
 
+namespace {
+
+// Oldest = earliest modification time, then name.
+void sort_oldest_first(std::vector<LogFileInfo>& files) {
+  std::sort(files.begin(), files.end(), [](const LogFileInfo& a, const LogFileInfo& b) {
+    return a.mtime_ns != b.mtime_ns ? a.mtime_ns < b.mtime_ns : a.path < b.path;
+  });
+}
+
+}  // namespace
+
 std::vector<LogFileInfo> files_to_prune(std::vector<LogFileInfo> files, std::string_view current,
                                         const LogRetentionOptions& o) {
   std::vector<LogFileInfo> out;
   if (!o.enabled()) return out;
-  std::sort(files.begin(), files.end(), [](const LogFileInfo& a, const LogFileInfo& b) {
-    return a.mtime_ns != b.mtime_ns ? a.mtime_ns < b.mtime_ns : a.path < b.path;
-  });
+  sort_oldest_first(files);
   std::int64_t count = static_cast<std::int64_t>(files.size());
   double bytes = 0;
   for (const auto& f : files) bytes += double(f.bytes);
@@ -66,15 +75,17 @@ bool is_own_log_file_name(std::string_view name, std::string_view prefix, std::s
   return std::all_of(name.begin() + 1, name.end(), [](char c) { return std::isdigit(static_cast<unsigned char>(c)); });
 }
 
-LogPruneResult prune_log_files(const std::string& dir, std::string_view prefix, std::string_view bench,
-                               const std::string& current, const LogRetentionOptions& options) {
-  LogPruneResult r;
+namespace {
+
+// The logger's own files in dir (r.files_kept and r.bytes_kept set), or an error in r.
+std::vector<LogFileInfo> list_own_files(const std::string& dir, std::string_view prefix, std::string_view bench,
+                                        LogPruneResult& r) {
+  std::vector<LogFileInfo> files;
   DIR* d = ::opendir(dir.c_str());
   if (!d) {
     r.errors.push_back(fmt::format("cannot list {} for retention: {}", dir, std::strerror(errno)));
-    return r;
+    return files;
   }
-  std::vector<LogFileInfo> files;
   while (const dirent* e = ::readdir(d)) {
     const std::string_view name = e->d_name;
     if (!is_own_log_file_name(name, prefix, bench)) continue;
@@ -89,15 +100,41 @@ LogPruneResult prune_log_files(const std::string& dir, std::string_view prefix, 
   ::closedir(d);
   r.files_kept = static_cast<std::int64_t>(files.size());
   for (const auto& f : files) r.bytes_kept += f.bytes;
-  for (auto& f : files_to_prune(std::move(files), current, options)) {
-    if (::unlink(f.path.c_str()) != 0 && errno != ENOENT) {
-      r.errors.push_back(fmt::format("cannot delete {} (retention): {}", f.path, std::strerror(errno)));
-      continue;
-    }
-    --r.files_kept;
-    r.bytes_kept -= f.bytes;
-    r.bytes_deleted += f.bytes;
-    r.deleted.push_back(std::move(f));
+  return files;
+}
+
+bool delete_file(LogFileInfo&& f, LogPruneResult& r) {
+  if (::unlink(f.path.c_str()) != 0 && errno != ENOENT) {
+    r.errors.push_back(fmt::format("cannot delete {} (retention): {}", f.path, std::strerror(errno)));
+    return false;
+  }
+  --r.files_kept;
+  r.bytes_kept -= f.bytes;
+  r.bytes_deleted += f.bytes;
+  r.deleted.push_back(std::move(f));
+  return true;
+}
+
+}  // namespace
+
+LogPruneResult prune_log_files(const std::string& dir, std::string_view prefix, std::string_view bench,
+                               const std::string& current, const LogRetentionOptions& options) {
+  LogPruneResult r;
+  std::vector<LogFileInfo> files = list_own_files(dir, prefix, bench, r);
+  for (auto& f : files_to_prune(std::move(files), current, options)) delete_file(std::move(f), r);
+  return r;
+}
+
+LogPruneResult free_log_space(const std::string& dir, std::string_view prefix, std::string_view bench,
+                              const std::string& current, const std::function<bool()>& enough) {
+  LogPruneResult r;
+  if (enough()) return r;
+  std::vector<LogFileInfo> files = list_own_files(dir, prefix, bench, r);
+  sort_oldest_first(files);  // every file but the current one may go, the oldest first
+  for (auto& f : files) {
+    if (f.path == current) continue;
+    delete_file(std::move(f), r);
+    if (enough()) break;
   }
   return r;
 }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <optional>
 #include <random>
 
 #include "spindown/coast_simulator.hpp"
@@ -31,6 +32,36 @@ void add_glitches(SyntheticRun& out, const SyntheticRunSpec& s) {
   }
 }
 
+// The floating pin of the handout's step 6, until it is connected: its level, hum and drift, and
+// the connection with its bounce. Drawn from its own random stream, so the rest of the recording
+// is the one another lead-in would give.
+struct FloatingPin {
+  double level, pickup, phase, connect_s;
+  int bounce;
+  double drift = 0;
+  std::mt19937_64 rng;
+  std::normal_distribution<double> gauss{0.0, 1.0};
+  FloatingPin(const SyntheticRunSpec& s) : rng(s.seed ^ 0xf10a7196ull) {
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    level = std::isfinite(s.float_level_v) ? s.float_level_v : 0.5 + 2.0 * u(rng);
+    pickup = std::isfinite(s.pickup_v) ? s.pickup_v : 0.05 + 0.55 * u(rng);
+    phase = 2 * M_PI * u(rng);
+    connect_s = std::isfinite(s.connect_s) ? s.connect_s : u(rng);
+    bounce = s.bounce_samples >= 0 ? s.bounce_samples : int(rng() % 4);
+  }
+  // What the open pin reads at device time t_ms: the level, a slow drift (a random walk pulled back
+  // over ~2 s), the hum at the sampling instant (the loop's period aliases it), noise.
+  double read(double t_ms, double period_s, double mains_hz, double noise_v) {
+    const double pull = std::min(1.0, period_s / 2.0);
+    drift = (1.0 - pull) * drift + 0.02 * std::sqrt(period_s / 0.02) * gauss(rng);
+    return level + drift + pickup * std::sin(2 * M_PI * mains_hz * t_ms / 1000.0 + phase) + noise_v * gauss(rng);
+  }
+  // A sample taken while the contact bounces: part way between the open pin and the motor.
+  double bounced(double open, double motor) {
+    return open + std::uniform_real_distribution<double>(0.0, 1.0)(rng) * (motor - open);
+  }
+};
+
 }  // namespace
 
 SyntheticRun make_synthetic_run(const SyntheticRunSpec& s) {
@@ -52,7 +83,10 @@ SyntheticRun make_synthetic_run(const SyntheticRunSpec& s) {
 
   const int adc_max = s.adc_bits > 0 ? (1 << s.adc_bits) - 1 : 0;
   const double p10 = s.decimals >= 0 ? std::pow(10.0, s.decimals) : 0.0;
-  double floating = 0.2;  // a floating pin wanders slowly between rails' noise and ~0.6 V
+  std::optional<FloatingPin> pin;
+  if (s.lead_in == LeadIn::floating && !mid_coast) pin.emplace(s);
+  out.t_connect_ms = pin ? out.t_cut_ms + 1000.0 * pin->connect_s : out.t_cut_ms;
+  int bounces_left = pin ? pin->bounce : 0;
   double t_real_ms = s.t0_ms;
   for (std::size_t guard = 0; guard < 50'000'000; ++guard) {
     if (s.gap_s > 0 && t_real_ms >= gap_from_ms && t_real_ms < gap_to_ms) {  // the logger paused
@@ -71,11 +105,12 @@ SyntheticRun make_synthetic_run(const SyntheticRunSpec& s) {
         }
         case LeadIn::zeros: v = 0.0; break;
         case LeadIn::supply: v = s.supply_v + s.noise_v * gauss(rng); break;
-        case LeadIn::floating:
-          floating = std::clamp(0.85 * floating + 0.15 * 0.25 + 0.12 * gauss(rng), 0.0, 0.7);
-          v = floating;
-          break;
+        case LeadIn::floating: v = pin ? pin->read(t_real_ms, s.period_s, s.mains_hz, s.noise_v) : 0.0; break;
       }
+    } else if (pin && t_real_ms < out.t_connect_ms) {
+      v = pin->read(t_real_ms, s.period_s, s.mains_hz, s.noise_v);  // the motor coasts, the pin is still open
+      const double tau = (t_real_ms - out.t_cut_ms) / 1000.0;
+      if (tau > sim.time()) sim.advance(tau - sim.time());
     } else {
       const double tau = (t_real_ms - out.t_cut_ms) / 1000.0;
       if (tau > sim.time()) sim.advance(tau - sim.time());
@@ -102,6 +137,13 @@ SyntheticRun make_synthetic_run(const SyntheticRunSpec& s) {
       const double ripple = s.ripple * std::sin(s.ripple_per_rev * sim.angle());
       // A per-revolution sensor's reading is a count, not an analog voltage: no noise on it.
       v = s.bench.kb_v_s_per_rad * w * (1.0 + ripple) + s.offset_v + (pulse_angle > 0 ? 0.0 : s.noise_v * gauss(rng));
+      if (bounces_left > 0) {  // the contact bounces: the pin reads part way between open and the motor
+        --bounces_left;
+        const double motor = v;
+        v = pin->bounced(pin->read(t_real_ms, s.period_s, s.mains_hz, s.noise_v), motor);
+        // Truth: a bounce that reads what the motor reads (within its noise, or 3 %) is no bad sample.
+        if (std::abs(v - motor) > std::max(0.03 * std::abs(motor), 4.0 * s.noise_v)) out.bounce_index.push_back(out.t_ms.size());
+      }
       const bool done_stopped = sim.stopped() && tau > sim.stop_time() + s.tail_s;
       const bool done_coast = !sim.stopped() && tau > s.max_coast_s;
       if (done_stopped || done_coast) break;

@@ -8,6 +8,7 @@
 #include <exception>
 #include <fmt/format.h>
 #include <limits>
+#include <optional>
 #include <regex>
 
 #include "spindown/fit_message.hpp"
@@ -21,6 +22,28 @@ namespace {
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Whether the command line or the bench's file names J, K_b or their uncertainties.
+bool names_bench(const BenchChoice& named, const BenchFile* file) {
+  return named.inertia_given || named.kb_given || named.inertia_error_given || named.kb_error_given ||
+         (file && (file->sets_inertia || file->sets_kb || file->sets_inertia_error || file->sets_kb_error));
+}
+
+// Where each of J and K_b came from, by choose_bench_params' rule, and what the CONFIG said when
+// it was overruled: "J: --inertia (over the log's CONFIG: 1.12688e-05 kg·m²); K_b: CONFIG".
+std::string named_bench_source(const BenchChoice& named, const BenchFile* file, const std::optional<BenchParams>& config) {
+  const auto one = [&](const char* what, bool given, bool file_sets, double config_value, const char* unit) {
+    std::string from = given ? std::string("the command line")
+                       : file_sets ? fmt::format("bench file {}", file->path)
+                       : config   ? std::string("CONFIG")
+                                  : std::string("the default");
+    if ((given || file_sets) && config)
+      from += fmt::format(" (over the log's CONFIG: {:.6g} {})", config_value, unit);
+    return fmt::format("{}: {}", what, from);
+  };
+  return one("J", named.inertia_given, file && file->sets_inertia, config ? config->inertia_kg_m2 : 0, "kg·m²") + "; " +
+         one("K_b", named.kb_given, file && file->sets_kb, config ? config->kb_v_s_per_rad : 0, "V·s/rad");
 }
 
 }  // namespace
@@ -120,7 +143,13 @@ void FitterCore::fit_and_publish(Bench& b, const Run& run, const std::string& wh
   r.detected_utime = recv_utime;
   FitOptions fo;
   fo.models = opt_.models;
-  if (opt_.ignore_config) {
+  const auto file_it = opt_.bench_files.find(b.id);
+  const BenchFile* file = file_it == opt_.bench_files.end() ? nullptr : &file_it->second;
+  if (names_bench(opt_.named, file)) {
+    const std::optional<BenchParams> config = opt_.ignore_config ? std::nullopt : b.config;
+    fo.bench = choose_bench_params(opt_.named, file, config);
+    r.bench_source = named_bench_source(opt_.named, file, config);
+  } else if (opt_.ignore_config) {
     fo.bench = opt_.default_bench;
     r.bench_source = "default (CONFIG ignored by option)";
   } else if (b.config) {
@@ -176,6 +205,27 @@ void FitterCore::finish(std::int64_t now_utime) {
     }
     trim_mirror(*b);
   }
+}
+
+void FitterCore::abandon_open_runs(std::int64_t now_utime, const std::string& why) {
+  std::vector<Bench*> order;
+  for (auto& [id, b] : benches_) order.push_back(b.get());
+  std::sort(order.begin(), order.end(), [](const Bench* a, const Bench* b) { return a->arrival < b->arrival; });
+  for (Bench* b : order) {
+    if (b->open_state == 0) continue;
+    Run run = b->open_run;
+    run.end_index = b->detector.samples_seen();  // every sample it had when the fitter stopped
+    ++counters_.runs_abandoned;
+    publish_run(*b, run, run_t::STATE_ABANDONED, why, now_utime);
+    b->open_state = 0;
+  }
+}
+
+bool FitterCore::silence_due(std::int64_t now_utime) const {
+  const auto silent_us = static_cast<std::int64_t>(opt_.silent_s * 1e6);
+  for (const auto& [id, b] : benches_)
+    if (b->open_state != 0 && now_utime - b->last_sample_utime >= silent_us) return true;
+  return false;
 }
 
 void FitterCore::poll(std::int64_t now_utime) {

@@ -81,6 +81,7 @@ status_t FitterCore::make_status(std::int64_t now_utime, std::string_view instan
       {"time_backwards", c.time_backwards}, {"quantity_errors", c.quantity_errors},
       {"bad_configs", c.bad_configs},     {"dropped_benches", c.dropped_benches},
       {"benches_refused", c.benches_refused}, {"partial_runs", c.partial_runs},
+      {"runs_abandoned", c.runs_abandoned},
       {"silent_benches", c.silent_benches},
       {"flood_drops", c.flood_drops},     {"flood_messages", c.flood_messages},
       {"internal_errors", c.internal_errors},

@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 #include <ctime>
+#include <filesystem>
 #include <fmt/format.h>
 #include <utility>
 #include <vector>
@@ -56,6 +57,28 @@ summary{cursor:pointer;color:#1f4e79}
 ol.story li{margin:4px 0}
 .fail{color:#c62828}
 ul.diag{font-size:12px;font-family:monospace}
+.print-only{display:none}
+table.runs td{white-space:nowrap}
+table.runs td.why{white-space:normal;font-size:12px}
+/* On paper: the summary, the trends, every run in one line of the runs table and the files with
+   problems; each run's figure, coefficients and story stay on the screen. A semester prints on a
+   few pages instead of one page per run. */
+@media print{
+@page{size:A4;margin:12mm}
+body{background:#fff;font-size:9pt}
+main{max-width:none;padding:0}
+h1{font-size:16pt}h2{font-size:13pt;margin:14px 0 6px;break-after:avoid}h4{break-after:avoid}
+nav,details,section.bench,.screen-only{display:none!important}
+.print-only{display:block}
+table{font-size:8pt;margin:4px 0}th,td{padding:1px 4px}tr{break-inside:avoid}
+table.runs td.why{font-size:7pt}
+#files tr.clean{display:none}
+figure{margin:2px 0;break-inside:avoid}
+svg.trend-plot{width:100%;height:auto;max-height:55mm}
+svg.run-plot{display:none}
+a{color:inherit;text-decoration:none}
+.badge{color:#000!important;background:none!important;border:1px solid #000;padding:0 4px}
+}
 )css";
 
 std::string esc(std::string_view s) { return html_escape(s); }
@@ -72,15 +95,6 @@ std::string level_badge(HealthLevel level) {
   std::string upper(name);
   for (char& c : upper) c = c == '_' ? ' ' : static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
   return fmt::format("<span class=\"badge {}\">{}</span>", name, upper);
-}
-
-std::string utc_text(double unix_s) {
-  const std::time_t t = static_cast<std::time_t>(std::floor(unix_s));
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%d %H:%M:%S", &tm);
-  return buf;
 }
 
 std::string value_unit(double value, double se, std::string_view ascii_unit) {
@@ -179,11 +193,17 @@ std::string run_figure_svg(const ReportRun& r) {
   for (const auto& m : r.fit.models)
     if (m.converged || !m.params.empty()) curves.emplace_back(&m, model_curve(r, m));
 
+  // The top panel shows the recording around the run (its context) with the fitted window shaded,
+  // so that what came before the cut is seen; the residuals are the fitted window's.
+  const std::size_t nc = std::min(r.context_tau.size(), r.context_y.size());
   double ymin = 0, ymax = 0;
   for (std::size_t i = 0; i < n; ++i)
     if (std::isfinite(r.y[i])) ymin = std::min(ymin, r.y[i]), ymax = std::max(ymax, r.y[i]);
+  for (std::size_t i = 0; i < nc; ++i)
+    if (std::isfinite(r.context_y[i])) ymin = std::min(ymin, r.context_y[i]), ymax = std::max(ymax, r.context_y[i]);
   const double tmin = std::min(0.0, r.tau.front()), tmax = std::max(r.tau[n - 1], tmin + 1e-3);
-  Panel top{80, 46, run_w - 110, 300, tmin, tmax, ymin, ymax + 0.05 * (ymax - ymin) + 1e-9};
+  const double cmin = nc ? std::min(tmin, r.context_tau.front()) : tmin, cmax = nc ? std::max(tmax, r.context_tau[nc - 1]) : tmax;
+  Panel top{80, 46, run_w - 110, 300, cmin, cmax, ymin, ymax + 0.05 * (ymax - ymin) + 1e-9};
 
   // Residuals: bin means for every model, every sample for the best one.
   const std::size_t m = samples_per_half_second(r);
@@ -205,11 +225,27 @@ std::string run_figure_svg(const ReportRun& r) {
 
   s += fmt::format("<text x=\"{}\" y=\"24\" text-anchor=\"middle\" font-size=\"15\" font-weight=\"bold\">{}</text>\n",
                    run_w / 2, html_escape(title));
-  s += svg::axes(top, "time after the cut (s)", fmt::format("reading ({})", unit));
+  // The fitted window, shaded (behind everything), and the cut.
+  s += fmt::format("<rect class=\"fitted-window\" x=\"{:.1f}\" y=\"{:.1f}\" width=\"{:.1f}\" height=\"{:.1f}\" "
+                   "fill=\"#1f77b4\" fill-opacity=\"0.10\" data-t-from=\"{:.6g}\" data-t-to=\"{:.6g}\"/>\n",
+                   top.px(r.tau.front()), top.y, std::max(1.0, top.px(r.tau[n - 1]) - top.px(r.tau.front())), top.h,
+                   r.tau.front(), r.tau[n - 1]);
+  s += svg::axes(top, nc ? "time after the cut (s): the recording around the run, the fitted window shaded"
+                         : "time after the cut (s)",
+                 fmt::format("reading ({})", unit));
+  s += fmt::format("<line class=\"cut\" x1=\"{0:.1f}\" y1=\"{1:.1f}\" x2=\"{0:.1f}\" y2=\"{2:.1f}\" stroke=\"#444\" "
+                   "stroke-width=\"1\" stroke-dasharray=\"5,3\"/>\n<text x=\"{3:.1f}\" y=\"{4:.1f}\" font-size=\"11\">cut</text>\n",
+                   top.px(0), top.y, top.y + top.h, top.px(0) + 3, top.y + 12);
   const std::size_t stride = std::max<std::size_t>(1, n / 2500);
+  std::vector<std::pair<std::string, std::string>> items;
+  if (nc) {
+    s += svg::dots(top, r.context_tau, r.context_y, std::max<std::size_t>(1, nc / 4000), 1.2, "#bbb");
+    items.push_back({"recording outside the fitted window", "stroke=\"#bbb\" stroke-width=\"4\" stroke-dasharray=\"2,4\""});
+  }
   s += svg::dots(top, r.tau, r.y, stride, 1.6, "#777");
-  std::vector<std::pair<std::string, std::string>> items{
-      {"measurement", "stroke=\"#777\" stroke-width=\"4\" stroke-dasharray=\"2,4\""}};
+  items.push_back({"measurement (fitted)", "stroke=\"#777\" stroke-width=\"4\" stroke-dasharray=\"2,4\""});
+  items.push_back({fmt::format("fitted window: {:.2f} s to {:.2f} s after the cut", r.tau.front(), r.tau[n - 1]),
+                   "stroke=\"#1f77b4\" stroke-opacity=\"0.2\" stroke-width=\"10\""});
   for (const auto& [model, curve] : curves) {
     const bool best = model_name(model->kind) == r.fit.best;
     s += svg::polyline(top, r.tau, curve, line_style(*model, best));
@@ -219,7 +255,7 @@ std::string run_figure_svg(const ReportRun& r) {
   }
   s += svg::legend(top.x + top.w - 300, top.y + 10, items, 290);
 
-  s += svg::axes(bot, "time after the cut (s)", fmt::format("measurement - model ({})", unit));
+  s += svg::axes(bot, "time after the cut (s): the fitted window", fmt::format("measurement - model ({})", unit));
   if (!best_res.empty()) s += svg::dots(bot, r.tau, best_res, stride, 1.2, "#9ecae1");
   std::vector<std::pair<std::string, std::string>> res_items;
   for (std::size_t c = 0; c < curves.size(); ++c) {
@@ -310,6 +346,33 @@ std::string trend_cell(const CoefficientTrend& t) {
   return out;
 }
 
+// Every run in one line: what a printed page keeps of each (the figures and stories stay on screen).
+std::string runs_table(const SessionReport& report) {
+  std::string s = fmt::format(
+      "<h3>Every run</h3>\n<p class=\"print-only meta\">On paper: one line per run; each run's figure, "
+      "coefficients and explain story are in this page on screen.</p>\n<table class=\"runs\">\n<tr><th>bench</th>"
+      "<th>run</th><th>recorded</th><th>file</th><th>best model</th><th>viscous c3</th><th>dry friction c4</th>"
+      "<th>health</th><th>why</th></tr>\n");
+  for (const auto& b : report.benches)
+    for (std::size_t i : b.runs) {
+      const ReportRun& r = report.runs[i];
+      const ReportFile* file = r.file_index < report.files.size() ? &report.files[r.file_index] : nullptr;
+      std::string who = file ? esc(std::filesystem::path(file->file).filename().string()) : esc(r.source);
+      if (file && !file->student.empty()) who += " (" + esc(file->student) + ")";
+      const auto f = combined_friction(r.fit);
+      s += fmt::format("<tr><td>{}</td><td class=\"num\"><a href=\"#{}\">{}</a></td><td>{}</td><td>{}</td><td>{}</td>"
+                       "<td class=\"num\">{}</td><td class=\"num\">{}</td><td>{}</td><td class=\"why\">{}</td></tr>\n",
+                       esc(r.bench), anchor("run-", fmt::format("{}-{}", r.bench, r.order)), r.order,
+                       r.cut_unix_s ? esc(recorded_at_text({*r.cut_unix_s, r.cut_local})) : "–", who,
+                       esc(r.fit.best.empty() ? "none converged" : r.fit.best) +
+                           (r.fit.doubts.empty() ? "" : " <span class=\"fail\">(doubtful)</span>"),
+                       f ? esc(value_unit(f->c_viscous, f->c_viscous_stderr, "N*m*s/rad")) : "–",
+                       f ? esc(value_unit(f->c_coulomb, f->c_coulomb_stderr, "N*m")) : "–", level_badge(r.health.level),
+                       esc(r.health.reason));
+    }
+  return s + "</table>\n";
+}
+
 std::string summary_section(const SessionReport& report) {
   std::string s = "<section id=\"summary\">\n<h2>Summary across benches and runs</h2>\n";
   std::size_t drifting = 0;
@@ -330,6 +393,7 @@ std::string summary_section(const SessionReport& report) {
                      trend_cell(b.viscous), trend_cell(b.coulomb));
   }
   s += "</table>\n";
+  s += runs_table(report);
   for (const auto& b : report.benches)
     if (b.runs.size() >= 2) {
       s += fmt::format("<h4>Bench {}: friction over its runs</h4>\n<figure>\n{}</figure>\n", esc(b.bench),
@@ -354,10 +418,11 @@ std::string files_section(const SessionReport& report) {
     for (const auto& d : f.diagnostics) warnings += d.severity != Diagnostic::Severity::note;
     std::string problems = fmt::format("{} warning{}", warnings, warnings == 1 ? "" : "s");
     for (const auto& why : f.failures) problems += fmt::format("<br><span class=\"fail\">not used: {}</span>", esc(why));
-    s += fmt::format("<tr><td>{}</td>{}<td>{}</td><td>{}</td><td class=\"num\">{}</td><td>{}</td><td>{}</td></tr>\n",
+    s += fmt::format("<tr{}><td>{}</td>{}<td>{}</td><td>{}</td><td class=\"num\">{}</td><td>{}</td><td>{}</td></tr>\n",
+                     warnings == 0 && f.failures.empty() ? " class=\"clean\"" : "",
                      esc(f.file), students ? fmt::format("<td>{}</td>", esc(f.student)) : "",
                      esc(file_format_name(f.format)), benches, f.samples,
-                     f.start_unix_s ? utc_text(*f.start_unix_s) : "–", problems);
+                     f.start_unix_s ? recorded_at_text({*f.start_unix_s, f.start_local}) : "–", problems);
   }
   s += "</table>\n";
   for (const auto& f : report.files) {
@@ -462,6 +527,15 @@ std::string explain_block(const ReportRun& r) {
                                        : esc(" — the fit's " + fit_name + " model above but for its zero level"),
                    esc(params_inline(e.base)), e.base.rmse, esc(e.unit), e.reading_noise, esc(e.unit));
   for (const auto& step : e.steps) {
+    std::string removed;
+    for (const auto& gone : step.removed) removed += (removed.empty() ? "" : ", ") + gone;
+    if (step.added.empty()) {  // a term of the belief the data do not need
+      s += fmt::format("<li>Not needed: <strong>{}</strong>. {}. RMSE {:.3g} → {:.3g} {}.<br><span class=\"meta\">{}: "
+                       "{}</span></li>\n",
+                       esc(removed), esc(step.why), step.rmse_before, step.rmse_after, esc(e.unit), esc(step.fit.title()),
+                       esc(params_inline(step.fit)));
+      continue;
+    }
     const Effect* effect = find_effect(step.added);
     std::string where;
     for (const auto& d : step.where)
@@ -472,7 +546,8 @@ std::string explain_block(const ReportRun& r) {
                      esc(where.empty() ? "—" : where), esc(step.added),
                      effect ? esc(" — " + (step.meaning.empty() ? std::string(effect->meaning) : step.meaning)) : "",
                      step.rmse_before, step.rmse_after, esc(e.unit),
-                     step.undecided.empty() ? std::string() : " <em>" + esc("Undecided: " + step.undecided) + "</em>",
+                     (step.undecided.empty() ? std::string() : " <em>" + esc("Undecided: " + step.undecided) + "</em>") +
+                         (removed.empty() ? std::string() : " " + esc("Removed (not needed once it is in): " + removed) + "."),
                      esc(step.fit.title()), esc(params_inline(step.fit)));
   }
   if (e.steps.empty()) s += "<li>Nothing needed adding: the belief explains the data within the noise.</li>\n";
@@ -496,7 +571,7 @@ std::string run_article(const SessionReport& report, const ReportRun& r) {
                               run.number, esc(file));
   s += fmt::format("<p class=\"meta\">cut at {:.3f} s{} · {} · {} samples fitted · lead-in {} · period {:.1f} ms · "
                    "zero level {:.3g} {} · reading noise σ {:.2g} {} · J = {:.6g} kg·m² ({}) · K_b = {:.6g} V·s/rad ({})</p>\n",
-                   run.t_cut_s, r.cut_unix_s ? fmt::format(" ({} UTC)", utc_text(*r.cut_unix_s)) : "",
+                   run.t_cut_s, r.cut_unix_s ? fmt::format(" ({})", recorded_at_text({*r.cut_unix_s, r.cut_local})) : "",
                    run.stopped ? fmt::format("stopped {:.2f} s after the cut", run.t_stop_s - run.t_cut_s)
                                : "did not stop",
                    r.tau.size(), esc(run.lead_in), 1e3 * run.period_s, run.zero_level, quantity_unit(r.fit.quantity),

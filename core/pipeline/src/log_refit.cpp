@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <limits>
 #include <map>
+#include <sys/stat.h>
 
 #include "spindown/fit_message.hpp"
 #include "spindown/session_id.hpp"
@@ -24,13 +25,13 @@ class RefitSink final : public FitterSink {
   void fit_ready(const FitResult& r) override {
     ++out_.runs_fitted;
     if (!each_run_) {
-      out_.runs.push_back({r.bench, r.fit, r.bench_source, r.first_seq, r.last_seq});
+      out_.runs.push_back({r.bench, r.fit, r.bench_source, r.first_seq, r.last_seq, r.health});
       return;
     }
     if (r.fit.best.empty())
       out_.file.failures.push_back(fmt::format("SPINDOWN.{}.SAMPLE: run {}: no model converged", r.bench,
                                                r.fit.run.number));
-    each_run_(RefitRun{r.bench, r.fit, r.bench_source, r.first_seq, r.last_seq});
+    each_run_(RefitRun{r.bench, r.fit, r.bench_source, r.first_seq, r.last_seq, r.health});
   }
   void problem(const std::string& text) override {
     if (++problems_ <= max_problems_listed)
@@ -57,94 +58,174 @@ class RefitSink final : public FitterSink {
 LogRefit refit_log(const std::string& path, const FitterOptions& options, bool keep_live_fits,
                    const std::function<void(const LcmLogEvent&)>& each_event, const RefitProgressFn& progress,
                    const RefitRunFn& each_run) {
-  LogRefit out;
-  out.file.file = path;
-  // The core reads samples in place; a caller that sees each event may want the samples_t.
-  LcmLogReader reader(path, each_event ? LcmSamples::view_and_message : LcmSamples::view_only);
-  if (!reader.good()) {
-    out.file.failures.push_back(reader.open_error());
-    return out;
+  return refit_log_session({path}, options, keep_live_fits, each_event, progress, each_run);
+}
+
+namespace {
+
+// The first and last event times of a log (0, 0 when it holds none).
+std::pair<std::int64_t, std::int64_t> log_time_span(const std::string& path) {
+  LcmLogReader reader(path, LcmSamples::view_only);
+  std::int64_t first = 0, last = 0;
+  LcmLogEvent ev;
+  while (reader.good() && reader.next(ev)) {
+    if (ev.number <= 0) continue;
+    if (first == 0) first = ev.log_utime;
+    last = ev.log_utime;
   }
+  return {first, last};
+}
+
+}  // namespace
+
+std::vector<std::vector<std::string>> log_sessions(const std::vector<std::string>& paths) {
+  struct Span {
+    std::string path;
+    std::int64_t first, last;
+  };
+  std::vector<Span> spans;
+  for (const auto& p : paths) {
+    const auto [first, last] = log_time_span(p);
+    spans.push_back({p, first, last});
+  }
+  // Unreadable or empty logs keep their place at the end, each alone.
+  std::stable_sort(spans.begin(), spans.end(), [](const Span& a, const Span& b) {
+    if ((a.first == 0) != (b.first == 0)) return b.first == 0;
+    return a.first < b.first;
+  });
+  std::vector<std::vector<std::string>> sessions;
+  std::int64_t session_end = 0;
+  for (const Span& sp : spans) {
+    if (sp.first != 0 && !sessions.empty() && session_end != 0 && sp.first >= session_end) {
+      sessions.back().push_back(sp.path);
+    } else {
+      sessions.push_back({sp.path});
+    }
+    session_end = sp.last;
+  }
+  return sessions;
+}
+
+LogRefit refit_log_session(const std::vector<std::string>& paths, const FitterOptions& options, bool keep_live_fits,
+                           const std::function<void(const LcmLogEvent&)>& each_event, const RefitProgressFn& progress,
+                           const RefitRunFn& each_run) {
+  LogRefit out;
+  out.file.file = paths.empty() ? std::string() : paths.front();
+  out.session_files = paths;
+  const std::string& path = out.file.file;
   RefitSink sink(out, path, each_run);
   FitterCore core(options, sink);
   std::map<std::string, std::size_t, std::less<>> order;
-  std::vector<char> channel_done;  // by LcmLogEvent::channel_id: its bench's place is known
+  std::vector<char> channel_done;  // by session channel id: its bench's place is known
+  // Each reader numbers its own channels; the core's numbering is the session's, by name.
+  std::map<std::string, std::int32_t, std::less<>> session_ids;
   std::vector<std::uint64_t> fitter_sessions;  // of the fitters' heartbeats in the log (keep_live_fits)
   std::int64_t last_utime = 0, next_poll = std::numeric_limits<std::int64_t>::min();
   std::size_t file_problems = 0;
+  std::int64_t events_read = 0, bytes_before = 0, bytes_total = 0;
+  for (const auto& p : paths) {
+    struct stat st {};
+    if (::stat(p.c_str(), &st) == 0) bytes_total += st.st_size;
+  }
   LcmLogEvent ev;
-  // Progress every 256 events, counted down (one test per event, none for a caller without one).
-  constexpr std::size_t progress_every = 256;
-  std::size_t until_progress = progress ? progress_every : std::numeric_limits<std::size_t>::max();
-  while (reader.next(ev)) {
-    if (each_event) each_event(ev);
-    if (--until_progress == 0) {
-      until_progress = progress_every;
-      progress(ev.file_offset, reader.file_size(), out.runs_fitted);
+  std::size_t opened = 0;
+  for (const std::string& file : paths) {
+    // The core reads samples in place; a caller that sees each event may want the samples_t.
+    LcmLogReader reader(file, each_event ? LcmSamples::view_and_message : LcmSamples::view_only);
+    if (!reader.good()) {
+      out.file.failures.push_back(reader.open_error());
+      continue;
     }
-    if (ev.number > 0) last_utime = ev.log_utime;
-    // Host time passes as the log's events do: benches gone silent mid-coast are closed as live.
-    if (ev.log_utime >= next_poll) {
-      core.poll(ev.log_utime);
-      next_poll = ev.log_utime + FitterCore::poll_period_us;
-    }
-    // A bench's first SAMPLE/CONFIG fixes its place; checked once per channel, not per event.
-    const auto id = static_cast<std::size_t>(ev.channel_id);
-    if (ev.channel_id < 0 || id >= channel_done.size() || !channel_done[id]) {
-      if (!ev.bench.empty() && (ev.channel.ends_with(".SAMPLE") || ev.channel.ends_with(".CONFIG")) &&
-          !order.contains(ev.bench)) {
-        order.emplace(ev.bench, order.size());
-        out.bench_order.emplace_back(ev.bench);
+    ++opened;
+    std::vector<std::int32_t> id_map;  // reader's channel id -> the session's
+    // Progress every 256 events, counted down (one test per event, none for a caller without one).
+    constexpr std::size_t progress_every = 256;
+    std::size_t until_progress = progress ? progress_every : std::numeric_limits<std::size_t>::max();
+    while (reader.next(ev)) {
+      if (each_event) each_event(ev);
+      if (--until_progress == 0) {
+        until_progress = progress_every;
+        progress(bytes_before + ev.file_offset, std::max(bytes_total, bytes_before + reader.file_size()),
+                 out.runs_fitted);
+      }
+      if (ev.number > 0) last_utime = ev.log_utime;
+      // Host time passes as the log's events do: benches gone silent mid-coast are closed as live.
+      if (ev.log_utime >= next_poll) {
+        core.poll(ev.log_utime);
+        next_poll = ev.log_utime + FitterCore::poll_period_us;
       }
       if (ev.channel_id >= 0) {
-        if (id >= channel_done.size()) channel_done.resize(id + 1, 0);
-        channel_done[id] = 1;
+        const auto rid = static_cast<std::size_t>(ev.channel_id);
+        if (rid >= id_map.size()) id_map.resize(rid + 1, -1);
+        if (id_map[rid] < 0) {
+          const auto [it, added] =
+                session_ids.try_emplace(std::string(ev.channel), static_cast<std::int32_t>(session_ids.size()));
+          id_map[rid] = it->second;
+        }
+        ev.channel_id = id_map[rid];
       }
-    }
-    switch (ev.kind) {
-      // Decoded (and checked) once, by the reader: the core takes the message as it is, once its
-      // gate let it through (the lab, and with a key its signature, as live).
-      case LcmLogEvent::Kind::samples:
-        if (core.admit_samples(ev.channel, ev.samples_view, ev.data, ev.data_size, ev.log_utime))
-          core.on_samples(ev.channel_id, ev.bench, ev.samples_view, ev.log_utime);
-        break;
-      case LcmLogEvent::Kind::config:
-        if (core.admit(ev.channel, ev.data, ev.data_size, ev.log_utime)) core.on_config(ev.bench, ev.config, ev.log_utime);
-        break;
-      case LcmLogEvent::Kind::problem:
-        if (ev.number > 0 && ev.data) {  // a message that does not decode: the core counts it
-          core.on_message(ev.channel, ev.data, ev.data_size, ev.log_utime);
-        } else if (++file_problems <= max_problems_listed) {
-          out.file.diagnostics.push_back({Diagnostic::Severity::warning, path, ev.number, ev.problem});
+      // A bench's first SAMPLE/CONFIG fixes its place; checked once per channel, not per event.
+      const auto id = static_cast<std::size_t>(ev.channel_id);
+      if (ev.channel_id < 0 || id >= channel_done.size() || !channel_done[id]) {
+        if (!ev.bench.empty() && (ev.channel.ends_with(".SAMPLE") || ev.channel.ends_with(".CONFIG")) &&
+            !order.contains(ev.bench)) {
+          order.emplace(ev.bench, order.size());
+          out.bench_order.emplace_back(ev.bench);
         }
-        break;
-      case LcmLogEvent::Kind::other:
-        if (keep_live_fits && ev.channel.starts_with("SPINDOWN.") && ev.channel.ends_with(".STATUS")) {
-          status_t st{};
-          if (core.admit(ev.channel, ev.data, ev.data_size, ev.log_utime) &&
-              decode_message(st, ev.data, ev.data_size) && st.service == "fitter" && st.source_session != 0 &&
-              std::find(fitter_sessions.begin(), fitter_sessions.end(), std::uint64_t(st.source_session)) ==
-                  fitter_sessions.end() &&
-              fitter_sessions.size() < 1024)
-            fitter_sessions.push_back(static_cast<std::uint64_t>(st.source_session));
+        if (ev.channel_id >= 0) {
+          if (id >= channel_done.size()) channel_done.resize(id + 1, 0);
+          channel_done[id] = 1;
+        }
+      }
+      switch (ev.kind) {
+        // Decoded (and checked) once, by the reader: the core takes the message as it is, once its
+        // gate let it through (the lab, and with a key its signature, as live).
+        case LcmLogEvent::Kind::samples:
+          if (core.admit_samples(ev.channel, ev.samples_view, ev.data, ev.data_size, ev.log_utime))
+            core.on_samples(ev.channel_id, ev.bench, ev.samples_view, ev.log_utime);
           break;
-        }
-        if (keep_live_fits && ev.channel.starts_with("SPINDOWN.") && ev.channel.ends_with(".FIT")) {
-          // A FIT the log holds is the live fitter's only when the gate lets it through (the lab,
-          // and with a key its signature): a forged one is counted and named, never compared.
-          if (!core.admit(ev.channel, ev.data, ev.data_size, ev.log_utime)) break;
-          fit_t m{};
-          if (decode_message(m, ev.data, ev.data_size)) {
-            out.live.push_back(std::move(m));
+        case LcmLogEvent::Kind::config:
+          if (core.admit(ev.channel, ev.data, ev.data_size, ev.log_utime))
+            core.on_config(ev.bench, ev.config, ev.log_utime);
+          break;
+        case LcmLogEvent::Kind::problem:
+          if (ev.number > 0 && ev.data) {  // a message that does not decode: the core counts it
+            core.on_message(ev.channel, ev.data, ev.data_size, ev.log_utime);
+          } else if (++file_problems <= max_problems_listed) {
+            out.file.diagnostics.push_back({Diagnostic::Severity::warning, file, ev.number, ev.problem});
+          }
+          break;
+        case LcmLogEvent::Kind::other:
+          if (keep_live_fits && ev.channel.starts_with("SPINDOWN.") && ev.channel.ends_with(".STATUS")) {
+            status_t st{};
+            if (core.admit(ev.channel, ev.data, ev.data_size, ev.log_utime) &&
+                decode_message(st, ev.data, ev.data_size) && st.service == "fitter" && st.source_session != 0 &&
+                std::find(fitter_sessions.begin(), fitter_sessions.end(), std::uint64_t(st.source_session)) ==
+                    fitter_sessions.end() &&
+                fitter_sessions.size() < 1024)
+              fitter_sessions.push_back(static_cast<std::uint64_t>(st.source_session));
             break;
           }
-          out.file.diagnostics.push_back({Diagnostic::Severity::warning, path, ev.number,
-                                          fmt::format("event {} on {}: not a decodable fit_t; skipped", ev.number,
-                                                      ev.channel)});
-        }
-        break;
+          if (keep_live_fits && ev.channel.starts_with("SPINDOWN.") && ev.channel.ends_with(".FIT")) {
+            // A FIT the log holds is the live fitter's only when the gate lets it through (the lab,
+            // and with a key its signature): a forged one is counted and named, never compared.
+            if (!core.admit(ev.channel, ev.data, ev.data_size, ev.log_utime)) break;
+            fit_t m{};
+            if (decode_message(m, ev.data, ev.data_size)) {
+              out.live.push_back(std::move(m));
+              break;
+            }
+            out.file.diagnostics.push_back({Diagnostic::Severity::warning, file, ev.number,
+                                            fmt::format("event {} on {}: not a decodable fit_t; skipped", ev.number,
+                                                        ev.channel)});
+          }
+          break;
+      }
     }
+    events_read += reader.events_read();
+    bytes_before += reader.file_size();
   }
+  if (opened == 0) return out;
   core.finish(last_utime);
   out.counters = core.counters();
   // A FIT whose source is no fitter heard in the log is not a live result (a forged one): left out.
@@ -179,7 +260,7 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
        fmt::format("{} events: {} sample messages, {} config messages, {} samples used; {} decode errors, {} sequence "
                    "gaps ({} samples lost), {} repeated messages, {} NaN values, {} samples with time going back, "
                    "{} clock restarts",
-                   reader.events_read(), c.sample_messages, c.config_messages, c.samples, c.decode_errors, c.seq_gaps,
+                   events_read, c.sample_messages, c.config_messages, c.samples, c.decode_errors, c.seq_gaps,
                    c.samples_lost, c.duplicates, c.nan_values, c.time_backwards, c.clock_restarts)});
 
   // Runs in the order `spindown fit` lists them: by bench (first appearance), then number.
@@ -194,8 +275,10 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
   out.file.samples = static_cast<std::size_t>(c.samples);
   out.file.lines_read = static_cast<std::size_t>(c.sample_messages);
   out.file.lines_skipped = static_cast<std::size_t>(c.decode_errors + c.duplicates + c.quantity_errors);
+  const bool any_health = std::any_of(out.runs.begin(), out.runs.end(), [](const RefitRun& r) { return r.health.has_value(); });
   for (const RefitRun& r : out.runs) {
     out.file.runs.push_back(r.fit);
+    if (any_health) out.file.health.push_back(r.health);
     if (r.fit.best.empty())
       out.file.failures.push_back(fmt::format("SPINDOWN.{}.SAMPLE: run {}: no model converged", r.bench,
                                               r.fit.run.number));
@@ -208,6 +291,7 @@ LogRefit refit_log(const std::string& path, const FitterOptions& options, bool k
 
 Json refit_file_json(const LogRefit& refit, const ReportOptions& opt) {
   Json j = file_fit_json(refit.file, opt);
+  if (refit.session_files.size() > 1) j["session_files"] = refit.session_files;
   Json& runs = j["runs"];
   for (std::size_t i = 0; i < refit.runs.size() && i < runs.size(); ++i)
     tag_run_json(runs[i], {refit.runs[i].bench, refit.runs[i].first_seq, refit.runs[i].last_seq});

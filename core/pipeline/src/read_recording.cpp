@@ -15,6 +15,7 @@
 #include "spindown/spindown_protocol.hpp"
 #include "spindown/text_repairs.hpp"
 #include "spindown/text_support.hpp"
+#include "spindown/trim.hpp"
 
 namespace spindown {
 
@@ -76,6 +77,16 @@ FileFormat detect_format(std::string_view head, const ReadOptions& options) {
   }
   if (options.format != FileFormat::automatic) return options.format;
   if (options.delimited.names_columns()) return FileFormat::delimited_text;
+  // A header whose units the lab's millis<TAB>volts reader would not honour ("millis<TAB>rpm").
+  {
+    text::LineCursor first(head.substr(0, 64 * 1024));
+    while (!first.at_end()) {
+      const std::string_view line = trim(first.next_line());
+      if (line.empty() || line.front() == '#' || line.starts_with("=~=~=~")) continue;
+      if (header_needs_delimited_reader(line)) return FileFormat::delimited_text;
+      break;
+    }
+  }
   // A spindown-v1 capture when the firmware's banner is there or at least half of the first 50
   // lines with content are its samples (checksums valid: no other text passes for one), else
   // Arduino text when at least half are lab samples.

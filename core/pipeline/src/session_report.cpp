@@ -11,7 +11,6 @@
 #include <numeric>
 #include <stdexcept>
 
-#include "spindown/lcm_log_reader.hpp"
 #include "spindown/offline_pipeline.hpp"
 #include "spindown/quantity.hpp"
 
@@ -22,26 +21,6 @@ namespace {
 // The bench a recording is reported under: an LCM log's bench id, else the plan's naming (roster,
 // --bench-pattern, --bench), else the file's name without its extension.
 std::string report_bench(const OfflineRecording& r) { return !r.bench.empty() ? r.bench : file_stem(r.path); }
-
-// The first bytes of a file (for the PuTTY header); "" when it cannot be read.
-std::string file_head(const std::string& path, std::size_t n) {
-  std::ifstream in(path, std::ios::binary);
-  std::string s(n, '\0');
-  in.read(s.data(), static_cast<std::streamsize>(n));
-  s.resize(static_cast<std::size_t>(std::max<std::streamsize>(in.gcount(), 0)));
-  return s;
-}
-
-// Receive time of the log's first event with a time set (seconds since the epoch), as
-// LcmLogReader finds it among the first few events (it resynchronises past damage at the start).
-std::optional<double> lcm_log_start(const std::string& path) {
-  LcmLogReader reader(path);
-  if (!reader.good()) return std::nullopt;
-  LcmLogEvent ev;
-  for (int i = 0; i < 64 && reader.next(ev); ++i)
-    if (ev.number > 0 && ev.log_utime > 0) return static_cast<double>(ev.log_utime) * 1e-6;
-  return std::nullopt;
-}
 
 void keep_diagnostics(ReportFile& file, std::span<const Diagnostic> more, std::size_t cap) {
   for (const auto& d : more) {
@@ -62,24 +41,6 @@ BenchReference bench_reference(const BenchFile& file) {
   ref.health = file.health;
   if (file.sets_inertia || file.sets_kb) ref.bench = file;
   return ref;
-}
-
-std::optional<double> putty_log_time(std::string_view head) {
-  const auto at = head.find("PuTTY log ");
-  if (at == std::string_view::npos || head.substr(0, at).find('\n') != std::string_view::npos) return std::nullopt;
-  std::tm tm{};
-  int year = 0, month = 0, day = 0, hour = 0, minute = 0, second = 0;
-  const std::string text(head.substr(at + 10, 19));
-  if (std::sscanf(text.c_str(), "%4d.%2d.%2d %2d:%2d:%2d", &year, &month, &day, &hour, &minute, &second) != 6)
-    return std::nullopt;
-  if (month < 1 || month > 12 || day < 1 || day > 31 || hour > 23 || minute > 59 || second > 60) return std::nullopt;
-  tm.tm_year = year - 1900;
-  tm.tm_mon = month - 1;
-  tm.tm_mday = day;
-  tm.tm_hour = hour;
-  tm.tm_min = minute;
-  tm.tm_sec = second;
-  return static_cast<double>(timegm(&tm));
 }
 
 CoefficientTrend coefficient_trend(std::string name, std::string unit, std::string x_unit, std::vector<double> x,
@@ -157,13 +118,27 @@ CoefficientTrend coefficient_trend(std::string name, std::string unit, std::stri
   }
   const bool significant = std::abs(t.slope) > rules.drift_sigma * t.slope_stderr;
   t.drifting = significant && std::abs(t.relative_change) >= rules.drift_fraction;
-  const std::string over = t.x_unit == "day" ? fmt::format("over {:.3g} days ({} runs)", span, n)
+  // Sessions: runs on one day are one session (runs 6 h or more apart are two); without dates, runs.
+  std::vector<double> when(t.x.begin(), t.x.begin() + static_cast<std::ptrdiff_t>(n));
+  std::sort(when.begin(), when.end());
+  std::size_t sessions = 1;
+  for (std::size_t i = 1; i < when.size(); ++i) sessions += t.x_unit == "day" ? when[i] - when[i - 1] >= 0.25 : 1;
+  const std::string sessions_text = t.x_unit == "day" ? fmt::format("{} session{}", sessions, sessions == 1 ? "" : "s")
+                                                       : fmt::format("{} runs", n);
+  const std::string over = t.x_unit == "day" ? fmt::format("over {:.3g} days ({} runs, {})", span, n, sessions_text)
                                              : fmt::format("over {} runs", n);
   // A line that leaves the runs far beyond their errors (a step, a stray run) is no evidence of
   // steadiness: "steady" only when the runs agree with the line.
   const bool line_misses = birge > rules.disagree_scatter;
   std::string verdict = t.drifting ? "drifting" : significant ? "a small but clear change" : "steady within its uncertainty";
-  if (disagree)
+  // Runs far apart that line up in time are a drift, not runs of another motor: friction that
+  // rises steadily is wear; one that falls steadily, running in (or a lubricant spreading).
+  if (t.drifting && !line_misses)
+    verdict += t.change >= 0 ? fmt::format(": friction rising steadily over {}: wear (bearings, brushes, alignment)",
+                                           sessions_text)
+                             : fmt::format(": friction falling steadily over {}: running in, or lubricant spreading",
+                                           sessions_text);
+  else if (disagree)
     verdict = t.drifting || significant ? verdict + "; " + disagreement : "not steady: " + disagreement;
   else if (line_misses && !t.drifting && !significant)
     verdict = "not steady: the runs scatter far beyond their errors about any straight line";
@@ -204,6 +179,39 @@ ReportRun make_report_run(const Recording& rec, const Run& run, const std::strin
   out.health = assess_health(out.fit, health);
   if (!out.health.has_reference) out.health_config.clear();
   return out;
+}
+
+void set_run_context(ReportRun& out, const Recording& rec, std::span<const Run> runs, std::size_t max_points) {
+  const Run& run = out.fit.run;
+  std::size_t from = 0, to = rec.size();
+  for (const Run& other : runs) {
+    if (other.cut_index < run.cut_index) from = std::max(from, std::min(other.end_index, run.cut_index));
+    if (other.cut_index > run.cut_index) to = std::min(to, other.cut_index);
+  }
+  to = std::min(to, rec.size());
+  out.context_tau.clear();
+  out.context_y.clear();
+  if (from >= to) return;
+  const auto add = [&](std::size_t i) {
+    out.context_tau.push_back(rec.t_s[i] - run.t_cut_s);
+    out.context_y.push_back(rec.value[i]);
+  };
+  const std::size_t count = to - from, half = std::max<std::size_t>(max_points / 2, 1);
+  if (count <= max_points) {
+    for (std::size_t i = from; i < to; ++i) add(i);
+    return;
+  }
+  const std::size_t stretch = (count + half - 1) / half;
+  for (std::size_t a = from; a < to; a += stretch) {
+    const std::size_t b = std::min(a + stretch, to);
+    std::size_t lo = a, hi = a;
+    for (std::size_t i = a; i < b; ++i) {
+      if (rec.value[i] < rec.value[lo]) lo = i;
+      if (rec.value[i] > rec.value[hi]) hi = i;
+    }
+    add(std::min(lo, hi));
+    if (lo != hi) add(std::max(lo, hi));
+  }
 }
 
 void summarize_session(SessionReport& report) {
@@ -281,13 +289,10 @@ SessionReport build_session_report(std::span<const std::string> paths, const Ses
     const auto size = std::filesystem::file_size(path, ec);
     f.bytes = ec ? 0 : size;
     total += f.bytes;
-    const std::string head = file_head(path, 512);
-    const FileFormat format = head.empty() ? FileFormat::automatic : detect_format(head, options.read);
-    f.format = format;
-    if (format == FileFormat::lcm_log)
-      f.start_unix_s = lcm_log_start(path);
-    else if (format == FileFormat::arduino_text || format == FileFormat::spindown_v1)
-      f.start_unix_s = putty_log_time(head);
+    if (const auto at = recording_start(path, FileFormat::automatic, options.read)) {
+      f.start_unix_s = at->unix_s;
+      f.start_local = at->local;
+    }
     report.files.push_back(std::move(f));
   }
   report.files_time_ordered =
@@ -341,8 +346,11 @@ SessionReport build_session_report(std::span<const std::string> paths, const Ses
       void run(const OfflineRecording& r, const Run& run) override {
         ReportRun rr = make_report_run(r.recording, run, report_bench(r), r.params, options);
         rr.file_index = fi;
-        if (file.start_unix_s && !r.recording.t_s.empty())
+        if (r.segmentation) set_run_context(rr, r.recording, r.segmentation->runs);
+        if (file.start_unix_s && !r.recording.t_s.empty()) {
           rr.cut_unix_s = *file.start_unix_s + (run.t_cut_s - r.recording.t_s.front());
+          rr.cut_local = file.start_local;
+        }
         if (rr.fit.best.empty()) {
           std::string why;
           for (const auto& m : rr.fit.models)

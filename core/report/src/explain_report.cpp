@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "spindown/fit_report.hpp"
 #include "spindown/lab_units.hpp"
@@ -201,6 +202,14 @@ std::string format_explain(const ExplainResult& r, std::string_view bench, const
   int number = 0;
   for (const auto& s : r.steps) {
     ++number;
+    if (s.added.empty()) {  // a term of the belief the data do not need, nothing added
+      out += fmt::format("\n  step {}: {} not needed\n", number, fmt::join(s.removed, " and "));
+      out += fmt::format("    why: {}\n", s.why);
+      out += fmt::format("    model now: {}\n", s.fit.title());
+      out += params_text(s.fit, "      ", opt);
+      out += fmt::format("    gap: RMSE {:.4g} {} -> {:.4g} {}\n", s.rmse_before, u, s.rmse_after, u);
+      continue;
+    }
     out += fmt::format("\n  step {}: where the model and the data disagree ({})\n", number, bin_noise_text(r, s.bin_noise));
     out += where_text(s.where, u, "    ");
     const Effect* e = find_effect(s.added);
@@ -215,6 +224,8 @@ std::string format_explain(const ExplainResult& r, std::string_view bench, const
     if (!s.undecided.empty()) out += fmt::format("    undecided: {}\n", s.undecided);
     for (const auto& t : s.trials)
       if (t.verdict != "added") out += fmt::format("    rejected {}: {}\n", t.effect, t.verdict);
+    for (const auto& gone : s.removed)
+      out += fmt::format("    removed {}: not needed once {} is in (the model does as well without it)\n", gone, s.added);
     out += fmt::format("    model now: {}\n", s.fit.title());
     out += params_text(s.fit, "      ", opt);
     out += fmt::format("    gap: RMSE {:.4g} {} -> {:.4g} {} ({})\n", s.rmse_before, u, s.rmse_after, u,
@@ -257,6 +268,7 @@ struct Stage {
   std::string label;
   const EffectFit* fit;
   std::string style;
+  std::string change;  // what the step did and what became of it ("+ stribeck [removed at step 3]"); "" for the base
 };
 
 std::vector<Stage> stages_of(const ExplainResult& r) {
@@ -264,15 +276,24 @@ std::vector<Stage> stages_of(const ExplainResult& r) {
   const std::string& u = r.unit;
   std::vector<Stage> out;
   out.push_back({fmt::format("base: {} - RMSE {:.3g} {}", r.base.title(), r.base.rmse, u), &r.base,
-                 "stroke=\"#d62728\" stroke-width=\"2\" stroke-dasharray=\"7,4\""});
+                 "stroke=\"#d62728\" stroke-width=\"2\" stroke-dasharray=\"7,4\"", ""});
   for (std::size_t i = 0; i < r.steps.size(); ++i) {
     const ExplainStep& s = r.steps[i];
     const bool last = i + 1 == r.steps.size();
-    out.push_back({fmt::format("step {}: + {} -> {} - RMSE {:.3g} {}{}", i + 1, s.added, s.fit.title(), s.rmse_after, u,
-                               last ? " (final)" : ""),
+    // What the step did: its effect added, the terms it removed; and, for an effect a later step
+    // removed again, that it was (the legend keeps every step, the removed ones marked).
+    std::string did = s.added.empty() ? std::string() : "+ " + s.added;
+    for (const auto& gone : s.removed) did += (did.empty() ? "" : ", ") + fmt::format("- {} (removed: not needed)", gone);
+    std::string later;
+    for (std::size_t k = i + 1; k < r.steps.size() && !s.added.empty(); ++k)
+      if (std::find(r.steps[k].removed.begin(), r.steps[k].removed.end(), s.added) != r.steps[k].removed.end())
+        later = fmt::format(" [{} removed at step {}]", s.added, k + 1);
+    out.push_back({fmt::format("step {}: {} -> {} - RMSE {:.3g} {}{}{}", i + 1, did, s.fit.title(), s.rmse_after, u,
+                               last ? " (final)" : "", later),
                    &s.fit,
                    last ? std::string("stroke=\"#1f77b4\" stroke-width=\"2\"")
-                        : fmt::format("stroke=\"{}\" stroke-width=\"1.6\" stroke-dasharray=\"4,3\"", colors[i % 6])});
+                        : fmt::format("stroke=\"{}\" stroke-width=\"1.6\" stroke-dasharray=\"4,3\"", colors[i % 6]),
+                   did + later});
   }
   return out;
 }
@@ -338,7 +359,8 @@ std::string run_figure(const std::string& file, std::string_view bench, const Ex
   for (std::size_t c = 0; c < stages.size(); ++c) {
     s += polyline(bot_p, bin_x[c], bin_y[c],
                   fmt::format("class=\"residual\" data-step=\"{}\" {}", c, stages[c].style));
-    res_items.emplace_back(fmt::format("{}: {} ({}-sample means{})", c == 0 ? "base" : fmt::format("step {}", c),
+    res_items.emplace_back(fmt::format("{}: {} ({}-sample means{})",
+                                       c == 0 ? "base" : fmt::format("step {} ({})", c, stages[c].change),
                                        stages[c].fit->title(), r.bin_samples,
                                        c + 1 == stages.size() ? "; dots: samples" : ""),
                            stages[c].style);

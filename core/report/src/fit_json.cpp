@@ -308,9 +308,10 @@ void tag_run_json(Json& run, const RunTags& tags) {
 }
 
 void append_run_fit_json_text(std::string& out, const RunFit& fit, const ReportOptions& opt, std::size_t indent,
-                              const RunTags* tags) {
+                              const RunTags* tags, const HealthVerdict* health) {
   if (has_repeated_param_names(fit)) {
-    const Json j = tags ? tagged_run_fit_json(fit, *tags, opt) : run_fit_json(fit, opt);
+    Json j = tags ? tagged_run_fit_json(fit, *tags, opt) : run_fit_json(fit, opt);
+    if (health) j["health"] = health_json(*health);
     for (char c : j.dump(2, ' ', false, Json::error_handler_t::replace)) {
       out += c;
       if (c == '\n') out.append(indent, ' ');  // a raw newline in a dump is always layout
@@ -319,6 +320,10 @@ void append_run_fit_json_text(std::string& out, const RunFit& fit, const ReportO
   }
   PrettyJsonWriter w(out, indent);
   write_run_fit(w, fit, opt, tags);
+  if (health) {  // last, as a file's entry has it
+    w.key("health");
+    write_health(w, *health);
+  }
   w.end_object();
 }
 

@@ -78,11 +78,11 @@ std::vector<Column> row(const FileFit& file, std::size_t i) {
   return r;
 }
 
-std::string csv_cell(const Cell& c) {
-  if (const auto* s = std::get_if<std::string>(&c)) return csv_field(*s);
+std::string csv_cell(const Cell& c, const CsvStyle& style) {
+  if (const auto* s = std::get_if<std::string>(&c)) return csv_field(*s, style);
   if (const auto* n = std::get_if<long long>(&c)) return std::to_string(*n);
   const double x = std::get<double>(c);
-  return std::isnan(x) ? std::string() : csv_number(x);  // an empty cell: not part of that run's fits
+  return std::isnan(x) ? std::string() : csv_number(x, style);  // an empty cell: not part of that run's fits
 }
 
 // A dummy file with one run, for the header's names.
@@ -96,23 +96,24 @@ std::vector<std::string> column_names() {
 
 }  // namespace
 
-std::string run_table_csv_header() {
-  static const std::string header = [] {
-    std::string h;
-    for (const auto& n : column_names()) h += (h.empty() ? "" : ",") + n;
-    return h + '\n';
-  }();
-  return header;
+std::string run_table_csv_header(const CsvStyle& style) {
+  static const std::vector<std::string> names = column_names();
+  std::string h(csv_file_start(style));
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (i > 0) h += style.delimiter;
+    h += names[i];
+  }
+  return h + '\n';
 }
 
-std::string run_table_csv_rows(const FileFit& file) {
+std::string run_table_csv_rows(const FileFit& file, const CsvStyle& style) {
   std::string out;
   for (std::size_t i = 0; i < file.runs.size(); ++i) {
     bool first = true;
     for (const auto& c : row(file, i)) {
-      if (!first) out += ',';
+      if (!first) out += style.delimiter;
       first = false;
-      out += csv_cell(c.value);
+      out += csv_cell(c.value, style);
     }
     out += '\n';
   }
@@ -132,7 +133,7 @@ void append_run_table_json_rows(const FileFit& file, std::string& out, bool& fir
       else if (const auto* n = std::get_if<long long>(&c.value))
         w.integer(*n);
       else
-        w.number(std::get<double>(c.value));  // shortest digits that read back; NaN/inf: null
+        w.number(csv_number_value(std::get<double>(c.value)));  // the CSV's 10 digits, shortest; NaN/inf: null
     }
     w.end_object();
   }

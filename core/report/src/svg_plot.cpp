@@ -4,6 +4,8 @@
 #include <cmath>
 #include <fmt/format.h>
 
+#include "spindown/utf8_text.hpp"
+
 namespace spindown::svg {
 
 std::vector<double> nice_ticks(double lo, double hi, int target) {
@@ -85,14 +87,39 @@ std::string dots(const Panel& p, std::span<const double> xs, std::span<const dou
 }
 
 std::string legend(double x, double y, const std::vector<std::pair<std::string, std::string>>& items, double width) {
+  // A label wider than the box (about 6.6 px a character at 12 px) goes on as many lines as it
+  // needs, broken at spaces, so that nothing of it falls outside the box or the figure.
+  const std::size_t room = static_cast<std::size_t>(std::max(10.0, (width - 52) / 6.6));
+  std::vector<std::vector<std::string>> lines(items.size());
+  std::size_t total = 0;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    std::string_view rest = items[i].first;
+    while (!rest.empty()) {
+      std::size_t cut = utf8_prefix_bytes(rest, room);
+      if (cut < rest.size()) {
+        const std::size_t space = rest.substr(0, cut).rfind(' ');
+        if (space != std::string_view::npos && space > 0) cut = space + 1;  // the space stays, at the line's end
+      }
+      lines[i].emplace_back(rest.substr(0, cut));
+      rest.remove_prefix(cut);
+    }
+    if (lines[i].empty()) lines[i].emplace_back();
+    total += lines[i].size();
+  }
   std::string s = fmt::format("<rect x=\"{:.1f}\" y=\"{:.1f}\" width=\"{:g}\" height=\"{}\" fill=\"white\" "
                               "fill-opacity=\"0.85\" stroke=\"#999\"/>\n",
-                              x, y, width, 8 + 18 * items.size());
+                              x, y, width, 8 + 18 * total);
+  std::size_t line = 0;
   for (std::size_t i = 0; i < items.size(); ++i) {
-    const double yy = y + 16 + 18.0 * static_cast<double>(i);
+    const double yy = y + 16 + 18.0 * static_cast<double>(line);
     s += fmt::format("<line x1=\"{:.1f}\" y1=\"{:.1f}\" x2=\"{:.1f}\" y2=\"{:.1f}\" {}/>\n", x + 8, yy - 4, x + 38,
                      yy - 4, items[i].second);
-    s += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\">{}</text>\n", x + 46, yy, escape(items[i].first));
+    s += fmt::format("<text x=\"{:.1f}\" y=\"{:.1f}\">", x + 46, yy);
+    for (std::size_t k = 0; k < lines[i].size(); ++k)
+      s += k == 0 ? escape(lines[i][k])
+                  : fmt::format("<tspan x=\"{:.1f}\" dy=\"18\">{}</tspan>", x + 46, escape(lines[i][k]));
+    s += "</text>\n";
+    line += lines[i].size();
   }
   return s;
 }

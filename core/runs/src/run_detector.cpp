@@ -403,6 +403,7 @@ void RunDetector::new_source(const std::string& why) {
 
 void RunDetector::restart_stream(const std::string& why, Run::End reason) {
   restarted_mid_coast_ = state_ == State::coasting;
+  after_silence_ = false;  // a new timeline: nothing on it continues the silenced coast
   if (state_ == State::coasting) {
     run_note_severity_ = Diagnostic::Severity::warning;  // the run is cut short: it changes the result
     close_unstopped(next_index_, why, reason);
@@ -417,7 +418,7 @@ void RunDetector::restart_stream(const std::string& why, Run::End reason) {
   last_t_ = -std::numeric_limits<double>::infinity();
   last_v_ = std::numeric_limits<double>::quiet_NaN();
   state_ = State::idle;
-  lo_ = next_index_;
+  lo_ = search_lo_ = next_index_;
   need_quiet_ = false;
   short_.clear(next_index_, 0.0);
   long_.clear(next_index_, 0.0);
@@ -444,6 +445,12 @@ void RunDetector::finish() {
 void RunDetector::went_silent(double silent_s) {
   if (state_ == State::coasting && next_index_ > base_) coast_checks(next_index_ - 1, ring_[(next_index_ - 1) & mask_], true);
   if (state_ == State::coasting) {
+    // Where the coast was when the samples stopped: what resumes below it is the same coast.
+    after_silence_ = true;
+    silenced_run_ = run_.number;
+    silence_s_ = silent_s;
+    silence_level_ = next_index_ > base_ ? v(next_index_ - 1) : v0_;
+    silence_band_ = std::max({4.0 * coast_sd_, 3.0 * coast_step_, 0.02 * std::abs(v0_)});
     run_note_severity_ = Diagnostic::Severity::warning;
     close_unstopped(next_index_,
                     fmt::format("no samples for {:g} s: the bench went silent mid-coast; fitted to its last sample, "
@@ -460,7 +467,20 @@ void RunDetector::went_silent(double silent_s) {
   }
 }
 
-void RunDetector::to_idle(std::size_t lo, bool need_quiet) {
+void RunDetector::watch_after_silence(double v) {
+  // A rise above where the silence began: the motor was powered again (a new run's lead-in).
+  if (v > silence_level_ + silence_band_) {
+    after_silence_ = false;
+    return;
+  }
+  // A standstill: a second of readings, low beside that level, with no significant slope.
+  if (long_.n >= 8 && duration(long_) >= 0.8 * long_.span_s && long_.mean() < standstill_max_fraction * silence_level_) {
+    const double sd = long_.resid_sd(), slope = long_.slope();
+    if (!(slope < 0 && -slope * std::sqrt(long_.sxx()) > 2.0 * sd)) after_silence_ = false;
+  }
+}
+
+void RunDetector::to_idle(std::size_t lo, bool need_quiet, std::size_t search_from) {
   // After a stop, a new coast must start above the standstill: a slow coast's last creep
   // after a premature stop is not a new run.
   need_rise_ = state_ == State::tail && run_.stopped;
@@ -468,6 +488,7 @@ void RunDetector::to_idle(std::size_t lo, bool need_quiet) {
   rise_level_ = run_.zero_level + depart_band_;
   state_ = State::idle;
   lo_ = lo;
+  search_lo_ = std::max(std::min(search_from, lo), base_);
   need_quiet_ = need_quiet;
   rising_ = departing_ = 0;
   reset_window(short_, lo, next_index_);
@@ -482,7 +503,7 @@ void RunDetector::trim_idle() {
   const double keep_s = idle_keep_s;
   const double t_now = t(next_index_ - 1);
   // The first sample within keep_s only moves forward: amortized O(1) per sample.
-  time_cursor_ = std::max({time_cursor_, lo_, base_});
+  time_cursor_ = std::max({time_cursor_, search_lo_, base_});
   while (time_cursor_ + 1 < next_index_ && t_now - t(time_cursor_) > keep_s) ++time_cursor_;
   std::size_t keep_from = time_cursor_;
   // Keep enough samples for a slow loop's back-search, and what the windows still use.
@@ -535,6 +556,8 @@ void RunDetector::idle_step(std::size_t i, Sample s, double prev_t) {
   advance(short_, i, s);
   advance(long_, i, s);
   advance(vlong_, i, s);
+  if (after_silence_) [[unlikely]]
+    watch_after_silence(s.v);
   if (need_quiet_) {
     // After a coast closed without a stop the decline may go on: wait for it to pause.
     const bool full = long_.n >= 8 && duration(long_) >= 0.8 * long_.span_s;
@@ -687,7 +710,7 @@ void RunDetector::retract_stop(std::size_t i, Sample s) {
 bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
   const std::size_t b = i;
   const std::size_t w0 = w.first;
-  const std::size_t lower = std::max(lo_, base_);
+  const std::size_t lower = std::max(search_lo_, base_);
   double span = std::max(back_search_s, 2.0 * w.span_s);
   CutSplit sp;
   std::string lead;
@@ -709,21 +732,33 @@ bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
 
   // The coast begins at the peak, never before a rise: a motor's ramp or a hand's push straight
   // into the peak (a speed sensor's reading) is the powered phase, not the coast.
-  const bool spin_up = at_peak(sp, b);
+  // (An open pin's hum rising into the connection is no spin-up: its lead-in is rough, the rise's smooth.)
+  const bool spin_up = lead != "floating" && at_peak(sp, b);
   if (spin_up) lead = "spin-up";
   // A coast whose start was not recorded: the recording (or the stream after a clock restart)
   // begins on it, or resumes on it after a pause. Its cut is not known: the coast is partial and
   // taken from its first sample, never given an invented cut in the pause or a lead-in.
   std::string unseen;
-  if (!spin_up && !sp.clipped) unseen = start_not_seen(sp);
+  if (after_silence_) {
+    unseen = rest_after_silence(sp);
+  } else if (!spin_up && !sp.clipped) {
+    unseen = start_not_seen(sp);
+  }
   if (!unseen.empty()) lead = "none";
+  bounce_.clear();
+  if (!spin_up && unseen.empty()) take_bounce(sp, w);
 
   // Whether this is a cut at all.
   bool plausible = sp.v0 > 0;
   const double scale = std::abs(sp.v0);
   if (lead == "none") plausible = plausible && !unseen.empty();  // a stream that starts mid-coast, or a pause
   if (lead == "powered" && sp.pre_sd > 0.05 * scale) plausible = false;  // a rough "plateau"
-  if ((lead == "zeros" || lead == "floating") && sp.v0 < 1.5 * sp.pre_max) plausible = false;
+  // A coast from a motor at rest starts well above the zeros it leaves. A floating pin (the
+  // handout's step 6: A0 is connected only after the cut) reads anywhere in 0.5–2.5 V, above or
+  // below the back-EMF it is connected to: its coast needs no step, only the smooth decline the
+  // open pin's hum never keeps up (a swing of the hum taken for a coast is set aside when it rises
+  // again: swing_reason).
+  if (lead == "zeros" && sp.v0 < 1.5 * sp.pre_max) plausible = false;
   if (spin_up && sp.pre_declining) sp.pre_declining = false;  // the rise's own end, not a decline
   if (sp.pre_declining) plausible = false;  // a decline with no cut in reach
   // A cut without a step (a kink, or a stream that starts mid-coast) rests on the slope alone:
@@ -741,6 +776,7 @@ bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
   run_note_severity_ = Diagnostic::Severity::note;
   fragment_ = restarted_mid_coast_ && sp.cut_index == stream_start_;
   restarted_mid_coast_ = false;
+  after_silence_ = false;
   if (!unseen.empty() && !fragment_) {
     run_note_ = unseen;
     run_note_severity_ = Diagnostic::Severity::warning;

@@ -61,7 +61,8 @@ void RunDetector::scan_coast(Run& r, std::size_t coast_end) {
   // Samples k of [cut + 1, coast_end - 1), over the ring in stretches whose triples (k - 1, k,
   // k + 1) do not wrap, each scanned first without a branch for any sample off by more than the
   // floor (the usual answer: none).
-  std::size_t k = r.cut_index + 1;
+  const std::size_t before = r.outliers.size();  // the coast's bounce at its start, already out
+  std::size_t k = before ? r.outliers.back() + 2 : r.cut_index + 1;
   while (k + 1 < coast_end) {
     const std::size_t at = (k - 1) & mask_;
     const std::size_t n = std::min(coast_end - 1 - k, ring_size() - 2 - std::min(at, ring_size() - 2));
@@ -110,10 +111,10 @@ void RunDetector::scan_coast(Run& r, std::size_t coast_end) {
   if (k < coast_end && k > r.cut_index && t(k) - t(k - 1) > std::max(longest, said))
     longest = t(k) - t(k - 1), gap_at = k;
   warn_of_gap_in_coast(r.number, r.cut_index, gap_at, longest, r.period_s);
-  if (r.outliers.empty()) return;
+  if (r.outliers.size() == before) return;
   emit_diag(Diagnostic::Severity::warning,
             fmt::format("run {}: {} single-sample outlier(s) left out of the fit (dropouts or glitches): {}{}", r.number,
-                        r.outliers.size(), where, r.outliers.size() > 10 ? ", …" : ""));
+                        r.outliers.size() - before, where, shown > 10 ? ", …" : ""));
 }
 
 std::string RunDetector::gap_before(std::size_t i) const {
@@ -217,7 +218,9 @@ void RunDetector::complete_run(std::size_t end) {
     r.stop_index = end;
     r.t_stop_s = std::numeric_limits<double>::quiet_NaN();
   }
-  const std::size_t coast_end = r.stopped ? r.stop_index : end;
+  std::size_t coast_end = r.stopped ? r.stop_index : end;
+  if (not_coast_.empty() && !fragment_) recut_after_rise(r, coast_end);
+  coast_end = r.stopped ? r.stop_index : end;
   if (coast_end > r.cut_index + 1) r.period_s = median_period(r.cut_index, coast_end);
   const std::size_t coast_n = coast_end - r.cut_index;
   const double coast_s = (r.stopped ? r.t_stop_s : (end > r.cut_index ? t(end - 1) : r.t_cut_s)) - r.t_cut_s;
@@ -227,7 +230,13 @@ void RunDetector::complete_run(std::size_t end) {
 
   RunEvent e;
   e.run = r;
-  if (fragment_) {
+  if (!not_coast_.empty()) {
+    e.kind = RunEvent::Kind::ignored;
+    e.has_diagnostic = true;
+    e.diagnostic = {Diagnostic::Severity::warning, source_, 0,
+                    fmt::format("decline from {} to {} ignored: {}", fmt_s(r.t_cut_s), fmt_s(r.t_end_s), not_coast_)};
+    not_coast_.clear();
+  } else if (fragment_) {
     e.kind = RunEvent::Kind::ignored;
     e.has_diagnostic = true;
     // Fragments are said in the default output: the user sees what was left out and why.
@@ -257,6 +266,12 @@ void RunDetector::complete_run(std::size_t end) {
     }
     largest_amp_ = std::max(largest_amp_, amp);
     longest_coast_s_ = std::max(longest_coast_s_, coast_s);
+    if (!bounce_.empty()) {
+      e.run.outliers = bounce_;
+      emit_diag(Diagnostic::Severity::note,
+                fmt::format("run {}: {} sample(s) of contact bounce at the coast's start left out of the fit (from {})",
+                            e.run.number, bounce_.size(), fmt_s(t(bounce_.front()))));
+    }
     scan_coast(e.run, coast_end);
     if (!run_note_.empty()) {
       e.has_diagnostic = true;
@@ -266,6 +281,7 @@ void RunDetector::complete_run(std::size_t end) {
   events_.push_back(std::move(e));
   run_note_.clear();
   run_note_severity_ = Diagnostic::Severity::note;
+  bounce_.clear();
 }
 
 }  // namespace spindown

@@ -5,7 +5,9 @@
 #include <cmath>
 #include <cstdint>
 #include <fmt/format.h>
+#include <limits>
 #include <string>
+#include <vector>
 
 #include "run_detector_tuning.hpp"
 
@@ -14,7 +16,7 @@ namespace spindown {
 using namespace detector_tuning;
 
 RunDetector::CutSplit RunDetector::split_at_cut(std::size_t a, std::size_t b, const WindowFit& w) {
-  const std::size_t lower = std::max(lo_, base_);
+  const std::size_t lower = std::max(search_lo_, base_);
   CutSplit sp;
   sp.a = a;
 
@@ -139,6 +141,20 @@ RunDetector::CutSplit RunDetector::split_at_cut(std::size_t a, std::size_t b, co
       kb = k;
       k = k2;
     }
+    // A rough lead-in (an open pin's hum) fits the coast's line about as badly as a constant, so
+    // the split may give the coast some of it. The coast itself is smooth, as the window that
+    // confirmed it shows: its first sample is the earliest from which the readings keep to that
+    // window's line, drawn back.
+    if (const double e = w.resid_sd();
+        w.n >= 6 && w.first >= a + k + 4 && post_line(k).sd > 2.0 * e + 1e-12 &&
+        rough_sd(a + k, w.first) > 3.0 * std::max(rough_sd(w.first, b + 1), 0.5 * e) &&
+        rough_sd(a, a + k) > 3.0 * std::max(rough_sd(w.first, b + 1), 0.5 * e)) {
+      const double tol = std::max(4.0 * e, 2.0 * reading_step(w.first, b + 1));
+      const double slope = w.slope(), t_mid = w.t0 + w.st() / w.n, mid = w.mean();
+      std::size_t j = w.first;
+      while (j > a + k && std::abs(v(j - 1) - (mid + slope * (t(j - 1) - t_mid))) <= tol) --j;
+      k = j - a;
+    }
     const Line l = post_line(k);
     const std::size_t c = a + k;
     sp.a = a + kb;
@@ -147,7 +163,7 @@ RunDetector::CutSplit RunDetector::split_at_cut(std::size_t a, std::size_t b, co
     sp.sd_post = l.sd;
     sp.cut_index = c;
     sp.pre_end = c;
-    const bool sample_before = c > base_ && c > stream_start_ && c - 1 >= lo_;
+    const bool sample_before = c > base_ && c > stream_start_ && c - 1 >= search_lo_;
     sp.t_cut_s = sample_before ? 0.5 * (t(c - 1) + t(c)) : t(c);
   }
 
@@ -162,17 +178,155 @@ RunDetector::CutSplit RunDetector::split_at_cut(std::size_t a, std::size_t b, co
       sp.pre_max = std::max(sp.pre_max, v(k));
     }
     sp.pre_mean = f.mean();
+    sp.pre_rough = rough_sd(sp.a, sp.pre_end);
     sp.pre_sd = std::sqrt(std::max(f.svv() / f.n - sp.pre_mean * sp.pre_mean, 0.0));
     // A lead-in falling at a good part of the coast's own rate is more coast: the cut lies
     // further back.
     const double s = f.slope(), sd = f.resid_sd();
     const double s_err = f.sxx() > 0 ? sd / std::sqrt(f.sxx()) : 0.0;
     const bool smooth = sd <= std::max(3.0 * sp.sd_post, 0.02 * std::abs(sp.v0));  // not a wandering pin
-    sp.pre_declining = sp.npre >= 8 && smooth && s < 0 && -s > 3.0 * s_err &&
+    // … and runs into the coast's start without a step: a decline that ends below the coast's
+    // start, the reading then jumping up to it (a floating pin's swing, then its connection to the
+    // motor), is another signal's, and the cut is the jump.
+    const double at_cut = f.mean() + s * (t(sp.pre_end) - f.t0 - f.st() / f.n);
+    const bool joins = sp.clipped || std::abs(at_cut - sp.v0) <= std::max({5.0 * sp.sd_post, 3.0 * sd, 0.03 * std::abs(sp.v0)});
+    sp.pre_declining = sp.npre >= 8 && smooth && joins && s < 0 && -s > 3.0 * s_err &&
                        (sp.clipped || sp.post_slope >= 0 || s <= 0.3 * sp.post_slope);
     sp.pre_flat = sp.npre >= 8 && std::abs(s) + 2.0 * s_err <= 0.3 * std::abs(sp.post_slope);
   }
   return sp;
+}
+
+void RunDetector::take_bounce(CutSplit& sp, const WindowFit& w) {
+  // Up to three samples around the coast's first that lie neither on the coast's course (a line
+  // through the samples that follow them) nor on the lead-in's course before them: a contact
+  // bouncing as a wire is pushed in (the handout's step 6 connects the pin to the motor by hand).
+  // The coast starts at the first of them; they are left out of the fit as outliers.
+  constexpr std::size_t most = 3, local = 8;
+  const std::size_t c = sp.cut_index, lower = std::max({search_lo_, base_, sp.a});
+  if (sp.clipped || w.end < c + most + local + 1 || c < lower + local + 1) return;
+  const double step = reading_step(c, std::min(w.end, c + 4 * local));
+  // The course of [from, from + local) at sample j, and how far from it a sample is off it.
+  const auto course = [&](std::size_t from, std::size_t j, double& off) {
+    const WindowFit f = window_over(ring_.get(), mask_, 1e300, from, from + local);
+    const double at = f.mean() + f.slope() * (t(j) - f.t0 - f.st() / f.n);
+    off = std::max({5.0 * f.resid_sd(), 0.03 * std::abs(at), 2.0 * step});
+    return at;
+  };
+  // After the cut found: samples off the course of the coast beyond the reach of any bounce.
+  std::size_t settled = c;
+  double off = 0;
+  while (settled < c + most && std::abs(v(settled) - course(c + most, settled, off)) > off) ++settled;
+  // Before it: samples off the coast's course (drawn back from where it settled) and off the
+  // lead-in's own course (a line through the samples before them: a rise into the cut goes on).
+  std::size_t first = c;
+  for (std::size_t m = 1; m + (settled - c) <= most && c >= lower + local + m; ++m) {
+    const std::size_t j = c - m;
+    double off_coast = 0, off_lead = 0;
+    if (std::abs(v(j) - course(c + most, j, off_coast)) <= off_coast) break;  // the coast already
+    if (std::abs(v(j) - course(j - local, j, off_lead)) <= std::max(off_lead, off_coast)) break;  // the lead-in
+    // … or within the lead-in's own recent swing (an open pin's hum turns up and down).
+    double lead_lo = v(j - 1), lead_hi = v(j - 1);
+    for (std::size_t k = j - local; k < j; ++k) lead_lo = std::min(lead_lo, v(k)), lead_hi = std::max(lead_hi, v(k));
+    if (v(j) >= lead_lo - off_lead && v(j) <= lead_hi + off_lead) break;
+    first = j;
+  }
+  if (first == c && settled == c) return;
+  for (std::size_t k = first; k < settled; ++k) bounce_.push_back(k);
+  if (first == c) return;  // the cut stays where the lead-in ended; its first samples bounced
+  sp.cut_index = first;
+  sp.pre_end = first;
+  sp.npre = first > sp.a ? first - sp.a : 0;
+  sp.t_cut_s = first > base_ && first > stream_start_ ? 0.5 * (t(first - 1) + t(first)) : t(first);
+}
+
+void RunDetector::recut_after_rise(Run& r, std::size_t coast_end) {
+  const std::size_t c = r.cut_index;
+  if (coast_end < c + 16) return;
+  const double zero = r.stopped ? r.zero_level : motor_zero();
+  const double amp = v0_ - zero;
+  // Far beyond the coast's sample-to-sample noise (the median over the whole coast: a rough stretch
+  // before the rise, an open pin's hum, does not set it).
+  const double thr = std::max({8.0 * rough_sd(c, coast_end), 0.05 * std::abs(amp), 3.0 * coast_step_});
+  // Medians of five: a dropout or two (a loose wire's zeros) are no rise.
+  const auto med5 = [&](std::size_t k) {
+    double a[5] = {v(k - 2), v(k - 1), v(k), v(k + 1), v(k + 2)};
+    std::nth_element(a, a + 2, a + 5);
+    return a[2];
+  };
+  double low = std::numeric_limits<double>::infinity();
+  std::size_t rise = 0;
+  double rose = 0, rose_from = 0;
+  for (std::size_t k = c + 2; k + 2 < coast_end; ++k) {
+    const double m = med5(k);
+    if (m - low > thr) {
+      if (rise == 0 || k > rise + 1) rose_from = low;
+      rise = k, rose = m - rose_from, low = m;
+    } else {
+      low = std::min(low, m);
+    }
+  }
+  // … nor steps down: a fall within three samples far steeper than the coast's own pace on either
+  // side of it (an open pin above the back-EMF, then connected to the motor).
+  if (coast_end >= c + 24) {
+    for (std::size_t k = c + 10; k + 10 < coast_end; ++k) {
+      const double drop = med5(k - 2) - med5(k + 1);
+      if (!(drop > thr)) continue;
+      const double before = (med5(k - 8) - med5(k - 2)) / (t(k - 2) - t(k - 8));
+      const double after = (med5(k + 1) - med5(k + 7)) / (t(k + 7) - t(k + 1));
+      const double pace = std::max({before, after, 0.0}) * (t(k + 1) - t(k - 2));
+      if (drop > 4.0 * pace + thr && k > rise) rise = k - 1, rose = -drop;
+    }
+  }
+  if (rise == 0) return;
+  // The coast after the rise: its cut found as any cut is, with the samples before the rise as lead-in.
+  std::size_t a = rise, b = rise;
+  while (a > c && t(rise) - t(a - 1) <= back_search_s) --a;
+  while (b + 1 < coast_end && t(b + 1) - t(rise) <= 1.0) ++b;
+  if (b < rise + 6 || rise < a + 4) return;
+  const WindowFit w = window_over(ring_.get(), mask_, 1.0, rise, b + 1);
+  const std::size_t keep_lo = search_lo_;
+  search_lo_ = std::max(search_lo_, c);
+  CutSplit sp = split_at_cut(a, b, w);
+  search_lo_ = keep_lo;
+  if (!(sp.v0 > 0) || sp.cut_index <= c) return;
+  const double t_old = r.t_cut_s;
+  bounce_.clear();
+  take_bounce(sp, w);
+  r.cut_index = sp.cut_index;
+  r.t_cut_s = sp.t_cut_s;
+  r.lead_in = classify_lead_in(sp);
+  v0_ = sp.v0;
+  const std::string said = fmt::format(
+      "the reading {} by {:.3g} at {}, inside the coast taken from {}: a coast never {}, so the coast is taken "
+      "from {} (the pin connected to the motor then? the power back on?), lead-in {}",
+      rose > 0 ? "rose" : "stepped down", std::abs(rose), fmt_s(t(rise)), fmt_s(t_old),
+      rose > 0 ? "rises" : "jumps", fmt_s(r.t_cut_s), r.lead_in);
+  run_note_ = run_note_.empty() ? said : said + "; " + run_note_;
+  run_note_severity_ = Diagnostic::Severity::warning;
+  // The standstill was judged against the old cut: from the new one, a coast whose last quarter
+  // creeps in is an exponential's (pure viscous friction), not a stop.
+  if (r.stopped && creeps_in(r.t_cut_s, last_quarter_time(c, r.stop_index, r.zero_level + 0.25 * (v0_ - r.zero_level)),
+                             r.t_stop_s)) {
+    r.stopped = false;
+    r.end = Run::End::asymptotic;
+    r.stop_index = r.end_index;
+    r.t_stop_s = std::numeric_limits<double>::quiet_NaN();
+    run_note_ += fmt::format("; from there the coast approaches its floor ({:g}) asymptotically, as pure viscous "
+                             "friction does: treated as never stopped, coast closed at {}",
+                             r.zero_level, fmt_s(r.t_end_s));
+  }
+}
+
+double RunDetector::rough_sd(std::size_t from, std::size_t to) const {
+  // Second differences cancel a smooth curve (a coast, a rise, a slow swing) and keep the
+  // sample-to-sample noise: σ = 1.4826·median|Δ²v| / √6. Its own space: the cut search's
+  // prefix sums live in scratch().
+  if (to < from + 3) return 0.0;
+  std::vector<double> d(to - from - 2);
+  for (std::size_t j = 0; j < d.size(); ++j) d[j] = std::abs(v(from + j + 2) - 2.0 * v(from + j + 1) + v(from + j));
+  std::nth_element(d.begin(), d.begin() + std::ptrdiff_t(d.size() / 2), d.end());
+  return 1.4826 * d[d.size() / 2] / std::sqrt(6.0);
 }
 
 double RunDetector::smoothed(std::size_t k, std::size_t lo, std::size_t hi) const {
@@ -256,10 +410,32 @@ std::string RunDetector::start_not_seen(CutSplit& sp) {
                      fmt_s(t(a)));
 }
 
+std::string RunDetector::rest_after_silence(CutSplit& sp) {
+  // The coast that went silent goes on: taken from the first sample after the silence (or the
+  // oldest still held), its cut long before and not in this stream.
+  const std::size_t a = std::max({resume_index_, base_, lo_});
+  if (a >= next_index_) return {};
+  const std::size_t c = sp.cut_index;
+  sp.v0 = sp.v0 + sp.post_slope * (t(a) - t(c));
+  sp.cut_index = a;
+  sp.pre_end = a;
+  sp.npre = 0;
+  sp.t_cut_s = t(a);
+  sp.clipped = false;
+  sp.pre_declining = false;
+  return fmt::format("the samples stopped for over {:g} s mid-coast and resumed on the same clock at {}: this is the "
+                     "rest of run {}'s coast, whose cut came before the silence, so it is partial (no cut)",
+                     silence_s_, fmt_s(t(a)), silenced_run_);
+}
+
 std::string RunDetector::classify_lead_in(const CutSplit& sp) const {
   if (sp.npre < 3) return "none";
   const double scale = std::abs(sp.v0);
   const double step = sp.v0 - sp.pre_mean;
+  // A lead-in far rougher from sample to sample than the coast is not the motor the coast is read
+  // from: an open pin (the handout's step 6) whose hum can hide any step to the back-EMF it is then
+  // connected to. (A rise into the cut is smooth, however far it climbs.)
+  if (sp.pre_rough > std::max(0.01 * scale, 4.0 * sp.sd_post)) return "floating";
   // No step beyond the noise of either side: a powered motor whose speed is the reading.
   if (std::abs(step) <= std::max({3.0 * sp.sd_post, 4.0 * sp.pre_sd, 0.01 * scale})) return "powered";
   if (step < 0) return "supply";

@@ -54,11 +54,92 @@ void RunDetector::coast_too_long(std::size_t i) {
   block_until_rise(v(i));
 }
 
+std::string RunDetector::swing_reason(std::size_t at) const {
+  // The coast fell from v0_ to its lowest level, then rose again. Before its cut, over up to 10 s
+  // (or three times the coast), did the reading already swing as far both ways? A motor's lead-in
+  // (at rest, powered, spun up) rises at most once, into the cut; an open analog pin whose jumper
+  // picks up the mains (the handout's step 6: A0 is connected only after the cut) swings up and
+  // down all the time, its 50 Hz hum aliased by the ~20 ms loop into a slow beat.
+  const std::size_t cut = run_.cut_index;
+  const double fall = v0_ - level_min_;
+  if (!(fall > 0) || !std::isfinite(fall) || at <= cut) return {};
+  constexpr double look_s = 10.0;
+  const std::size_t lower = std::max({base_, stream_start_});
+  std::size_t from = cut;
+  while (from > lower && t(cut) - t(from - 1) <= look_s) --from;
+  if (cut < from + 8) return {};
+  // Zigzag of the 3-sample mean with hysteresis h: a turn is a move of at least h from the last
+  // extreme against the direction before it (the first move counts as one).
+  const double h = std::max({0.3 * fall, 4.0 * coast_sd_, 3.0 * coast_step_});
+  int turns = 0, dir = 0;
+  double x0 = smoothed(from, from, cut - 1), top = x0, bottom = x0, hi = x0, lo = x0;
+  for (std::size_t k = from + 1; k < cut; ++k) {
+    const double x = smoothed(k, from, cut - 1);
+    hi = std::max(hi, x), lo = std::min(lo, x);
+    top = std::max(top, x), bottom = std::min(bottom, x);
+    if (dir >= 0 && top - x >= h) ++turns, dir = -1, bottom = x;      // a fall from the last top
+    else if (dir <= 0 && x - bottom >= h) ++turns, dir = 1, top = x;  // a rise from the last bottom
+  }
+  // A rise into the cut is one turn (a spin-up); a fall and a rise before it are a swing.
+  if (turns < 2 || !(hi - lo >= 0.5 * fall)) return {};
+  return fmt::format("the reading swings up and down before it too ({} turns of at least {:.3g} within {:.3g} s, "
+                     "between {:.3g} and {:.3g}), as an open analog input picking up mains hum does: not a coast "
+                     "(the handout's step 6 connects A0 to the motor only after the cut)",
+                     turns, h, t(cut) - t(from), lo, hi);
+}
+
+std::string RunDetector::stall_reason(std::size_t at) const {
+  // Friction slows a coast at every speed it passes: the deceleration at speed ω is T(ω)/J, and
+  // T falls with ω no faster than windage's ω² (Coulomb holds it, viscous ∝ ω, Stribeck raises it).
+  // A decline that levels off while the reading is still well above standstill, then rises, was
+  // no coast: an open pin's slow wander (the handout's step 6) or a drive holding a lower speed.
+  const std::size_t cut = run_.cut_index;
+  if (at < cut + 24) return {};
+  const std::size_t third = (at - cut) / 3;
+  const WindowFit first = window_over(ring_.get(), mask_, 1e300, cut, cut + third);
+  const WindowFit last = window_over(ring_.get(), mask_, 1e300, at - third, at);
+  const double rate0 = -first.slope(), rate1 = -last.slope();
+  const double se1 = last.sxx() > 0 ? last.resid_sd() / std::sqrt(last.sxx()) : INFINITY;
+  const double se0 = first.sxx() > 0 ? first.resid_sd() / std::sqrt(first.sxx()) : INFINITY;
+  const double zero = motor_zero();
+  const double u0 = first.mean() - zero, u1 = last.mean() - zero;
+  // Not even lower at the end than at the start, beyond the noise of the two means.
+  const double se_means = std::hypot(first.resid_sd() / std::sqrt(first.n), last.resid_sd() / std::sqrt(last.n));
+  if (u0 - u1 < 3.0 * se_means)
+    return fmt::format("over its last third the reading is no lower than over its first ({:.3g} against {:.3g}) before "
+                       "it rose again: no coast (an open pin's wander before it was connected? a drive holding its "
+                       "speed?)",
+                       last.mean(), first.mean());
+  if (!(rate0 > 4.0 * se0) || !(u0 > 0) || !(u1 > 0.3 * u0)) return {};
+  const double least = 0.25 * (u1 / u0) * (u1 / u0) * (rate0 - 2.0 * se0);
+  if (!(rate1 + 2.0 * se1 < least)) return {};
+  return fmt::format("the decline levelled off at {:.3g} ({:.0f} % of where it began) before the reading rose again: "
+                     "it fell {:.3g} a second at first and {:.2g} at the end, where friction would still slow it at "
+                     "least {:.2g} — no motor coasts like that (an open pin's wander before it was connected? a drive "
+                     "holding a lower speed?)",
+                     last.mean(), 100.0 * u1 / u0, rate0, rate1, least);
+}
+
 void RunDetector::power_back() {
-  const std::size_t at = rise_start_;
-  close_unstopped(at, fmt::format("the reading rose again at {} before standstill (power restored?)", fmt_s(t(at))),
+  const std::size_t at = rise_start_, cut = run_.cut_index;
+  not_coast_ = swing_reason(at);
+  if (not_coast_.empty()) not_coast_ = stall_reason(at);
+  // Its start not recorded and its end a rise: nothing shows this decline was a motor's coast.
+  if (not_coast_.empty() && run_.partial())
+    not_coast_ = "neither its cut nor a standstill was seen (the recording starts on it, and the reading rose again): a "
+                 "piece of a coast, or an open pin's wander before it was connected — not a run";
+  // The window ends early, so the result changes: said in the default output.
+  run_note_severity_ = Diagnostic::Severity::warning;
+  close_unstopped(at,
+                  fmt::format("the reading rose again at {}, {:.3g} s after the cut, before standstill: the motor "
+                              "powered again (the coast is fitted up to there), or, if A0 was not yet connected to "
+                              "the motor, an open pin's hum and no coast",
+                              fmt_s(t(at)), t(at) - run_.t_cut_s),
                   Run::End::power_back);
-  to_idle(at, false);
+  // The samples before the rise are the next coast's lead-in: what the reading did before a step up
+  // to it (a floating pin connected to the motor, a motor powered again) tells where that coast's
+  // cut is.
+  to_idle(at, false, cut);
 }
 
 void RunDetector::standstill_checks(std::size_t i, bool at_end, double mu, double sxx, double e) {
@@ -114,14 +195,9 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
   if (signal_lost(i, first_in, z, amp)) return;
 
   // Where the coast crossed the last quarter of its amplitude.
-  const double quarter = z + 0.25 * amp;
+  const double t_quarter = last_quarter_time(run_.cut_index, first_in, z + 0.25 * amp);
   std::size_t k = first_in;
-  while (k > run_.cut_index && v(k - 1) <= quarter) --k;
-  double t_quarter = t(k);
-  if (k > run_.cut_index) {
-    const double va = v(k - 1), vb = v(k);
-    t_quarter = va > vb ? t(k - 1) + (t(k) - t(k - 1)) * (va - quarter) / (va - vb) : t(k);
-  }
+  while (k > run_.cut_index && v(k - 1) <= z + 0.25 * amp) --k;
 
   // Stop time: the approach line (the last ≤2 s above the band) meets the zero level.
   double t_hit = t(first_in);
@@ -181,7 +257,8 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
       approach_t = e > 0 ? -f.slope() * std::sqrt(f.sxx()) / e : (f.slope() < 0 ? approach_t : 0.0);
     }
   }
-  if (end_rate >= stop_min_end_rate || approach_t >= stop_min_approach_t || amp <= 0) {
+  stop_approach_t_ = approach_t;
+  if (!creeps_in(run_.t_cut_s, t_quarter, t_stop) || amp <= 0) {
     run_.stopped = true;
     run_.stop_index = stop;
     run_.t_stop_s = t_stop;
@@ -221,6 +298,23 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
     complete_run(i + 1);
     to_idle(i + 1, true);
   }
+}
+
+double RunDetector::last_quarter_time(std::size_t cut, std::size_t first_in, double quarter) const {
+  std::size_t k = first_in;
+  while (k > cut && v(k - 1) <= quarter) --k;
+  if (k == cut) return t(k);
+  const double va = v(k - 1), vb = v(k);
+  return va > vb ? t(k - 1) + (t(k) - t(k - 1)) * (va - quarter) / (va - vb) : t(k);
+}
+
+bool RunDetector::creeps_in(double t_cut, double t_quarter, double t_stop) const {
+  // A real stop arrives with a finite slope; an exponential creeps in: its last quarter of the
+  // amplitude takes far more than a quarter of the coast, and right before it the reading no
+  // longer falls clearly.
+  const double last_quarter = t_stop - t_quarter;
+  const double end_rate = last_quarter > 0 ? 0.25 * (t_stop - t_cut) / last_quarter : std::numeric_limits<double>::infinity();
+  return end_rate < stop_min_end_rate && stop_approach_t_ < stop_min_approach_t;
 }
 
 void RunDetector::block_until_rise(double level) {

@@ -160,6 +160,12 @@ VirtualBench::VirtualBench(VirtualBenchOptions options) : o_(std::move(options))
     nlohmann::json rt{{"run", k + 1},        {"e0", spec.e0_v},       {"w0", run.omega0},
                       {"t_stop_s", run.t_stop_s}, {"stopped", run.stopped}, {"cut_bench_s", run_start_s + run.t_cut_ms / 1000.0}};
     if (spec.start_s > 0) rt["starts_mid_coast_s"] = spec.start_s;
+    // The handout's floating pin: the coast is in the readings from the pin's connection on.
+    if (run.t_connect_ms != run.t_cut_ms) rt["connect_bench_s"] = run_start_s + run.t_connect_ms / 1000.0;
+    if (!run.bounce_index.empty()) {
+      auto& b = rt["bounce_bench_s"] = nlohmann::json::array();
+      for (std::size_t i : run.bounce_index) b.push_back(run_start_s + run.t_ms[i] / 1000.0);
+    }
     if (spec.gap_s > 0) rt["gap_bench_s"] = {run_start_s + run.t_cut_ms / 1000.0 + spec.gap_from_s, spec.gap_s};
     if (run.t_signal_lost_ms >= 0) rt["signal_lost_bench_s"] = run_start_s + run.t_signal_lost_ms / 1000.0;
     if (!run.glitch_index.empty()) {

@@ -4,67 +4,26 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <limits>
+#include <span>
 #include <fmt/format.h>
 #include <system_error>
 #include <vector>
 
+#include "spindown/column_guess.hpp"
+#include "spindown/csv_fields.hpp"
+#include "spindown/ascii_lower.hpp"
 #include "spindown/text_support.hpp"
+#include "spindown/trim.hpp"
 
 namespace spindown {
 
-std::string_view time_unit_name(TimeUnit unit) {
-  switch (unit) {
-    case TimeUnit::s: return "s";
-    case TimeUnit::ms: return "ms";
-    case TimeUnit::us: return "us";
-  }
-  return "?";
-}
-
 namespace {
 
-std::string lower(std::string_view s) {
-  std::string out(s);
-  std::transform(out.begin(), out.end(), out.begin(),
-                 [](unsigned char c) { return static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c); });
-  return out;
-}
-
-bool is_blank(char c) { return c == ' ' || c == '\t'; }
-
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && is_blank(s.front())) s.remove_prefix(1);
-  while (!s.empty() && is_blank(s.back())) s.remove_suffix(1);
-  if (s.size() >= 2 && ((s.front() == '"' && s.back() == '"') || (s.front() == '\'' && s.back() == '\''))) {
-    s = s.substr(1, s.size() - 2);
-    while (!s.empty() && is_blank(s.front())) s.remove_prefix(1);
-    while (!s.empty() && is_blank(s.back())) s.remove_suffix(1);
-  }
+// A field in single quotes ('time'), as some loggers write them: without them.
+std::string_view unquote_single(std::string_view s) {
+  if (s.size() >= 2 && s.front() == '\'' && s.back() == '\'') s = trim(s.substr(1, s.size() - 2));
   return s;
-}
-
-// Fields of one line into out (reused: no allocation once it has grown).
-void split(std::string_view line, char delimiter, std::vector<std::string_view>& out) {
-  out.clear();
-  if (delimiter == ' ') {
-    std::size_t i = 0;
-    while (i < line.size()) {
-      while (i < line.size() && is_blank(line[i])) ++i;
-      if (i == line.size()) break;
-      std::size_t j = i;
-      while (j < line.size() && !is_blank(line[j])) ++j;
-      out.push_back(trim(line.substr(i, j - i)));
-      i = j;
-    }
-    return;
-  }
-  std::size_t start = 0;
-  for (;;) {
-    const std::size_t at = line.find(delimiter, start);
-    out.push_back(trim(line.substr(start, at == std::string_view::npos ? std::string_view::npos : at - start)));
-    if (at == std::string_view::npos) break;
-    start = at + 1;
-  }
 }
 
 // A number field; decimal_comma accepts "2,81" (semicolon CSV from European spreadsheets).
@@ -99,46 +58,7 @@ bool parse_number(std::string_view field, bool decimal_comma, double& out, std::
   return true;
 }
 
-struct Column {
-  std::string name;  // as written
-  std::string base;  // lower case, unit removed: "time (s)" -> "time"
-  std::string unit;  // lower case: "s", "ms", "v", "rpm", "rad/s" or empty
-};
-
-bool is_unit_word(std::string_view u) { return parse_time_unit(u) || parse_quantity(u); }
-
-Column describe_column(std::string_view name) {
-  Column c;
-  c.name = text::escape_invalid_utf8(name);  // shown in messages, which must stay UTF-8
-  std::string l = lower(name);
-  const std::size_t open = l.find_first_of("([");
-  if (open != std::string::npos) {
-    const std::size_t close = l.find_first_of(")]", open);
-    c.unit = std::string(trim(std::string_view(l).substr(open + 1, close == std::string::npos ? std::string::npos
-                                                                                             : close - open - 1)));
-    c.base = std::string(trim(std::string_view(l).substr(0, open)));
-  } else {
-    c.base = l;
-    const std::size_t us = l.rfind('_');
-    if (us != std::string::npos && us > 0 && is_unit_word(std::string_view(l).substr(us + 1))) {
-      c.unit = l.substr(us + 1);
-      c.base = l.substr(0, us);
-    }
-  }
-  return c;
-}
-
-constexpr std::array time_names{"time", "t", "millis", "ms", "micros", "us", "µs", "timestamp", "seconds", "sec", "s"};
-constexpr std::array value_names{"volts", "volt", "voltage", "v", "u", "emf", "back_emf", "back-emf", "backemf",
-                                 "bemf", "a0", "rpm", "omega", "w", "ω", "angular_velocity", "angular_speed",
-                                 "speed", "value", "reading"};
-
-template <std::size_t N>
-bool in(const std::array<const char*, N>& names, std::string_view s) {
-  return std::any_of(names.begin(), names.end(), [&](const char* n) { return s == n; });
-}
-
-std::string list_columns(const std::vector<Column>& cols) {
+std::string list_columns(const std::vector<ColumnName>& cols) {
   std::string out;
   for (std::size_t i = 0; i < cols.size(); ++i)
     out += fmt::format("{}{} '{}'", i ? ", " : "", i + 1, cols[i].name);
@@ -150,7 +70,7 @@ bool all_digits(std::string_view s) {
 }
 
 // The column the user named: index or header name. -1 and *why when there is none.
-int resolve_named(const std::string& spec, const std::vector<Column>& cols, bool have_header, std::string* why) {
+int resolve_named(const std::string& spec, const std::vector<ColumnName>& cols, bool have_header, std::string* why) {
   if (all_digits(spec)) {
     const unsigned long k = std::stoul(spec);
     if (k >= 1 && k <= cols.size()) return static_cast<int>(k - 1);
@@ -161,10 +81,10 @@ int resolve_named(const std::string& spec, const std::vector<Column>& cols, bool
     *why = fmt::format("column '{}' is named but the file has no header row; give its 1-based index", spec);
     return -1;
   }
-  const std::string want = lower(spec);
+  const std::string want = ascii_lower(trim(spec));
   int found = -1;
   for (std::size_t i = 0; i < cols.size(); ++i) {
-    if (lower(cols[i].name) == want || cols[i].base == want) {
+    if (ascii_lower(cols[i].name) == want || cols[i].base == want) {
       if (found >= 0) {
         *why = fmt::format("column name '{}' matches both column {} and column {}; give the index", spec, found + 1,
                            i + 1);
@@ -177,42 +97,7 @@ int resolve_named(const std::string& spec, const std::vector<Column>& cols, bool
   return found;
 }
 
-std::optional<TimeUnit> implied_time_unit(const Column& c) {
-  if (!c.unit.empty()) return parse_time_unit(c.unit);
-  return parse_time_unit(c.base);  // "millis", "ms", "seconds"; "time" gives nothing
-}
-
-std::optional<Quantity> implied_quantity(const Column& c) {
-  if (!c.unit.empty()) return parse_quantity(c.unit);
-  const std::string& b = c.base;
-  if (b == "volts" || b == "volt" || b == "voltage" || b == "v" || b == "u" || b == "emf" || b == "back_emf" ||
-      b == "back-emf" || b == "backemf" || b == "bemf" || b == "a0")
-    return Quantity::back_emf_volts;
-  if (b == "rpm") return Quantity::rpm;
-  if (b == "omega" || b == "w" || b == "ω" || b == "angular_velocity" || b == "angular_speed")
-    return Quantity::rad_per_s;
-  return std::nullopt;
-}
-
 }  // namespace
-
-std::optional<TimeUnit> parse_time_unit(std::string_view unit) {
-  const std::string u = lower(unit);
-  if (u == "s" || u == "sec" || u == "secs" || u == "second" || u == "seconds") return TimeUnit::s;
-  if (u == "ms" || u == "msec" || u == "millis" || u == "millisecond" || u == "milliseconds") return TimeUnit::ms;
-  if (u == "us" || u == "µs" || u == "usec" || u == "micros" || u == "microsecond" || u == "microseconds")
-    return TimeUnit::us;
-  return std::nullopt;
-}
-
-double time_units_per_second(TimeUnit unit) {
-  switch (unit) {
-    case TimeUnit::s: return 1.0;
-    case TimeUnit::ms: return 1e3;
-    case TimeUnit::us: return 1e6;
-  }
-  return 1.0;
-}
 
 bool DelimitedTextOptions::names_columns() const {
   return !time_column.empty() || !value_column.empty() || time_unit.has_value() || quantity.has_value() ||
@@ -228,12 +113,41 @@ bool DelimitedTextOptions::is_valid(std::string* why) const {
     if (all_digits(*c) && (c->size() > 6 || std::stoul(*c) == 0))
       return fail(fmt::format("column index '{}' must be between 1 and 999999", *c));
   }
-  if (!time_column.empty() && lower(time_column) == lower(value_column))
+  if (!time_column.empty() && ascii_lower(time_column) == ascii_lower(value_column))
     return fail(fmt::format("time and value are both column '{}'", time_column));
   if (delimiter != 0 && delimiter != ',' && delimiter != ';' && delimiter != '\t' && delimiter != ' ')
     return fail(fmt::format("delimiter '{}' is not one of ',', ';', tab or blank", delimiter));
   if (max_line_reports == 0) return fail("max_line_reports must be at least 1");
+  if (!std::isfinite(value_scale) || value_scale <= 0)
+    return fail(fmt::format("value scale {} is not a positive number", value_scale));
   return true;
+}
+
+bool header_needs_delimited_reader(std::string_view line) {
+  char delim = ' ';
+  for (char cand : {'\t', ';', ','})
+    if (line.find(cand) != std::string_view::npos) {
+      delim = cand;
+      break;
+    }
+  CsvFieldSplitter splitter;
+  std::vector<std::string_view> fields;
+  splitter.split(line, delim, fields);
+  if (fields.size() < 2) return false;
+  for (const auto f : fields) {
+    double x;
+    std::string_view w;
+    if (f.empty() || parse_number(f, delim != ',', x, w)) return false;
+  }
+  for (const auto f : fields) {
+    const ColumnName c = describe_column(unquote_single(f));
+    if (unknown_value_unit(c)) return true;
+    if (const auto t = implied_time_unit(c); t && *t != TimeUnit::ms) return true;
+    const auto v = implied_value_unit(c);
+    if (v && (v->quantity != Quantity::back_emf_volts || v->scale != 1)) return true;
+    if (!v && !likely_value_unit(c).empty() && likely_value_unit(c) != "V") return true;
+  }
+  return false;
 }
 
 Recording read_delimited_text(std::string_view text, std::string source, const DelimitedTextOptions& options) {
@@ -241,7 +155,8 @@ Recording read_delimited_text(std::string_view text, std::string source, const D
   rec.source = std::move(source);
   if (!text::readable_text(text, options, "delimited text", rec)) return rec;
 
-  // Content lines (not blank, not a comment, not a PuTTY header), as views into text.
+  // Content lines (not blank, not a comment, not a PuTTY header), as views into text. A row of
+  // separators alone (";;;;", as a spreadsheet saves its empty rows) is blank.
   struct Line {
     std::int64_t number;
     std::string_view text;
@@ -251,7 +166,7 @@ Recording read_delimited_text(std::string_view text, std::string source, const D
   std::size_t blank = 0, comments = 0, headers = 0;
   const std::int64_t lines = text::for_each_line(text, [&](std::int64_t n, std::string_view line) {
     const std::string_view t = trim(line);
-    if (t.empty()) ++blank;
+    if (t.empty() || t.find_first_not_of(" \t;,") == std::string_view::npos) ++blank;
     else if (t.front() == '#') ++comments;
     else if (t.starts_with("=~=~=~")) {
       ++headers;
@@ -279,24 +194,51 @@ Recording read_delimited_text(std::string_view text, std::string source, const D
       }
     }
   }
-  const bool decimal_comma = delim == ';';
+  // A comma that is not the delimiter is a decimal comma ("2,81": a European spreadsheet's CSV or
+  // "Unicode text").
+  const bool decimal_comma = delim != ',';
   const std::string_view delim_name = delim == '\t' ? "tab" : delim == ' ' ? "blanks" : std::string_view(&delim, 1);
 
+  CsvFieldSplitter splitter;
   std::vector<std::string_view> fields;
   fields.reserve(16);
-  split(content.front().text, delim, fields);
+  const auto split = [&](std::string_view line) {
+    splitter.split(line, delim, fields);
+    for (auto& f : fields) f = unquote_single(f);
+  };
+  const auto is_number = [&](std::string_view f) {
+    double x;
+    std::string_view w;
+    return parse_number(f, decimal_comma, x, w);
+  };
+  split(content.front().text);
   bool have_header = false;
   if (options.header) {
     have_header = *options.header;
   } else {
-    double x;
-    std::string_view w;
-    have_header = std::any_of(fields.begin(), fields.end(),
-                              [&](std::string_view f) { return !parse_number(f, decimal_comma, x, w); });
+    have_header = !std::all_of(fields.begin(), fields.end(), is_number);
   }
-  std::vector<Column> cols;
+  std::vector<ColumnName> cols;
   for (std::size_t i = 0; i < fields.size(); ++i)
-    cols.push_back(have_header ? describe_column(fields[i]) : Column{fmt::format("{}", i + 1), "", ""});
+    cols.push_back(have_header ? describe_column(fields[i]) : ColumnName{fmt::format("{}", i + 1), "", ""});
+  // A row of units under the names ("s;rpm", "[ms]\t[V]"): no number in it and a unit read.
+  std::size_t first_data = have_header ? 1 : 0, unit_rows = 0;
+  if (have_header && content.size() > 1) {
+    split(content[1].text);
+    std::vector<std::string> units;
+    for (const auto f : fields) units.push_back(unit_cell(f));
+    const bool units_row = std::none_of(fields.begin(), fields.end(), is_number) &&
+                           std::any_of(units.begin(), units.end(), [](const std::string& u) { return !u.empty(); }) &&
+                           std::all_of(fields.begin(), fields.end(), [&](std::string_view f) {
+                             return f.empty() || !unit_cell(f).empty();
+                           });
+    if (units_row) {
+      for (std::size_t i = 0; i < cols.size() && i < units.size(); ++i)
+        if (cols[i].unit.empty() && !units[i].empty()) cols[i].unit = units[i];
+      first_data = 2;
+      unit_rows = 1;
+    }
+  }
 
   auto give_up = [&](std::string message) {
     rec.error(0, std::move(message));
@@ -306,6 +248,31 @@ Recording read_delimited_text(std::string_view text, std::string source, const D
   if (cols.size() < 2)
     return give_up(fmt::format("no samples: line {} has {} field (delimiter {}); need a time and a value column",
                                content.front().number, cols.size(), delim_name));
+
+  // What the numbers say when the names do not: the table's first rows, column by column.
+  std::optional<ColumnGuess> guessed;
+  const auto guess = [&]() -> const ColumnGuess& {
+    if (!guessed) {
+      constexpr std::size_t max_rows = 100'000;
+      std::vector<std::vector<double>> table(cols.size());
+      for (std::size_t i = first_data; i < content.size() && i - first_data < max_rows; ++i) {
+        split(content[i].text);
+        for (std::size_t c = 0; c < cols.size(); ++c) {
+          double x = std::numeric_limits<double>::quiet_NaN();
+          std::string_view w;
+          if (c >= fields.size() || !parse_number(fields[c], decimal_comma, x, w))
+            x = std::numeric_limits<double>::quiet_NaN();
+          table[c].push_back(x);
+        }
+      }
+      guessed = guess_columns(table);
+    }
+    return *guessed;
+  };
+  const auto proposal = [&]() {
+    const auto p = column_proposal(guess());
+    return p ? "; " + *p : std::string();
+  };
 
   // Columns.
   int tcol = -1, vcol = -1;
@@ -330,41 +297,64 @@ Recording read_delimited_text(std::string_view text, std::string source, const D
     for (std::size_t k = 0; k < idx.size(); ++k) out += fmt::format("{}'{}'", k ? " and " : "", cols[idx[k]].name);
     return out;
   };
+  const std::string unnamed = have_header ? "" : " (the file has no header row)";
   if (tcol < 0) {
-    auto c = candidates([](const Column& col) { return in(time_names, col.base); }, vcol);
+    auto c = candidates([](const ColumnName& col) { return is_time_name(col); }, vcol);
     if (c.size() == 1) tcol = c[0];
     else if (c.size() > 1)
       return give_up(fmt::format("columns {} could each be the time; name one (time column)", names_of(c)));
     else if (cols.size() == 2) tcol = vcol == 0 ? 1 : 0;
+    else if (const auto p = column_proposal(guess()))
+      return give_up(fmt::format("cannot tell which of the {} columns is the time{}: {}", cols.size(), unnamed, *p));
     else
-      return give_up(fmt::format("cannot tell which of the {} columns is the time ({}); name it (time column)",
-                                 cols.size(), list_columns(cols)));
+      return give_up(fmt::format("cannot tell which of the {} columns is the time{} ({}); name it (time column)",
+                                 cols.size(), unnamed, list_columns(cols)));
   }
   if (vcol < 0) {
-    auto c = candidates([](const Column& col) { return in(value_names, col.base) || implied_quantity(col); }, tcol);
+    auto c = candidates([](const ColumnName& col) { return is_value_name(col); }, tcol);
     if (c.size() == 1) vcol = c[0];
     else if (c.size() > 1)
-      return give_up(fmt::format("columns {} could each be the value; name one (value column)", names_of(c)));
+      return give_up(fmt::format("columns {} could each be the value; name one (value column){}", names_of(c),
+                                 proposal()));
     else if (cols.size() == 2) vcol = tcol == 0 ? 1 : 0;
+    else if (const auto p = column_proposal(guess()); p && guess().time == tcol)
+      return give_up(fmt::format("cannot tell which of the {} columns is the value{}: {}", cols.size(), unnamed, *p));
     else
-      return give_up(fmt::format("cannot tell which of the {} columns is the value ({}); name it (value column)",
-                                 cols.size(), list_columns(cols)));
+      return give_up(fmt::format("cannot tell which of the {} columns is the value{} ({}); name it (value column)",
+                                 cols.size(), unnamed, list_columns(cols)));
   }
 
-  // Quantity.
+  // Quantity, and the factor that turns a reading into it (mV: 0.001 V).
   std::string quantity_from = "given";
+  std::string value_unit_name;
+  double value_scale = 1;
+  const ColumnName& value_col = cols[vcol];
   if (options.quantity) {
     rec.quantity = *options.quantity;
-  } else if (auto q = implied_quantity(cols[vcol])) {
-    rec.quantity = *q;
+    value_scale = options.value_scale;
+  } else if (auto u = implied_value_unit(value_col)) {
+    rec.quantity = u->quantity;
+    value_scale = u->scale;
+    value_unit_name = u->name;
     quantity_from = "from the header";
   } else if (!have_header) {
     rec.quantity = Quantity::back_emf_volts;
     quantity_from = "assumed: no header";
   } else {
-    return give_up(fmt::format("cannot tell the unit of value column '{}' (V, rpm or rad/s); name it",
-                               cols[vcol].name));
+    const std::string_view likely = likely_value_unit(value_col);
+    const std::string option = likely.empty() ? std::string("--value-unit V, rpm or rad/s")
+                                              : fmt::format("--value-unit {}", likely);
+    if (unknown_value_unit(value_col))
+      return give_up(fmt::format("value column '{}': its unit '{}' is not one spindown reads ({}); if the readings "
+                                 "are one of those under another name, say which: {}",
+                                 value_col.name, value_col.unit, value_units_read(), option));
+    return give_up(fmt::format("cannot tell the unit of value column '{}' (V, rpm or rad/s); name it: {}",
+                               value_col.name, option));
   }
+  if (!options.time_unit && !cols[tcol].unit.empty() && !parse_time_unit(cols[tcol].unit))
+    return give_up(fmt::format("time column '{}': its unit '{}' is not one spindown reads (s, ms, us); convert the "
+                               "times or name their unit: --time-unit s, ms or us",
+                               cols[tcol].name, cols[tcol].unit));
 
   // Rows.
   text::LineReporter reporter(rec, options.max_line_reports);
@@ -372,9 +362,9 @@ Recording read_delimited_text(std::string_view text, std::string source, const D
   raw.reserve(content.size());
   std::size_t bad = 0;
   const std::size_t need = static_cast<std::size_t>(std::max(tcol, vcol)) + 1;
-  for (std::size_t i = have_header ? 1 : 0; i < content.size(); ++i) {
+  for (std::size_t i = first_data; i < content.size(); ++i) {
     const Line& line = content[i];
-    split(line.text, delim, fields);
+    split(line.text);
     if (fields.size() < need) {
       ++bad;
       reporter.warn(line.number, fmt::format("{}: {} fields, column {} is missing; skipped",
@@ -395,7 +385,7 @@ Recording read_delimited_text(std::string_view text, std::string source, const D
                                              text::escape_invalid_utf8(fields[vcol].substr(0, 40)), w));
       continue;
     }
-    raw.add(line.number, line.text.data(), t, v, false);
+    raw.add(line.number, line.text.data(), t, v * value_scale, false);
   }
 
   // Time unit.
@@ -407,19 +397,10 @@ Recording read_delimited_text(std::string_view text, std::string source, const D
     unit = *u;
     unit_from = "from the header";
   } else {
-    // Whole numbers with steps of at least 1 are counter ticks: ms, or µs for big steps.
-    std::vector<double> steps;
-    bool integral = true;
-    for (std::size_t i = 0; i < raw.size() && i < 65; ++i) {
-      integral = integral && raw.t[i] == std::floor(raw.t[i]);
-      if (i > 0 && raw.t[i] > raw.t[i - 1]) steps.push_back(raw.t[i] - raw.t[i - 1]);
-    }
+    bool integral = false;
     double step = 0;
-    if (!steps.empty()) {
-      std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
-      step = steps[steps.size() / 2];
-    }
-    unit = integral && step >= 1 ? (step >= 5000 ? TimeUnit::us : TimeUnit::ms) : TimeUnit::s;
+    unit = time_unit_from_values(std::span<const double>(raw.t.data(), std::min<std::size_t>(raw.size(), 65)),
+                                 &integral, &step);
     unit_from = "assumed";
     rec.note(0, fmt::format("time unit not given: times {} with steps of ~{:g}, read as {}; name the unit if "
                             "that is wrong",
@@ -437,16 +418,22 @@ Recording read_delimited_text(std::string_view text, std::string source, const D
   text::sort_by_line(rec);
   rec.lines_skipped = rec.lines_read - rec.size();
 
+  const std::string value_unit =
+      value_scale != 1 && !value_unit_name.empty()
+          ? fmt::format("{} read as {}", value_unit_name, quantity_unit(rec.quantity))
+          : value_scale != 1 ? fmt::format("{} x {:g}", quantity_unit(rec.quantity), value_scale)
+                             : std::string(quantity_unit(rec.quantity));
   const std::string columns = fmt::format("time = column {} '{}' in {} ({}), value = column {} '{}' in {} ({}), "
                                           "delimiter {}",
                                           tcol + 1, cols[tcol].name, time_unit_name(unit), unit_from, vcol + 1,
-                                          cols[vcol].name, quantity_unit(rec.quantity), quantity_from, delim_name);
+                                          cols[vcol].name, value_unit, quantity_from, delim_name);
   if (rec.empty()) {
     rec.error(0, fmt::format("no samples: {} lines, none with a usable time and value ({})", lines, columns));
     return rec;
   }
   rec.note(0, text::summary_with_counts(fmt::format("{} samples from {} lines; {}", rec.size(), lines, columns),
                                         {{have_header ? 1u : 0u, "header row"},
+                                         {unit_rows, "units row"},
                                          {headers, "PuTTY header"},
                                          {comments, "comment"},
                                          {blank, "blank"},

@@ -4,78 +4,15 @@
 #include <cstdint>
 #include <fmt/format.h>
 
+#include "spindown/text_encoding.hpp"
+#include "spindown/text_support.hpp"
+
 namespace spindown {
 
 namespace {
 
 constexpr std::size_t head_bytes = 8192;  // what the checks look at
 constexpr bool is_digit(char c) { return c >= '0' && c <= '9'; }
-
-enum class Utf16 { none, little_endian, big_endian };
-
-// A byte-order mark, or (no mark) ASCII text every other byte of which is NUL.
-Utf16 utf16_kind(std::string_view text, bool* has_bom) {
-  *has_bom = false;
-  if (text.size() >= 2) {
-    const auto b0 = static_cast<unsigned char>(text[0]), b1 = static_cast<unsigned char>(text[1]);
-    if (b0 == 0xFF && b1 == 0xFE) return *has_bom = true, Utf16::little_endian;
-    if (b0 == 0xFE && b1 == 0xFF) return *has_bom = true, Utf16::big_endian;
-  }
-  const std::size_t n = std::min(text.size(), std::size_t{512}) & ~std::size_t{1};
-  if (n < 16) return Utf16::none;
-  std::size_t even_nul = 0, odd_nul = 0;
-  for (std::size_t i = 0; i < n; i += 2) {
-    even_nul += text[i] == '\0';
-    odd_nul += text[i + 1] == '\0';
-  }
-  const std::size_t pairs = n / 2;
-  if (odd_nul * 10 >= pairs * 9 && even_nul * 20 <= pairs) return Utf16::little_endian;
-  if (even_nul * 10 >= pairs * 9 && odd_nul * 20 <= pairs) return Utf16::big_endian;
-  return Utf16::none;
-}
-
-void append_utf8(std::string& out, std::uint32_t cp) {
-  if (cp < 0x80) {
-    out += static_cast<char>(cp);
-  } else if (cp < 0x800) {
-    out += static_cast<char>(0xC0 | (cp >> 6));
-    out += static_cast<char>(0x80 | (cp & 0x3F));
-  } else if (cp < 0x10000) {
-    out += static_cast<char>(0xE0 | (cp >> 12));
-    out += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
-    out += static_cast<char>(0x80 | (cp & 0x3F));
-  } else {
-    out += static_cast<char>(0xF0 | (cp >> 18));
-    out += static_cast<char>(0x80 | ((cp >> 12) & 0x3F));
-    out += static_cast<char>(0x80 | ((cp >> 6) & 0x3F));
-    out += static_cast<char>(0x80 | (cp & 0x3F));
-  }
-}
-
-// UTF-16 to UTF-8; a lone surrogate or an odd last byte becomes U+FFFD.
-std::string utf16_to_utf8(std::string_view text, Utf16 kind, bool skip_bom) {
-  std::string out;
-  out.reserve(text.size() / 2 + 16);
-  const auto unit = [&](std::size_t i) -> std::uint32_t {
-    const auto a = static_cast<unsigned char>(text[i]), b = static_cast<unsigned char>(text[i + 1]);
-    return kind == Utf16::little_endian ? (std::uint32_t(b) << 8 | a) : (std::uint32_t(a) << 8 | b);
-  };
-  std::size_t i = skip_bom ? 2 : 0;
-  for (; i + 1 < text.size(); i += 2) {
-    const std::uint32_t u = unit(i);
-    if (u >= 0xD800 && u <= 0xDBFF && i + 3 < text.size()) {
-      const std::uint32_t lo = unit(i + 2);
-      if (lo >= 0xDC00 && lo <= 0xDFFF) {
-        append_utf8(out, 0x10000 + ((u - 0xD800) << 10) + (lo - 0xDC00));
-        i += 2;
-        continue;
-      }
-    }
-    append_utf8(out, u >= 0xD800 && u <= 0xDFFF ? 0xFFFD : u);
-  }
-  if (i < text.size()) append_utf8(out, 0xFFFD);
-  return out;
-}
 
 // "10:21:38.234 -> ": the Arduino IDE serial monitor's "Show timestamp". Its length, or 0.
 std::size_t timestamp_prefix(std::string_view line) {
@@ -155,21 +92,30 @@ bool commas_to_read(const HeadCounts& c) { return c.comma >= 5 && c.point == 0; 
 
 }  // namespace
 
+namespace {
+
+// The encoding to undo: none for binary data and office documents, which the readers refuse.
+EncodingGuess encoding_to_undo(std::string_view text) {
+  EncodingGuess g = guess_text_encoding(text);
+  if (!needs_decoding(g)) return g;  // the usual ASCII file: no binary check here (the reader makes it)
+  const bool wide = g.encoding == TextEncoding::utf16le || g.encoding == TextEncoding::utf16be;
+  if (!wide && (text::looks_binary(text) || office_document(text))) return {};
+  return g;
+}
+
+}  // namespace
+
 bool needs_text_repair(std::string_view text) {
-  bool bom = false;
-  if (utf16_kind(text, &bom) != Utf16::none) return true;
+  if (needs_decoding(encoding_to_undo(text))) return true;
   const HeadCounts c = count_head(text);
   return timestamps_to_strip(c) || commas_to_read(c);
 }
 
 std::vector<std::string> repair_text(std::string& text) {
   std::vector<std::string> notes;
-  bool bom = false;
-  if (const Utf16 kind = utf16_kind(text, &bom); kind != Utf16::none) {
-    text = utf16_to_utf8(text, kind, bom);
-    notes.push_back(fmt::format("read as UTF-16 ({}{}), as a Windows editor saves \"Unicode\" text",
-                                kind == Utf16::little_endian ? "little-endian" : "big-endian",
-                                bom ? ", with a byte-order mark" : ", no byte-order mark"));
+  if (const EncodingGuess g = encoding_to_undo(text); needs_decoding(g)) {
+    text = decode_text(text, g);
+    if (std::string note = decoding_note(g); !note.empty()) notes.push_back(std::move(note));
   }
   const HeadCounts c = count_head(text);
   const bool strip = timestamps_to_strip(c), commas = commas_to_read(c);

@@ -1,6 +1,7 @@
 // spindown-coast: the improved spin-down firmware, protocol spindown-v1 (README.md here is the
 // normative definition; core/sources/src/spindown_protocol.cpp parses exactly that).
-//   - raw ADC counts (the lab sketch's 2-decimal volts lose half the 10-bit resolution)
+//   - raw ADC counts (the lab sketch's 2-decimal volts lose half the 10-bit resolution); volts =
+//     count * adc_ref_v / 1024, the ATmega328P datasheet's ADC = V_in * 1024 / V_ref
 //   - micros() time stamps on a fixed schedule (not delay(): the loop period does not drift)
 //   - a sequence number and a CRC-8 per line, 115200 baud
 //   - period 1-20 ms: compile with -DSPINDOWN_PERIOD_US=…, or send "P<ms>\n" at run time

@@ -128,6 +128,10 @@ class LcmLoop {
   // own loopback self-test fails it has no socket to wait on).
   bool can_receive();
 
+  // Whether LCM holds received messages not yet dispatched (its receive thread's queue): its
+  // notify pipe is readable. Safe from any thread (a poll with no wait on LCM's descriptor).
+  bool messages_waiting() const;
+
   // Dispatches messages until a stop, a deadline or too many failed receives (see LcmRunOptions).
   // Rethrows a handler's exception (unless on_handler_error is set).
   LcmLoopEnd run(const LcmRunOptions& options = {});
@@ -155,6 +159,7 @@ class LcmLoop {
 
   lcm::LCM lcm_;
   MessageStamp* stamp_ = nullptr;
+  std::atomic<int> receive_fd_{-1};  // LCM's descriptor, once it has one (for messages_waiting())
   std::vector<std::unique_ptr<Subscription>> subscriptions_;
   std::vector<Timer> timers_;
   std::function<void(const LcmDecodeError&)> decode_report_;

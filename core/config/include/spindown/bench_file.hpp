@@ -6,6 +6,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "spindown/bench.hpp"
@@ -21,10 +22,16 @@ struct BenchFile {
   bool sets_kb = false;        // the file gives K_b (kb_v_s_per_rad or speed_constant_rpm_per_v)
   bool sets_inertia_error = false, sets_kb_error = false;  // [bench] inertia_error_pct, kb_error_pct
   MotorHealthConfig health;    // [motor], [baseline], [health]
+  // Usable but doubtful (BridgeSettings::warnings: a [bench] K_b the [motor] datasheet contradicts),
+  // each a whole line "PATH: warning: …"; every command that reads the file prints them.
+  std::vector<std::string> warnings;
 };
 
 struct BenchFiles {
   std::map<std::string, BenchFile, std::less<>> files;  // by bench id
+  // The file for a recording of bench (an LCM log's bench id, a text file's from the roster or
+  // --bench-pattern); a recording that names no bench ("") takes the only file given, if one.
+  const BenchFile* for_bench(std::string_view bench) const;
 };
 
 // J and K_b for one recording, by the one rule every offline command follows (fit, explain,

@@ -26,6 +26,7 @@
 #include "spindown/message_gate.hpp"
 #include "spindown/sample_stream.hpp"
 #include "spindown/service_instances.hpp"
+#include "spindown/utf8_text.hpp"  // display_width: the columns this table's text takes
 
 namespace spindown {
 
@@ -38,6 +39,10 @@ struct LabTableOptions {
   double gap_event_every_s = 10.0; // sequence-gap events at most this often per bench
   bool signatures_checked = false; // messages pass a gate with the lab key first (watch --key)
   SampleStreamOptions stream;      // a bench's SAMPLE sources, as the fitter follows them
+  // A run shown coasting (or at a provisional stop) is no longer followed once no fitter has
+  // sent a heartbeat for this long (or the last one said "stopping") and its last RUN is as old:
+  // the row says "not followed (no fitter for N s)" instead of "coasting" for ever.
+  double fitter_lost_s = 10.0;
 };
 
 // What the table knows about one bench.
@@ -52,6 +57,7 @@ struct LabBenchRow {
   double t_cut_s = 0, t_stop_s = 0;
   std::int32_t run_samples = 0;
   bool run_partial = false;          // the cut was not seen (joined mid-coast)
+  std::int64_t last_run_us = 0;      // host time of the last RUN
 
   // From SPINDOWN.<bench>.FIT: the latest fit.
   bool has_fit = false;
@@ -63,6 +69,9 @@ struct LabBenchRow {
   std::string coefficients;          // the best model's friction coefficients ± error (no units)
   double rmse = 0;
   std::string residual_unit;
+  // The combined model's c3 and c4 with their total standard errors (J's and K_b's uncertainty
+  // included), in SI or the lab's units as the table shows them; NaN when it has none.
+  double c3 = 0, c3_error = 0, c4 = 0, c4_error = 0;
   std::string bench_source;          // "config" or why a default J/K_b was used
   std::string health;                // motor health verdict "ok"/"check"/"service" ("" when not assessed)
   std::string health_reason;         // its reason in words
@@ -124,7 +133,12 @@ class LabTable {
   // never shown as data; counted, the first of each kind an event, the latest in the footer.
   void on_refused(const GateResult& refused, std::int64_t now_us);
 
-  // The table at now_us. width > 0 cuts lines to that many characters (a terminal's width).
+  // Whether row's open run is no longer followed by a fitter at now_us (fitter_lost_s).
+  bool run_unfollowed(const LabBenchRow& row, std::int64_t now_us) const;
+  // The table at now_us. width > 0 fits it to that many columns (a terminal's width): one row per
+  // bench with its run, the last fit's model, the combined model's c3 and c4 with their errors and
+  // the health verdict always; headers and cells shortened first, then the columns worth least
+  // dropped one by one (bridge, sequence gaps, RMSE, age, last fit), and only then lines cut.
   std::string render(std::int64_t now_us, std::size_t width = 0) const;
   // Events since the last call, oldest first, without time stamps ("bench-a: run 2 coasting…").
   std::vector<std::string> take_events();
@@ -138,6 +152,7 @@ class LabTable {
   std::size_t bench_count() const { return benches_.size(); }
   const LabServiceRow* service(std::string_view service, std::string_view instance) const;
   std::size_t service_count() const { return services_.size(); }
+  std::vector<const LabServiceRow*> services() const;  // sorted by service, then instance
   std::int64_t bad_messages() const { return bad_messages_; }
   std::int64_t refused_messages() const { return refused_; }
   std::int64_t forgotten_rows() const { return forgotten_rows_; }
@@ -145,11 +160,15 @@ class LabTable {
 
  private:
   LabBenchRow& row(std::string_view bench, std::int64_t now_us);
+  std::string bench_table(std::int64_t now_us, std::size_t width) const;  // the rows and their units line
+  bool two_sources_now(const LabBenchRow& r, std::int64_t now_us) const;  // a second SAMPLE source heard lately
   void event(std::string text);
 
   LabTableOptions opt_;
   std::map<std::string, LabBenchRow, std::less<>> benches_;
   std::map<std::string, LabServiceRow, std::less<>> services_;  // "service/instance"
+  std::int64_t last_fitter_us_ = 0;  // the newest heartbeat of any fitter
+  bool fitter_stopping_ = false;     // that heartbeat said "stopping"
   std::deque<std::string> events_;
   std::int64_t bad_messages_ = 0;
   std::string last_bad_message_;
@@ -169,7 +188,7 @@ class LabTable {
 // usable best model.
 std::string fit_coefficients_text(const fit_t& msg, bool lab_units, bool with_units = true);
 
-// Code points of a UTF-8 string (the columns it takes for the text this table prints).
-std::size_t display_width(std::string_view utf8);
+// A line cut to width code points (never inside a character); width 0 leaves it whole.
+std::string cut_to_width(const std::string& line, std::size_t width);
 
 }  // namespace spindown

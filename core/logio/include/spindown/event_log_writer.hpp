@@ -19,8 +19,10 @@
 // - other write errors (directory removed, I/O error) are counted with the path and errno text;
 //   the file is closed and a new one tried every reopen_interval_s;
 // - retention (log_retention.hpp): with keep_files or keep_mb set, the oldest of its own files
-//   are deleted when a file is opened and every prune_interval_s (a full disk too gets space
-//   back that way), never the file being written.
+//   are deleted when a file is opened and every prune_interval_s, never the file being written;
+//   and before a flush would not fit on the disk, its oldest files go until it does, whatever the
+//   budget allows (a --keep-mb above the free space never loses events while its old files
+//   stay).
 #include <cstdint>
 #include <cstdio>
 #include <ctime>
@@ -80,6 +82,7 @@ struct EventLogCounters {
   std::int64_t disk_full_episodes = 0;  // times the disk filled up (each one write error)
   std::int64_t oversize_drops = 0;   // events larger than the recorder's max_event_bytes, not recorded
   std::int64_t files_deleted = 0;    // old log files deleted by retention
+  std::int64_t files_deleted_for_space = 0;  // of those, deleted because the disk was about to fill
   std::int64_t bytes_deleted = 0;    // and their bytes
   std::int64_t retention_errors = 0; // files retention could not delete (or list)
 };
@@ -149,6 +152,10 @@ class EventLogWriter {
   void pause_for_space(std::int64_t now_us, const std::string& what, int err);
   bool cut_back_to_committed();
   void resume_if_due(std::int64_t now_us);
+  // Retention on a disk about to fill: with retention on, the oldest of its own files are
+  // deleted until `bytes` and a margin fit. False when they still do not.
+  bool make_room(std::int64_t bytes, std::int64_t now_us);
+  void count_deletions(LogPruneResult& r, std::int64_t now_us);
   void track_samples(std::string_view channel, const void* data, std::int32_t size);
   bool rotation_due(std::int64_t now_us, std::int64_t next_event_bytes) const;
 

@@ -9,6 +9,7 @@
 // The policy (files_to_prune) is a pure function of the listing; prune_log_files() lists the
 // directory, applies it and unlinks.
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -45,6 +46,11 @@ struct LogPruneResult {
   std::int64_t files_kept = 0;
   std::vector<std::string> errors;     // "cannot delete PATH: errno text", "cannot list DIR: …"
 };
+
+// Lists dir and deletes the logger's own files, oldest first and never `current`, one at a time
+// until enough() says there is room (a disk about to fill, whatever the budget allows).
+LogPruneResult free_log_space(const std::string& dir, std::string_view prefix, std::string_view bench,
+                              const std::string& current, const std::function<bool()>& enough);
 
 // Lists dir, deletes what files_to_prune says. current: the path being written (as the writer
 // names it: dir + "/" + name).

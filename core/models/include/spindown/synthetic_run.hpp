@@ -3,6 +3,7 @@
 // (zeros, a floating pin or the supply voltage), the coast from the simulator, sensor
 // offset, commutator ripple, white noise, 10-bit ADC, 2-decimal printing, loop period with
 // jitter. Used by the virtual bench, by tests and by benchmarks.
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -13,10 +14,15 @@
 
 namespace spindown {
 
-// zeros, floating, supply: what the pin reads while the motor is powered, the reading jumping to
-// the back-EMF at the cut (the lab's rig). spin_up: a speed sensor (tachometer, encoder) on a
-// rig spun up by a motor ramp or by hand: at rest, then over the last spin_up_s of the lead-in
-// the reading rises to e0 and the supply is cut at the peak, with no steady plateau.
+// zeros, supply: what the pin reads while the motor is powered, the reading jumping to the
+// back-EMF at the cut (the lab's rig). floating: the handout's own procedure (step 6: "immediately
+// after the motor is switched off, connect the analog pin to the motor"): until the pin is
+// connected, a moment after the cut, A0 floats — a high-impedance input whose jumper picks up the
+// mains (a level anywhere in 0.5–2.5 V, the 50 Hz hum aliased by the sketch's ~20 ms loop into a
+// slow beat, a slow drift) — then a few samples of contact bounce, then the back-EMF of a coast
+// already under way. spin_up: a speed sensor (tachometer, encoder) on a rig spun up by a motor ramp
+// or by hand: at rest, then over the last spin_up_s of the lead-in the reading rises to e0 and the
+// supply is cut at the peak, with no steady plateau.
 enum class LeadIn { zeros, floating, supply, spin_up };
 
 struct SyntheticRunSpec {
@@ -24,6 +30,12 @@ struct SyntheticRunSpec {
   FrictionTerms friction{1.822e-7, 1.1389e-4};
   double e0_v = 2.8;           // back-EMF at the cut
   double supply_v = 3.0;       // what the pin reads before the cut with LeadIn::supply
+  // LeadIn::floating, each drawn from the run's seed (its own random stream) when NaN or negative:
+  double float_level_v = NAN;  // the floating pin's mean level (drawn in 0.5–2.5 V)
+  double pickup_v = NAN;       // amplitude of the mains hum it picks up (drawn in 0.05–0.6 V)
+  double mains_hz = 50.0;      // the mains frequency (60 in the Americas)
+  double connect_s = NAN;      // the pin is connected this long after the cut (drawn in 0–1 s)
+  int bounce_samples = -1;     // samples of contact bounce at the connection (drawn 0–3)
   LeadIn lead_in = LeadIn::zeros;
   double lead_in_s = 3.0;      // recorded time before the cut
   double tail_s = 3.0;         // recorded time after the stop (or after max_coast_s)
@@ -58,11 +70,16 @@ struct SyntheticRun {
   std::vector<double> volts;  // the printed value
   std::vector<int> adc;       // raw ADC counts (−1 when not quantized)
   double t_cut_ms = 0;        // device time of the power cut
+  // Device time the coast begins in the readings: the cut, or with LeadIn::floating the moment the
+  // pin was connected to the motor after it (the cut itself is not in the readings then).
+  double t_connect_ms = 0;
   double t_stop_s = 0;        // seconds from the cut to the stop (or max_coast_s)
   double omega0 = 0;          // rad/s at the cut
   bool stopped = false;
   // Truth for run finding, in the recording's own samples.
   std::vector<std::size_t> glitch_index;  // samples replaced by a dropout or glitch
+  std::vector<std::size_t> bounce_index;  // LeadIn::floating: samples read while the contact bounced, off
+                                          // what the motor reads (by over 3 % or 4 noise sd)
   double t_signal_lost_ms = -1;  // per-revolution sensor: device time of its last pulse before it gave up
                                  // (read 0) or froze on its last value (-1: never)
 };

@@ -33,6 +33,7 @@
 #include <spindown/status_t.hpp>
 
 #include "spindown/bench.hpp"
+#include "spindown/bench_file.hpp"
 #include "spindown/fit.hpp"
 #include "spindown/message_decode.hpp"
 #include "spindown/message_gate.hpp"
@@ -51,6 +52,13 @@ struct FitterOptions {
   std::vector<ModelKind> models{all_models[0], all_models[1], all_models[2]};
   BenchParams default_bench;             // J, K_b for a bench without (usable) CONFIG
   bool ignore_config = false;            // always use default_bench (like `spindown fit --inertia`)
+  // J and K_b named for a refit (spindown refit and export of a log: --inertia/--kb/… and a
+  // --bench-config file's [bench], by bench id): what they name wins over the CONFIG, each
+  // parameter on its own, by the offline rule (choose_bench_params: command line, else the bench's
+  // file, else the CONFIG, else default_bench), and bench_source says where each came from. The
+  // live fitter names none: CONFIG, else default_bench.
+  BenchChoice named{default_bench};      // its given: default_bench with the command line's values
+  std::map<std::string, BenchFile, std::less<>> bench_files;
   std::string bench_regex = ".*";        // benches handled (full match on the id)
   // Benches held at once. A new bench takes a free place, or the place of the least recently
   // active bench with no run in progress; new benches are admitted at most admit_rate_hz per
@@ -100,6 +108,7 @@ struct FitterCounters {
   std::int64_t dropped_benches = 0;    // benches evicted (max_benches), never one with a run in progress
   std::int64_t benches_refused = 0;    // messages of new benches refused (table full or admission rate)
   std::int64_t partial_runs = 0;       // runs completed whose cut was not seen (joined mid-coast)
+  std::int64_t runs_abandoned = 0;     // runs still open when the fitter stopped (RUN abandoned)
   std::int64_t silent_benches = 0;     // runs closed because their bench went silent (silent_s)
   std::int64_t flood_drops = 0;        // samples dropped by the rate cap
   std::int64_t flood_messages = 0;     // messages dropped by the rate cap
@@ -189,10 +198,17 @@ class FitterCore {
   // End of the stream (refit, shutdown): open coasts are closed and fitted as `spindown fit`
   // does at the end of a file.
   void finish(std::int64_t now_utime);
+  // The service stops: every run still open is published abandoned with the note why (not
+  // fitted: a fitter started again takes the rest of its coast as partial), counted in
+  // runs_abandoned. The core takes no samples after it.
+  void abandon_open_runs(std::int64_t now_utime, const std::string& why);
   // The passing of host time (the service calls it a few times a second, refit at the log's
   // event times): a bench with a run in progress and no samples for silent_s has it closed.
   void poll(std::int64_t now_utime);
   static constexpr std::int64_t poll_period_us = 500'000;  // how often poll() is worth calling
+  // Whether poll(now_utime) would close a run: a bench with a run in progress and no samples
+  // for silent_s. The service then first makes sure nothing it received still waits.
+  bool silence_due(std::int64_t now_utime) const;
 
   const FitterCounters& counters() const { return counters_; }
   std::size_t bench_count() const { return benches_.size(); }

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,10 +23,13 @@ struct RefitRun {
   RunFit fit;
   std::string bench_source;
   std::int64_t first_seq = 0, last_seq = 0;
+  std::optional<HealthVerdict> health;  // when FitterOptions::health has the bench (as the live FIT)
 };
 
 struct LogRefit {
-  FileFit file;                 // runs ordered by bench (first appearance), then run number
+  FileFit file;                 // runs ordered by bench (first appearance), then run number, with their
+                                // health; file: the session's first log
+  std::vector<std::string> session_files;  // the logs read as this one session, in time order
   std::vector<RefitRun> runs;   // the same runs, with their bench ids (empty when streamed)
   std::size_t runs_fitted = 0;  // runs fitted, kept or streamed
   // SPINDOWN.<bench>.FIT messages recorded in the log (when asked) that passed the gate (the lab;
@@ -49,6 +53,20 @@ using RefitRunFn = std::function<void(RefitRun&& run)>;
 LogRefit refit_log(const std::string& path, const FitterOptions& options, bool keep_live_fits,
                    const std::function<void(const LcmLogEvent&)>& each_event = {},
                    const RefitProgressFn& progress = {}, const RefitRunFn& each_run = {});
+
+// Several logs of one session (a logger's files rotated hourly, or by size), read one after the
+// other through the same FitterCore, as the live fitter saw that traffic: a run that crosses a
+// file boundary is one run, as it was live. `paths` must be in time order (log_session_order()).
+// progress's bytes count over all the files.
+LogRefit refit_log_session(const std::vector<std::string>& paths, const FitterOptions& options, bool keep_live_fits,
+                           const std::function<void(const LcmLogEvent&)>& each_event = {},
+                           const RefitProgressFn& progress = {}, const RefitRunFn& each_run = {});
+
+// Logs grouped into sessions, each in time order: sorted by their first event's time; a log
+// joins the session before it when it starts no earlier than that session's last log ends (a
+// rotation), else (another logger's copy of the same traffic, an overlap) it starts a session
+// of its own. A log whose events cannot be read is a session of its own (its refit says why).
+std::vector<std::vector<std::string>> log_sessions(const std::vector<std::string>& paths);
 
 // file_fit_json() with each run tagged as fit_message_json() tags a live FIT: bench.id,
 // first_seq, last_seq.

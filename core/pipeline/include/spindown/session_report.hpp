@@ -16,9 +16,6 @@
 #include <vector>
 
 #include "spindown/bench.hpp"
-#include "spindown/bench_naming.hpp"
-#include "spindown/bench_file.hpp"
-#include "spindown/bench_naming.hpp"
 #include "spindown/bench_file.hpp"
 #include "spindown/bench_naming.hpp"
 #include "spindown/explain.hpp"
@@ -26,6 +23,7 @@
 #include "spindown/motor_health.hpp"
 #include "spindown/read_recording.hpp"
 #include "spindown/recording.hpp"
+#include "spindown/recording_time.hpp"
 #include "spindown/runs.hpp"
 
 namespace spindown {
@@ -60,9 +58,15 @@ struct ReportRun {
   bool explained = false;
   ExplainResult explain;          // when explained
   std::vector<double> tau, y;     // the fitted samples: seconds after the cut, raw reading
+  // The recording around the run (set_run_context), seconds after the cut and raw reading: from the
+  // end of the run before it (else the recording's start) to the cut of the run after it (else the
+  // recording's end), so that what came before the cut (a lead-in, a coast the cut missed) shows
+  // beside the fitted window. Empty: the figure shows the fitted window only.
+  std::vector<double> context_tau, context_y;
   HealthVerdict health;
   std::string health_config;      // the bench file the verdict used; "" = no reference configured
   std::optional<double> cut_unix_s;  // wall-clock time of the cut when the file tells it
+  bool cut_local = false;            // that time is the recording PC's local time (PuTTY), not UTC
   int order = 0;                  // 1-based position among its bench's runs (time order)
 };
 
@@ -73,7 +77,8 @@ struct ReportFile {
   std::size_t samples = 0;
   std::vector<std::string> benches;
   std::string student;                  // a text file's, when the roster or --bench-pattern names one
-  std::optional<double> start_unix_s;   // PuTTY header or the log's first event
+  std::optional<double> start_unix_s;   // PuTTY header or the log's first event (recording_time.hpp)
+  bool start_local = false;             // a PuTTY header's: the recording PC's local time, not UTC
   std::vector<Diagnostic> diagnostics;  // at most max_diagnostics_per_file
   std::size_t diagnostics_dropped = 0;
   std::vector<std::string> failures;    // why the file or a run in it could not be used
@@ -146,11 +151,12 @@ SessionReport build_session_report(std::span<const std::string> paths, const Ses
 // One run of rec on bench: fit, explain, health.
 ReportRun make_report_run(const Recording& rec, const Run& run, const std::string& bench, const BenchParams& params,
                           const SessionReportOptions& options);
+// Fills run.context_tau/context_y from rec, whose runs (in any order) are runs: at most max_points
+// samples, the lowest and the highest of each stretch kept when it must thin them (a spike, a
+// floating pin or a lost coast stays visible).
+void set_run_context(ReportRun& run, const Recording& rec, std::span<const Run> runs, std::size_t max_points = 4000);
 // Sorts runs by bench then time order, numbers them, and fills the bench summaries.
 void summarize_session(SessionReport& report);
 
-// "=~=~=~ PuTTY log 2023.09.14 10:21:33 =~=~=~" → seconds since the epoch (the clock's local
-// time taken as UTC); nullopt when the text does not start with such a header.
-std::optional<double> putty_log_time(std::string_view head);
 
 }  // namespace spindown

@@ -76,8 +76,9 @@ Json tagged_run_fit_json(const RunFit& fit, const RunTags& tags, const ReportOpt
 // dump(2, ' ', false, Json::error_handler_t::replace) lays it out nested indent spaces deep,
 // appended to out without building the document; its first line is not indented (the caller
 // places the opening brace).
+// health, when given, is the run's "health" member, last (as a file's entry has it).
 void append_run_fit_json_text(std::string& out, const RunFit& fit, const ReportOptions& opt, std::size_t indent,
-                              const RunTags* tags = nullptr);
+                              const RunTags* tags = nullptr, const HealthVerdict* health = nullptr);
 
 // `spindown fit --json` without a document: one entry of fit_report_json(files)'s "files"
 // array exactly as dump(2, ' ', false, Json::error_handler_t::replace) lays it out there

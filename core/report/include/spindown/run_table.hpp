@@ -1,6 +1,8 @@
 #pragma once
 // A class's table: one row per run across many files (every student's recording), as CSV for a
-// spreadsheet or as a JSON array of the same rows. `spindown fit --table csv|json`.
+// spreadsheet or as a JSON array of the same rows. `spindown fit --table csv|json`. The CSV in
+// either style of csv_cells.hpp: ',' and decimal points, or ';' and decimal commas for a European
+// Excel; a file for a spreadsheet starts with a byte-order mark.
 //
 // Columns, SI units (as `spindown export`):
 //   file, bench, student       the file as named; its bench and student (roster, --bench-pattern,
@@ -19,14 +21,15 @@
 //   J_kg_m2, J_rel_error, Kb_V_s_per_rad, Kb_rel_error
 #include <string>
 
+#include "spindown/csv_cells.hpp"
 #include "spindown/fit_report.hpp"
 
 namespace spindown {
 
-// The header line, with its newline.
-std::string run_table_csv_header();
+// The header line, with its newline (after the style's byte-order mark, when it has one).
+std::string run_table_csv_header(const CsvStyle& style = {});
 // One line per run of the file, each with its newline.
-std::string run_table_csv_rows(const FileFit& file);
+std::string run_table_csv_rows(const FileFit& file, const CsvStyle& style = {});
 
 // The file's rows as JSON objects (the same columns as keys; numbers, null for none), appended to
 // an array being written ("[" before the first file, "\n]" after the last): each row starts on a

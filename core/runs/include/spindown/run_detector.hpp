@@ -23,6 +23,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <string>
@@ -72,8 +73,10 @@ class RunDetector {
   // End of the stream: an open coast is closed (never stopped), a tail is cut short.
   void finish();
   // Live: no sample came for silent_s (host time). An open coast is closed there (End::silent,
-  // a warning), a tail is cut short; samples that come after are found afresh, a coast going on
-  // as a partial one. Nothing happens when idle.
+  // a warning), a tail is cut short; samples that come after are found afresh. A coast that goes
+  // on after the silence (the samples resume on the same clock: an outage, a frozen fitter) is
+  // that run's rest: partial, never given a cut, until the reading shows the coast is over (it
+  // rises above where the silence began, or holds still at a standstill). Nothing happens when idle.
   void went_silent(double silent_s);
 
   // Events since the last call, oldest first.
@@ -214,6 +217,7 @@ class RunDetector {
     std::size_t a = 0, cut_index = 0, pre_end = 0, npre = 0;
     double t_cut_s = 0, v0 = 0, sd_post = 0, post_slope = 0;
     double pre_mean = 0, pre_sd = 0, pre_max = 0;
+    double pre_rough = 0;   // the lead-in's sample-to-sample noise (rough_sd)
     bool pre_declining = false;
     bool pre_flat = false;  // lead-in slope shown to be well below the coast's
     bool clipped = false;
@@ -222,9 +226,35 @@ class RunDetector {
   };
   CutSplit split_at_cut(std::size_t a, std::size_t b, const WindowFit& w);
   std::string classify_lead_in(const CutSplit& sp) const;
+  // Samples of contact bounce at the start of the coast in sp (a wire pushed onto the pin), judged
+  // against the line of w (the window that confirmed the coast): the cut moves to the first of
+  // them, and they go to bounce_ (left out of the fit).
+  void take_bounce(CutSplit& sp, const WindowFit& w);
+  std::vector<std::size_t> bounce_;  // the open run's bounce samples, ascending
+  // Why the open coast, closed by a rise at sample at, was a swing of an open (floating) input and
+  // no coast: the readings before its cut swung up and down as much; empty when it was a coast.
+  std::string swing_reason(std::size_t at) const;
+  // Why the open coast, closed by a rise at sample at, was no coast: it levelled off well above
+  // standstill, where friction would still slow it; empty when it kept falling as a coast does.
+  std::string stall_reason(std::size_t at) const;
+  std::string not_coast_;  // set: the open run is ignored with this warning when it completes
+  // A coast never rises: when the reading rose inside r's coast [cut, coast_end) by far more than its
+  // noise, what came before the rise was no part of it (an open pin's swing before it was connected,
+  // a coast the power came back on unseen). r then starts at the last such rise, with a warning.
+  void recut_after_rise(Run& r, std::size_t coast_end);
   // Why the coast in sp has no recorded cut (the stream begins on it, or a pause hides it), with
   // sp moved to the coast's first sample; empty when its cut is in the data.
   std::string start_not_seen(CutSplit& sp);
+  // When the coast cut at `cut` crossed `quarter` for the last time before first_in (interpolated).
+  double last_quarter_time(std::size_t cut, std::size_t first_in, double quarter) const;
+  // Whether a coast from t_cut that crossed its last quarter at t_quarter and reached its floor at
+  // t_stop creeps in as an exponential does, rather than stopping.
+  bool creeps_in(double t_cut, double t_quarter, double t_stop) const;
+  // The sample-to-sample noise of [from, to) (second differences; 0 for fewer than 3 samples).
+  double rough_sd(std::size_t from, std::size_t to) const;
+  // The same for a coast found while after_silence_: the silenced coast's rest, from the first
+  // sample after the silence; empty only when nothing of it is held.
+  std::string rest_after_silence(CutSplit& sp);
   // The mean of samples k-1..k+1 within [lo, hi].
   double smoothed(std::size_t k, std::size_t lo, std::size_t hi) const;
   // Whether the coast found in sp follows a rise straight into its peak (a spin-up): a rise after
@@ -264,7 +294,9 @@ class RunDetector {
   // The longest silence in a coast from sample from, before sample at (0: none), longest seconds.
   void warn_of_gap_in_coast(int number, std::size_t from, std::size_t at, double longest, double period_s);
   std::string gap_before(std::size_t i) const;  // "no samples for … s mid-coast (from … to …)", before sample i
-  void to_idle(std::size_t lo, bool need_quiet);
+  // Idle from sample lo on (windows start there); the lead-in search may reach back to search_from
+  // (lo when not given).
+  void to_idle(std::size_t lo, bool need_quiet, std::size_t search_from = SIZE_MAX);
   void emit_diag(Diagnostic::Severity sev, std::string msg);
   double median_of(std::size_t from, std::size_t to);
   // The smallest positive change between consecutive readings in [from, to): the converter's or
@@ -285,7 +317,9 @@ class RunDetector {
   std::size_t base_ = 0;        // absolute index of the oldest buffered sample
   std::size_t next_index_ = 0;  // absolute index of the next sample
   std::size_t time_cursor_ = 0;  // first buffered sample within the idle keep time
-  std::size_t lo_ = 0;          // earliest index the current lead-in search may use
+  std::size_t lo_ = 0;          // earliest index a window that confirms a coast may start at
+  std::size_t search_lo_ = 0;   // earliest index the current lead-in search may use (<= lo_): after a
+                                // rise that closed a coast, what came before the rise is lead-in too
   std::size_t stream_start_ = 0;  // first index after the stream start / last clock restart
   std::size_t resume_index_ = 0;  // first sample after the last pause (over 2 s) while idle
   double resume_pause_s_ = 0;     // that pause's length
@@ -310,7 +344,14 @@ class RunDetector {
   double hold_half_s_ = 0.5, hold_full_s_ = 0.9;     // hold_ durations: 0.5 and 0.9 of its span
   bool hold_long_live_ = false;
   bool creeping_ = false;
+  double stop_approach_t_ = 0;  // found_standstill's approach t-value of the run's standstill
   bool restarted_mid_coast_ = false;  // the clock restarted while a coast was open: its rest is a fragment
+  // A coast closed by went_silent(): until the reading rises above silence_level_ +
+  // silence_band_ or holds still low, a coast found is that one's rest (partial, no cut).
+  bool after_silence_ = false;
+  int silenced_run_ = 0;
+  double silence_level_ = 0, silence_band_ = 0, silence_s_ = 0;
+  void watch_after_silence(double v);  // idle: releases after_silence_ when the coast is over
   bool fragment_ = false;             // the open run is such a rest: ignored when complete  // the coast was seen approaching standstill asymptotically
   double quiet_until_s_ = -std::numeric_limits<double>::infinity();  // after a rejected cut
 

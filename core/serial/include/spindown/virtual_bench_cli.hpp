@@ -40,8 +40,14 @@ inline void add_virtual_bench_options(CLI::App& app, VirtualBenchOptions& o, Vir
   app.add_option("--e0-step", o.e0_step_v, "added to e0 at each further run (V)");
   app.add_option("--supply", sp.supply_v, "pin reading before the cut with --lead-in supply (V)");
   app.add_option("--lead-in", cli.lead_in,
-                 "what the pin reads before the cut (spin-up: a speed sensor's rise to the peak, cut there)")
+                 "what the pin reads before the cut (floating: the handout's step 6, A0 open until it is connected "
+                 "after the cut; spin-up: a speed sensor's rise to the peak, cut there)")
       ->check(CLI::IsMember({"zeros", "floating", "supply", "spin-up"}));
+  app.add_option("--float-level", sp.float_level_v, "--lead-in floating: the open pin's level (V; default drawn in 0.5-2.5)");
+  app.add_option("--pickup", sp.pickup_v, "--lead-in floating: amplitude of the mains hum on the open pin (V; default drawn in 0.05-0.6)");
+  app.add_option("--mains-hz", sp.mains_hz, "--lead-in floating: mains frequency (Hz)");
+  app.add_option("--connect-s", sp.connect_s, "--lead-in floating: seconds from the cut to the pin's connection (default drawn in 0-1)");
+  app.add_option("--bounce", sp.bounce_samples, "--lead-in floating: samples of contact bounce at the connection (default drawn 0-3)");
   app.add_option("--spin-up-s", sp.spin_up_s, "--lead-in spin-up: seconds of the rise (0.3: by hand)");
   app.add_option("--start-s", sp.start_s, "the recording starts this long after the cut (mid-coast)");
   app.add_option("--gap-from-s", sp.gap_from_s, "a pause in the recording from this long after the cut (< 0: before)");

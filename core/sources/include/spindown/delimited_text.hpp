@@ -1,24 +1,23 @@
 #pragma once
 // Delimited text with a time column and a value column: CSV, semicolon CSV (decimal comma
-// allowed), TSV or whitespace-separated, with or without a header row. The user names the
-// columns and units when they are not obvious; otherwise they are detected from header
-// names ("time", "t", "millis", "ms" / "volts", "V", "emf", "rpm", "omega", units in
-// brackets like "time (s)" or suffixes like "time_ms") and a clear error says what is
-// ambiguous.
+// allowed), TSV or whitespace-separated, with or without a header row; fields in double quotes
+// as RFC 4180 has them ("RR_Wheel,Speed" is one name). The user names the columns and units when
+// they are not obvious; otherwise they are detected from the header's names and units in the
+// spellings column_names.hpp reads ("millis", "time_ms", "Drehzahl [U/min]", "omega (rad/s)",
+// "Voltage [mV]", a row of units under the names), and a clear error says what is ambiguous: a
+// unit the header gives that spindown cannot read names the --value-unit to give, a table without
+// names proposes its time and speed columns from the numbers (column_guess.hpp). Rows of
+// separators alone (";;;;", a spreadsheet's empty rows) are blank.
 #include <cstddef>
 #include <optional>
 #include <string>
 #include <string_view>
 
+#include "spindown/column_names.hpp"
 #include "spindown/quantity.hpp"
 #include "spindown/recording.hpp"
 
 namespace spindown {
-
-enum class TimeUnit { s, ms, us };
-std::string_view time_unit_name(TimeUnit unit);                // "s", "ms", "us"
-std::optional<TimeUnit> parse_time_unit(std::string_view unit);  // s, sec, ms, millis, us, µs, micros…
-double time_units_per_second(TimeUnit unit);
 
 struct DelimitedTextOptions {
   // Column by header name (case-insensitive; "time" also matches "time (s)") or 1-based
@@ -27,6 +26,7 @@ struct DelimitedTextOptions {
   std::string value_column;
   std::optional<TimeUnit> time_unit;  // empty: from the header, else from the data (a note says so)
   std::optional<Quantity> quantity;   // empty: from the header, else volts without a header
+  double value_scale = 1;             // with quantity: a reading times this is in it (mV: 0.001)
   char delimiter = 0;                 // ',', ';', '\t' or ' ' (any run of blanks); 0: detect
   std::optional<bool> header;         // empty: a first row with a non-number is a header
   std::size_t max_line_reports = 20;  // bad lines reported one by one before only a count
@@ -36,6 +36,12 @@ struct DelimitedTextOptions {
   bool names_columns() const;
   bool is_valid(std::string* why) const;
 };
+
+// Whether a file whose first line with content is `line` must be read as delimited text for its
+// header to be honoured: a header row (no field a number) in any delimiter that gives a value unit
+// other than volts (rpm, U/min, rad/s, mV, …), a time unit other than ms, a unit spindown cannot
+// read, or names a speed without a unit. The lab's own "millis<TAB>volts" does not.
+bool header_needs_delimited_reader(std::string_view line);
 
 Recording read_delimited_text(std::string_view text, std::string source, const DelimitedTextOptions& options = {});
 Recording read_delimited_text_file(const std::string& path, const DelimitedTextOptions& options = {});

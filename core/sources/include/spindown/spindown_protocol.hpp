@@ -25,8 +25,10 @@ struct SpindownBanner {
   std::int32_t baud = 0;
   // The largest count the converter gives (2^bits − 1).
   std::int32_t max_count() const { return (std::int32_t{1} << adc_bits) - 1; }
-  // Volts per ADC count, as the lab sketch converts (ref / (2^bits − 1)).
-  double volts_per_count() const { return adc_ref_v / double(max_count()); }
+  // Volts per ADC count as the converter defines it: the ATmega328P datasheet's
+  // ADC = V_in·1024/V_ref, so V = count·V_ref/2^bits (deploy/firmware/README.md). The lab
+  // sketch's own `× 5.0 / 1023` reads 0.1 % high; that is its protocol's business, not this one's.
+  double volts_per_count() const { return adc_ref_v / double(std::int32_t{1} << adc_bits); }
   // A sample's count in volts: the one conversion of spindown-v1 counts, shared by the serial
   // bridge and the file reader (spindown_text.hpp) so that both give the same numbers. Before
   // any banner, a default-constructed banner gives the protocol's defaults.

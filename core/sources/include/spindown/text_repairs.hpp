@@ -2,8 +2,8 @@
 // What students' editors and terminals do to the lab's text, undone before it is read. Each
 // repair keeps every line where it was (diagnostics still name the right line) and is said in a
 // note:
-//  - UTF-16 from a Windows editor ("Unicode" in Notepad), with or without a byte-order mark:
-//    decoded to UTF-8;
+//  - the encoding: UTF-16, Windows-1252, a byte-order mark, a trailing Ctrl-Z (text_encoding.hpp),
+//    decoded to UTF-8 (binary data and office documents are left to the readers, which refuse them);
 //  - the Arduino IDE serial monitor's timestamps ("10:21:38.234 -> 5234<TAB>0.00"): removed, the
 //    sample's own millis stays its time;
 //  - a decimal comma in the lab's two columns ("5234<TAB>2,45", a spreadsheet with a European
@@ -14,7 +14,7 @@
 
 namespace spindown {
 
-// Whether repair_text would change text (looks at its first lines only; cheap).
+// Whether repair_text would change text (its first lines, and the whole text for bytes above 0x7F; cheap).
 bool needs_text_repair(std::string_view text);
 
 // Rewrites text in place; returns one note per repair made (empty: nothing to do).

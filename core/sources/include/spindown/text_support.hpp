@@ -14,6 +14,7 @@
 
 #include "spindown/file_bytes.hpp"
 #include "spindown/recording.hpp"
+#include "spindown/text_encoding.hpp"
 #include "spindown/utf8_text.hpp"
 
 namespace spindown::text {
@@ -226,8 +227,9 @@ struct Count {
 };
 std::string summary_with_counts(std::string head, std::initializer_list<Count> counts, const TimelineCounts& timeline);
 
-// The checks every text reader makes before it reads a line: its options, an empty file and (unless
-// the reader decides that itself on its fast path, binary_check false) bytes that are not text.
+// The checks every text reader makes before it reads a line: its options, an empty file, an office
+// document (an Excel workbook: "save it as CSV (UTF-8)") and (unless the reader decides that itself
+// on its fast path, binary_check false) bytes that are not text.
 // False when rec now holds the error; `what` names what the reader expected ("delimited text").
 template <class Options>
 bool readable_text(std::string_view text, const Options& options, std::string_view what, Recording& rec,
@@ -239,6 +241,10 @@ bool readable_text(std::string_view text, const Options& options, std::string_vi
   }
   if (text.empty()) {
     rec.error(0, "no samples: the file is empty");
+    return false;
+  }
+  if (const auto office = office_document(text)) {
+    rec.error(0, "no samples: " + *office);
     return false;
   }
   std::size_t control = 0, looked_at = 0;

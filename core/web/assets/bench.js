@@ -1,0 +1,309 @@
+// spindown-web's bench page: the current run's readings as they arrive, the cut and the stop
+// once the fitter finds them, the three models' curves when the FIT arrives, the best model's
+// residuals, the explain story, the session's earlier runs (to overlay and compare), the run's
+// CSV, and a print layout for the lab report.
+"use strict";
+
+(() => {
+  const { el, setText, setCoefficient, setHealth, setDoubts, setBridge, bridgeDetail } = spindown;
+  const id = decodeURIComponent(location.pathname.replace(/^\/bench\//, "").replace(/\/$/, ""));
+  const $ = (x) => document.getElementById(x);
+  const head = $("head"), plotBox = $("plot"), residualBox = $("residuals");
+  const colors = { viscous: "#d62728", coulomb: "#2ca02c", combined: "#1f77b4" };
+  const overlayColors = ["#9ca3af", "#c084fc", "#f59e0b", "#14b8a6", "#f472b6", "#84cc16", "#60a5fa"];
+
+  document.title = `spindown · ${id}`;
+  head.setAttribute("data-bench", id);
+  setText($("bench-name"), id);
+
+  // What the page knows.
+  let trace = { key: 0, n: 0, x: [], y: [] };
+  let detail = null;              // the current run's detail event
+  const overlays = new Map();     // run number -> {points, color}
+  let plot = null, residualPlot = null, dirty = true;
+
+  // ---- the main plot ------------------------------------------------------------------------
+  function series() {
+    const s = [{ label: "s after the cut" }, { label: "reading", stroke: "#222", width: 1.5, points: { show: false } }];
+    const models = curveModels();
+    for (const m of models) s.push({ label: m.name, stroke: colors[m.name] || "#555", width: m.name === bestName() ? 3 : 2,
+                                     dash: m.name === "viscous" ? [8, 4] : m.name === "coulomb" ? [3, 3] : undefined,
+                                     spanGaps: true, points: { show: false } });
+    for (const [n, o] of overlays) s.push({ label: `run ${n}`, stroke: o.color, width: 1, spanGaps: true, points: { show: false } });
+    return s;
+  }
+
+  function curveModels() {
+    const c = detail && detail.run && detail.run.curves;
+    return c ? c.models.filter((m) => m.converged && m.curve.length > 1) : [];
+  }
+
+  function bestName() {
+    const f = detail && detail.run && detail.run.fit;
+    return f ? f.best : "";
+  }
+
+  // uPlot wants one x for every series: the union of the readings', the curves' and the
+  // overlays' x, each series null where it has no point (drawn across: spanGaps).
+  function plotData() {
+    const lines = [{ x: trace.x, y: trace.y }];
+    for (const m of curveModels()) lines.push({ x: m.curve.map((p) => p[0]), y: m.curve.map((p) => p[1]) });
+    for (const o of overlays.values()) lines.push({ x: o.points.map((p) => p[0]), y: o.points.map((p) => p[1]) });
+    const xs = [];
+    lines.forEach((l, li) => l.x.forEach((x, i) => xs.push([x, li, i])));
+    xs.sort((a, b) => a[0] - b[0]);
+    const out = [[]];
+    for (let i = 0; i < lines.length; i++) out.push([]);
+    for (const [x, li, i] of xs) {
+      out[0].push(x);
+      for (let k = 0; k < lines.length; k++) out[k + 1].push(k === li ? lines[li].y[i] : null);
+    }
+    return out;
+  }
+
+  function plotSize(box, height) {
+    const printing = window.matchMedia && window.matchMedia("print").matches;
+    const width = printing ? 680 : Math.max(240, box.clientWidth || 600);
+    return { width, height: printing ? Math.round(height * 0.6) : height };
+  }
+
+  // The cut and the stop as lines on the plot (drawn on the canvas: they print too).
+  function drawMarkers(u) {
+    const m = detail && detail.run && detail.run.markers;
+    if (!m) return;
+    const g = u.ctx;
+    g.save();
+    g.strokeStyle = "#9a3412";
+    g.fillStyle = "#9a3412";
+    g.lineWidth = 1.5 * devicePixelRatio;
+    g.setLineDash([6 * devicePixelRatio, 4 * devicePixelRatio]);
+    g.font = `${12 * devicePixelRatio}px system-ui, sans-serif`;
+    for (const [name, x] of Object.entries({ cut: m.cut, stop: m.stop })) {
+      if (x === null || x === undefined) continue;
+      const px = u.valToPos(x, "x", true);
+      if (px < u.bbox.left || px > u.bbox.left + u.bbox.width) continue;
+      g.beginPath();
+      g.moveTo(px, u.bbox.top);
+      g.lineTo(px, u.bbox.top + u.bbox.height);
+      g.stroke();
+      g.fillText(name, px + 4 * devicePixelRatio, u.bbox.top + 14 * devicePixelRatio);
+    }
+    g.restore();
+  }
+
+  function rebuildPlot() {
+    if (typeof uPlot === "undefined") return;
+    if (plot) plot.destroy();
+    const unit = (detail && detail.unit) || "V";
+    plot = new uPlot({
+      ...plotSize(plotBox, 340),
+      series: series(),
+      scales: { x: { time: false } },
+      axes: [{ label: "s after the cut" }, { label: unit }],
+      legend: { show: false },
+      cursor: { drag: { x: true, y: false } },
+      hooks: { draw: [drawMarkers] },
+    }, plotData(), plotBox);
+  }
+
+  function redraw() {
+    dirty = false;
+    plotBox.setAttribute("data-points", String(trace.n));
+    if (!plot || plot.series.length !== series().length) rebuildPlot();
+    else plot.setData(plotData());
+  }
+
+  // ---- residuals ---------------------------------------------------------------------------
+  function showResiduals() {
+    const r = detail && detail.run && detail.run.curves && detail.run.curves.residuals;
+    if (residualPlot) { residualPlot.destroy(); residualPlot = null; }
+    setText($("residuals-title"), r ? `of the ${r.model} model, ${r.unit} (reading noise σ ${r.noise === null ? "?" : r.noise.toPrecision(2)} ${r.unit})` : "after the fit");
+    residualBox.setAttribute("data-count", r ? String(r.points.length) : "0");
+    if (!r || typeof uPlot === "undefined") return;
+    const x = r.points.map((p) => p[0]), y = r.points.map((p) => p[1]);
+    residualPlot = new uPlot({
+      ...plotSize(residualBox, 180),
+      series: [{ label: "s" }, { label: "residual", stroke: colors[r.model] || "#1f77b4", width: 0, paths: () => null,
+                                  points: { show: true, size: 2.5, fill: colors[r.model] || "#1f77b4" } },
+               { label: "0", stroke: "#888", width: 1 }],
+      scales: { x: { time: false } },
+      axes: [{ label: "s after the cut" }, { label: r.unit }],
+      legend: { show: false },
+    }, [x, y, x.map(() => 0)], residualBox);
+  }
+
+  // ---- the run's detail: title, markers, fit, curves, explain, earlier runs -----------------
+  function showDetail(d) {
+    const newRun = !detail || !detail.run || !d.run || detail.run.key !== d.run.key;
+    detail = d;
+    const run = d.run;
+    setText($("unit"), d.unit || "V");
+    if (!run) {
+      setText($("run-title"), "Waiting for a run");
+    } else {
+      setText($("run-title"), `Run ${run.number}${run.partial ? " (partial: the cut was not seen)" : ""} · ${run.state}`);
+    }
+    setText($("run-note"), run ? run.note : "Spin the motor up and cut the supply: the run appears here as it coasts.");
+    // Markers present once the fitter found them.
+    const markers = [];
+    if (run && run.markers.cut !== null) markers.push(el("li", { "data-marker": "cut" }, `cut at t = ${run.t_cut_s.toFixed(3)} s`));
+    if (run && run.markers.stop !== null) markers.push(el("li", { "data-marker": "stop" },
+      `stop at t = ${run.t_stop_s.toFixed(3)} s (${run.markers.stop.toFixed(2)} s after the ${run.partial ? "first sample" : "cut"})`));
+    $("markers").replaceChildren(...markers);
+    // The fit.
+    const fit = run ? run.fit : null;
+    setText($("best"), fit ? (fit.best || "no model converged") : "–");
+    setCoefficient($("c3"), fit ? fit.c3 : null, fit ? fit.run : undefined);
+    setCoefficient($("c4"), fit ? fit.c4 : null, fit ? fit.run : undefined);
+    setHealth($("health"), fit);
+    setDoubts($("doubts"), fit);
+    $("best-reason").textContent = fit ? fit.best_reason : "";
+    $("health-reason").textContent = fit && fit.health_reason ? `health: ${fit.health_reason}` : "";
+    // One legend entry per model the FIT carries.
+    const legend = [el("li", {}, el("span", { class: "swatch" }), "readings")];
+    if (run && run.curves) for (const m of run.curves.models) {
+      const rmse = m.rmse === null ? "" : ` RMSE ${m.rmse.toPrecision(3)} ${fit.residual_unit}`;
+      legend.push(el("li", { "data-curve": m.name, "data-converged": m.converged ? "true" : "false", class: m.name === fit.best ? "best" : null },
+        el("span", { class: "swatch" }), m.name + (m.converged ? rmse : ": did not converge") + (m.name === fit.best ? " (best)" : "")));
+    }
+    $("legend").replaceChildren(...legend);
+    // CSV of this run.
+    const csv = $("csv");
+    if (run) {
+      csv.href = run.csv;
+      csv.setAttribute("download", `${id}-run${run.number}.csv`);
+      csv.removeAttribute("aria-disabled");
+    } else {
+      csv.href = "#";
+      csv.setAttribute("aria-disabled", "true");
+    }
+    showExplain(run ? run.explain : null);
+    showRuns(d.earlier || [], run);
+    // The plots in a task of their own: the numbers, curves' legend and markers show at once.
+    setTimeout(() => {
+      showResiduals();
+      if (newRun) rebuildPlot();
+      dirty = true;
+    }, 0);
+  }
+
+  function showExplain(x) {
+    const list = $("explain");
+    if (!x) {
+      list.replaceChildren();
+      setText($("explain-base"), "");
+      $("explain-final").textContent = "The story arrives after the fit (the fitter's EXPLAIN).";
+      return;
+    }
+    setText($("explain-base"), `from ${x.base.join("+")}: RMSE ${fmt(x.rmse_base)}`);
+    const base = x.rmse_base > 0 ? x.rmse_base : 1;
+    list.replaceChildren(...x.steps.map((s) => {
+      const pct = Math.max(1, Math.min(100, 100 * (s.rmse_after || 0) / base));
+      return el("li", { "data-explain-step": s.added },
+        el("strong", {}, `+ ${s.added}`), " ",
+        el("span", { class: "gap" }, `gap ${fmt(s.rmse_before)} → ${fmt(s.rmse_after)}`),
+        el("div", { class: "bar", role: "img", "aria-label": `${pct.toFixed(0)} % of the base model's RMSE` }, barFill(pct)),
+        el("div", { class: "why" }, s.why));
+    }));
+    const params = x.params.map((p) => `${p.name} = ${p.text}`).join(", ");
+    $("explain-final").textContent = x.steps.length
+      ? `final model: ${x.final.join("+")}, RMSE ${fmt(x.rmse_final)} (${(x.rmse_base / x.rmse_final).toFixed(1)}× smaller); ${params}`
+      : `nothing missing: ${x.base.join("+")} explains the run to the noise (${fmt(x.noise_level)}); ${params}`;
+  }
+
+  function barFill(pct) {
+    const s = el("span");
+    s.style.width = pct + "%";
+    return s;
+  }
+
+  function fmt(v) { return v === null || v === undefined ? "?" : Number(v).toPrecision(3); }
+
+  // Every kept run of the session, the current one first: its fit, and a box to overlay it.
+  function showRuns(earlier, current) {
+    const all = (current ? [current] : []).concat(earlier.slice().reverse());
+    const rows = all.map((r) => {
+      const f = r.fit;
+      const isCurrent = current && r.key === current.key;
+      let compare = "this run";
+      if (!isCurrent) {
+        compare = el("input", { type: "checkbox", class: "compare", "aria-label": `overlay run ${r.number}` });
+        compare.checked = overlays.has(r.number);
+        compare.addEventListener("change", () => toggleOverlay(r.number, compare.checked));
+      }
+      return el("tr", { "data-run": r.number, class: isCurrent ? "current" : null },
+        el("td", {}, `${r.number}${r.partial ? " (partial)" : ""}`),
+        el("td", {}, f ? f.best || "–" : r.state),
+        el("td", { "data-si": f && f.c3 ? f.c3.value : null }, f && f.c3 ? f.c3.text : "–"),
+        el("td", { "data-si": f && f.c4 ? f.c4.value : null }, f && f.c4 ? f.c4.text : "–"),
+        el("td", {}, f ? f.health : "–"),
+        el("td", {}, compare),
+        el("td", {}, el("a", { href: r.csv, download: `${id}-run${r.number}.csv` }, "CSV")));
+    });
+    if (rows.length === 0) rows.push(el("tr", {}, el("td", { colspan: 7 }, "no run yet")));
+    $("runs").replaceChildren(...rows);
+    // Overlays of runs no longer kept go.
+    const kept = new Set(earlier.map((r) => r.number));
+    for (const n of Array.from(overlays.keys())) if (!kept.has(n)) overlays.delete(n);
+  }
+
+  async function toggleOverlay(n, on) {
+    if (!on) { overlays.delete(n); rebuildPlot(); return; }
+    try {
+      const r = await fetch(`/api/bench/${encodeURIComponent(id)}/runs/${n}`);
+      if (!r.ok) return;
+      const j = await r.json();
+      overlays.set(n, { points: j.points, color: overlayColors[overlays.size % overlayColors.length] });
+      rebuildPlot();
+    } catch (e) {
+      // the run is gone (no longer kept): nothing to overlay
+    }
+  }
+
+  // ---- the stream ---------------------------------------------------------------------------
+  function showSummary(s) {
+    if (s.id !== id) return;
+    head.setAttribute("data-state", s.state);
+    setText($("state"), s.state);
+    setBridge($("bridge"), s.bridge);
+    setText($("bridge-detail"), bridgeDetail(s.bridge));
+  }
+
+  function takeSamples(all) {
+    const p = (all.benches || {})[id];
+    if (!p) return;
+    if (p.reset || p.key !== trace.key) trace = { key: p.key, n: 0, x: [], y: [] };
+    for (const [x, y] of p.p) {
+      trace.x.push(x);
+      trace.y.push(y);
+    }
+    trace.n = p.n;
+    plotBox.setAttribute("data-points", String(trace.n));
+    if (p.live !== null && p.live !== undefined) setText($("live"), `${p.live.toFixed(2)} ${(detail && detail.unit) || "V"}`);
+    dirty = true;
+  }
+
+  spindown.live(id, {
+    snapshot(d) {
+      const s = d.benches.find((b) => b.id === id);
+      if (s) showSummary(s);
+      else { head.setAttribute("data-state", "silent"); setText($("state"), "not heard yet"); }
+      trace = { key: -1, n: 0, x: [], y: [] };
+      takeSamples({ benches: d.samples || {} });
+      showDetail(d.detail || { bench: id, run: null, earlier: [] });
+      setText($("connection"), "live");
+    },
+    bench: showSummary,
+    samples: takeSamples,
+    detail: showDetail,
+  });
+
+  $("print").addEventListener("click", () => window.print());
+  const resize = () => { if (plot) plot.setSize(plotSize(plotBox, 340)); if (residualPlot) residualPlot.setSize(plotSize(residualBox, 180)); };
+  window.addEventListener("resize", resize);
+  window.addEventListener("beforeprint", resize);
+  window.addEventListener("afterprint", resize);
+  if (window.matchMedia) window.matchMedia("print").addEventListener("change", resize);
+  setInterval(() => { if (dirty) redraw(); }, 100);
+  redraw();
+})();

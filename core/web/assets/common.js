@@ -1,0 +1,124 @@
+// spindown-web: what the room page and the bench page share — the live stream (Server-Sent
+// Events from /events: a snapshot, then the changes; pushed, never polled) and small DOM helpers.
+// Every text from the lab goes into the page as text (textContent), never as HTML.
+"use strict";
+
+const spindown = (() => {
+  // el("li", {class: "x", "data-curve": "viscous"}, "text", child…)
+  function el(tag, attrs, ...children) {
+    const e = document.createElement(tag);
+    for (const [k, v] of Object.entries(attrs || {})) {
+      if (v === null || v === undefined || v === false) continue;
+      e.setAttribute(k, v === true ? "" : String(v));
+    }
+    for (const c of children) {
+      if (c === null || c === undefined) continue;
+      e.append(c instanceof Node ? c : document.createTextNode(String(c)));
+    }
+    return e;
+  }
+
+  function setText(e, text) {
+    const t = text === null || text === undefined || text === "" ? "–" : String(text);
+    if (e.textContent !== t) e.textContent = t;
+  }
+
+  // A coefficient's field: its text in the lab's units with ± error, the SI value in data-si.
+  function setCoefficient(e, c, fitRun) {
+    if (!c || c.value === null || c.value === undefined) {
+      setText(e, "–");
+      e.removeAttribute("data-si");
+      e.removeAttribute("data-si-stderr");
+      e.removeAttribute("data-fit-run");
+      e.title = "";
+      return;
+    }
+    setText(e, c.text);
+    e.setAttribute("data-si", String(c.value));
+    if (c.stderr !== null && c.stderr !== undefined) e.setAttribute("data-si-stderr", String(c.stderr));
+    if (fitRun !== undefined) e.setAttribute("data-fit-run", String(fitRun));
+    e.title = `${c.value} ± ${c.stderr} ${c.unit} (SI)` + (c.total_text ? `; with J and K_b: ${c.total_text}` : "");
+  }
+
+  function setHealth(e, fit) {
+    const h = fit ? fit.health : "";
+    setText(e, h || "–");
+    if (h) e.setAttribute("data-health", h); else e.removeAttribute("data-health");
+    e.title = fit && fit.health_reason ? fit.health_reason : "";
+  }
+
+  function setDoubts(e, fit) {
+    const doubts = fit && fit.doubts ? fit.doubts : [];
+    e.setAttribute("data-count", String(doubts.length));
+    const now = Array.from(e.children).map((c) => c.textContent);
+    if (now.length === doubts.length && now.every((t, i) => t === doubts[i])) return;
+    e.replaceChildren(...doubts.map((d) => el("li", {}, d)));
+  }
+
+  function setBridge(e, bridge) {
+    const health = bridge ? bridge.health : "silent";
+    setText(e, health);
+    e.setAttribute("data-bridge", health);
+  }
+
+  function bridgeDetail(bridge) {
+    if (!bridge) return "";
+    const parts = [];
+    if (bridge.state) parts.push(bridge.state);
+    if (bridge.rate_hz) parts.push(`${bridge.rate_hz} Hz`);
+    if (bridge.reconnects) parts.push(`replugged ${bridge.reconnects}×`);
+    if (bridge.error) parts.push(bridge.error.length > 70 ? bridge.error.slice(0, 69) + "…" : bridge.error);
+    return parts.join(" · ");
+  }
+
+  function servicesText(lab) {
+    if (!lab || !lab.services || lab.services.length === 0) return "no fitter heard yet";
+    return lab.services.map((s) => `${s.service} ${s.state}`).join(" · ");
+  }
+
+  function problemsText(lab) {
+    if (!lab) return "";
+    const p = [];
+    if (lab.bad_messages) p.push(`${lab.bad_messages} undecodable message(s)`);
+    if (lab.refused_messages) p.push(`${lab.refused_messages} refused message(s) not shown (${lab.last_refused})`);
+    return p.join("; ");
+  }
+
+  // The live stream: handlers.snapshot/bench/samples/detail/roster/lab(data). Reconnects by
+  // itself (EventSource), and after a refusal (503: too many pages) every 5 s.
+  function live(bench, handlers) {
+    const url = "/events" + (bench ? "?bench=" + encodeURIComponent(bench) : "");
+    let source = null;
+    const status = document.getElementById("connection");
+    const connected = (yes, text) => {
+      document.body.setAttribute("data-connected", yes ? "true" : "false");
+      if (status) status.textContent = text;
+    };
+    const open = () => {
+      source = new EventSource(url);
+      source.onopen = () => connected(true, "live");
+      source.onerror = () => {
+        connected(false, "reconnecting…");
+        if (source.readyState === EventSource.CLOSED) {
+          source = null;
+          setTimeout(open, 5000);
+        }
+      };
+      for (const name of ["snapshot", "bench", "samples", "detail", "roster", "lab"]) {
+        source.addEventListener(name, (ev) => {
+          if (!handlers[name]) return;
+          let data;
+          try {
+            data = JSON.parse(ev.data);
+          } catch (e) {
+            return;
+          }
+          handlers[name](data);
+        });
+      }
+    };
+    open();
+  }
+
+  return { el, setText, setCoefficient, setHealth, setDoubts, setBridge, bridgeDetail, servicesText, problemsText, live };
+})();

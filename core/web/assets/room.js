@@ -1,0 +1,154 @@
+// spindown-web's room page: every bench as a tile (state, the latest run's curve and fit,
+// c3/c4 in the lab's units, health, doubts, the bridge's health), live.
+"use strict";
+
+(() => {
+  const { el, setText, setCoefficient, setHealth, setDoubts, setBridge, bridgeDetail, servicesText, problemsText } = spindown;
+  const tilesBox = document.getElementById("tiles");
+  const tiles = new Map(); // id -> {root, parts…, summary, trace}
+
+  function makeTile(id) {
+    const name = el("a", { class: "name", href: "/bench/" + encodeURIComponent(id) }, id);
+    const state = el("span", { class: "state" }, "…");
+    const run = el("span", { class: "run" });
+    const canvas = el("canvas", { width: 600, height: 160, "aria-label": `${id}: the latest run's readings` });
+    const best = el("dd", { "data-field": "best" }, "–");
+    const c3 = el("dd", { "data-field": "c3" }, "–");
+    const c4 = el("dd", { "data-field": "c4" }, "–");
+    const health = el("dd", { "data-field": "health" }, "–");
+    const doubts = el("ul", { class: "doubts", "data-field": "doubts" });
+    const bridge = el("span", { "data-field": "bridge" }, "…");
+    const bridgeInfo = el("span", { class: "detail" });
+    const root = el("article", { class: "tile", "data-bench": id, "data-state": "idle" },
+      el("header", {}, name, state),
+      run,
+      canvas,
+      el("dl", {}, el("dt", {}, "best"), best, el("dt", {}, "c3"), c3, el("dt", {}, "c4"), c4, el("dt", {}, "health"), health),
+      doubts,
+      el("footer", {}, "bridge ", bridge, " ", bridgeInfo));
+    const t = { id, root, state, run, canvas, best, c3, c4, health, doubts, bridge, bridgeInfo, summary: null,
+                trace: { key: 0, x: [], y: [] }, dirty: true };
+    tiles.set(id, t);
+    placeTiles();
+    return t;
+  }
+
+  function placeTiles() {
+    const ids = Array.from(tiles.keys()).sort();
+    ids.forEach((id, i) => {
+      const root = tiles.get(id).root;
+      if (tilesBox.children[i] !== root) tilesBox.insertBefore(root, tilesBox.children[i] || null);
+    });
+    document.getElementById("empty").hidden = tiles.size > 0;
+  }
+
+  function tile(id) { return tiles.get(id) || makeTile(id); }
+
+  function showSummary(s) {
+    const t = tile(s.id);
+    t.summary = s;
+    t.root.setAttribute("data-state", s.state);
+    setText(t.state, s.state);
+    const fit = s.last_fit;
+    const run = s.run;
+    let runText = run ? `run ${run.number}${run.partial ? " (partial)" : ""}: ${run.state}` : "no run yet";
+    if (fit && run && fit.run !== run.number) runText += ` · fit of run ${fit.run}`;
+    setText(t.run, runText);
+    setText(t.best, fit ? (fit.best || "no model converged") : "–");
+    setCoefficient(t.c3, fit ? fit.c3 : null, fit ? fit.run : undefined);
+    setCoefficient(t.c4, fit ? fit.c4 : null, fit ? fit.run : undefined);
+    setHealth(t.health, fit);
+    setDoubts(t.doubts, fit);
+    setBridge(t.bridge, s.bridge);
+    setText(t.bridgeInfo, bridgeDetail(s.bridge));
+    t.dirty = true;
+  }
+
+  function takeSamples(all) {
+    for (const [id, p] of Object.entries(all.benches || {})) {
+      const t = tile(id);
+      if (p.reset || p.key !== t.trace.key) t.trace = { key: p.key, x: [], y: [] };
+      for (const [x, y] of p.p) {
+        t.trace.x.push(x);
+        t.trace.y.push(y);
+      }
+      t.dirty = true;
+    }
+  }
+
+  // The sparkline: the run's readings, and the best model's curve when the fit is this run's.
+  function draw(t) {
+    const c = t.canvas;
+    const w = c.clientWidth || 300, h = c.clientHeight || 80;
+    const dpr = window.devicePixelRatio || 1;
+    if (c.width !== Math.round(w * dpr) || c.height !== Math.round(h * dpr)) {
+      c.width = Math.round(w * dpr);
+      c.height = Math.round(h * dpr);
+    }
+    const g = c.getContext("2d");
+    g.setTransform(dpr, 0, 0, dpr, 0, 0);
+    g.clearRect(0, 0, w, h);
+    const { x, y } = t.trace;
+    const s = t.summary;
+    const fit = s && s.last_fit;
+    const curve = fit && s.run && fit.run === s.run.number ? s.last_fit_curve || [] : [];
+    if (x.length < 2 && curve.length < 2) return;
+    let x0 = Infinity, x1 = -Infinity, y0 = 0, y1 = 0.1;
+    for (let i = 0; i < x.length; i++) {
+      x0 = Math.min(x0, x[i]); x1 = Math.max(x1, x[i]);
+      y0 = Math.min(y0, y[i]); y1 = Math.max(y1, y[i]);
+    }
+    for (const [cx, cy] of curve) {
+      if (cy === null) continue;
+      x0 = Math.min(x0, cx); x1 = Math.max(x1, cx); y1 = Math.max(y1, cy);
+    }
+    if (!(x1 > x0)) x1 = x0 + 1;
+    const px = (v) => 4 + (w - 8) * (v - x0) / (x1 - x0);
+    const py = (v) => h - 4 - (h - 8) * (v - y0) / (y1 - y0);
+    g.lineWidth = 1.5;
+    g.strokeStyle = "#333";
+    g.beginPath();
+    for (let i = 0; i < x.length; i++) (i ? g.lineTo : g.moveTo).call(g, px(x[i]), py(y[i]));
+    g.stroke();
+    if (curve.length > 1) {
+      g.lineWidth = 2.5;
+      g.strokeStyle = fit.best === "viscous" ? "#d62728" : fit.best === "coulomb" ? "#2ca02c" : "#1f77b4";
+      g.beginPath();
+      curve.forEach(([cx, cy], i) => (i ? g.lineTo : g.moveTo).call(g, px(cx), py(cy)));
+      g.stroke();
+    }
+  }
+
+  function frame() {
+    for (const t of tiles.values()) if (t.dirty) { t.dirty = false; draw(t); }
+    requestAnimationFrame(frame);
+  }
+
+  function showLab(lab) {
+    setText(document.getElementById("services"), servicesText(lab));
+    setText(document.getElementById("problems"), problemsText(lab));
+  }
+
+  spindown.live("", {
+    snapshot(d) {
+      const ids = new Set(d.benches.map((b) => b.id));
+      for (const id of Array.from(tiles.keys())) if (!ids.has(id)) { tiles.get(id).root.remove(); tiles.delete(id); }
+      for (const t of tiles.values()) t.trace = { key: 0, x: [], y: [] };
+      d.benches.forEach(showSummary);
+      takeSamples(d.samples ? { benches: d.samples } : {});
+      showLab(d.lab);
+      placeTiles();
+    },
+    bench: showSummary,
+    samples: takeSamples,
+    roster(d) {
+      const ids = new Set(d.benches);
+      for (const id of Array.from(tiles.keys())) if (!ids.has(id)) { tiles.get(id).root.remove(); tiles.delete(id); }
+      for (const id of d.benches) tile(id);
+      placeTiles();
+    },
+    lab: showLab,
+  });
+  window.addEventListener("resize", () => { for (const t of tiles.values()) t.dirty = true; });
+  requestAnimationFrame(frame);
+})();

@@ -1,0 +1,306 @@
+#include "spindown/web_server.hpp"
+
+#include <atomic>
+#include <charconv>
+#include <chrono>
+#include <fmt/format.h>
+#include <thread>
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+
+#include <httplib.h>
+
+#include "spindown/clock.hpp"
+#include "spindown/lcm_channels.hpp"
+#include "spindown/web_assets.hpp"
+
+namespace spindown {
+
+namespace {
+
+// Scripts, styles, images and the event stream from this server only: nothing from a CDN, and a
+// page that tried would say so in the browser's console.
+constexpr const char* content_security_policy =
+    "default-src 'self'; img-src 'self' data:; style-src 'self' 'unsafe-inline'; object-src 'none'; "
+    "base-uri 'none'; frame-ancestors 'none'; form-action 'none'";
+
+constexpr const char* json_type = "application/json; charset=utf-8";
+
+void send_json(httplib::Response& res, const Json& j) {
+  res.set_header("Cache-Control", "no-store");
+  res.set_content(j.dump(-1, ' ', false, Json::error_handler_t::replace), json_type);
+}
+
+void not_found(httplib::Response& res, const std::string& what) {
+  res.status = 404;
+  res.set_content(what + "\n", "text/plain; charset=utf-8");
+}
+
+void send_asset(httplib::Response& res, const WebAsset& a) {
+  res.set_header("Cache-Control", "no-cache");
+  res.set_content(a.data.data(), a.data.size(), std::string(a.content_type));
+}
+
+std::optional<std::int32_t> run_number(const std::string& text) {
+  std::int32_t n = 0;
+  const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), n);
+  if (ec != std::errc() || end != text.data() + text.size() || n < 0) return std::nullopt;
+  return n;
+}
+
+// cpp-httplib's server, able to serve on a listening socket it did not open (one inherited from
+// deploy/run-lab, which opens it outside the lab's private network namespace).
+class AdoptingServer : public httplib::Server {
+ public:
+  void adopt(int fd) { svr_sock_ = fd; }
+};
+
+// The address and port a socket is bound to; false when fd is not a listening TCP socket.
+bool listening_address(int fd, std::string& host, int& port) {
+  int listening = 0;
+  socklen_t len = sizeof listening;
+  if (::getsockopt(fd, SOL_SOCKET, SO_ACCEPTCONN, &listening, &len) != 0 || !listening) return false;
+  sockaddr_storage a{};
+  len = sizeof a;
+  if (::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) != 0) return false;
+  char text[INET6_ADDRSTRLEN] = {};
+  if (a.ss_family == AF_INET) {
+    const auto* in = reinterpret_cast<const sockaddr_in*>(&a);
+    ::inet_ntop(AF_INET, &in->sin_addr, text, sizeof text);
+    port = ntohs(in->sin_port);
+  } else if (a.ss_family == AF_INET6) {
+    const auto* in = reinterpret_cast<const sockaddr_in6*>(&a);
+    ::inet_ntop(AF_INET6, &in->sin6_addr, text, sizeof text);
+    port = ntohs(in->sin6_port);
+  } else {
+    return false;
+  }
+  host = text;
+  return true;
+}
+
+}  // namespace
+
+bool parse_listen_address(std::string_view text, std::string& host, int& port, std::string* why) {
+  const auto fail = [&](std::string w) {
+    if (why) *why = std::move(w);
+    return false;
+  };
+  const std::size_t colon = text.rfind(':');
+  if (colon == std::string_view::npos || colon == 0)
+    return fail(fmt::format("'{}' is not ADDR:PORT (e.g. 0.0.0.0:8080, 127.0.0.1:8080, [::]:8080)", text));
+  std::string_view h = text.substr(0, colon), p = text.substr(colon + 1);
+  if (h.size() >= 2 && h.front() == '[' && h.back() == ']') h = h.substr(1, h.size() - 2);
+  int value = -1;
+  const auto [end, ec] = std::from_chars(p.data(), p.data() + p.size(), value);
+  if (ec != std::errc() || end != p.data() + p.size() || value < 0 || value > 65535)
+    return fail(fmt::format("'{}': the port '{}' is not a number from 0 to 65535", text, p));
+  if (h.empty()) return fail(fmt::format("'{}': no address before the port", text));
+  host = std::string(h);
+  port = value;
+  return true;
+}
+
+struct WebServer::Impl {
+  WebLab& lab;
+  std::mutex& lab_mutex;
+  EventFanout& fanout;
+  WebServerOptions opt;
+  AdoptingServer server;
+  std::thread thread;
+  int port = -1;
+  std::string host;
+  std::atomic<std::int64_t> requests{0};
+
+  Impl(WebLab& l, std::mutex& m, EventFanout& f, WebServerOptions o) : lab(l), lab_mutex(m), fanout(f), opt(std::move(o)) {}
+
+  void routes();
+  void events(const httplib::Request& req, httplib::Response& res);
+};
+
+void WebServer::Impl::routes() {
+  const std::size_t threads = fanout.options().max_clients + opt.spare_threads;
+  server.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
+  const auto write_s = static_cast<time_t>(opt.write_timeout_s);
+  server.set_write_timeout(write_s, static_cast<time_t>((opt.write_timeout_s - double(write_s)) * 1e6));
+  server.set_read_timeout(5, 0);
+  server.set_keep_alive_timeout(5);
+  server.set_keep_alive_max_count(100);
+  server.set_payload_max_length(64 * 1024);  // GET only: a request has no business being larger
+  server.set_default_headers({{"Content-Security-Policy", content_security_policy},
+                              {"X-Content-Type-Options", "nosniff"},
+                              {"Referrer-Policy", "no-referrer"}});
+  server.set_pre_routing_handler([this](const httplib::Request&, httplib::Response&) {
+    ++requests;
+    return httplib::Server::HandlerResponse::Unhandled;
+  });
+  server.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
+    if (!res.body.empty()) return;
+    res.set_content(res.status == 404 ? fmt::format("not found: {} (the room page is /)\n", req.path)
+                                      : fmt::format("error {}\n", res.status),
+                    "text/plain; charset=utf-8");
+  });
+
+  server.Get("/", [](const httplib::Request&, httplib::Response& res) { send_asset(res, *find_web_asset("/")); });
+  server.Get("/favicon.ico", [](const httplib::Request&, httplib::Response& res) {
+    send_asset(res, *find_web_asset("/assets/icon.svg"));
+  });
+  server.Get(R"(/assets/(.+))", [](const httplib::Request& req, httplib::Response& res) {
+    if (const WebAsset* a = find_web_asset(req.path)) return send_asset(res, *a);
+    not_found(res, fmt::format("no asset {}", req.path));
+  });
+  server.Get(R"(/bench/([A-Za-z0-9_-]{1,32})/?)", [](const httplib::Request&, httplib::Response& res) {
+    send_asset(res, *find_web_asset("/bench.html"));
+  });
+  server.Get(R"(/bench/([A-Za-z0-9_-]{1,32})/runs/([0-9]{1,9})\.csv)",
+             [this](const httplib::Request& req, httplib::Response& res) {
+               const std::string id = req.matches[1];
+               const auto n = run_number(req.matches[2]);
+               std::optional<std::string> csv;
+               {
+                 std::lock_guard lock(lab_mutex);
+                 if (n) csv = lab.run_csv(id, *n);
+               }
+               if (!csv) return not_found(res, fmt::format("bench {} has no run {} kept", id, req.matches[2].str()));
+               res.set_header("Content-Disposition", fmt::format("attachment; filename=\"{}-run{}.csv\"", id, *n));
+               res.set_header("Cache-Control", "no-store");
+               res.set_content(std::move(*csv), "text/csv; charset=utf-8");
+             });
+  server.Get("/api/state", [this](const httplib::Request&, httplib::Response& res) {
+    Json j;
+    {
+      std::lock_guard lock(lab_mutex);
+      j = lab.state_json(wall_us());
+    }
+    const EventFanoutCounters c = fanout.counters();
+    j["clients"] = {{"connected", c.clients},       {"max", fanout.options().max_clients},
+                    {"refused", c.refused},         {"resyncs", c.resyncs},
+                    {"dropped_events", c.dropped_events}};
+    send_json(res, j);
+  });
+  server.Get(R"(/api/bench/([A-Za-z0-9_-]{1,32}))", [this](const httplib::Request& req, httplib::Response& res) {
+    std::optional<Json> j;
+    {
+      std::lock_guard lock(lab_mutex);
+      j = lab.bench_json(req.matches[1].str(), wall_us());
+    }
+    if (!j) return not_found(res, fmt::format("no bench {} heard", req.matches[1].str()));
+    send_json(res, *j);
+  });
+  server.Get(R"(/api/bench/([A-Za-z0-9_-]{1,32})/runs/([0-9]{1,9}))",
+             [this](const httplib::Request& req, httplib::Response& res) {
+               const auto n = run_number(req.matches[2]);
+               std::optional<Json> j;
+               {
+                 std::lock_guard lock(lab_mutex);
+                 if (n) j = lab.run_json(req.matches[1].str(), *n);
+               }
+               if (!j) return not_found(res, fmt::format("bench {} has no run {} kept", req.matches[1].str(),
+                                                         req.matches[2].str()));
+               send_json(res, *j);
+             });
+  server.Get("/events", [this](const httplib::Request& req, httplib::Response& res) { events(req, res); });
+}
+
+// One page's event stream: its snapshot, then what changes; a page that fell behind gets a new
+// snapshot; a comment every keepalive_s when nothing happens (a dead page's socket then fails).
+void WebServer::Impl::events(const httplib::Request& req, httplib::Response& res) {
+  const std::string bench = req.get_param_value("bench");
+  std::string why;
+  if (!bench.empty() && !is_valid_bench_id(bench, &why)) {
+    res.status = 400;
+    res.set_content(fmt::format("bench '{}': {}\n", bench, why), "text/plain; charset=utf-8");
+    return;
+  }
+  std::optional<EventFanout::ClientId> id;
+  {
+    std::lock_guard lock(lab_mutex);
+    id = fanout.connect(bench, "retry: 2000\n\n" + lab.snapshot_event(bench, wall_us()));
+  }
+  if (!id) {
+    const auto c = fanout.counters();
+    res.status = 503;
+    res.set_header("Retry-After", "10");
+    res.set_content(fmt::format("spindown-web: {} pages are connected, the most it serves (--max-clients); "
+                                "try again later\n",
+                                c.clients),
+                    "text/plain; charset=utf-8");
+    return;
+  }
+  res.set_header("Cache-Control", "no-store");
+  res.set_header("X-Accel-Buffering", "no");
+  const auto keepalive = std::chrono::milliseconds(static_cast<std::int64_t>(opt.keepalive_s * 1000));
+  res.set_chunked_content_provider(
+      "text/event-stream",
+      [this, client = *id, keepalive](std::size_t, httplib::DataSink& sink) {
+        std::string out;
+        switch (fanout.next(client, out, keepalive)) {
+          case EventFanout::Next::closed: return false;
+          case EventFanout::Next::resync: {
+            std::lock_guard lock(lab_mutex);
+            const auto b = fanout.bench_of(client);
+            if (!b) return false;
+            fanout.resync(client, lab.snapshot_event(*b, wall_us()));
+            return true;
+          }
+          case EventFanout::Next::idle: out = ": keep-alive\n\n"; break;
+          case EventFanout::Next::events: break;
+        }
+        return sink.write(out.data(), out.size());
+      },
+      [this, client = *id](bool) { fanout.disconnect(client); });
+}
+
+WebServer::WebServer(WebLab& lab, std::mutex& lab_mutex, EventFanout& fanout, WebServerOptions options)
+    : impl_(std::make_unique<Impl>(lab, lab_mutex, fanout, std::move(options))) {
+  impl_->routes();
+}
+
+WebServer::~WebServer() { stop(); }
+
+bool WebServer::bind(std::string* why) {
+  impl_->host = impl_->opt.host;
+  if (impl_->opt.listen_fd >= 0) {
+    if (!listening_address(impl_->opt.listen_fd, impl_->host, impl_->port)) {
+      if (why) *why = fmt::format("file descriptor {} is not a listening TCP socket", impl_->opt.listen_fd);
+      return false;
+    }
+    impl_->server.adopt(impl_->opt.listen_fd);
+    return true;
+  }
+  if (impl_->opt.port == 0) {
+    impl_->port = impl_->server.bind_to_any_port(impl_->opt.host);
+  } else {
+    impl_->port = impl_->server.bind_to_port(impl_->opt.host, impl_->opt.port) ? impl_->opt.port : -1;
+  }
+  if (impl_->port < 0) {
+    if (why)
+      *why = fmt::format("cannot listen on {}:{} (in use, or not an address of this host)", impl_->opt.host,
+                         impl_->opt.port);
+    return false;
+  }
+  return true;
+}
+
+int WebServer::bound_port() const { return impl_->port; }
+
+std::string WebServer::bound_host() const { return impl_->host; }
+
+void WebServer::start() {
+  impl_->thread = std::thread([this] { impl_->server.listen_after_bind(); });
+}
+
+void WebServer::stop() {
+  if (!impl_) return;
+  impl_->fanout.close_all();
+  impl_->server.stop();
+  if (impl_->thread.joinable()) impl_->thread.join();
+}
+
+bool WebServer::running() const { return impl_->server.is_running(); }
+
+std::int64_t WebServer::requests() const { return impl_->requests.load(); }
+
+}  // namespace spindown
