@@ -326,7 +326,10 @@ std::uint64_t hash_of(const void* data, std::int64_t size) {
 // appended fields. legacy tells which it was.
 bool walk_type(const TypeInfo& t, const void* data, std::int64_t size, std::string* why, bool* legacy,
                Positions* positions = nullptr) {
-  *legacy = size >= hash_bytes && data != nullptr && hash_of(data, size) == t.legacy_hash;
+  // The fingerprint is read only from a size walk() takes (a size beyond an LCM message is refused
+  // there, before any byte is read).
+  *legacy = size >= hash_bytes && size <= std::numeric_limits<int>::max() && data != nullptr &&
+            hash_of(data, size) == t.legacy_hash;
   if (*legacy) return walk(t.name, t.legacy_hash, t.fields.first(t.legacy_fields), data, size, why, positions);
   return walk(t.name, t.hash, t.fields, data, size, why, positions);
 }
