@@ -368,6 +368,18 @@ TEST(FitReportJsonText, MatchesTheDocumentsDumpByteForByte) {
   EXPECT_EQ(streamed_compact({}, {}), fit_report_json({}, {}).dump(-1));
 }
 
+// A doubt stands before the numbers it doubts: a reader who stops at the table has seen it.
+TEST(FitReportText, ADoubtStandsBeforeTheNumbers) {
+  RunFit fit = lab_like_fit();
+  fit.doubts = {"readings up to 3364 V: try --value-unit rpm"};
+  const std::string text = format_run_fit(fit);
+  const auto doubt = text.find("doubtful: readings up to 3364 V"), table = text.find("coefficients ± standard error");
+  ASSERT_NE(doubt, std::string::npos) << text;
+  ASSERT_NE(table, std::string::npos) << text;
+  EXPECT_LT(doubt, table) << text;
+  EXPECT_LT(doubt, text.find("zero level")) << text;
+}
+
 // `spindown fit` on an LCM log of several benches: a "-- bench" line before each bench's runs,
 // "bench" -> "id" in JSON (no sequence numbers: those are the refit's), messages not lines.
 TEST(FitReportText, RunsOfSeveralBenchesSayWhoseTheyAre) {
