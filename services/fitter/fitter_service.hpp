@@ -27,9 +27,6 @@ struct FitterServiceOptions {
   std::size_t max_queue_messages = 200000;  // received but not yet processed
   std::size_t max_queue_bytes = 64u << 20;
   bool verbose = false;                 // one line per run event and fit on stderr
-  // The discrepancy workflow on every fitted run, published on SPINDOWN.<bench>.EXPLAIN,
-  // starting from this base (the lab's belief: viscous). Empty = off.
-  std::vector<const Effect*> explain_base{find_effect("viscous")};
 };
 
 class FitterService final : public FitterSink {

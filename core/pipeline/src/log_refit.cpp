@@ -24,13 +24,13 @@ class RefitSink final : public FitterSink {
   void fit_ready(const FitResult& r) override {
     ++out_.runs_fitted;
     if (!each_run_) {
-      out_.runs.push_back({r.bench, r.fit, r.bench_source, r.first_seq, r.last_seq, r.health});
+      out_.runs.push_back({r.bench, r.fit, r.bench_source, r.first_seq, r.last_seq, r.health, r.explain});
       return;
     }
     if (r.fit.best.empty())
       out_.file.failures.push_back(fmt::format("SPINDOWN.{}.SAMPLE: run {}: no model converged", r.bench,
                                                r.fit.run.number));
-    each_run_(RefitRun{r.bench, r.fit, r.bench_source, r.first_seq, r.last_seq, r.health});
+    each_run_(RefitRun{r.bench, r.fit, r.bench_source, r.first_seq, r.last_seq, r.health, r.explain});
   }
   void problem(const std::string& text) override {
     if (++problems_ <= max_problems_listed)
@@ -191,6 +191,19 @@ LogRefit refit_log_session(const std::vector<std::string>& paths, const FitterOp
           }
           break;
         case LcmLogEvent::Kind::other:
+          if (keep_live_fits && ev.channel.starts_with("SPINDOWN.") && ev.channel.ends_with(".EXPLAIN")) {
+            explain_t m;
+            try {
+              if (m.decode(ev.data, 0, ev.data_size) >= 0) {
+                out.live_explains.push_back(std::move(m));
+                break;
+              }
+            } catch (const std::exception&) {
+            }
+            out.file.diagnostics.push_back({Diagnostic::Severity::warning, file, ev.number,
+                                            fmt::format("event {} on {}: not a decodable explain_t; skipped", ev.number,
+                                                        ev.channel)});
+          }
           if (keep_live_fits && ev.channel.starts_with("SPINDOWN.") && ev.channel.ends_with(".FIT")) {
             fit_t m;
             try {

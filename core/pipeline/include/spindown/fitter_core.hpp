@@ -31,6 +31,7 @@
 
 #include "spindown/bench.hpp"
 #include "spindown/bench_file.hpp"
+#include "spindown/explain.hpp"
 #include "spindown/fit.hpp"
 #include "spindown/message_decode.hpp"
 #include "spindown/motor_health.hpp"
@@ -69,6 +70,10 @@ struct FitterOptions {
   // Motor health references per bench id (the benches' TOML files): each fit of such a bench
   // carries a verdict (FitResult::health); other benches' fits carry none.
   std::map<std::string, MotorHealthConfig, std::less<>> health;
+  // The discrepancy workflow (explain_run) on every fitted run's own window, starting from this
+  // base (FitResult::explain; published live on SPINDOWN.<bench>.EXPLAIN, reproduced by refit).
+  // Empty: off.
+  std::vector<const Effect*> explain_base;
   bool is_valid(std::string* why) const;
 };
 
@@ -117,6 +122,10 @@ struct FitResult {
   std::optional<HealthVerdict> health;  // when FitterOptions::health has the bench
   std::span<const double> t_s;     // the run's samples [cut, end), valid during the call only
   std::span<const double> value;
+  // The run rebased onto t_s/value (cut 0; its stop, end and outliers moved with it): the one
+  // window the FIT was fitted to, and the EXPLAIN too.
+  Run window;
+  std::optional<ExplainResult> explain;  // when FitterOptions::explain_base is set
 };
 
 class FitterSink {

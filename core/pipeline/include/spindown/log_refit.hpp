@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include <spindown/explain_t.hpp>
 #include <spindown/fit_t.hpp>
 
 #include "spindown/fit_report.hpp"
@@ -24,6 +25,7 @@ struct RefitRun {
   std::string bench_source;
   std::int64_t first_seq = 0, last_seq = 0;
   std::optional<HealthVerdict> health;  // when FitterOptions::health has the bench (as the live FIT)
+  std::optional<ExplainResult> explain; // when FitterOptions::explain_base is set (as the live EXPLAIN)
 };
 
 struct LogRefit {
@@ -33,6 +35,7 @@ struct LogRefit {
   std::vector<RefitRun> runs;   // the same runs, with their bench ids (empty when streamed)
   std::size_t runs_fitted = 0;  // runs fitted, kept or streamed
   std::vector<fit_t> live;      // SPINDOWN.<bench>.FIT messages recorded in the log (when asked)
+  std::vector<explain_t> live_explains;  // SPINDOWN.<bench>.EXPLAIN messages recorded (when asked)
   FitterCounters counters;
   std::vector<std::string> bench_order;  // benches in order of first appearance
 };
