@@ -192,7 +192,7 @@ LogRefit export_text(const ExportCommandOptions& o, OfflinePlan plan, const std:
       opt.bench = r.params;
       RunFit fit = fit_run(r.recording, run, opt);
       out.runs.push_back({csv_bench(r), fit, fmt::format("J: {}; K_b: {}", r.params.inertia_source, r.params.kb_source),
-                          0, 0, std::nullopt});
+                          0, 0, std::nullopt, std::nullopt});
       out.file.runs.push_back(std::move(fit));
     }
   } sink(wanted, style, f, rows);

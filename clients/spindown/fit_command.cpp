@@ -130,6 +130,9 @@ void setup_fit(CLI::App& app) {
   sub->add_option("FILE", opt->files, "Arduino/PuTTY log, delimited text (CSV/TSV) or LCM log")->required();
   auto* json = sub->add_flag("--json", opt->json,
                              "Print one JSON object {\"files\":[{\"runs\":[{\"models\":…}]}]} instead of tables");
+  sub->add_flag("--pretty", opt->pretty,
+                "Indent the JSON (as on a terminal); into a pipe or a file it is compact, without layout whitespace")
+      ->needs(json);
   sub->add_option("--table", opt->table,
                   "A class's table instead: one row per run across all files (file, bench, student, best model, "
                   "c1…c4 ± errors, doubts, health), as csv or json (an array of the same rows)")
@@ -178,9 +181,11 @@ int run_fit(const FitCommandOptions& options) {
   // file or a pipe it goes out in pieces as the workers finish them, so that writing it overlaps
   // the fitting instead of following it (5 MB for 1000 runs: milliseconds, and a 5 MB buffer
   // grown by doubling).
-  std::string json;
-  FitReportJsonText json_files;
+  // Compact (no layout whitespace) unless it is for a person: a terminal, or --pretty.
   const bool json_in_pieces = options.json && (to_file || !isatty(STDOUT_FILENO));
+  const bool json_compact = json_in_pieces && !options.pretty;
+  std::string json;
+  FitReportJsonText json_files(json_compact);
   constexpr std::size_t json_piece_bytes = 256 * 1024;
   // --table: one row per run across the files, in the order given.
   const bool csv_table = options.table == "csv", json_table = options.table == "json";
@@ -201,6 +206,7 @@ int run_fit(const FitCommandOptions& options) {
           d.text = run_table_csv_rows(d.file, csv_style);
         else if (!json_table)
           d.text = options.json ? file_fit_json_text(d.file, plan.report) : format_file_fit(d.file, plan.report);
+        if (json_compact) compact_json(d.text);
         return d;
       },
       [&](std::size_t, Done d) {

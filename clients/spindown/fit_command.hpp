@@ -16,6 +16,7 @@ namespace spindown::cli {
 struct FitCommandOptions {
   std::vector<std::string> files;
   bool json = false;
+  bool pretty = false;  // --pretty: indented JSON into a pipe or file too
   std::string table;     // "csv" | "json": one row per run across all files (run_table.hpp)
   std::string output;    // -o: the output (text, JSON or table) to this file instead of stdout
   std::string csv_locale;  // --csv-locale: the table's CSV style (csv_output.hpp)

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <exception>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <iostream>
 #include <limits>
 #include <memory>
@@ -18,6 +19,9 @@
 #include "exit_codes.hpp"
 #include "file_problems.hpp"
 #include "spindown/bench.hpp"
+#include "spindown/effects.hpp"
+#include "spindown/explain_message.hpp"
+#include "spindown/explain_report.hpp"
 #include "spindown/fit_message.hpp"
 #include "spindown/health_report.hpp"
 #include "spindown/progress.hpp"
@@ -133,8 +137,67 @@ FitterOptions fitter_options(const RefitCommandOptions& o, const BenchFiles& fil
   }
   if (!o.models.empty()) f.models = models_from(o.models);
   std::string why;
+  if (o.explain || o.compare) {
+    f.explain_base = parse_effect_list(o.explain_base, &why);
+    if (f.explain_base.empty()) throw CLI::ValidationError("--explain-base: " + why);
+  }
   if (!f.is_valid(&why)) throw CLI::ValidationError(why);
   return f;
+}
+
+// --compare's EXPLAIN: each refitted run's EXPLAIN against the recorded one of its bench and run
+// number, every field but the time; one line of counts. False when one differs.
+bool compare_explains(const std::string& path, const LogRefit& r, const std::regex& wanted) {
+  std::vector<const explain_t*> live;
+  for (const explain_t& m : r.live_explains)
+    if (std::regex_match(m.bench, wanted)) live.push_back(&m);
+  std::vector<bool> paired(live.size(), false);
+  std::size_t refitted = 0, same = 0, differ = 0, only_refit = 0;
+  const auto close = [](double a, double b) {
+    return a == b || (std::isnan(a) && std::isnan(b)) || std::abs(a - b) <= 1e-9 * std::max(std::abs(a), std::abs(b));
+  };
+  for (const RefitRun& run : r.runs) {
+    if (!run.explain) continue;
+    ++refitted;
+    const explain_t ours = to_explain_message(*run.explain, run.bench, 0);
+    std::size_t k = 0;
+    while (k < live.size() && (paired[k] || live[k]->bench != run.bench || live[k]->run != ours.run)) ++k;
+    if (k == live.size()) {
+      ++only_refit;
+      continue;
+    }
+    paired[k] = true;
+    const explain_t& theirs = *live[k];
+    std::string d;
+    if (ours.base != theirs.base) d = "base";
+    else if (ours.step_added != theirs.step_added) d = "steps";
+    else if (ours.final_effects != theirs.final_effects) d = "final model";
+    else if (!close(ours.rmse_base, theirs.rmse_base) || !close(ours.rmse_final, theirs.rmse_final)) d = "RMSE";
+    else if (ours.param_name != theirs.param_name) d = "parameters";
+    else
+      for (std::size_t j = 0; j < ours.param_value.size() && d.empty(); ++j)
+        if (!close(ours.param_value[j], theirs.param_value[j]) || !close(ours.param_stderr[j], theirs.param_stderr[j]))
+          d = "parameter " + ours.param_name[j];
+    if (d.empty()) {
+      ++same;
+    } else {
+      ++differ;
+      std::cout << fmt::format("{}: {} run {}: EXPLAIN differs: {} (live final {}, RMSE {:.6g}; refit final {}, RMSE {:.6g})\n",
+                               path, run.bench, ours.run, d, fmt::join(theirs.final_effects, "+"), theirs.rmse_final,
+                               fmt::join(ours.final_effects, "+"), ours.rmse_final);
+    }
+  }
+  const std::size_t only_live = static_cast<std::size_t>(std::count(paired.begin(), paired.end(), false));
+  if (live.empty()) {
+    std::cout << fmt::format("{}: EXPLAIN: {} runs explained, no live EXPLAIN messages recorded (the live fitter ran "
+                             "with --no-explain): nothing to compare\n",
+                             path, refitted);
+    return true;
+  }
+  std::cout << fmt::format("{}: EXPLAIN: {} runs explained, {} live EXPLAIN messages: {} identical, {} different, {} only "
+                           "refitted, {} only live\n",
+                           path, refitted, live.size(), same, differ, only_refit, only_live);
+  return differ == 0 && only_refit == 0 && only_live == 0;
 }
 
 // Whether the command line or a bench file names J or K_b (what --compare leaves to the CONFIG).
@@ -234,6 +297,13 @@ void setup_refit(CLI::App& app) {
   sub->add_flag("-v,--verbose", opt->verbose, "Show every diagnostic, notes included");
   sub->add_flag("--no-progress", opt->no_progress, "No progress line on a terminal (there is none when stderr is not one)");
   auto* live = sub->add_flag("--live", opt->live, "Print the FIT messages recorded in the log instead of refitting");
+  sub->add_flag("--explain", opt->explain,
+                "Also each run's EXPLAIN as the live fitter publishes it (the discrepancy workflow on the FIT's own "
+                "window); in JSON the file's \"explains\"")
+      ->excludes(live);
+  sub->add_option("--explain-base", opt->explain_base,
+                  "The EXPLAIN's starting model, as spindown-fitter --explain-base (default viscous)")
+      ->capture_default_str();
   sub->add_flag("--compare", opt->compare,
                 "Refit and compare with the recorded FIT messages, timing fields aside (exit 1 on a difference)")
       ->excludes(live);
@@ -290,7 +360,9 @@ int run_refit(const RefitCommandOptions& o) {
     // the log is done, as the order contract wants.
     std::vector<std::pair<std::string, std::unique_ptr<RunSpool>>> spools;
     std::string run_text;  // reused: one run's JSON at a time
+    Json explains = Json::array();  // --explain: each run's EXPLAIN, as spindown explain --json gives a run
     auto each_run = [&](RefitRun&& run) {
+      if (run.explain) explains.push_back(Json::parse(explain_run_json(*run.explain, run.bench, report).dump()));
       RunSpool* spool = nullptr;
       for (auto& [bench, sp] : spools)
         if (bench == run.bench) spool = sp.get();
@@ -453,6 +525,7 @@ int run_refit(const RefitCommandOptions& o) {
                                "refitted, {} only live{}\n",
                                path, r.runs.size(), live.size(), same, differ, missing_live, missing_refit, verdicts);
       if (differ || verdict_differ || missing_live || missing_refit || live.empty()) ok = false;
+      if (!compare_explains(path, r, std::regex(o.bench_regex))) ok = false;
       continue;
     }
 
@@ -470,6 +543,7 @@ int run_refit(const RefitCommandOptions& o) {
       // the same bytes as dumping the whole document at once.
       constexpr std::string_view hole = "(runs spliced here)";  // printed by dump() as it is
       Json file = refit_file_json(r, report);
+      if (o.explain) file["explains"] = std::move(explains);
       file["runs"] = hole;
       const std::string text = indented(dump_json(file), 4);
       const std::string key = fmt::format("\n      \"runs\": \"{}\"", hole);

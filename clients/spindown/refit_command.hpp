@@ -36,6 +36,10 @@ struct RefitCommandOptions {
   bool live = false;     // print the recorded FIT messages, not a refit
   bool compare = false;  // refit and compare with the recorded FIT messages (exit 1 on a difference)
   bool no_progress = false;  // no progress line on a terminal
+  // --explain: each run's EXPLAIN as the live fitter publishes it (its discrepancy workflow from
+  // explain_base on the FIT's own window); --compare always checks them against the recorded ones.
+  bool explain = false;
+  std::string explain_base = "viscous";  // as spindown-fitter --explain-base
   std::string bench_regex = ".*";
   std::vector<std::string> models;
   // J and K_b (--inertia/--flywheel-*, --kb/--speed-constant, their errors) and --bench-config, as

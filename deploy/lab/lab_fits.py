@@ -102,7 +102,8 @@ def check_runs(live_path, truth_args, cut_tolerance_s=0.2):
         got = list(fits.get(bench, []))
         worst = 0.0
         for tr in t["runs"]:
-            cut = tr["cut_device_us"] / 1e6
+            # The cut the readings show: a floating pin's connection, else the power cut.
+            cut = tr.get("connect_device_us", tr["cut_device_us"]) / 1e6
             match = [f for f in got if f.get("t_cut_s") is not None and abs(f["t_cut_s"] - cut) < cut_tolerance_s]
             if len(match) != 1:
                 problems.append(f"{bench}: run {tr['run']} (cut at {cut:.3f} s): {len(match)} fits")

@@ -80,19 +80,11 @@ void FitterService::fit_ready(const FitResult& r) {
   publish_explain(r);
 }
 
-// The discrepancy workflow (design §6) on the run's own samples: r.t_s/r.value hold [cut, end)
-// of the bench's stream, so the run's indices are rebased onto them.
+// The discrepancy workflow (design §6), run by the core on the FIT's own window (FitResult::explain).
 void FitterService::publish_explain(const FitResult& r) {
-  if (opt_.explain_base.empty() || r.t_s.empty()) return;
-  Run run = r.fit.run;
-  const std::size_t cut = run.cut_index;
-  run.cut_index = 0;
-  run.stop_index = std::min(run.stop_index - std::min(run.stop_index, cut), r.t_s.size());
-  run.end_index = std::min(run.end_index - std::min(run.end_index, cut), r.t_s.size());
-  ExplainOptions eo;
-  eo.bench = r.fit.bench;
-  eo.base = opt_.explain_base;
-  const ExplainResult ex = explain_run(r.t_s, r.value, r.fit.quantity, run, eo);
+  if (!r.explain) return;
+  const ExplainResult& ex = *r.explain;
+  const Run& run = ex.run;
   if (!ex.ok) ++explain_failures_;
   const explain_t msg = to_explain_message(ex, r.bench, wall_us());
   const std::string channel = channel_name(r.bench, ChannelKind::explain);

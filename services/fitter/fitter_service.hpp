@@ -32,9 +32,6 @@ struct FitterServiceOptions {
   std::size_t max_queue_messages = 200000;  // received but not yet processed
   std::size_t max_queue_bytes = 64u << 20;
   bool verbose = false;                 // one line per run event and fit on stderr
-  // The discrepancy workflow on every fitted run, published on SPINDOWN.<bench>.EXPLAIN,
-  // starting from this base (the lab's belief: viscous). Empty = off.
-  std::vector<const Effect*> explain_base{find_effect("viscous")};
   LabSettings lab{"lab", std::nullopt, ""};  // the lab's name and key (also in core.gate)
 };
 

@@ -115,10 +115,10 @@ std::optional<int> parse_options(int argc, char** argv, spindown::FitterServiceO
     return 2;
   }
   if (no_explain) {
-    o.explain_base.clear();
+    o.core.explain_base.clear();
   } else {
-    o.explain_base = spindown::parse_effect_list(explain_base, &why);
-    if (o.explain_base.empty()) {
+    o.core.explain_base = spindown::parse_effect_list(explain_base, &why);
+    if (o.core.explain_base.empty()) {
       fmt::print(stderr, "spindown-fitter: --explain-base: {}\n", why);
       return 2;
     }

@@ -138,6 +138,21 @@ TEST(MotorHealth, DryFrictionTwoAndAHalfTimesTheBaselineNeedsService) {
   EXPECT_NE(stop->reason.find("sooner than the baseline predicts"), std::string::npos) << stop->reason;
 }
 
+// A doubted run (an rpm file read as volts: friction 1000x any baseline) gets no verdict: its
+// numbers are not the motor's friction until the doubt is resolved.
+TEST(MotorHealth, ADoubtedRunIsNotJudged) {
+  MotorHealthConfig cfg;
+  cfg.baseline = lab_baseline();
+  RunFit fit = combined_fit(cv0, 2e-9, 1000 * cc0, 5e-7);
+  EXPECT_EQ(assess_health(fit, cfg).level, HealthLevel::service);
+  fit.doubts = {"readings up to 3364 V: they look like a speed in rpm: try --value-unit rpm"};
+  const HealthVerdict v = assess_health(fit, cfg);
+  EXPECT_EQ(v.level, HealthLevel::not_judged) << v.reason;
+  EXPECT_NE(v.reason.find("doubted"), std::string::npos) << v.reason;
+  EXPECT_NE(v.reason.find("try --value-unit rpm"), std::string::npos) << v.reason;
+  EXPECT_TRUE(v.findings.empty());
+}
+
 TEST(MotorHealth, BetweenThresholdsIsCheck) {
   MotorHealthConfig cfg;
   cfg.baseline = lab_baseline();

@@ -71,6 +71,26 @@ TEST(FitChecks, AViscousMotorIsNotCalledCombinedOnWhatThePrintCannotResolve) {
   EXPECT_GT(rescued, 0);  // the check did the work at least once (BIC alone would have said combined)
 }
 
+// A viscous motor read by a converter that truncates (every reading half a step low: within the
+// ATmega's ±2 LSB) on a print fine enough to resolve it: by BIC combined wins by thousands, its dry
+// friction being the offset; kept viscous, said as such. A real dry friction (the lab's motor) is
+// far beyond any offset and still wins.
+TEST(FitChecks, ACoulombTermASensorOffsetImitatesDoesNotDecideTheModel) {
+  SyntheticRunSpec spec;
+  spec.friction = {1.2e-6, 0};
+  spec.max_coast_s = 40;
+  spec.noise_v = 0.0005;
+  spec.decimals = 4;
+  spec.seed = 3;
+  const Case c = make_case(spec);
+  std::vector<double> low;
+  for (double v : c.run.volts) low.push_back(v > 0 ? v - 0.0024 : v);  // half of a 10-bit step at 5 V
+  const RunFit f = fit_of(c, low);
+  EXPECT_EQ(f.best, "viscous") << f.best_reason;
+  EXPECT_NE(f.best_reason.find("cannot tell dry friction from a zero level"), std::string::npos) << f.best_reason;
+  EXPECT_EQ(fit_of(make_case(SyntheticRunSpec{}), make_case(SyntheticRunSpec{}).run.volts).best, "combined");
+}
+
 TEST(FitChecks, AStribeckRunSaysTheModelMissesAndPointsToExplain) {
   SyntheticRunSpec spec;
   spec.friction.stribeck_static = 2.5e-4;

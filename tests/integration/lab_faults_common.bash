@@ -49,7 +49,8 @@ lab_faults_finish() {
 }
 
 # lab_faults_judge NAME [PYTHON]: the FIT messages in the log against every bench's truth. A FIT
-# that claims a cut (lead-in other than "none") must be within 1.5 sample periods of a true cut
+# that claims a cut (lead-in other than "none") must be within 1.5 sample periods of a true cut (a
+# floating pin's: its connection, where the coast enters the readings)
 # of its bench: 0 invented cuts, or the test fails. Prints "PROMISE NAME: …" with what was
 # measured; PYTHON (optional) asserts more with fits, whole, partial and truth in scope.
 lab_faults_judge() {
@@ -67,10 +68,15 @@ fits = [r for f in doc["files"] for r in f["runs"]]
 whole, partial, invented = [], [], []
 for f in fits:
     t = truth[f["bench"]["id"]]
-    cuts = [r["cut_device_us"] / 1e6 for r in t["runs"] if "cut_device_us" in r]
+    # The cut a reader of the readings can see: a floating pin's connection (to its last sample of
+    # contact bounce, which may hold the coast's first sample up), else the power cut.
+    P = t["period_s"]
+    cuts = [(r.get("connect_device_us", r["cut_device_us"]) / 1e6 - 1.5 * P,
+             r.get("connect_device_us", r["cut_device_us"]) / 1e6 + (len(r.get("bounce_bench_s", [])) + 1.5) * P)
+            for r in t["runs"] if "cut_device_us" in r]
     if f["lead_in"] == "none":
         partial.append(f)
-    elif min(abs(f["t_cut_s"] - c) for c in cuts) <= 1.5 * t["period_s"]:
+    elif any(lo <= f["t_cut_s"] <= hi for lo, hi in cuts):
         whole.append(f)
     else:
         invented.append(f)

@@ -283,6 +283,19 @@ std::string document(std::span<const FileFit> files, const ReportOptions& opt) {
   return fit_report_json(files, opt).dump(2, ' ', false, Json::error_handler_t::replace);
 }
 
+// As `spindown fit --json` writes into a pipe or a file: each entry compacted.
+std::string streamed_compact(std::span<const FileFit> files, const ReportOptions& opt) {
+  std::string out;
+  FitReportJsonText doc(true);
+  for (const auto& f : files) {
+    std::string text = file_fit_json_text(f, opt);
+    compact_json(text);
+    doc.add(text, out);
+  }
+  doc.finish(out);
+  return out;
+}
+
 HealthVerdict a_verdict() {
   HealthVerdict v;
   v.level = HealthLevel::check;
@@ -346,9 +359,25 @@ TEST(FitReportJsonText, MatchesTheDocumentsDumpByteForByte) {
     ReportOptions opt;
     opt.lab_units = lab_units;
     EXPECT_EQ(streamed(all, opt), document(all, opt));
+    // Compact: the document's dump without indentation, byte for byte (strings with spaces,
+    // quotes, backslashes and line breaks inside them keep them).
+    EXPECT_EQ(streamed_compact(all, opt), fit_report_json(all, opt).dump(-1, ' ', false, Json::error_handler_t::replace));
     for (const auto& f : all) EXPECT_EQ(streamed({&f, 1}, opt), document({&f, 1}, opt)) << f.file;
   }
   EXPECT_EQ(streamed({}, {}), document({}, {}));
+  EXPECT_EQ(streamed_compact({}, {}), fit_report_json({}, {}).dump(-1));
+}
+
+// A doubt stands before the numbers it doubts: a reader who stops at the table has seen it.
+TEST(FitReportText, ADoubtStandsBeforeTheNumbers) {
+  RunFit fit = lab_like_fit();
+  fit.doubts = {"readings up to 3364 V: try --value-unit rpm"};
+  const std::string text = format_run_fit(fit);
+  const auto doubt = text.find("doubtful: readings up to 3364 V"), table = text.find("coefficients ± standard error");
+  ASSERT_NE(doubt, std::string::npos) << text;
+  ASSERT_NE(table, std::string::npos) << text;
+  EXPECT_LT(doubt, table) << text;
+  EXPECT_LT(doubt, text.find("zero level")) << text;
 }
 
 // `spindown fit` on an LCM log of several benches: a "-- bench" line before each bench's runs,

@@ -178,6 +178,30 @@ void check_fit(RunFit& fit, std::span<const double> tau, std::span<const double>
     }
   }
 
+  // What a sensor offset imitates: the combined model's dry friction ends its curve at −k·d/r
+  // (decel over rate) below zero, an offset of the whole coast's tail. A term that acts like an
+  // offset within a converter's own (±2 reading steps: the ATmega's ±2 LSB) or of no physical size
+  // (under 0.2 % of the reading at the cut: the Coulomb torque is then under 0.2 % of the viscous
+  // one there) is not told from a zero level a few mV off, however large ΔBIC grows with thousands
+  // of samples: the simpler viscous model is kept, and the reason says the readings cannot tell.
+  if (best && best->kind == ModelKind::combined && best->rate > 0) {
+    const ModelFit* viscous = fit.model(ModelKind::viscous);
+    const double offset = std::fabs(k * best->decel / best->rate);
+    const double v0 = std::fabs(k * best->omega0);
+    const double allowed = std::max(2.0 * fit.reading_step, offset_allowance_fraction * v0);
+    if (viscous && viscous->converged && offset <= allowed) {
+      const std::string unit(quantity_unit(fit.quantity));
+      fit.best_reason = fmt::format(
+          "viscous kept: the combined model's dry friction acts like an offset of {:.2g} {} at the coast's end, "
+          "within what a sensor offset imitates (±{:.2g} {}: 2 reading steps or 0.2 % of the reading at the cut) — "
+          "the readings cannot tell dry friction from a zero level that far off (by BIC alone combined would win, "
+          "ΔBIC {:.1f})",
+          offset, unit, allowed, unit, viscous->bic - best->bic);
+      fit.best = std::string(model_name(ModelKind::viscous));
+      best = viscous;
+    }
+  }
+
   // A best model that misses: its residuals, binned, stand further from zero than the run's noise.
   // Looked at only when the fit's χ² per degree of freedom says the residuals are larger than the
   // noise model expects (the lab's runs: 0.3 to 1.0; a missing Stribeck or windage term: 10 to 25):

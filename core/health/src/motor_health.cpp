@@ -360,6 +360,15 @@ HealthVerdict assess_health(const RunFit& fit, const MotorHealthConfig& cfg) {
   const bool datasheet_torque = cfg.datasheet && cfg.datasheet->no_load_friction_torque().has_value();
   v.has_reference = datasheet_torque || cfg.baseline.has_value();
 
+  // A doubted run (readings in other units than taken, a model that misses) is not the motor's
+  // friction as it stands: no verdict is drawn from it, whatever the numbers say.
+  if (!fit.doubts.empty()) {
+    v.level = HealthLevel::not_judged;
+    v.reason = fmt::format("the run is doubted ({}) — resolve that first; its friction is not compared",
+                           fit.doubts.front());
+    return v;
+  }
+
   const ModelFit* best = best_of(fit);
   const ModelFit* combined = fit.model(ModelKind::combined);
   const auto combined_fr = friction_of(combined);

@@ -171,6 +171,7 @@ void FitterCore::fit_and_publish(Bench& b, const Run& run, const std::string& wh
     return;
   }
   r.fit_seconds = seconds_since(t0);
+  r.window = local;
   r.fit.run = run;  // indices as in the bench's stream
   if (r.fit.best.empty()) {
     ++counters_.fit_failures;
@@ -182,6 +183,17 @@ void FitterCore::fit_and_publish(Bench& b, const Run& run, const std::string& wh
     } catch (const std::exception& e) {
       ++counters_.internal_errors;
       error(fmt::format("{}: run {}: the health verdict failed: {}", b.channel, run.number, e.what()), recv_utime);
+    }
+  }
+  if (!opt_.explain_base.empty()) {
+    try {
+      ExplainOptions eo;
+      eo.bench = r.fit.bench;
+      eo.base = opt_.explain_base;
+      r.explain = explain_run(scratch_t_, scratch_v_, r.fit.quantity, local, eo);
+    } catch (const std::exception& e) {
+      ++counters_.internal_errors;
+      error(fmt::format("{}: run {}: the explain workflow failed: {}", b.channel, run.number, e.what()), recv_utime);
     }
   }
   r.t_s = scratch_t_;

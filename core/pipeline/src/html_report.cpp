@@ -469,7 +469,10 @@ std::string verdict_block(const ReportRun& r) {
 
 std::string coefficient_table(const RunFit& fit) {
   const std::string unit(quantity_unit(fit.quantity));
-  std::string s = "<table class=\"coef\">\n<tr><th>model</th><th>parameter</th><th>value ± standard error (SI)</th>"
+  // A doubt stands before the numbers it doubts.
+  std::string s;
+  for (const auto& d : fit.doubts) s += fmt::format("<p class=\"fail\">doubtful: {}</p>\n", esc(d));
+  s += "<table class=\"coef\">\n<tr><th>model</th><th>parameter</th><th>value ± standard error (SI)</th>"
                   "<th>lab units</th><th>RMSE</th><th>R²</th><th>BIC</th><th>stop predicted</th></tr>\n";
   for (const auto& m : fit.models) {
     const bool best = model_name(m.kind) == fit.best;
@@ -500,7 +503,6 @@ std::string coefficient_table(const RunFit& fit) {
   }
   s += "</table>\n";
   if (!fit.best_reason.empty()) s += fmt::format("<p class=\"meta\">best: {}</p>\n", esc(fit.best_reason));
-  for (const auto& d : fit.doubts) s += fmt::format("<p class=\"fail\">doubtful: {}</p>\n", esc(d));
   return s;
 }
 

@@ -25,13 +25,13 @@ class RefitSink final : public FitterSink {
   void fit_ready(const FitResult& r) override {
     ++out_.runs_fitted;
     if (!each_run_) {
-      out_.runs.push_back({r.bench, r.fit, r.bench_source, r.first_seq, r.last_seq, r.health});
+      out_.runs.push_back({r.bench, r.fit, r.bench_source, r.first_seq, r.last_seq, r.health, r.explain});
       return;
     }
     if (r.fit.best.empty())
       out_.file.failures.push_back(fmt::format("SPINDOWN.{}.SAMPLE: run {}: no model converged", r.bench,
                                                r.fit.run.number));
-    each_run_(RefitRun{r.bench, r.fit, r.bench_source, r.first_seq, r.last_seq, r.health});
+    each_run_(RefitRun{r.bench, r.fit, r.bench_source, r.first_seq, r.last_seq, r.health, r.explain});
   }
   void problem(const std::string& text) override {
     if (++problems_ <= max_problems_listed)
@@ -204,6 +204,19 @@ LogRefit refit_log_session(const std::vector<std::string>& paths, const FitterOp
                     fitter_sessions.end() &&
                 fitter_sessions.size() < 1024)
               fitter_sessions.push_back(static_cast<std::uint64_t>(st.source_session));
+            break;
+          }
+          if (keep_live_fits && ev.channel.starts_with("SPINDOWN.") && ev.channel.ends_with(".EXPLAIN")) {
+            // As a FIT: the live fitter's only when the gate lets it through.
+            if (!core.admit(ev.channel, ev.data, ev.data_size, ev.log_utime)) break;
+            explain_t m{};
+            if (decode_message(m, ev.data, ev.data_size)) {
+              out.live_explains.push_back(std::move(m));
+              break;
+            }
+            out.file.diagnostics.push_back({Diagnostic::Severity::warning, file, ev.number,
+                                            fmt::format("event {} on {}: not a decodable explain_t; skipped", ev.number,
+                                                        ev.channel)});
             break;
           }
           if (keep_live_fits && ev.channel.starts_with("SPINDOWN.") && ev.channel.ends_with(".FIT")) {

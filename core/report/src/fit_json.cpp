@@ -328,11 +328,33 @@ void append_run_fit_json_text(std::string& out, const RunFit& fit, const ReportO
 }
 
 void FitReportJsonText::add(std::string_view file_json, std::string& out) {
-  out += any_ ? ",\n" : "{\n  \"files\": [\n";
+  if (compact_) out += any_ ? "," : "{\"files\":[";
+  else out += any_ ? ",\n" : "{\n  \"files\": [\n";
   out += file_json;
   any_ = true;
 }
 
-void FitReportJsonText::finish(std::string& out) const { out += any_ ? "\n  ]\n}" : "{\n  \"files\": []\n}"; }
+void FitReportJsonText::finish(std::string& out) const {
+  if (compact_) out += any_ ? "]}" : "{\"files\":[]}";
+  else out += any_ ? "\n  ]\n}" : "{\n  \"files\": []\n}";
+}
+
+void compact_json(std::string& text) {
+  std::size_t w = 0;
+  bool in_string = false, escaped = false;
+  for (const char c : text) {
+    if (in_string) {
+      if (escaped) escaped = false;
+      else if (c == '\\') escaped = true;
+      else if (c == '"') in_string = false;
+    } else if (c == ' ' || c == '\n' || c == '\t' || c == '\r') {
+      continue;
+    } else if (c == '"') {
+      in_string = true;
+    }
+    text[w++] = c;
+  }
+  text.resize(w);
+}
 
 }  // namespace spindown

@@ -255,6 +255,8 @@ std::string format_run_fit(const RunFit& fit, const ReportOptions& opt) {
     out += fmt::format(", did not stop: fitted to t = {:.3f} s ({})", run.t_end_s, end_name(run.end));
   out += fmt::format(", {} samples", samples_in(run));
   if (!run.lead_in.empty()) out += fmt::format(", lead-in: {}", run.lead_in);
+  // A doubt stands before the numbers it doubts.
+  for (const auto& d : fit.doubts) out += fmt::format("\n  doubtful: {}", d);
   // The reading noise σ (reading_noise.hpp), the one noise figure fit, explain and the report name.
   // A zero level other than 0 is subtracted here; spindown explain names it as a sensor offset instead.
   out += fmt::format("\n  zero level {:.3g} {}{}, reading noise σ {:.2g} {}, period {:.1f} ms\n", run.zero_level, unit,
@@ -280,7 +282,6 @@ std::string format_run_fit(const RunFit& fit, const ReportOptions& opt) {
   out += render_table(rows, "  ");
   out += fit.best.empty() ? fmt::format("\n  best: none ({})\n", explain_best(fit))
                           : fmt::format("\n  best: {} — {}\n", fit.best, explain_best(fit));
-  for (const auto& d : fit.doubts) out += fmt::format("  doubtful: {}\n", d);
   for (const auto& m : fit.models)
     if (!m.message.empty()) out += fmt::format("  {}: {}\n", model_name(m.kind), m.message);
   if (opt.details) out += fit_details(fit, unit);

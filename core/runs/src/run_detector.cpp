@@ -419,6 +419,7 @@ void RunDetector::restart_stream(const std::string& why, Run::End reason) {
   last_v_ = std::numeric_limits<double>::quiet_NaN();
   state_ = State::idle;
   lo_ = search_lo_ = next_index_;
+  rest_level_ = std::numeric_limits<double>::infinity();
   need_quiet_ = false;
   short_.clear(next_index_, 0.0);
   long_.clear(next_index_, 0.0);
@@ -556,6 +557,12 @@ void RunDetector::idle_step(std::size_t i, Sample s, double prev_t) {
   advance(short_, i, s);
   advance(long_, i, s);
   advance(vlong_, i, s);
+  // The motor's reading at rest: the lowest level a full long window has held while idle.
+  if (long_.n >= 8 && long_.mean() < rest_level_ && duration(long_) >= 0.8 * long_.span_s) [[unlikely]] {
+    const double sd = long_.resid_sd(), slope = long_.slope();
+    if (std::abs(slope) * std::sqrt(long_.sxx()) <= 2.0 * sd + 1e-12 * std::max(1.0, std::abs(long_.mean())))
+      rest_level_ = long_.mean();
+  }
   if (after_silence_) [[unlikely]]
     watch_after_silence(s.v);
   if (need_quiet_) {
@@ -665,6 +672,12 @@ void RunDetector::tail_step(std::size_t i, Sample s) {
   if (hold_long_live_) advance(hold_long_, i, s);
   if (hold_.n >= 3 && hold_.first >= run_.stop_index) {
     const double drop = run_.zero_level - hold_.mean();
+    // A quiet, quantized reading that sat on one value above the rest's and now holds a step
+    // lower: an exponential's slow steps down the print, not a standstill.
+    if (floor_doubt_ && drop >= 0.5 * coast_step_) {
+      retract_stop(i, s);
+      return;
+    }
     // drop <= 0 never exceeds the band (its first term is >= 0): the usual case, without a sqrt.
     if (drop > 0 &&
         drop > std::max(4.0 * run_.noise_level / std::sqrt(hold_.n), retract_fraction * (v0_ - run_.zero_level))) {
@@ -684,7 +697,7 @@ void RunDetector::tail_step(std::size_t i, Sample s) {
   } else {
     departing_ = 0;
   }
-  if (s.t >= run_.t_stop_s + opt_.tail_s) {
+  if (s.t >= tail_until_s_) {
     if (still_falling(i)) {
       retract_stop(i, s);
       return;

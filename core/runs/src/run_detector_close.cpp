@@ -125,6 +125,8 @@ std::string RunDetector::gap_before(std::size_t i) const {
 std::string RunDetector::fragment_reason(const Run& r, double amp, double coast_s) const {
   // How far the reading fell in this coast, against what the reading can resolve and against the
   // runs already found in this stream (a nudge, a few samples at a crawl, a piece of a coast).
+  if (amp <= 0)
+    return fmt::format("the reading does not fall: it ends {:.3g} higher than it began", -amp);
   if (amp < 3.0 * coast_step_)
     return fmt::format("it falls {:.3g}, under 3 of the reading's steps ({:.2g})", amp, coast_step_);
   // Beside the runs before it, only a coast seen to stop is judged: one cut short (end of data, a

@@ -161,6 +161,7 @@ RunDetector::CutSplit RunDetector::split_at_cut(std::size_t a, std::size_t b, co
     sp.v0 = l.v0;
     sp.post_slope = l.slope;
     sp.sd_post = l.sd;
+    sp.post_rough = rough_sd(c, b + 1);
     sp.cut_index = c;
     sp.pre_end = c;
     const bool sample_before = c > base_ && c > stream_start_ && c - 1 >= search_lo_;
@@ -435,7 +436,10 @@ std::string RunDetector::classify_lead_in(const CutSplit& sp) const {
   // A lead-in far rougher from sample to sample than the coast is not the motor the coast is read
   // from: an open pin (the handout's step 6) whose hum can hide any step to the back-EMF it is then
   // connected to. (A rise into the cut is smooth, however far it climbs.)
-  if (sp.pre_rough > std::max(0.01 * scale, 4.0 * sp.sd_post)) return "floating";
+  // The coast's own noise: the smaller of its line's scatter and its sample-to-sample noise (the
+  // line's scatter counts the contact bounce at the connection; the second differences do not).
+  const double post_noise = sp.post_rough > 0 ? std::min(sp.sd_post, sp.post_rough) : sp.sd_post;
+  if (sp.pre_rough > std::max(0.01 * scale, 4.0 * post_noise)) return "floating";
   // No step beyond the noise of either side: a powered motor whose speed is the reading.
   if (std::abs(step) <= std::max({3.0 * sp.sd_post, 4.0 * sp.pre_sd, 0.01 * scale})) return "powered";
   if (step < 0) return "supply";

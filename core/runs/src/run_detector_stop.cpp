@@ -262,6 +262,12 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
     run_.stopped = true;
     run_.stop_index = stop;
     run_.t_stop_s = t_stop;
+    // A standstill that sits on one value of a quantized reading (a quiet converter) a step or
+    // more above the lowest the motor read at rest may be a slow exponential's dwell on that value
+    // (a viscous coast near its end takes seconds per step of the print): the tail is watched
+    // longer, and a step down held retracts the stop (tail_step).
+    floor_doubt_ = quiet_dwell_above_rest(z, sd_z, amp);
+    tail_until_s_ = t_stop + (floor_doubt_ ? std::max(opt_.tail_s, 0.25 * (t_stop - run_.t_cut_s)) : opt_.tail_s);
     depart_band_ = std::max(6.0 * sd_z, 0.05 * std::abs(amp));
     departing_ = 0;
     state_ = State::tail;
@@ -288,6 +294,15 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
     if (std::isfinite(lead_in_zero_) && std::abs(z - lead_in_zero_) <= band * (1 + 1e-9) && z != lead_in_zero_) {
       run_.zero_level = lead_in_zero_;
       floor_said = fmt::format(", not to be told from the lead-in's zero, so zero level {:g}", lead_in_zero_);
+    } else if (std::isfinite(rest_level_) && z > rest_level_ &&
+               (z - rest_level_ <= band * (1 + 1e-9) || quiet_dwell_above_rest(z, sd_z, amp))) {
+      // No zeros before this cut (the supply's lead-in), but the stream held the motor's reading
+      // at rest before (rest_level_): a floor that cannot be told from it, or a quiet print's last
+      // value a few steps above it, is where the decay was lost, and the exponential heads on to
+      // the rest reading.
+      run_.zero_level = rest_level_;
+      floor_said = fmt::format(", {:g} above the motor's reading at rest, where the decay heads: zero level {:g}",
+                               z - rest_level_, rest_level_);
     }
     run_note_ = fmt::format(
         "run cut at {}: the coast approaches its floor ({:g}{}) asymptotically (last quarter {:.2f}x slower than "
@@ -298,6 +313,12 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
     complete_run(i + 1);
     to_idle(i + 1, true);
   }
+}
+
+bool RunDetector::quiet_dwell_above_rest(double z, double sd_z, double amp) const {
+  const double step = coast_step_;
+  return std::isfinite(rest_level_) && step > 0 && sd_z < quiet_floor_sd * step && z - rest_level_ >= 0.99 * step &&
+         z - rest_level_ < 0.25 * amp;
 }
 
 double RunDetector::last_quarter_time(std::size_t cut, std::size_t first_in, double quarter) const {
@@ -366,7 +387,7 @@ bool RunDetector::signal_lost(std::size_t i, std::size_t first_in, double z, dou
 }
 
 void RunDetector::tail_ends_by_time(std::size_t upto) {
-  const double t_end = run_.t_stop_s + opt_.tail_s;
+  const double t_end = tail_until_s_;
   for (std::size_t e = run_.stop_index + 1; e <= upto; ++e) {
     if (t(e) >= t_end) {
       complete_run(e);

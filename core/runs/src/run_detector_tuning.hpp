@@ -34,6 +34,8 @@ inline constexpr double slope_resolution = 0.05;
 // In the tail, a hold-window mean this fraction of the amplitude below the zero level retracts
 // the stop.
 inline constexpr double retract_fraction = 0.01;
+// A standstill whose readings spread less than this many reading steps (sd) sits on one value.
+inline constexpr double quiet_floor_sd = 0.3;
 // The spread of a reading rounded to steps of 1, as uniform rounding error: 1/sqrt(12).
 inline constexpr double step_sd = 0.2886751345948129;
 // The long hold window spans at least this fraction of the coast before it.

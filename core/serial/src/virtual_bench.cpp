@@ -229,6 +229,11 @@ VirtualBench::VirtualBench(VirtualBenchOptions options) : o_(std::move(options))
         rt["cut_epoch"] = dev.epoch;
         rt["cut_device_us"] = s.device_time_us + std::int64_t(std::llround((run.t_cut_ms - run.t_ms[i]) * 1000.0));
       }
+      // The floating pin's connection: where the coast enters the readings (the cut as a reader of
+      // the readings can see it; the power was cut earlier, unseen).
+      if (run.t_connect_ms != run.t_cut_ms && i + 1 < run.t_ms.size() && run.t_ms[i] <= run.t_connect_ms &&
+          run.t_ms[i + 1] > run.t_connect_ms)
+        rt["connect_device_us"] = s.device_time_us + std::int64_t(std::llround((run.t_connect_ms - run.t_ms[i]) * 1000.0));
       if (o_.garbage_every > 0 && sample_lines % o_.garbage_every == 0) {
         std::string junk;
         const int n = 3 + int(rng() % 20);

@@ -239,6 +239,12 @@ Recording read_delimited_text(std::string_view text, std::string source, const D
       unit_rows = 1;
     }
   }
+  // Names and units go into messages (and JSON): bytes that are not UTF-8 (a header in a legacy
+  // encoding read raw) are written \xNN there, once, here.
+  for (ColumnName& c : cols) {
+    c.name = text::escape_invalid_utf8(c.name);
+    c.unit = text::escape_invalid_utf8(c.unit);
+  }
 
   auto give_up = [&](std::string message) {
     rec.error(0, std::move(message));

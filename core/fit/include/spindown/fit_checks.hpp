@@ -38,6 +38,10 @@ std::vector<std::string> unit_doubts(const RunFit& fit, double peak);
 double largest_curve_difference(const ModelFit& a, const ModelFit& b, std::span<const double> tau, double k,
                                 double enough = INFINITY);
 
+// A combined model whose dry friction acts like an offset under max(2 reading steps, this fraction
+// of the reading at the cut) is not told from viscous with a zero level that far off (check_fit).
+inline constexpr double offset_allowance_fraction = 0.002;
+
 // The binned residual test runs only when the best model's reduced χ² is above this (or unknown).
 inline constexpr double suspicious_chi2 = 2.0;
 

@@ -34,6 +34,7 @@
 
 #include "spindown/bench.hpp"
 #include "spindown/bench_file.hpp"
+#include "spindown/explain.hpp"
 #include "spindown/fit.hpp"
 #include "spindown/message_decode.hpp"
 #include "spindown/message_gate.hpp"
@@ -78,6 +79,10 @@ struct FitterOptions {
   MessageGateOptions gate;
   // A bench stream's sources and far jumps (sample_stream.hpp).
   SampleStreamOptions stream;
+  // The discrepancy workflow (explain_run) on every fitted run's own window, starting from this
+  // base (FitResult::explain; published live on SPINDOWN.<bench>.EXPLAIN, reproduced by refit).
+  // Empty: off.
+  std::vector<const Effect*> explain_base;
   bool is_valid(std::string* why) const;
 };
 
@@ -139,6 +144,10 @@ struct FitResult {
   std::span<const double> value;
   std::string bridge_host;         // the source whose samples these are (samples_t.source_*)
   std::uint64_t bridge_session = 0;
+  // The run rebased onto t_s/value (cut 0; its stop, end and outliers moved with it): the one
+  // window the FIT was fitted to, and the EXPLAIN too.
+  Run window;
+  std::optional<ExplainResult> explain;  // when FitterOptions::explain_base is set
 };
 
 class FitterSink {

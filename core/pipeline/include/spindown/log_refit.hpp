@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include <spindown/explain_t.hpp>
 #include <spindown/fit_t.hpp>
 
 #include "spindown/fit_report.hpp"
@@ -24,6 +25,7 @@ struct RefitRun {
   std::string bench_source;
   std::int64_t first_seq = 0, last_seq = 0;
   std::optional<HealthVerdict> health;  // when FitterOptions::health has the bench (as the live FIT)
+  std::optional<ExplainResult> explain; // when FitterOptions::explain_base is set (as the live EXPLAIN)
 };
 
 struct LogRefit {
@@ -37,6 +39,7 @@ struct LogRefit {
   // session none of them has is not one (a forged FIT) and is left out, named in the diagnostics.
   std::vector<fit_t> live;
   std::size_t live_left_out = 0;  // FITs from a session no fitter in the log has
+  std::vector<explain_t> live_explains;  // SPINDOWN.<bench>.EXPLAIN messages recorded (when asked)
   FitterCounters counters;
   std::vector<std::string> bench_order;  // benches in order of first appearance
 };

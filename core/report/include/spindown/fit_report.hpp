@@ -88,14 +88,21 @@ std::string file_fit_json_text(const FileFit& file, const ReportOptions& opt = {
 
 // Appends file_fit_json_text() entries, in order, into the bytes of
 // fit_report_json(files).dump(2, ' ', false, Json::error_handler_t::replace).
+// compact: the same document without layout whitespace (compact_json), as a pipe or a file gets it.
 class FitReportJsonText {
  public:
+  explicit FitReportJsonText(bool compact = false) : compact_(compact) {}
   void add(std::string_view file_json, std::string& out);
   void finish(std::string& out) const;  // no final newline, as dump() gives none
 
  private:
   bool any_ = false;
+  bool compact_ = false;
 };
+
+// JSON text without its layout: every space, tab and line break outside strings dropped (the
+// same document, a third of the bytes of an indented one). In place; text is whole JSON values.
+void compact_json(std::string& text);
 
 // Text for people.
 std::string format_run_fit(const RunFit& fit, const ReportOptions& opt = {});

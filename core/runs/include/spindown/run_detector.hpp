@@ -218,6 +218,7 @@ class RunDetector {
     double t_cut_s = 0, v0 = 0, sd_post = 0, post_slope = 0;
     double pre_mean = 0, pre_sd = 0, pre_max = 0;
     double pre_rough = 0;   // the lead-in's sample-to-sample noise (rough_sd)
+    double post_rough = 0;  // the coast's (rough_sd: a bounce sample or two at its start do not set it)
     bool pre_declining = false;
     bool pre_flat = false;  // lead-in slope shown to be well below the coast's
     bool clipped = false;
@@ -245,6 +246,9 @@ class RunDetector {
   // Why the coast in sp has no recorded cut (the stream begins on it, or a pause hides it), with
   // sp moved to the coast's first sample; empty when its cut is in the data.
   std::string start_not_seen(CutSplit& sp);
+  // Whether a standstill or floor z (spread sd_z, of a coast falling amp) sits on one value of a
+  // quantized reading a step or more above the motor's reading at rest (rest_level_).
+  bool quiet_dwell_above_rest(double z, double sd_z, double amp) const;
   // When the coast cut at `cut` crossed `quarter` for the last time before first_in (interpolated).
   double last_quarter_time(std::size_t cut, std::size_t first_in, double quarter) const;
   // Whether a coast from t_cut that crossed its last quarter at t_quarter and reached its floor at
@@ -344,6 +348,9 @@ class RunDetector {
   double hold_half_s_ = 0.5, hold_full_s_ = 0.9;     // hold_ durations: 0.5 and 0.9 of its span
   bool hold_long_live_ = false;
   bool creeping_ = false;
+  double rest_level_ = std::numeric_limits<double>::infinity();  // the lowest level held while idle (idle_step)
+  bool floor_doubt_ = false;  // the standstill may be a quiet reading's dwell on one step (found_standstill)
+  double tail_until_s_ = 0;   // the tail ends then (t_stop + tail_s, longer on floor_doubt_)
   double stop_approach_t_ = 0;  // found_standstill's approach t-value of the run's standstill
   bool restarted_mid_coast_ = false;  // the clock restarted while a coast was open: its rest is a fragment
   // A coast closed by went_silent(): until the reading rises above silence_level_ +
