@@ -43,6 +43,7 @@ class FitterService final : public FitterSink {
   // FitterSink (worker thread).
   void run_changed(const run_t& run) override;
   void fit_ready(const FitResult& result) override;
+  void explain_ready(const FitResult& result) override;
   void diagnostic(const std::string& bench, const Diagnostic& d) override;
 
  private:
@@ -51,7 +52,6 @@ class FitterService final : public FitterSink {
   bool nothing_waiting() const;
   void publish_status(std::int64_t now_us, const char* state);
   // SPINDOWN.<bench>.EXPLAIN, after the FIT (the workflow takes tens of ms; FIT goes first).
-  void publish_explain(const FitResult& result);
 
   FitterServiceOptions opt_;
   LcmLoop loop_;
