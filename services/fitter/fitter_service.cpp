@@ -77,11 +77,10 @@ void FitterService::fit_ready(const FitResult& r) {
       fmt::print(stderr, "spindown-fitter: {} run {} health: {} — {}\n", r.bench, r.fit.run.number,
                  health_level_name(r.health->level), r.health->reason);
   }
-  publish_explain(r);
 }
 
 // The discrepancy workflow (design §6), run by the core on the FIT's own window (FitResult::explain).
-void FitterService::publish_explain(const FitResult& r) {
+void FitterService::explain_ready(const FitResult& r) {
   if (!r.explain) return;
   const ExplainResult& ex = *r.explain;
   const Run& run = ex.run;

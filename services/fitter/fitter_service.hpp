@@ -50,6 +50,7 @@ class FitterService final : public FitterSink {
   // FitterSink (worker thread).
   void run_changed(const run_t& run) override;
   void fit_ready(const FitResult& result) override;
+  void explain_ready(const FitResult& result) override;
   void diagnostic(const std::string& bench, const Diagnostic& d) override;
   void notice(std::string_view kind, std::string_view channel, const std::string& text) override;
 
@@ -61,7 +62,6 @@ class FitterService final : public FitterSink {
   // A STATUS on this instance's own channel: another fitter with the same name is named.
   void own_channel_status(const QueuedMessage& m);
   // SPINDOWN.<bench>.EXPLAIN, after the FIT (the workflow takes tens of ms; FIT goes first).
-  void publish_explain(const FitResult& result);
 
   FitterServiceOptions opt_;
   MessageStamp stamp_;  // this fitter's lab, host, session and key on everything it publishes

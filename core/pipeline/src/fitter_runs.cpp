@@ -185,6 +185,11 @@ void FitterCore::fit_and_publish(Bench& b, const Run& run, const std::string& wh
       error(fmt::format("{}: run {}: the health verdict failed: {}", b.channel, run.number, e.what()), recv_utime);
     }
   }
+  r.t_s = scratch_t_;
+  r.value = scratch_v_;
+  ++counters_.fits;
+  sink_.fit_ready(r);
+  // The discrepancy workflow on the same window, once the FIT is out.
   if (!opt_.explain_base.empty()) {
     try {
       ExplainOptions eo;
@@ -195,11 +200,8 @@ void FitterCore::fit_and_publish(Bench& b, const Run& run, const std::string& wh
       ++counters_.internal_errors;
       error(fmt::format("{}: run {}: the explain workflow failed: {}", b.channel, run.number, e.what()), recv_utime);
     }
+    sink_.explain_ready(r);  // r.explain empty when it failed (said above)
   }
-  r.t_s = scratch_t_;
-  r.value = scratch_v_;
-  ++counters_.fits;
-  sink_.fit_ready(r);
 }
 
 void FitterCore::finish(std::int64_t now_utime) {

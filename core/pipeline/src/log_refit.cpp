@@ -4,6 +4,8 @@
 #include <fmt/format.h>
 #include <limits>
 #include <map>
+#include <string_view>
+#include <vector>
 #include <sys/stat.h>
 
 #include "spindown/fit_message.hpp"
@@ -19,11 +21,17 @@ constexpr std::size_t max_detector_notes = 1000;  // per file, then counted (mem
 
 class RefitSink final : public FitterSink {
  public:
-  RefitSink(LogRefit& out, const std::string& path, const RefitRunFn& each_run)
-      : out_(out), path_(path), each_run_(each_run) {}
+  // explains: the core explains each run (explain_ready follows fit_ready): a run is given out
+  // with its EXPLAIN.
+  RefitSink(LogRefit& out, const std::string& path, const RefitRunFn& each_run, bool explains)
+      : out_(out), path_(path), each_run_(each_run), explains_(explains) {}
   void run_changed(const run_t&) override {}
   void fit_ready(const FitResult& r) override {
     ++out_.runs_fitted;
+    if (!explains_) give(r);
+  }
+  void explain_ready(const FitResult& r) override { give(r); }
+  void give(const FitResult& r) {
     if (!each_run_) {
       out_.runs.push_back({r.bench, r.fit, r.bench_source, r.first_seq, r.last_seq, r.health, r.explain});
       return;
@@ -50,8 +58,22 @@ class RefitSink final : public FitterSink {
   LogRefit& out_;
   const std::string& path_;
   const RefitRunFn& each_run_;
+  bool explains_ = false;
   std::size_t problems_ = 0, notes_ = 0;
 };
+
+// A recorded message of type T appended to kept, or a warning naming the event when it does not decode.
+template <typename T>
+void keep_recorded(const LcmLogEvent& ev, const std::string& file, std::vector<T>& kept, std::string_view type,
+                   std::vector<Diagnostic>& diagnostics) {
+  T m{};
+  if (decode_message(m, ev.data, ev.data_size)) {
+    kept.push_back(std::move(m));
+    return;
+  }
+  diagnostics.push_back({Diagnostic::Severity::warning, file, ev.number,
+                         fmt::format("event {} on {}: not a decodable {}; skipped", ev.number, ev.channel, type)});
+}
 
 }  // namespace
 
@@ -113,7 +135,7 @@ LogRefit refit_log_session(const std::vector<std::string>& paths, const FitterOp
   out.file.file = paths.empty() ? std::string() : paths.front();
   out.session_files = paths;
   const std::string& path = out.file.file;
-  RefitSink sink(out, path, each_run);
+  RefitSink sink(out, path, each_run, !options.explain_base.empty());
   FitterCore core(options, sink);
   std::map<std::string, std::size_t, std::less<>> order;
   std::vector<char> channel_done;  // by session channel id: its bench's place is known
@@ -206,31 +228,14 @@ LogRefit refit_log_session(const std::vector<std::string>& paths, const FitterOp
               fitter_sessions.push_back(static_cast<std::uint64_t>(st.source_session));
             break;
           }
-          if (keep_live_fits && ev.channel.starts_with("SPINDOWN.") && ev.channel.ends_with(".EXPLAIN")) {
-            // As a FIT: the live fitter's only when the gate lets it through.
-            if (!core.admit(ev.channel, ev.data, ev.data_size, ev.log_utime)) break;
-            explain_t m{};
-            if (decode_message(m, ev.data, ev.data_size)) {
-              out.live_explains.push_back(std::move(m));
-              break;
-            }
-            out.file.diagnostics.push_back({Diagnostic::Severity::warning, file, ev.number,
-                                            fmt::format("event {} on {}: not a decodable explain_t; skipped", ev.number,
-                                                        ev.channel)});
-            break;
-          }
-          if (keep_live_fits && ev.channel.starts_with("SPINDOWN.") && ev.channel.ends_with(".FIT")) {
-            // A FIT the log holds is the live fitter's only when the gate lets it through (the lab,
-            // and with a key its signature): a forged one is counted and named, never compared.
-            if (!core.admit(ev.channel, ev.data, ev.data_size, ev.log_utime)) break;
-            fit_t m{};
-            if (decode_message(m, ev.data, ev.data_size)) {
-              out.live.push_back(std::move(m));
-              break;
-            }
-            out.file.diagnostics.push_back({Diagnostic::Severity::warning, file, ev.number,
-                                            fmt::format("event {} on {}: not a decodable fit_t; skipped", ev.number,
-                                                        ev.channel)});
+          // The live fitter's results as recorded (for --live and --compare): its own only when the
+          // gate lets them through (the lab, and with a key their signature): a forged one is
+          // counted and named, never compared.
+          if (keep_live_fits && ev.channel.starts_with("SPINDOWN.") &&
+              (ev.channel.ends_with(".FIT") || ev.channel.ends_with(".EXPLAIN")) &&
+              core.admit(ev.channel, ev.data, ev.data_size, ev.log_utime)) {
+            if (ev.channel.ends_with(".FIT")) keep_recorded(ev, file, out.live, "fit_t", out.file.diagnostics);
+            else keep_recorded(ev, file, out.live_explains, "explain_t", out.file.diagnostics);
           }
           break;
       }

@@ -147,14 +147,19 @@ struct FitResult {
   // The run rebased onto t_s/value (cut 0; its stop, end and outliers moved with it): the one
   // window the FIT was fitted to, and the EXPLAIN too.
   Run window;
-  std::optional<ExplainResult> explain;  // when FitterOptions::explain_base is set
+  // When FitterOptions::explain_base is set: filled after fit_ready (the FIT goes out first, its
+  // latency never waits for the workflow), then given to explain_ready.
+  std::optional<ExplainResult> explain;
 };
 
 class FitterSink {
  public:
   virtual ~FitterSink() = default;
   virtual void run_changed(const run_t& run) = 0;         // SPINDOWN.<bench>.RUN
-  virtual void fit_ready(const FitResult& result) = 0;    // SPINDOWN.<bench>.FIT (and EXPLAIN)
+  virtual void fit_ready(const FitResult& result) = 0;    // SPINDOWN.<bench>.FIT
+  // SPINDOWN.<bench>.EXPLAIN: the same result, its explain filled (empty if the workflow failed),
+  // right after fit_ready, only when FitterOptions::explain_base is set. Default: ignored.
+  virtual void explain_ready(const FitResult& result) { (void)result; }
   // A message or sample that could not be used, in words naming the channel (also kept as
   // last_error for the heartbeat). Default: ignored.
   virtual void problem(const std::string& text) { (void)text; }
