@@ -29,7 +29,7 @@ print("faults: all 6 runs of the 3 real benches fitted")
 EOF
 
 # The fitter's counters (also in every heartbeat) from its summary line.
-SUMMARY=$(tail -1 "$T/fitter.err")
+SUMMARY=$(grep "stopped: " "$T/fitter.err" | tail -1)
 echo "$SUMMARY"
 for what in "decode errors" "sequence gaps" "duplicates" "NaN values" "time backwards" "benches evicted"; do
   n=$(echo "$SUMMARY" | grep -o "[0-9]* $what" | grep -o '^[0-9]*')

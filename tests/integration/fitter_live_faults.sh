@@ -74,7 +74,7 @@ exec(sys.argv[4])
 EOF
 }
 summary_count() {  # summary_count FILE "what": the number before "what" in the fitter's exit summary
-  tail -1 "$1" | grep -o "[0-9]* $2" | grep -o '^[0-9]*' || echo 0
+  grep "stopped: " "$1" | tail -1 | grep -o "[0-9]* $2" | grep -o '^[0-9]*' || echo 0
 }
 
 FITTER_OPTS=()
