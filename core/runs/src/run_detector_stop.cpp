@@ -195,9 +195,8 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
   if (signal_lost(i, first_in, z, amp)) return;
 
   // Where the coast crossed the last quarter of its amplitude.
-  const double t_quarter = last_quarter_time(run_.cut_index, first_in, z + 0.25 * amp);
-  std::size_t k = first_in;
-  while (k > run_.cut_index && v(k - 1) <= z + 0.25 * amp) --k;
+  const std::size_t k = last_quarter_index(run_.cut_index, first_in, z + 0.25 * amp);
+  const double t_quarter = quarter_crossing_time(k, run_.cut_index, z + 0.25 * amp);
 
   // Stop time: the approach line (the last ≤2 s above the band) meets the zero level.
   double t_hit = t(first_in);
@@ -321,12 +320,20 @@ bool RunDetector::quiet_dwell_above_rest(double z, double sd_z, double amp) cons
          z - rest_level_ < 0.25 * amp;
 }
 
-double RunDetector::last_quarter_time(std::size_t cut, std::size_t first_in, double quarter) const {
+std::size_t RunDetector::last_quarter_index(std::size_t cut, std::size_t first_in, double quarter) const {
   std::size_t k = first_in;
   while (k > cut && v(k - 1) <= quarter) --k;
+  return k;
+}
+
+double RunDetector::quarter_crossing_time(std::size_t k, std::size_t cut, double quarter) const {
   if (k == cut) return t(k);
   const double va = v(k - 1), vb = v(k);
   return va > vb ? t(k - 1) + (t(k) - t(k - 1)) * (va - quarter) / (va - vb) : t(k);
+}
+
+double RunDetector::last_quarter_time(std::size_t cut, std::size_t first_in, double quarter) const {
+  return quarter_crossing_time(last_quarter_index(cut, first_in, quarter), cut, quarter);
 }
 
 bool RunDetector::creeps_in(double t_cut, double t_quarter, double t_stop) const {

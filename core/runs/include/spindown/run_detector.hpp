@@ -249,6 +249,10 @@ class RunDetector {
   // Whether a standstill or floor z (spread sd_z, of a coast falling amp) sits on one value of a
   // quantized reading a step or more above the motor's reading at rest (rest_level_).
   bool quiet_dwell_above_rest(double z, double sd_z, double amp) const;
+  // The first sample of the coast cut at `cut` at or below `quarter` for good before first_in.
+  std::size_t last_quarter_index(std::size_t cut, std::size_t first_in, double quarter) const;
+  // When the coast crossed `quarter` into sample k (interpolated; t(cut) when k is the cut).
+  double quarter_crossing_time(std::size_t k, std::size_t cut, double quarter) const;
   // When the coast cut at `cut` crossed `quarter` for the last time before first_in (interpolated).
   double last_quarter_time(std::size_t cut, std::size_t first_in, double quarter) const;
   // Whether a coast from t_cut that crossed its last quarter at t_quarter and reached its floor at
