@@ -101,6 +101,43 @@ TEST(FitChecks, AStribeckRunSaysTheModelMissesAndPointsToExplain) {
   EXPECT_TRUE(mentions(f.doubts, "spindown explain"));
 }
 
+// A windage torque of 3 % of the friction at the cut: a few stretches of 25 readings show it
+// beyond 4 standard errors, all of them together clearly, and it moves c3 by ~8 %, tens of its
+// ±: doubted. The same term 3,000 times smaller moves nothing and is not. (Quantization off and
+// fine noise, so that the misfit is the model's.)
+TEST(FitChecks, AMisfitTheStretchesShowTogetherIsDoubtedAndANegligibleOneIsNot) {
+  auto run_with_windage = [](double fraction) {
+    SyntheticRunSpec spec;
+    spec.adc_bits = 0;
+    spec.decimals = -1;
+    spec.noise_v = 0.001;
+    const double omega0 = spec.e0_v / spec.bench.kb_v_s_per_rad;
+    spec.friction.windage = fraction * spec.friction.torque(omega0) / (omega0 * omega0);
+    const Case c = make_case(spec);
+    return fit_of(c, c.run.volts);
+  };
+  const RunFit three_percent = run_with_windage(0.03);  // c3 +8 %, c4 -1 %
+  EXPECT_TRUE(mentions(three_percent.doubts, "model misses")) << "3 % windage not doubted";
+  EXPECT_TRUE(mentions(three_percent.doubts, "beyond their ±"));
+  const RunFit negligible = run_with_windage(1e-5);
+  EXPECT_TRUE(negligible.doubts.empty()) << negligible.doubts.front();
+}
+
+// A coast of ~90 readings that a brake cuts short half-way: under 200 samples, so the misfit
+// test's bins follow the run's length (here ~11 readings each) and the gross misfit is said.
+TEST(FitChecks, AShortCoastThatTheModelGrosslyMissesIsDoubted) {
+  SyntheticRunSpec spec;
+  spec.friction.stribeck_static = 8e-4;  // a hard extra drag at low speed: the coast ends abruptly
+  spec.friction.stribeck_speed = 150;
+  spec.friction.coulomb = 3e-4;
+  spec.e0_v = 1.2;
+  spec.noise_v = 0.002;
+  const Case c = make_case(spec);
+  const RunFit f = fit_of(c, c.run.volts);
+  ASSERT_LT(c.run.t_stop_s / spec.period_s, 200) << "the coast is meant to be short";
+  EXPECT_TRUE(mentions(f.doubts, "model misses")) << (f.doubts.empty() ? "no doubt" : f.doubts.front());
+}
+
 TEST(FitChecks, CorrelationsAndReducedChiSquare) {
   const Case c = make_case(SyntheticRunSpec{});
   const RunFit f = fit_of(c, c.run.volts);

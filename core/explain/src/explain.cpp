@@ -14,13 +14,6 @@ namespace {
 
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 
-double median_of(std::vector<double> v) {
-  if (v.empty()) return 0;
-  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
-  std::nth_element(v.begin(), mid, v.end());
-  return *mid;
-}
-
 std::vector<double> residual_of(std::span<const double> y, const EffectFit& f) {
   std::vector<double> r(y.size());
   for (std::size_t i = 0; i < y.size(); ++i) r[i] = y[i] - f.simulated[i];
@@ -195,32 +188,6 @@ std::string effect_signature(const Effect& effect, const EffectFit& fit, double 
     return "the coast decelerates harder as it slows over much of its length, more than viscous and Coulomb friction "
            "allow: residuals of one sign early and late, of the other in between";
   return std::string(effect.signature);
-}
-
-ResidualBins bin_residuals(std::span<const double> r, std::size_t m, double white_sigma) {
-  ResidualBins b;
-  b.m = std::max<std::size_t>(m, 1);
-  b.white = white_sigma;
-  const std::size_t n = r.size();
-  for (std::size_t i = 0; i < n; i += b.m) {
-    // A short last bin joins the one before it.
-    if (i > 0 && n - i < b.m / 2) break;
-    b.first.push_back(i);
-  }
-  for (std::size_t k = 0; k < b.first.size(); ++k) {
-    const std::size_t i0 = b.first[k];
-    const std::size_t i1 = k + 1 < b.first.size() ? b.first[k + 1] : n;
-    double s = 0;
-    for (std::size_t i = i0; i < i1; ++i) s += r[i];
-    b.mean.push_back(s / static_cast<double>(i1 - i0));
-  }
-  // Noise of a bin mean from the data: bin-to-bin jumps (a smooth misfit barely changes from
-  // one bin to the next; correlated noise does), never below the white-noise value.
-  std::vector<double> jumps;
-  for (std::size_t k = 1; k < b.mean.size(); ++k) jumps.push_back(std::abs(b.mean[k] - b.mean[k - 1]));
-  const double from_jumps = jumps.size() >= 4 ? 1.4826 * median_of(jumps) / std::sqrt(2.0) : 0.0;
-  b.bin_se = std::max({white_sigma / std::sqrt(static_cast<double>(b.m)), from_jumps, 1e-15});
-  return b;
 }
 
 ExplainResult explain_run(std::span<const double> t_s, std::span<const double> value, Quantity q, const Run& run,

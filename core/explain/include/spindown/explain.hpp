@@ -29,6 +29,7 @@
 #include "spindown/effect_fit.hpp"
 #include "spindown/effects.hpp"
 #include "spindown/recording.hpp"
+#include "spindown/residual_bins.hpp"
 #include "spindown/runs.hpp"
 
 namespace spindown {
@@ -119,16 +120,8 @@ ExplainResult explain_run(const Recording& rec, const Run& run, const ExplainOpt
 ExplainResult explain_run(std::span<const double> t_s, std::span<const double> value, Quantity q, const Run& run,
                           const ExplainOptions& opt);
 
-// Residual analysis used by the workflow (exposed for tests and reports).
-struct ResidualBins {
-  std::size_t m = 0;                 // samples per bin
-  std::vector<std::size_t> first;    // first sample of each bin
-  std::vector<double> mean;          // mean residual per bin
-  double white = 0;                  // white-noise σ of one reading
-  double bin_se = 0;                 // noise SE of a bin mean
-};
-ResidualBins bin_residuals(std::span<const double> residual, std::size_t m, double white_sigma);
-// White noise of the readings from second differences over [0, n) (robust to smooth signal): the
+// Residual analysis used by the workflow (bin_residuals: residual_bins.hpp, shared with fit's
+// misfit doubt). White noise of the readings from second differences over [0, n) (robust to smooth signal): the
 // reading noise σ (reading_noise_sigma), under the name the workflow's tests know.
 double white_noise(std::span<const double> y);
 

@@ -42,23 +42,28 @@ double largest_curve_difference(const ModelFit& a, const ModelFit& b, std::span<
 // of the reading at the cut) is not told from viscous with a zero level that far off (check_fit).
 inline constexpr double offset_allowance_fraction = 0.002;
 
-// The binned residual test runs only when the best model's reduced χ² is above this (or unknown).
-inline constexpr double suspicious_chi2 = 2.0;
-
-// How far the best model's residuals lie from zero in bins of residual_bin samples over the
-// moving part of the coast, against the reading noise σ (RunFit::reading_noise; when not given,
-// from the residuals' first differences, which the smooth part cancels) and the reading's step (a
-// bin's mean is known no better than step/√12): the bins' z-scores, a bin's standard error being
-// hypot(σ/√residual_bin, step/√12).
+// How far the best model's residuals lie from zero in bins over the moving part of the coast
+// (residual_bin samples, fewer on a short run: n/8, at least min_residual_bin), against the noise of
+// a bin's mean: the reading noise σ (RunFit::reading_noise; when not given, from the residuals'
+// first differences, which the smooth part cancels) over √bin, or what the bins' jumps show when
+// the noise is correlated (with honest_noise_bins bins or more), and the reading's step (a bin's
+// mean is known no better than step/√12). check_fit doubts the model when the bins' Σz² (each
+// counted up to 4²: one stretch at the cut does not decide) stands
+// more than misfit_excess_z of its spread √(2·bins) above the bin count.
 inline constexpr std::size_t residual_bin = 25;
+inline constexpr std::size_t min_residual_bin = 4;
+inline constexpr std::size_t honest_noise_bins = 16;
+inline constexpr double misfit_excess_z = 5.0;
 struct ResidualStructure {
   std::size_t bins = 0;
+  std::size_t bin = 0;        // samples per bin
   std::size_t beyond = 0;     // bins further than 4 standard errors from zero
-  double mean_z2 = 0;         // mean squared z of the bins (about 1 for a model that holds)
+  double chi2 = 0;            // Σ min(z², 16) over the bins (about `bins` for a model that holds)
+  double excess_z = 0;        // (chi2 − bins)/√(2·bins)
   double worst_tau_s = 0;     // where the worst bin lies (s after the cut)
   double worst_mean = 0;      // its mean residual (reading unit)
   double sigma = 0;           // the reading noise σ used (reading unit)
-  double bin_se = 0;          // a bin mean's standard error derived from it
+  double bin_se = 0;          // a bin mean's standard error
 };
 ResidualStructure residual_structure(const ModelFit& m, std::span<const double> tau, std::span<const double> y,
                                      std::size_t moving, double k, double step, double sigma = 0);
