@@ -35,3 +35,19 @@ TEST(LcmChannels, ParsesItsOwnNames) {
   EXPECT_FALSE(parse_channel("SPINDOWN.a.b.FIT"));
   EXPECT_FALSE(parse_channel("SPINDOWN..FIT"));
 }
+
+// The split that readers counting a bad bench id apart use: views into the channel, the bench not
+// checked; every suffix of the contract names its kind and nothing else does.
+TEST(LcmChannels, SplitsWithoutCheckingTheBenchAndNamesEachKind) {
+  const auto p = split_channel("SPINDOWN.bad bench!.SAMPLE");
+  ASSERT_TRUE(p);
+  EXPECT_EQ(p->bench, "bad bench!");
+  EXPECT_EQ(p->suffix, "SAMPLE");
+  EXPECT_FALSE(split_channel("SPINDOWN"));
+  EXPECT_FALSE(split_channel("OTHER.a.FIT"));
+  for (auto kind : {ChannelKind::sample, ChannelKind::config, ChannelKind::run, ChannelKind::fit,
+                    ChannelKind::explain, ChannelKind::status})
+    EXPECT_EQ(channel_kind(channel_suffix(kind)), kind);
+  EXPECT_FALSE(channel_kind("sample"));
+  EXPECT_FALSE(channel_kind("OTHER"));
+}

@@ -52,17 +52,26 @@ std::string channel_name(std::string_view bench, ChannelKind kind) {
   return fmt::format("{}{}.{}", channel_prefix, bench, channel_suffix(kind));
 }
 
-std::optional<ParsedChannel> parse_channel(std::string_view channel) {
+std::optional<ChannelParts> split_channel(std::string_view channel) {
   if (!channel.starts_with(channel_prefix)) return std::nullopt;
   channel.remove_prefix(channel_prefix.size());
   const auto dot = channel.rfind('.');
   if (dot == std::string_view::npos) return std::nullopt;
-  const auto bench = channel.substr(0, dot);
-  const auto suffix = channel.substr(dot + 1);
-  if (!is_valid_bench_id(bench)) return std::nullopt;
+  return ChannelParts{channel.substr(0, dot), channel.substr(dot + 1)};
+}
+
+std::optional<ChannelKind> channel_kind(std::string_view suffix) {
   for (const auto& [k, s] : kSuffixes)
-    if (s == suffix) return ParsedChannel{std::string(bench), k};
+    if (s == suffix) return k;
   return std::nullopt;
+}
+
+std::optional<ParsedChannel> parse_channel(std::string_view channel) {
+  const auto parts = split_channel(channel);
+  if (!parts || !is_valid_bench_id(parts->bench)) return std::nullopt;
+  const auto kind = channel_kind(parts->suffix);
+  if (!kind) return std::nullopt;
+  return ParsedChannel{std::string(parts->bench), *kind};
 }
 
 }  // namespace spindown

@@ -119,18 +119,13 @@ bool FitterCore::admit(std::string_view id, std::int64_t recv_utime, std::string
 
 void FitterCore::on_message(std::string_view channel, const void* data, std::int64_t size, std::int64_t recv_utime) {
   ++counters_.messages;
-  constexpr std::string_view prefix = "SPINDOWN.";
-  const std::size_t dot = channel.rfind('.');
-  if (!channel.starts_with(prefix) || dot == std::string_view::npos || dot < prefix.size()) {
+  const auto parts = split_channel(channel);
+  const auto kind = parts ? channel_kind(parts->suffix) : std::nullopt;
+  if (kind != ChannelKind::sample && kind != ChannelKind::config) {
     ++counters_.other_channels;
     return;
   }
-  const std::string_view kind = channel.substr(dot + 1);
-  const std::string_view bench = channel.substr(prefix.size(), dot - prefix.size());
-  if (kind != "SAMPLE" && kind != "CONFIG") {
-    ++counters_.other_channels;
-    return;
-  }
+  const std::string_view bench = parts->bench;
   std::string why;
   if (!is_valid_bench_id(bench, &why)) {
     ++counters_.invalid_bench;
@@ -142,7 +137,7 @@ void FitterCore::on_message(std::string_view channel, const void* data, std::int
     error(fmt::format("{}: no payload", channel), recv_utime);
     return;
   }
-  if (kind == "SAMPLE") {
+  if (kind == ChannelKind::sample) {
     SamplesView msg;
     if (!view_samples_message(msg, data, size, &why)) {
       ++counters_.decode_errors;

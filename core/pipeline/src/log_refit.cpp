@@ -9,6 +9,7 @@
 #include <sys/stat.h>
 
 #include "spindown/fit_message.hpp"
+#include "spindown/lcm_channels.hpp"
 #include "spindown/session_id.hpp"
 
 namespace spindown {
@@ -217,8 +218,10 @@ LogRefit refit_log_session(const std::vector<std::string>& paths, const FitterOp
             out.file.diagnostics.push_back({Diagnostic::Severity::warning, file, ev.number, ev.problem});
           }
           break;
-        case LcmLogEvent::Kind::other:
-          if (keep_live_fits && ev.channel.starts_with("SPINDOWN.") && ev.channel.ends_with(".STATUS")) {
+        case LcmLogEvent::Kind::other: {
+          const auto parts = keep_live_fits ? split_channel(ev.channel) : std::nullopt;
+          const auto kind = parts ? channel_kind(parts->suffix) : std::nullopt;
+          if (kind == ChannelKind::status) {
             status_t st{};
             if (core.admit(ev.channel, ev.data, ev.data_size, ev.log_utime) &&
                 decode_message(st, ev.data, ev.data_size) && st.service == "fitter" && st.source_session != 0 &&
@@ -231,13 +234,13 @@ LogRefit refit_log_session(const std::vector<std::string>& paths, const FitterOp
           // The live fitter's results as recorded (for --live and --compare): its own only when the
           // gate lets them through (the lab, and with a key their signature): a forged one is
           // counted and named, never compared.
-          if (keep_live_fits && ev.channel.starts_with("SPINDOWN.") &&
-              (ev.channel.ends_with(".FIT") || ev.channel.ends_with(".EXPLAIN")) &&
+          if ((kind == ChannelKind::fit || kind == ChannelKind::explain) &&
               core.admit(ev.channel, ev.data, ev.data_size, ev.log_utime)) {
-            if (ev.channel.ends_with(".FIT")) keep_recorded(ev, file, out.live, "fit_t", out.file.diagnostics);
+            if (kind == ChannelKind::fit) keep_recorded(ev, file, out.live, "fit_t", out.file.diagnostics);
             else keep_recorded(ev, file, out.live_explains, "explain_t", out.file.diagnostics);
           }
           break;
+        }
       }
     }
     events_read += reader.events_read();

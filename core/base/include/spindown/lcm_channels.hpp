@@ -25,6 +25,14 @@ struct ParsedChannel {
   std::string bench;
   ChannelKind kind;
 };
+// The bench and suffix of "SPINDOWN.<bench>.<SUFFIX>" as views into the channel, neither checked
+// (a reader that counts a bad bench id apart needs them); nullopt without the prefix or a dot.
+struct ChannelParts {
+  std::string_view bench, suffix;
+};
+std::optional<ChannelParts> split_channel(std::string_view channel);
+// The kind a channel's suffix names; nullopt for a suffix that is not the suite's.
+std::optional<ChannelKind> channel_kind(std::string_view suffix);
 // The inverse of channel_name; nullopt for channels that are not the suite's.
 std::optional<ParsedChannel> parse_channel(std::string_view channel);
 
