@@ -56,27 +56,16 @@ void StatusHeartbeat::mark_sent(std::int64_t now_us) {
 }
 
 status_t StatusHeartbeat::message(std::int64_t now_us) const {
-  status_t st{};
-  st.utime = now_us;
-  st.service = service_;
-  st.instance = instance_;
-  st.host = host_;
-  st.pid = pid_;
-  st.state = state_;
-  st.uptime_s = double(now_us - start_us_) * 1e-6;
-  for (const auto& [n, v] : counters_) {
-    st.counter_name.push_back(n);
-    st.counter_value.push_back(v);
-  }
-  st.ncounters = static_cast<std::int32_t>(st.counter_name.size());
-  for (const auto& [n, v] : gauges_) {
-    st.gauge_name.push_back(n);
-    st.gauge_value.push_back(v);
-  }
-  st.ngauges = static_cast<std::int32_t>(st.gauge_name.size());
-  st.last_error = last_error_;
-  st.last_error_utime = last_error_utime_;
-  return st;
+  return status_message(now_us,
+                        {.service = service_,
+                         .instance = instance_,
+                         .host = host_,
+                         .pid = pid_,
+                         .state = state_,
+                         .uptime_s = double(now_us - start_us_) * 1e-6,
+                         .last_error = last_error_,
+                         .last_error_utime = last_error_utime_},
+                        counters_, gauges_);
 }
 
 int StatusHeartbeat::publish(lcm::LCM& lcm, const std::string& channel, std::int64_t now_us) {

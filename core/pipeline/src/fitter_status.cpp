@@ -12,6 +12,7 @@
 #include "spindown/fit_message.hpp"
 #include "spindown/lab_name.hpp"
 #include "spindown/lcm_channels.hpp"
+#include "spindown/lcm_status.hpp"
 
 #include "fitter_bench.hpp"
 
@@ -58,14 +59,6 @@ std::size_t FitterCore::buffered_samples() const {
 
 status_t FitterCore::make_status(std::int64_t now_utime, std::string_view instance, std::string_view host,
                                  std::int32_t pid, std::string_view state, double uptime_s) const {
-  status_t s{};
-  s.utime = now_utime;
-  s.service = "fitter";
-  s.instance = std::string(instance);
-  s.host = std::string(host);
-  s.pid = pid;
-  s.state = std::string(state);
-  s.uptime_s = uptime_s;
   const FitterCounters& c = counters_;
   const std::pair<const char*, std::int64_t> counters[] = {
       {"messages", c.messages},           {"sample_messages", c.sample_messages},
@@ -91,11 +84,6 @@ status_t FitterCore::make_status(std::int64_t now_utime, std::string_view instan
       {"other_source_samples", c.other_source_samples}, {"seq_jumps", c.seq_jumps},
       {"seq_jump_samples", c.seq_jump_samples},
   };
-  for (const auto& [name, value] : counters) {
-    s.counter_name.emplace_back(name);
-    s.counter_value.push_back(value);
-  }
-  s.ncounters = static_cast<std::int32_t>(s.counter_name.size());
   std::size_t coasting = 0;
   for (const auto& [id, b] : benches_) coasting += b->open_state != 0;
   const std::pair<const char*, double> gauges[] = {
@@ -103,14 +91,16 @@ status_t FitterCore::make_status(std::int64_t now_utime, std::string_view instan
       {"benches_coasting", double(coasting)},
       {"buffered_samples", double(buffered_samples())},
   };
-  for (const auto& [name, value] : gauges) {
-    s.gauge_name.emplace_back(name);
-    s.gauge_value.push_back(value);
-  }
-  s.ngauges = static_cast<std::int32_t>(s.gauge_name.size());
-  s.last_error = last_error_;
-  s.last_error_utime = last_error_utime_;
-  return s;
+  return status_message(now_utime,
+                        {.service = "fitter",
+                         .instance = instance,
+                         .host = host,
+                         .pid = pid,
+                         .state = state,
+                         .uptime_s = uptime_s,
+                         .last_error = last_error_,
+                         .last_error_utime = last_error_utime_},
+                        counters, gauges);
 }
 
 }  // namespace spindown

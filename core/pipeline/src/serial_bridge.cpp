@@ -7,6 +7,7 @@
 #include "spindown/clock.hpp"
 #include "spindown/host_name.hpp"
 #include "spindown/lab_line.hpp"
+#include "spindown/lcm_status.hpp"
 
 namespace spindown {
 
@@ -333,14 +334,6 @@ config_t SerialBridge::make_config(std::int64_t now_us) const {
 }
 
 status_t SerialBridge::make_status(std::int64_t now_us) const {
-  status_t st{};
-  st.utime = now_us;
-  st.service = "bridge";
-  st.instance = s_.bench;
-  st.host = s_.host;
-  st.pid = s_.pid;
-  st.state = state_;
-  st.uptime_s = double(now_us - start_us_) * 1e-6;
   const std::pair<const char*, std::int64_t> counters[] = {
       {"lines_good", counters_.lines_good},
       {"lines_bad", counters_.lines_bad},
@@ -357,11 +350,6 @@ status_t SerialBridge::make_status(std::int64_t now_us) const {
       {"device_seq_gaps", counters_.device_seq_gaps},
       {"partial_lines", counters_.partial_lines},
   };
-  for (const auto& [name, value] : counters) {
-    st.counter_name.emplace_back(name);
-    st.counter_value.push_back(value);
-  }
-  st.ncounters = static_cast<std::int32_t>(st.counter_name.size());
   const std::pair<const char*, double> gauges[] = {
       {"connected", connected_ ? 1.0 : 0.0},
       {"rate_hz", rate_hz_},
@@ -371,14 +359,16 @@ status_t SerialBridge::make_status(std::int64_t now_us) const {
       {"latency_p99_us", latency_quantile_us(0.99)},
       {"latency_max_us", latency_quantile_us(1.0)},
   };
-  for (const auto& [name, value] : gauges) {
-    st.gauge_name.emplace_back(name);
-    st.gauge_value.push_back(value);
-  }
-  st.ngauges = static_cast<std::int32_t>(st.gauge_name.size());
-  st.last_error = last_error_;
-  st.last_error_utime = last_error_utime_;
-  return st;
+  return status_message(now_us,
+                        {.service = "bridge",
+                         .instance = s_.bench,
+                         .host = s_.host,
+                         .pid = s_.pid,
+                         .state = state_,
+                         .uptime_s = double(now_us - start_us_) * 1e-6,
+                         .last_error = last_error_,
+                         .last_error_utime = last_error_utime_},
+                        counters, gauges);
 }
 
 }  // namespace spindown

@@ -20,6 +20,45 @@ class LCM;
 
 namespace spindown {
 
+// Who a heartbeat is from and how it stands: the fields every status_t carries beside its counters
+// and gauges.
+struct StatusHeader {
+  std::string_view service, instance, host;
+  std::int32_t pid = 0;
+  std::string_view state;
+  double uptime_s = 0;
+  std::string_view last_error;
+  std::int64_t last_error_utime = 0;
+};
+
+// The one builder of a status_t: the header, then the named counters and gauges in the order
+// given (ranges of (name, value) pairs), so lcm-spy's rows stay put. StatusHeartbeat, the
+// fitter's and the bridge's heartbeats are all made here.
+template <class Counters, class Gauges>
+status_t status_message(std::int64_t utime, const StatusHeader& h, const Counters& counters, const Gauges& gauges) {
+  status_t st{};
+  st.utime = utime;
+  st.service = std::string(h.service);
+  st.instance = std::string(h.instance);
+  st.host = std::string(h.host);
+  st.pid = h.pid;
+  st.state = std::string(h.state);
+  st.uptime_s = h.uptime_s;
+  for (const auto& [name, value] : counters) {
+    st.counter_name.emplace_back(name);
+    st.counter_value.push_back(static_cast<std::int64_t>(value));
+  }
+  st.ncounters = static_cast<std::int32_t>(st.counter_name.size());
+  for (const auto& [name, value] : gauges) {
+    st.gauge_name.emplace_back(name);
+    st.gauge_value.push_back(static_cast<double>(value));
+  }
+  st.ngauges = static_cast<std::int32_t>(st.gauge_name.size());
+  st.last_error = std::string(h.last_error);
+  st.last_error_utime = h.last_error_utime;
+  return st;
+}
+
 class StatusHeartbeat {
  public:
   // host empty = host_name(); pid 0 = getpid(). interval_s: how often due() says yes.
