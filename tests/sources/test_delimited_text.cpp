@@ -352,3 +352,45 @@ TEST(DelimitedText, HeaderThatNeedsTheDelimitedReader) {
   EXPECT_FALSE(header_needs_delimited_reader("5234\t2.45"));
   EXPECT_FALSE(header_needs_delimited_reader("rpm"));
 }
+
+// A dyno's log as another lab's repository keeps it (blank-separated, nine columns, no names):
+// the logger started mid-line, so the first line holds only the last three fields of a row, and
+// the recording starts and ends mid-coast with a 1.8 s pause. The first line does not set the
+// table's width (it is skipped and said), and the proposal names the clock (column 6, ms) and the
+// falling speed (column 4, rpm) although the coast neither starts at a peak nor ends at rest (column
+// 8, a quantity in proportion to it, is rougher, as in the real file).
+TEST(DelimitedText, ACutFirstLineAndACoastUnderWayStillGetTheirColumns) {
+  std::string text = "0.00 884.973 3612.600\n";
+  double rpm = 436.0;
+  std::int64_t ms = 783072;
+  for (int i = 0; i < 250; ++i) {
+    ms += i == 4 ? 1807 : 20;  // the logger's pause
+    rpm -= i == 4 ? 4.3 : 0.045;
+    const double jitter = 0.06 * std::sin(1.7 * i);
+    text += fmt::format("15.93 0.0375 0.5973 {:.2f} 4.00 {} 0.00 {:.3f} {:.3f}\n", rpm + jitter, ms,
+                        2.03 * rpm + 0.6 * std::cos(0.9 * i), 3612.6 + 0.012 * i);
+  }
+  const Recording r = read_delimited_text(text, "dyno.txt");
+  ASSERT_TRUE(r.has_errors());
+  EXPECT_TRUE(mentions(r, "3 fields where the rows below have 9: a line cut at the start")) << all_diagnostics(r);
+  EXPECT_TRUE(mentions(r, "--time-column 6 --time-unit ms --value-column 4 --value-unit rpm")) << all_diagnostics(r);
+  EXPECT_TRUE(mentions(r, "a coast under way")) << all_diagnostics(r);
+
+  DelimitedTextOptions o;
+  o.time_column = "6";
+  o.value_column = "4";
+  o.time_unit = TimeUnit::ms;
+  o.quantity = Quantity::rpm;
+  const Recording named = read_delimited_text(text, "dyno.txt", o);
+  EXPECT_FALSE(named.has_errors()) << all_diagnostics(named);
+  EXPECT_EQ(named.size(), 250u);
+}
+
+// With no column that falls as a coast does, the clock is still proposed.
+TEST(DelimitedText, NoSpeedColumnFoundStillProposesTheClock) {
+  std::string text;
+  for (int i = 0; i < 100; ++i) text += fmt::format("{},{:.2f},{:.2f}\n", 1000 + 20 * i, 5 + std::sin(i), 3.0);
+  const Recording r = read_delimited_text(text, "flat.csv");
+  ASSERT_TRUE(r.has_errors());
+  EXPECT_TRUE(mentions(r, "try --time-column 1 --time-unit ms and name the speed")) << all_diagnostics(r);
+}

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <utility>
+#include <vector>
 
 namespace spindown {
 
@@ -50,7 +52,7 @@ std::optional<TimeCandidate> as_time(const std::vector<double>& v, int column) {
   TimeCandidate c;
   c.column = column;
   c.first = v.front();
-  c.last = v.back();
+  c.last = *std::max_element(v.begin(), v.end());  // (a last line cut short is no end)
   c.step = step;
   c.unit = time_unit_from_values(v);
   c.counter = step == 1 && (v.front() == 0 || v.front() == 1) &&
@@ -63,6 +65,7 @@ struct ValueCandidate {
   double roughness = 0;  // median |second difference| over the range: small for a coast
   std::string why;
   double peak = 0;
+  bool partial = false;  // a fall under way that neither starts at a peak nor ends at rest
 };
 
 // Rises and falls, or falls to a rest, over at least 5 samples from 90 % to 10 % of its drop, and
@@ -79,8 +82,22 @@ std::optional<ValueCandidate> as_value(const std::vector<double>& v, int column)
   const std::size_t tail = std::max<std::size_t>(3, v.size() / 20);
   const bool rests = std::all_of(v.end() - static_cast<std::ptrdiff_t>(tail), v.end(),
                                  [&](double x) { return x - lo <= 0.05 * range; });
-  const bool falls_to_rest = rests && hi - end >= 0.5 * range;
-  if (!rises_and_falls && !falls_to_rest) return std::nullopt;
+  // (and a rest is near zero: a fall from 436 that ends at 420 is a coast under way, not at rest)
+  const bool falls_to_rest = rests && hi - end >= 0.5 * range && std::abs(end) <= 0.2 * std::abs(hi);
+  // A coast under way (a recording started and stopped mid-coast): its level at the end (median of
+  // the last tenth) at least 1 % below its level at the start and far more than the reading's
+  // sample-to-sample jitter.
+  bool falls_steadily = false;
+  if (!rises_and_falls && !falls_to_rest) {
+    const std::size_t k = std::max<std::size_t>(3, v.size() / 10);
+    const double a = median(std::vector<double>(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k)));
+    const double b = median(std::vector<double>(v.end() - static_cast<std::ptrdiff_t>(k), v.end()));
+    std::vector<double> jitter;
+    jitter.reserve(v.size());
+    for (std::size_t i = 1; i < v.size(); ++i) jitter.push_back(std::abs(v[i] - v[i - 1]));
+    falls_steadily = a - b >= 0.01 * std::abs(a) && a - b > 20 * median(std::move(jitter));
+  }
+  if (!rises_and_falls && !falls_to_rest && !falls_steadily) return std::nullopt;
   // How long the fall after the peak takes from 90 % to 10 % of the way down.
   std::size_t at90 = peak, at10 = peak;
   while (at90 < v.size() && v[at90] > end + 0.9 * (hi - end)) ++at90;
@@ -88,9 +105,11 @@ std::optional<ValueCandidate> as_value(const std::vector<double>& v, int column)
   while (at10 < v.size() && v[at10] > end + 0.1 * (hi - end)) ++at10;
   if (at10 - at90 < 5) return std::nullopt;
   // Smoothly: no fall of more than a tenth of the range from one sample to the next (a current
-  // that stops at the cut, a relay).
+  // that stops at the cut, a relay). A fall under way, a few per cent of its level, may lose a
+  // good part of that over a logger's pause of a second or two: half of it there.
+  const double largest_drop = falls_steadily ? 0.5 * range : 0.1 * range;
   for (std::size_t i = 1; i < v.size(); ++i)
-    if (v[i - 1] - v[i] > 0.1 * range) return std::nullopt;
+    if (v[i - 1] - v[i] > largest_drop) return std::nullopt;
   std::vector<double> curvature;
   curvature.reserve(v.size());
   for (std::size_t i = 1; i + 1 < v.size(); ++i) curvature.push_back(std::abs(v[i + 1] - 2 * v[i] + v[i - 1]));
@@ -98,8 +117,11 @@ std::optional<ValueCandidate> as_value(const std::vector<double>& v, int column)
   c.column = column;
   c.roughness = median(curvature) / range;
   c.peak = hi;
+  c.partial = falls_steadily;
   c.why = rises_and_falls ? fmt::format("rises to {:g} and falls to {:g} over {} samples", hi, end, at10 - peak)
-                          : fmt::format("falls from {:g} to a rest at {:g} over {} samples", hi, end, at10 - peak);
+          : falls_to_rest ? fmt::format("falls from {:g} to a rest at {:g} over {} samples", hi, end, at10 - peak)
+                          : fmt::format("falls steadily from {:g} to {:g} over {} samples (a coast under way)", start,
+                                        end, v.size());
   return c;
 }
 
@@ -152,7 +174,9 @@ ColumnGuess guess_columns(const std::vector<std::vector<double>>& columns) {
     if (static_cast<int>(c) == g.time) continue;
     if (std::any_of(times.begin(), times.end(), [&](const TimeCandidate& t) { return t.column == int(c); })) continue;
     auto v = as_value(finite[c], static_cast<int>(c));
-    if (v && (!best || v->roughness < best->roughness)) best = std::move(v);
+    // A whole coast before a fall under way; the smoother of two alike.
+    if (v && (!best || std::pair(v->partial, v->roughness) < std::pair(best->partial, best->roughness)))
+      best = std::move(v);
   }
   if (best) {
     g.value = best->column;
@@ -163,7 +187,11 @@ ColumnGuess guess_columns(const std::vector<std::vector<double>>& columns) {
 }
 
 std::optional<std::string> column_proposal(const ColumnGuess& g) {
-  if (g.time < 0 || g.value < 0) return std::nullopt;
+  if (g.time < 0) return std::nullopt;
+  if (g.value < 0)
+    return fmt::format("column {} {}: try --time-column {} --time-unit {} and name the speed (or back-EMF) column "
+                       "with --value-column (no column falls as a coast does)",
+                       g.time + 1, g.time_why, g.time + 1, time_unit_name(g.time_unit));
   std::string s = fmt::format("column {} {} and column {} {}: try --time-column {} --time-unit {} --value-column {}",
                               g.time + 1, g.time_why, g.value + 1, g.value_why, g.time + 1, time_unit_name(g.time_unit),
                               g.value + 1);

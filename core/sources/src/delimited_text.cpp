@@ -211,6 +211,25 @@ Recording read_delimited_text(std::string_view text, std::string source, const D
     std::string_view w;
     return parse_number(f, decimal_comma, x, w);
   };
+  // A first line cut short (a logger started mid-line: the last fields of a row, all numbers) does
+  // not set the table's width: with fewer fields than most of the first lines have, it is skipped
+  // and said.
+  if (content.size() > 2 && !options.header.value_or(false)) {
+    std::vector<std::size_t> widths;
+    for (std::size_t i = 1; i < probe; ++i) {
+      split(content[i].text);
+      widths.push_back(fields.size());
+    }
+    std::nth_element(widths.begin(), widths.begin() + std::ptrdiff_t(widths.size() / 2), widths.end());
+    const std::size_t usual = widths[widths.size() / 2];
+    split(content.front().text);
+    if (fields.size() < usual && std::all_of(fields.begin(), fields.end(), is_number)) {
+      rec.warn(content.front().number,
+               fmt::format("{} fields where the rows below have {}: a line cut at the start of the recording; skipped",
+                           fields.size(), usual));
+      content.erase(content.begin());
+    }
+  }
   split(content.front().text);
   bool have_header = false;
   if (options.header) {
