@@ -15,7 +15,7 @@
 #include "spindown/host_name.hpp"
 #include "spindown/lcm_channels.hpp"
 #include "spindown/loop_watchdog.hpp"
-#include "spindown/network_checks.hpp"
+#include "spindown/udp_socket_drops.hpp"
 
 namespace spindown {
 

@@ -21,7 +21,7 @@
 #include "spindown/message_gate.hpp"
 #include "spindown/message_stamp.hpp"
 #include "spindown/loop_watchdog.hpp"
-#include "spindown/network_checks.hpp"
+#include "spindown/udp_socket_drops.hpp"
 #include "spindown/service_notifier.hpp"
 #include "spindown/stop_signal.hpp"
 

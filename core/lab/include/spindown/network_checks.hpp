@@ -15,6 +15,8 @@
 #include "spindown/doctor_check.hpp"
 #include "spindown/lcm_url.hpp"
 
+#include "spindown/udp_socket_drops.hpp"
+
 namespace spindown {
 
 // One line of /proc/net/route (the main IPv4 table); addresses in host byte order.
@@ -66,25 +68,7 @@ DoctorCheck check_receive_buffer(std::optional<long> rmem_max, std::optional<lon
 // Udp RcvbufErrors from the text of /proc/net/snmp.
 std::optional<long> parse_udp_rcvbuf_errors(std::string_view proc_net_snmp);
 
-// Datagrams the kernel dropped on particular UDP sockets (a full receive buffer, a bad
-// checksum): the `drops` column of /proc/net/udp and udp6, unlike RcvbufErrors, which counts
-// every socket of the network namespace (another program's drops too).
-struct UdpSocketDrops {
-  std::size_t sockets = 0;  // sockets found among the inodes asked for
-  std::int64_t drops = 0;   // their drops, summed
-  std::int64_t queued_bytes = 0;  // their rx_queue: received by the kernel, not yet read
-};
-// From the text of /proc/net/udp or /proc/net/udp6: the lines whose inode is one of inodes.
-UdpSocketDrops parse_udp_socket_drops(std::string_view proc_net_udp, const std::vector<std::uint64_t>& inodes);
-// This process's own UDP sockets: the inodes of /proc/self/fd's "socket:[N]" links, looked up
-// in /proc/self/net/udp and udp6. Nullopt when /proc cannot be read.
-std::optional<UdpSocketDrops> own_udp_socket_drops();
-// Their drops alone, -1 when /proc cannot be read: what the services' heartbeats and their last
-// line on stderr report as udp_drops.
-std::int64_t own_udp_drop_count();
-// Bytes waiting in their receive queues, -1 when /proc cannot be read: the fitter judges no bench
-// silent while datagrams wait there (after a freeze, SIGSTOP, its backlog is not silence).
-std::int64_t own_udp_queued_bytes();
+// A process's own UDP sockets' drops: udp_socket_drops.hpp (bus).
 
 // The firewall as `nft list ruleset` and/or `iptables-save` print it (nullopt: not available;
 // unreadable is the caller's skip). fail: a rule that drops or rejects the LCM port, the group,

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "spindown/network_checks.hpp"
+#include "spindown/udp_socket_drops.hpp"
 
 using namespace spindown;
 
