@@ -779,6 +779,7 @@ bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
   if ((lead == "powered" || lead == "none") && w.span_s < 1.0) plausible = false;
   if (need_rise_ && sp.v0 < rise_level_) plausible = false;  // the last coast, still creeping down
   if (!plausible) return false;
+  if (lead == "powered" && sp.pre_flat && !sp.clipped && bounce_.empty()) refine_plateau_cut(sp, i);
 
   run_ = Run{};
   run_.number = accepted_ + 1;

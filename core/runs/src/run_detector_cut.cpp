@@ -241,6 +241,41 @@ void RunDetector::take_bounce(CutSplit& sp, const WindowFit& w) {
   sp.t_cut_s = first > base_ && first > stream_start_ ? 0.5 * (t(first - 1) + t(first)) : t(first);
 }
 
+void RunDetector::refine_plateau_cut(CutSplit& sp, std::size_t b) {
+  // Up to 50 samples of the plateau and of the coast on either side of the split (the coast's
+  // curve is a line that near its start), then y = level + slope·max(0, t − tc) by least squares
+  // for each tc on a grid of a tenth of a period over ±4 samples of the split.
+  constexpr std::size_t side = 50, reach = 4;
+  const std::size_t c = sp.cut_index;
+  const std::size_t lo = std::max(sp.a, c >= side ? c - side : 0), hi = std::min(b + 1, c + side);
+  if (c < lo + 8 || hi < c + 8 || c < lo + reach + 1 || hi < c + reach + 1) return;
+  // The plateau must meet the coast without a step: at the split, within 4 of the coast's noise.
+  if (!(std::abs(sp.pre_mean - sp.v0) <= 4.0 * std::max(sp.sd_post, sp.pre_sd))) return;
+  const double period = (t(hi - 1) - t(lo)) / double(hi - 1 - lo);
+  if (!(period > 0)) return;
+  const double from = t(c - reach), to = t(c + reach);
+  double best_sse = std::numeric_limits<double>::infinity(), best_tc = sp.t_cut_s;
+  for (double tc = from; tc <= to; tc += 0.1 * period) {
+    double sx = 0, sy = 0, sxx = 0, sxy = 0, syy = 0;
+    for (std::size_t k = lo; k < hi; ++k) {
+      const double x = std::max(0.0, t(k) - tc), y = v(k);
+      sx += x, sy += y, sxx += x * x, sxy += x * y, syy += y * y;
+    }
+    const double n = double(hi - lo);
+    const double vxx = sxx - sx * sx / n, vxy = sxy - sx * sy / n, vyy = syy - sy * sy / n;
+    if (!(vxx > 0)) continue;
+    const double slope = vxy / vxx;
+    const double sse = vyy - slope * vxy;
+    if (slope < 0 && sse < best_sse) best_sse = sse, best_tc = tc;
+  }
+  if (!std::isfinite(best_sse)) return;
+  std::size_t first = c - reach;
+  while (first < c + reach && t(first) < best_tc) ++first;
+  sp.t_cut_s = best_tc;
+  sp.cut_index = sp.pre_end = first;
+  sp.npre = first > sp.a ? first - sp.a : 0;
+}
+
 void RunDetector::recut_after_rise(Run& r, std::size_t coast_end) {
   const std::size_t c = r.cut_index;
   if (coast_end < c + 16) return;

@@ -225,6 +225,12 @@ class RunDetector {
     std::size_t pin_first = 0, pin_last = 0;
     double pin_level = 0;
   };
+  // A powered plateau that runs into the coast without a step (a speed reading: the speed is
+  // continuous at the cut): the cut is where a level and the coast's line meet, found to a tenth of
+  // a period by least squares over the samples around it, not the sample split of split_at_cut
+  // (which lets the line start with a step, so noise moves it by samples). Leaves sp as it is when
+  // the two do not meet within a few samples of the split.
+  void refine_plateau_cut(CutSplit& sp, std::size_t b);
   CutSplit split_at_cut(std::size_t a, std::size_t b, const WindowFit& w);
   std::string classify_lead_in(const CutSplit& sp) const;
   // Samples of contact bounce at the start of the coast in sp (a wire pushed onto the pin), judged
