@@ -17,6 +17,8 @@
 #include "spindown/lcm_log_reader.hpp"
 #include "spindown/synthetic_run.hpp"
 
+#include "lab_messages.hpp"
+
 using namespace spindown;
 using Severity = Diagnostic::Severity;
 
@@ -70,28 +72,6 @@ samples_t batch(const std::string& bench, std::int64_t seq, std::int64_t t0_us, 
   return m;
 }
 
-config_t config(const std::string& bench, double j = 1.12687602e-5) {
-  config_t c{};
-  c.utime = 1;
-  c.bench = bench;
-  c.inertia_kg_m2 = j;
-  c.inertia_source = "lab default";
-  c.kb_v_s_per_rad = 1.0 / 123.569311;
-  c.kb_source = "lab default";
-  c.quantity = samples_t::QUANTITY_BACK_EMF_V;
-  c.adc_volts_per_count = 5.0 / 1024;
-  c.adc_bits = 10;
-  c.firmware = "lab sketch";
-  c.protocol = "lab-tsv";
-  c.sample_period_s = 0.02;
-  c.baud = 9600;
-  c.device = "/dev/ttyACM0";
-  c.host = "test";
-  c.inertia_rel_error = 0;
-  c.kb_rel_error = 0;
-  return c;
-}
-
 std::vector<char> file_bytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
@@ -134,13 +114,13 @@ TEST(LcmLogReader, TwoBenchesWithConfigAndOtherChannels) {
   TempFile f("two");
   {
     LogWriter w(f.path);
-    w.write("SPINDOWN.a.CONFIG", config("a", 1e-5));
+    w.write("SPINDOWN.a.CONFIG", test::lab_config("a", 1e-5));
     w.write("SPINDOWN.a.SAMPLE", batch("a", 0, 5'234'000, 10));
     w.write("SPINDOWN.b.SAMPLE", batch("b", 100, 1'000'000, 5, 3.0));
     w.write("SPINDOWN.a.STATUS", batch("a", 0, 0, 1));  // not read as samples
-    w.write("OTHER_CHANNEL", config("x"));
+    w.write("OTHER_CHANNEL", test::lab_config("x"));
     w.write("SPINDOWN.a.SAMPLE", batch("a", 10, 5'434'000, 10));
-    w.write("SPINDOWN.a.CONFIG", config("a", 2e-5));
+    w.write("SPINDOWN.a.CONFIG", test::lab_config("a", 2e-5));
     w.write("SPINDOWN.b.SAMPLE", batch("b", 105, 1'100'000, 5, 3.0));
   }
   const LcmLogContents c = read_lcm_log(f.path);
@@ -194,7 +174,7 @@ TEST(LcmLogReader, SyntheticRunSurvivesTheLog) {
   TempFile f("synthetic");
   {
     LogWriter w(f.path);
-    w.write("SPINDOWN.lab1.CONFIG", config("lab1"));
+    w.write("SPINDOWN.lab1.CONFIG", test::lab_config("lab1"));
     for (std::size_t i = 0; i < run.t_ms.size(); i += 10) {
       samples_t m{};
       m.bench = "lab1";
@@ -283,7 +263,7 @@ TEST(LcmLogReader, UndecodableEventsAreReportedAndSkipped) {
   {
     LogWriter w(f.path);
     w.write("SPINDOWN.a.SAMPLE", batch("a", 0, 0, 10));
-    w.write("SPINDOWN.a.SAMPLE", config("a"));  // wrong type on the channel: event 2
+    w.write("SPINDOWN.a.SAMPLE", test::lab_config("a"));  // wrong type on the channel: event 2
     auto bytes = std::vector<std::uint8_t>(static_cast<std::size_t>(batch("a", 10, 200'000, 10).getEncodedSize()));
     batch("a", 10, 200'000, 10).encode(bytes.data(), 0, static_cast<int>(bytes.size()));
     bytes.resize(bytes.size() - 30);  // truncated payload: event 3
@@ -489,9 +469,9 @@ TEST(LcmLogReader, StreamingReaderHandsOutEventsInOrder) {
   TempFile f("stream");
   {
     LogWriter w(f.path);
-    w.write("SPINDOWN.a.CONFIG", config("a"), 1000);
+    w.write("SPINDOWN.a.CONFIG", test::lab_config("a"), 1000);
     w.write("SPINDOWN.a.SAMPLE", batch("a", 0, 0, 3), 2000);
-    w.write("SOMETHING", config("a"), 3000);
+    w.write("SOMETHING", test::lab_config("a"), 3000);
     w.write("SPINDOWN.bad id!.SAMPLE", batch("a", 0, 0, 3), 4000);  // not a valid bench id
   }
   LcmLogReader reader(f.path);
@@ -577,8 +557,8 @@ TEST(LcmLogReader, ConfigWithABadStringLengthIsReportedNotDecoded) {
     LogWriter w(f.path);
     w.write("SPINDOWN.a.SAMPLE", batch("a", 0, 0, 10));
     for (const std::uint32_t len : {0x80000000u, 0u, 0x7fffffffu}) {
-      std::vector<std::uint8_t> bytes(static_cast<std::size_t>(config("a").getEncodedSize()));
-      config("a").encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+      std::vector<std::uint8_t> bytes(static_cast<std::size_t>(test::lab_config("a").getEncodedSize()));
+      test::lab_config("a").encode(bytes.data(), 0, static_cast<int>(bytes.size()));
       for (int k = 0; k < 4; ++k) bytes[16 + k] = static_cast<std::uint8_t>(len >> (24 - 8 * k));  // bench's length
       w.write_raw("SPINDOWN.a.CONFIG", bytes);
     }

@@ -27,7 +27,7 @@ TEST(FitterCore, OneFitPerRunWithTheBenchsConfigAndTheDefaultFlagged) {
   CollectingSink sink;
   FitterCore core({}, sink);
   const Stream s = make_stream(2, 7);
-  core.on_config("withcfg", config("withcfg", 2.0e-5), 1);
+  core.on_config("withcfg", lab_config("withcfg", 2.0e-5), 1);
   std::int64_t utime = 10;
   feed(core, "withcfg", s, 5, utime);
   feed(core, "nocfg", s, 5, utime);
@@ -38,7 +38,7 @@ TEST(FitterCore, OneFitPerRunWithTheBenchsConfigAndTheDefaultFlagged) {
   ASSERT_EQ(b.size(), 2u);
   EXPECT_EQ(a[0]->bench_source, "config");
   EXPECT_DOUBLE_EQ(a[0]->fit.bench.inertia_kg_m2, 2.0e-5);
-  EXPECT_EQ(a[0]->fit.bench.inertia_source, "test geometry");
+  EXPECT_EQ(a[0]->fit.bench.inertia_source, "lab flywheel + rotor");
   EXPECT_NE(b[0]->bench_source.find("no CONFIG"), std::string::npos) << b[0]->bench_source;
   EXPECT_DOUBLE_EQ(b[0]->fit.bench.inertia_kg_m2, BenchParams{}.inertia_kg_m2);
   EXPECT_EQ(a[0]->fit.run.number, 1);
@@ -68,7 +68,7 @@ TEST(FitterCore, WhatARefitNamesWinsOverTheConfigAndIsSaid) {
   const auto run_with = [&](const FitterOptions& o) {
     CollectingSink sink;
     FitterCore core(o, sink);
-    core.on_config("b1", config("b1", 2.0e-5), 1);
+    core.on_config("b1", lab_config("b1", 2.0e-5), 1);
     std::int64_t utime = 10;
     feed(core, "b1", s, 5, utime);
     core.finish(utime);
@@ -88,7 +88,7 @@ TEST(FitterCore, WhatARefitNamesWinsOverTheConfigAndIsSaid) {
   flag.named.inertia_given = true;
   const FitResult by_flag = run_with(flag);
   EXPECT_DOUBLE_EQ(by_flag.fit.bench.inertia_kg_m2, 3.0e-5);
-  EXPECT_DOUBLE_EQ(by_flag.fit.bench.kb_v_s_per_rad, config("b1", 2.0e-5).kb_v_s_per_rad);  // K_b: still the CONFIG's
+  EXPECT_DOUBLE_EQ(by_flag.fit.bench.kb_v_s_per_rad, lab_config("b1", 2.0e-5).kb_v_s_per_rad);  // K_b: still the CONFIG's
   EXPECT_EQ(by_flag.bench_source, "J: the command line (over the log's CONFIG: 2e-05 kg·m²); K_b: CONFIG");
   const double c4_plain = plain.fit.model(ModelKind::combined)->param("c4")->value;
   EXPECT_NEAR(by_flag.fit.model(ModelKind::combined)->param("c4")->value / c4_plain, 1.5, 1e-6);

@@ -47,7 +47,7 @@ struct Bridge {
   }
   void send_config(FitterCore& core, double j, std::int64_t utime, const std::string& bench = "a") {
     const std::string channel = "SPINDOWN." + bench + ".CONFIG";
-    config_t c = config(bench, j);
+    config_t c = lab_config(bench, j);
     c.utime = utime;
     const auto bytes = stamp.encode(channel, c);
     core.on_message(channel, bytes.data(), static_cast<std::int64_t>(bytes.size()), utime);

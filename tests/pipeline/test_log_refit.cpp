@@ -38,7 +38,7 @@ void write_log(const std::string& path, const Stream& s, const fit_t* live_fit) 
     e.data = const_cast<unsigned char*>(bytes.data());
     ASSERT_EQ(log.writeEvent(&e), 0);
   };
-  const config_t c = config("a", 2.0e-5);
+  const config_t c = lab_config("a", 2.0e-5);
   std::vector<unsigned char> cb(static_cast<std::size_t>(c.getEncodedSize()));
   c.encode(cb.data(), 0, static_cast<int>(cb.size()));
   put("SPINDOWN.a.CONFIG", cb);
@@ -54,7 +54,7 @@ TEST(LogRefit, SameRunsAndNumbersAsTheCoreFedDirectly) {
   const Stream s = make_stream(2, 17);
   CollectingSink sink;
   FitterCore core({}, sink);
-  core.on_config("a", config("a", 2.0e-5), 1);
+  core.on_config("a", lab_config("a", 2.0e-5), 1);
   std::int64_t utime = 10;
   feed(core, "a", s, 5, utime);
   core.finish(utime);

@@ -13,6 +13,7 @@
 #include "spindown/offline_pipeline.hpp"
 #include "spindown/synthetic_run.hpp"
 
+#include "lab_messages.hpp"
 #include "lcm_log_events.hpp"
 
 using namespace spindown;
@@ -68,14 +69,6 @@ struct RecordingSink : OfflineSink {
 
 using spindown::testing::write_event;
 
-config_t config(const std::string& bench, double j, double kb) {
-  config_t c{};
-  c.bench = bench;
-  c.inertia_kg_m2 = j;
-  c.kb_v_s_per_rad = kb;
-  return c;
-}
-
 samples_t one_sample(const std::string& bench, std::int64_t seq, std::int64_t t_us, double value) {
   samples_t m{};
   m.bench = bench;
@@ -96,8 +89,8 @@ std::string two_bench_log() {
   const SyntheticRun run = make_synthetic_run(SyntheticRunSpec{});
   lcm::LogFile log(path, "w");
   EXPECT_TRUE(log.good());
-  write_event(log, "SPINDOWN.b.CONFIG", config("b", 3e-5, 0.02), 1);
-  write_event(log, "SPINDOWN.a.CONFIG", config("a", 2e-5, 0.01), 2);
+  write_event(log, "SPINDOWN.b.CONFIG", test::lab_config("b", 3e-5, 0.02), 1);
+  write_event(log, "SPINDOWN.a.CONFIG", test::lab_config("a", 2e-5, 0.01), 2);
   for (int i = 0; i < 3; ++i)
     write_event(log, "SPINDOWN.b.SAMPLE", one_sample("b", i, 20000 * (i + 1), std::nan("")), 3 + i);
   for (std::size_t i = 0; i < run.t_ms.size(); ++i) {

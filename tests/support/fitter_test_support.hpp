@@ -11,6 +11,7 @@
 #include "spindown/fit_message.hpp"
 #include "spindown/fitter_core.hpp"
 #include "spindown/synthetic_run.hpp"
+#include "lab_messages.hpp"
 
 namespace spindown::test {
 
@@ -72,19 +73,6 @@ inline samples_t batch(const std::string& bench, const Stream& s, std::size_t fr
   }
   m.n = static_cast<std::int32_t>(m.value.size());
   return m;
-}
-
-inline config_t config(const std::string& bench, double j) {
-  config_t c{};
-  c.bench = bench;
-  c.inertia_kg_m2 = j;
-  c.inertia_source = "test geometry";
-  c.kb_v_s_per_rad = 1.0 / 123.569311;
-  c.kb_source = "test";
-  c.quantity = samples_t::QUANTITY_BACK_EMF_V;
-  c.inertia_rel_error = 0;  // lcm-gen leaves numbers uninitialized
-  c.kb_rel_error = 0;
-  return c;
 }
 
 inline std::vector<unsigned char> encode(const samples_t& m) {

@@ -1,10 +1,40 @@
 #pragma once
-// Messages as the live lab publishes them, for the tests of spindown watch's table and screen.
+// Messages as the live lab publishes them, for the tests of spindown watch's table and screen, the
+// fitter, the log reader and the benchmarks' logs.
+#include <cstdint>
 #include <string>
 
+#include <spindown/config_t.hpp>
 #include <spindown/fit_t.hpp>
+#include <spindown/samples_t.hpp>
 
 namespace spindown::test {
+
+// A CONFIG as a bench's bridge publishes it for the lab's motor and flywheel (the lab sketch on a
+// 10-bit converter at 50 Hz), with the J and K_b a test needs. Every field set: lcm-gen's structs
+// leave numbers uninitialized.
+inline config_t lab_config(const std::string& bench, double j = 1.12687602e-5, double kb = 1.0 / 123.569311,
+                           std::int64_t utime = 1) {
+  config_t c{};
+  c.utime = utime;
+  c.bench = bench;
+  c.inertia_kg_m2 = j;
+  c.inertia_source = "lab flywheel + rotor";
+  c.kb_v_s_per_rad = kb;
+  c.kb_source = "speed constant 1180 rpm/V";
+  c.quantity = samples_t::QUANTITY_BACK_EMF_V;
+  c.adc_volts_per_count = 5.0 / 1023;
+  c.adc_bits = 10;
+  c.firmware = "lab sketch";
+  c.protocol = "lab-tsv";
+  c.sample_period_s = 0.02;
+  c.baud = 9600;
+  c.device = "/dev/ttyACM0";
+  c.host = "lab-pc-3";
+  c.inertia_rel_error = 0;
+  c.kb_rel_error = 0;
+  return c;
+}
 
 // A combined-model fit as spindown-fitter publishes it (flat arrays; model 2 is the best).
 inline fit_t fit_msg(const std::string& bench, int run, const std::string& best = "combined") {
