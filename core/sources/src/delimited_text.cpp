@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <span>
 #include <fmt/format.h>
 #include <system_error>
@@ -150,286 +151,318 @@ bool header_needs_delimited_reader(std::string_view line) {
   return false;
 }
 
-Recording read_delimited_text(std::string_view text, std::string source, const DelimitedTextOptions& options) {
-  Recording rec;
-  rec.source = std::move(source);
-  if (!text::readable_text(text, options, "delimited text", rec)) return rec;
+namespace {
 
-  // Content lines (not blank, not a comment, not a PuTTY header), as views into text. A row of
-  // separators alone (";;;;", as a spreadsheet saves its empty rows) is blank.
+// One delimited-text file read step by step (read_delimited_text): its content lines, the
+// delimiter, the header, the columns, the value's and the time's units, then the rows. A step that
+// cannot go on returns the reason, which read_delimited_text reports as the file's error.
+class DelimitedReader {
+ public:
+  DelimitedReader(std::string_view text, const DelimitedTextOptions& options, Recording& rec)
+      : text_(text), o_(options), rec_(rec), raw_(text) {}
+
+  void collect_lines();
+  bool empty() const { return content_.empty(); }
+  std::string nothing_in_it() const {
+    return fmt::format("no samples: {} lines, none with data ({} blank, {} comments)", lines_, blank_, comments_);
+  }
+  void choose_delimiter();
+  void skip_cut_first_line();
+  void read_header();
+  std::optional<std::string> choose_columns();
+  std::optional<std::string> choose_value_unit();
+  void read_rows();
+  void choose_time_unit_and_finish();
+
+ private:
   struct Line {
     std::int64_t number;
     std::string_view text;
   };
-  std::vector<Line> content;
-  content.reserve(text.size() / 12 + 1);
-  std::size_t blank = 0, comments = 0, headers = 0;
-  const std::int64_t lines = text::for_each_line(text, [&](std::int64_t n, std::string_view line) {
-    const std::string_view t = trim(line);
-    if (t.empty() || t.find_first_not_of(" \t;,") == std::string_view::npos) ++blank;
-    else if (t.front() == '#') ++comments;
-    else if (t.starts_with("=~=~=~")) {
-      ++headers;
-      rec.note(n, text::putty_header_note(line));
-    } else content.push_back({n, line});
-  });
-  rec.lines_read = static_cast<std::size_t>(lines);
-  if (content.empty()) {
-    rec.error(0, fmt::format("no samples: {} lines, none with data ({} blank, {} comments)", lines, blank, comments));
-    rec.lines_skipped = rec.lines_read;
-    return rec;
+  void split(std::string_view line) {
+    splitter_.split(line, delim_, fields_);
+    for (auto& f : fields_) f = unquote_single(f);
+  }
+  bool is_number(std::string_view f) const {
+    double x;
+    std::string_view w;
+    return parse_number(f, decimal_comma_, x, w);
+  }
+  const ColumnGuess& guess();
+  std::string proposal() {
+    const auto p = column_proposal(guess());
+    return p ? "; " + *p : std::string();
   }
 
-  // Delimiter: the first of tab, ';', ',' found on nearly every one of the first lines.
-  char delim = options.delimiter;
-  const std::size_t probe = std::min<std::size_t>(content.size(), 20);
-  if (delim == 0) {
-    delim = ' ';
+  std::string_view text_;
+  const DelimitedTextOptions& o_;
+  Recording& rec_;
+  std::vector<Line> content_;
+  std::size_t blank_ = 0, comments_ = 0, headers_ = 0;
+  std::int64_t lines_ = 0;
+  char delim_ = ' ';
+  bool decimal_comma_ = false;
+  std::string_view delim_name_;
+  CsvFieldSplitter splitter_;
+  std::vector<std::string_view> fields_;
+  std::vector<ColumnName> cols_;
+  bool have_header_ = false;
+  std::size_t first_data_ = 0, unit_rows_ = 0;
+  std::optional<ColumnGuess> guessed_;
+  int tcol_ = -1, vcol_ = -1;
+  std::string quantity_from_ = "given", value_unit_name_;
+  double value_scale_ = 1;
+  text::RawSamples raw_;
+  std::size_t bad_ = 0;
+  std::optional<text::LineReporter> reporter_;
+};
+
+// Content lines (not blank, not a comment, not a PuTTY header), as views into the text. A row of
+// separators alone (";;;;", as a spreadsheet saves its empty rows) is blank.
+void DelimitedReader::collect_lines() {
+  content_.reserve(text_.size() / 12 + 1);
+  lines_ = text::for_each_line(text_, [&](std::int64_t n, std::string_view line) {
+    const std::string_view t = trim(line);
+    if (t.empty() || t.find_first_not_of(" \t;,") == std::string_view::npos) ++blank_;
+    else if (t.front() == '#') ++comments_;
+    else if (t.starts_with("=~=~=~")) {
+      ++headers_;
+      rec_.note(n, text::putty_header_note(line));
+    } else content_.push_back({n, line});
+  });
+  rec_.lines_read = static_cast<std::size_t>(lines_);
+}
+
+// The delimiter: the one given, else the first of tab, ';', ',' found on nearly every one of the
+// first lines, else blanks. A comma that is not the delimiter is a decimal comma ("2,81": a
+// European spreadsheet's CSV or "Unicode text").
+void DelimitedReader::choose_delimiter() {
+  delim_ = o_.delimiter;
+  const std::size_t probe = std::min<std::size_t>(content_.size(), 20);
+  if (delim_ == 0) {
+    delim_ = ' ';
     for (char cand : {'\t', ';', ','}) {
       std::size_t with = 0;
-      for (std::size_t i = 0; i < probe; ++i) with += content[i].text.find(cand) != std::string_view::npos;
+      for (std::size_t i = 0; i < probe; ++i) with += content_[i].text.find(cand) != std::string_view::npos;
       if (with * 5 >= probe * 4) {
-        delim = cand;
+        delim_ = cand;
         break;
       }
     }
   }
-  // A comma that is not the delimiter is a decimal comma ("2,81": a European spreadsheet's CSV or
-  // "Unicode text").
-  const bool decimal_comma = delim != ',';
-  const std::string_view delim_name = delim == '\t' ? "tab" : delim == ' ' ? "blanks" : std::string_view(&delim, 1);
+  decimal_comma_ = delim_ != ',';
+  delim_name_ = delim_ == '\t' ? "tab" : delim_ == ' ' ? "blanks" : std::string_view(&delim_, 1);
+}
 
-  CsvFieldSplitter splitter;
-  std::vector<std::string_view> fields;
-  fields.reserve(16);
-  const auto split = [&](std::string_view line) {
-    splitter.split(line, delim, fields);
-    for (auto& f : fields) f = unquote_single(f);
-  };
-  const auto is_number = [&](std::string_view f) {
-    double x;
-    std::string_view w;
-    return parse_number(f, decimal_comma, x, w);
-  };
-  // A first line cut short (a logger started mid-line: the last fields of a row, all numbers) does
-  // not set the table's width: with fewer fields than most of the first lines have, it is skipped
-  // and said.
-  if (content.size() > 2 && !options.header.value_or(false)) {
-    std::vector<std::size_t> widths;
-    for (std::size_t i = 1; i < probe; ++i) {
-      split(content[i].text);
-      widths.push_back(fields.size());
-    }
-    std::nth_element(widths.begin(), widths.begin() + std::ptrdiff_t(widths.size() / 2), widths.end());
-    const std::size_t usual = widths[widths.size() / 2];
-    split(content.front().text);
-    if (fields.size() < usual && std::all_of(fields.begin(), fields.end(), is_number)) {
-      rec.warn(content.front().number,
-               fmt::format("{} fields where the rows below have {}: a line cut at the start of the recording; skipped",
-                           fields.size(), usual));
-      content.erase(content.begin());
-    }
+// A first line cut short (a logger started mid-line: the last fields of a row, all numbers) does
+// not set the table's width: with fewer fields than most of the first lines have, it is skipped
+// and said.
+void DelimitedReader::skip_cut_first_line() {
+  if (content_.size() <= 2 || o_.header.value_or(false)) return;
+  const std::size_t probe = std::min<std::size_t>(content_.size(), 20);
+  std::vector<std::size_t> widths;
+  for (std::size_t i = 1; i < probe; ++i) {
+    split(content_[i].text);
+    widths.push_back(fields_.size());
   }
-  split(content.front().text);
-  bool have_header = false;
-  if (options.header) {
-    have_header = *options.header;
-  } else {
-    have_header = !std::all_of(fields.begin(), fields.end(), is_number);
+  std::nth_element(widths.begin(), widths.begin() + std::ptrdiff_t(widths.size() / 2), widths.end());
+  const std::size_t usual = widths[widths.size() / 2];
+  split(content_.front().text);
+  if (fields_.size() < usual && std::all_of(fields_.begin(), fields_.end(), [&](auto f) { return is_number(f); })) {
+    rec_.warn(content_.front().number,
+              fmt::format("{} fields where the rows below have {}: a line cut at the start of the recording; skipped",
+                          fields_.size(), usual));
+    content_.erase(content_.begin());
   }
-  std::vector<ColumnName> cols;
-  for (std::size_t i = 0; i < fields.size(); ++i)
-    cols.push_back(have_header ? describe_column(fields[i]) : ColumnName{fmt::format("{}", i + 1), "", ""});
-  // A row of units under the names ("s;rpm", "[ms]\t[V]"): no number in it and a unit read.
-  std::size_t first_data = have_header ? 1 : 0, unit_rows = 0;
-  if (have_header && content.size() > 1) {
-    split(content[1].text);
+}
+
+// The header (a first row with a non-number, unless told), a row of units under it ("s;rpm",
+// "[ms]\t[V]": no number in it and a unit read), and the columns' names and units.
+void DelimitedReader::read_header() {
+  split(content_.front().text);
+  have_header_ = o_.header ? *o_.header
+                           : !std::all_of(fields_.begin(), fields_.end(), [&](auto f) { return is_number(f); });
+  for (std::size_t i = 0; i < fields_.size(); ++i)
+    cols_.push_back(have_header_ ? describe_column(fields_[i]) : ColumnName{fmt::format("{}", i + 1), "", ""});
+  first_data_ = have_header_ ? 1 : 0;
+  if (have_header_ && content_.size() > 1) {
+    split(content_[1].text);
     std::vector<std::string> units;
-    for (const auto f : fields) units.push_back(unit_cell(f));
-    const bool units_row = std::none_of(fields.begin(), fields.end(), is_number) &&
+    for (const auto f : fields_) units.push_back(unit_cell(f));
+    const bool units_row = std::none_of(fields_.begin(), fields_.end(), [&](auto f) { return is_number(f); }) &&
                            std::any_of(units.begin(), units.end(), [](const std::string& u) { return !u.empty(); }) &&
-                           std::all_of(fields.begin(), fields.end(), [&](std::string_view f) {
+                           std::all_of(fields_.begin(), fields_.end(), [&](std::string_view f) {
                              return f.empty() || !unit_cell(f).empty();
                            });
     if (units_row) {
-      for (std::size_t i = 0; i < cols.size() && i < units.size(); ++i)
-        if (cols[i].unit.empty() && !units[i].empty()) cols[i].unit = units[i];
-      first_data = 2;
-      unit_rows = 1;
+      for (std::size_t i = 0; i < cols_.size() && i < units.size(); ++i)
+        if (cols_[i].unit.empty() && !units[i].empty()) cols_[i].unit = units[i];
+      first_data_ = 2;
+      unit_rows_ = 1;
     }
   }
   // Names and units go into messages (and JSON): bytes that are not UTF-8 (a header in a legacy
   // encoding read raw) are written \xNN there, once, here.
-  for (ColumnName& c : cols) {
+  for (ColumnName& c : cols_) {
     c.name = text::escape_invalid_utf8(c.name);
     c.unit = text::escape_invalid_utf8(c.unit);
   }
+}
 
-  auto give_up = [&](std::string message) {
-    rec.error(0, std::move(message));
-    rec.lines_skipped = rec.lines_read;
-    return rec;
-  };
-  if (cols.size() < 2)
-    return give_up(fmt::format("no samples: line {} has {} field (delimiter {}); need a time and a value column",
-                               content.front().number, cols.size(), delim_name));
-
-  // What the numbers say when the names do not: the table's first rows, column by column.
-  std::optional<ColumnGuess> guessed;
-  const auto guess = [&]() -> const ColumnGuess& {
-    if (!guessed) {
-      constexpr std::size_t max_rows = 100'000;
-      std::vector<std::vector<double>> table(cols.size());
-      for (std::size_t i = first_data; i < content.size() && i - first_data < max_rows; ++i) {
-        split(content[i].text);
-        for (std::size_t c = 0; c < cols.size(); ++c) {
-          double x = std::numeric_limits<double>::quiet_NaN();
-          std::string_view w;
-          if (c >= fields.size() || !parse_number(fields[c], decimal_comma, x, w))
-            x = std::numeric_limits<double>::quiet_NaN();
-          table[c].push_back(x);
-        }
+// What the numbers say when the names do not: the table's first rows, column by column.
+const ColumnGuess& DelimitedReader::guess() {
+  if (!guessed_) {
+    constexpr std::size_t max_rows = 100'000;
+    std::vector<std::vector<double>> table(cols_.size());
+    for (std::size_t i = first_data_; i < content_.size() && i - first_data_ < max_rows; ++i) {
+      split(content_[i].text);
+      for (std::size_t c = 0; c < cols_.size(); ++c) {
+        double x = std::numeric_limits<double>::quiet_NaN();
+        std::string_view w;
+        if (c >= fields_.size() || !parse_number(fields_[c], decimal_comma_, x, w))
+          x = std::numeric_limits<double>::quiet_NaN();
+        table[c].push_back(x);
       }
-      guessed = guess_columns(table);
     }
-    return *guessed;
-  };
-  const auto proposal = [&]() {
-    const auto p = column_proposal(guess());
-    return p ? "; " + *p : std::string();
-  };
+    guessed_ = guess_columns(table);
+  }
+  return *guessed_;
+}
 
-  // Columns.
-  int tcol = -1, vcol = -1;
+// The time and value columns: as named, else by their header names, else the two of a two-column
+// file; else the reason, with what the numbers propose.
+std::optional<std::string> DelimitedReader::choose_columns() {
+  if (cols_.size() < 2)
+    return fmt::format("no samples: line {} has {} field (delimiter {}); need a time and a value column",
+                       content_.front().number, cols_.size(), delim_name_);
   std::string why;
-  if (!options.time_column.empty()) {
-    tcol = resolve_named(options.time_column, cols, have_header, &why);
-    if (tcol < 0) return give_up("time column: " + why);
-  }
-  if (!options.value_column.empty()) {
-    vcol = resolve_named(options.value_column, cols, have_header, &why);
-    if (vcol < 0) return give_up("value column: " + why);
-  }
-  if (tcol >= 0 && tcol == vcol) return give_up(fmt::format("time and value are both column {}", tcol + 1));
+  if (!o_.time_column.empty() && (tcol_ = resolve_named(o_.time_column, cols_, have_header_, &why)) < 0)
+    return "time column: " + why;
+  if (!o_.value_column.empty() && (vcol_ = resolve_named(o_.value_column, cols_, have_header_, &why)) < 0)
+    return "value column: " + why;
+  if (tcol_ >= 0 && tcol_ == vcol_) return fmt::format("time and value are both column {}", tcol_ + 1);
   auto candidates = [&](auto pred, int exclude) {
     std::vector<int> out;
-    for (std::size_t i = 0; i < cols.size(); ++i)
-      if (static_cast<int>(i) != exclude && pred(cols[i])) out.push_back(static_cast<int>(i));
+    for (std::size_t i = 0; i < cols_.size(); ++i)
+      if (static_cast<int>(i) != exclude && pred(cols_[i])) out.push_back(static_cast<int>(i));
     return out;
   };
   auto names_of = [&](const std::vector<int>& idx) {
     std::string out;
-    for (std::size_t k = 0; k < idx.size(); ++k) out += fmt::format("{}'{}'", k ? " and " : "", cols[idx[k]].name);
+    for (std::size_t k = 0; k < idx.size(); ++k) out += fmt::format("{}'{}'", k ? " and " : "", cols_[idx[k]].name);
     return out;
   };
-  const std::string unnamed = have_header ? "" : " (the file has no header row)";
-  if (tcol < 0) {
-    auto c = candidates([](const ColumnName& col) { return is_time_name(col); }, vcol);
-    if (c.size() == 1) tcol = c[0];
-    else if (c.size() > 1)
-      return give_up(fmt::format("columns {} could each be the time; name one (time column)", names_of(c)));
-    else if (cols.size() == 2) tcol = vcol == 0 ? 1 : 0;
+  const std::string unnamed = have_header_ ? "" : " (the file has no header row)";
+  if (tcol_ < 0) {
+    auto c = candidates([](const ColumnName& col) { return is_time_name(col); }, vcol_);
+    if (c.size() == 1) tcol_ = c[0];
+    else if (c.size() > 1) return fmt::format("columns {} could each be the time; name one (time column)", names_of(c));
+    else if (cols_.size() == 2) tcol_ = vcol_ == 0 ? 1 : 0;
     else if (const auto p = column_proposal(guess()))
-      return give_up(fmt::format("cannot tell which of the {} columns is the time{}: {}", cols.size(), unnamed, *p));
+      return fmt::format("cannot tell which of the {} columns is the time{}: {}", cols_.size(), unnamed, *p);
     else
-      return give_up(fmt::format("cannot tell which of the {} columns is the time{} ({}); name it (time column)",
-                                 cols.size(), unnamed, list_columns(cols)));
+      return fmt::format("cannot tell which of the {} columns is the time{} ({}); name it (time column)", cols_.size(),
+                         unnamed, list_columns(cols_));
   }
-  if (vcol < 0) {
-    auto c = candidates([](const ColumnName& col) { return is_value_name(col); }, tcol);
-    if (c.size() == 1) vcol = c[0];
+  if (vcol_ < 0) {
+    auto c = candidates([](const ColumnName& col) { return is_value_name(col); }, tcol_);
+    if (c.size() == 1) vcol_ = c[0];
     else if (c.size() > 1)
-      return give_up(fmt::format("columns {} could each be the value; name one (value column){}", names_of(c),
-                                 proposal()));
-    else if (cols.size() == 2) vcol = tcol == 0 ? 1 : 0;
-    else if (const auto p = column_proposal(guess()); p && guess().time == tcol)
-      return give_up(fmt::format("cannot tell which of the {} columns is the value{}: {}", cols.size(), unnamed, *p));
+      return fmt::format("columns {} could each be the value; name one (value column){}", names_of(c), proposal());
+    else if (cols_.size() == 2) vcol_ = tcol_ == 0 ? 1 : 0;
+    else if (const auto p = column_proposal(guess()); p && guess().time == tcol_)
+      return fmt::format("cannot tell which of the {} columns is the value{}: {}", cols_.size(), unnamed, *p);
     else
-      return give_up(fmt::format("cannot tell which of the {} columns is the value{} ({}); name it (value column)",
-                                 cols.size(), unnamed, list_columns(cols)));
+      return fmt::format("cannot tell which of the {} columns is the value{} ({}); name it (value column)",
+                         cols_.size(), unnamed, list_columns(cols_));
   }
+  return std::nullopt;
+}
 
-  // Quantity, and the factor that turns a reading into it (mV: 0.001 V).
-  std::string quantity_from = "given";
-  std::string value_unit_name;
-  double value_scale = 1;
-  const ColumnName& value_col = cols[vcol];
-  if (options.quantity) {
-    rec.quantity = *options.quantity;
-    value_scale = options.value_scale;
+// The quantity and the factor that turns a reading into it (mV: 0.001 V): as given, else from the
+// value column's header, else volts when there is no header; and a time unit spindown reads.
+std::optional<std::string> DelimitedReader::choose_value_unit() {
+  const ColumnName& value_col = cols_[vcol_];
+  if (o_.quantity) {
+    rec_.quantity = *o_.quantity;
+    value_scale_ = o_.value_scale;
   } else if (auto u = implied_value_unit(value_col)) {
-    rec.quantity = u->quantity;
-    value_scale = u->scale;
-    value_unit_name = u->name;
-    quantity_from = "from the header";
-  } else if (!have_header) {
-    rec.quantity = Quantity::back_emf_volts;
-    quantity_from = "assumed: no header";
+    rec_.quantity = u->quantity;
+    value_scale_ = u->scale;
+    value_unit_name_ = u->name;
+    quantity_from_ = "from the header";
+  } else if (!have_header_) {
+    rec_.quantity = Quantity::back_emf_volts;
+    quantity_from_ = "assumed: no header";
   } else {
     const std::string_view likely = likely_value_unit(value_col);
-    const std::string option = likely.empty() ? std::string("--value-unit V, rpm or rad/s")
-                                              : fmt::format("--value-unit {}", likely);
+    const std::string option =
+        likely.empty() ? std::string("--value-unit V, rpm or rad/s") : fmt::format("--value-unit {}", likely);
     if (unknown_value_unit(value_col))
-      return give_up(fmt::format("value column '{}': its unit '{}' is not one spindown reads ({}); if the readings "
-                                 "are one of those under another name, say which: {}",
-                                 value_col.name, value_col.unit, value_units_read(), option));
-    return give_up(fmt::format("cannot tell the unit of value column '{}' (V, rpm or rad/s); name it: {}",
-                               value_col.name, option));
+      return fmt::format("value column '{}': its unit '{}' is not one spindown reads ({}); if the readings are one "
+                         "of those under another name, say which: {}",
+                         value_col.name, value_col.unit, value_units_read(), option);
+    return fmt::format("cannot tell the unit of value column '{}' (V, rpm or rad/s); name it: {}", value_col.name,
+                       option);
   }
-  if (!options.time_unit && !cols[tcol].unit.empty() && !parse_time_unit(cols[tcol].unit))
-    return give_up(fmt::format("time column '{}': its unit '{}' is not one spindown reads (s, ms, us); convert the "
-                               "times or name their unit: --time-unit s, ms or us",
-                               cols[tcol].name, cols[tcol].unit));
+  if (!o_.time_unit && !cols_[tcol_].unit.empty() && !parse_time_unit(cols_[tcol_].unit))
+    return fmt::format("time column '{}': its unit '{}' is not one spindown reads (s, ms, us); convert the times or "
+                       "name their unit: --time-unit s, ms or us",
+                       cols_[tcol_].name, cols_[tcol_].unit);
+  return std::nullopt;
+}
 
-  // Rows.
-  text::LineReporter reporter(rec, options.max_line_reports);
-  text::RawSamples raw(text);
-  raw.reserve(content.size());
-  std::size_t bad = 0;
-  const std::size_t need = static_cast<std::size_t>(std::max(tcol, vcol)) + 1;
-  for (std::size_t i = first_data; i < content.size(); ++i) {
-    const Line& line = content[i];
+// Each row's time and value; a row without them is said (the first few one by one) and skipped.
+void DelimitedReader::read_rows() {
+  reporter_.emplace(rec_, o_.max_line_reports);
+  raw_.reserve(content_.size());
+  const std::size_t need = static_cast<std::size_t>(std::max(tcol_, vcol_)) + 1;
+  for (std::size_t i = first_data_; i < content_.size(); ++i) {
+    const Line& line = content_[i];
     split(line.text);
-    if (fields.size() < need) {
-      ++bad;
-      reporter.warn(line.number, fmt::format("{}: {} fields, column {} is missing; skipped",
-                                             text::quote_line(line.text), fields.size(), need));
+    if (fields_.size() < need) {
+      ++bad_;
+      reporter_->warn(line.number, fmt::format("{}: {} fields, column {} is missing; skipped",
+                                               text::quote_line(line.text), fields_.size(), need));
       continue;
     }
     double t = 0, v = 0;
     std::string_view w;
-    if (!parse_number(fields[tcol], decimal_comma, t, w)) {
-      ++bad;
-      reporter.warn(line.number, fmt::format("{}: time '{}' is {}; skipped", text::quote_line(line.text),
-                                             text::escape_invalid_utf8(fields[tcol].substr(0, 40)), w));
+    if (!parse_number(fields_[tcol_], decimal_comma_, t, w)) {
+      ++bad_;
+      reporter_->warn(line.number, fmt::format("{}: time '{}' is {}; skipped", text::quote_line(line.text),
+                                               text::escape_invalid_utf8(fields_[tcol_].substr(0, 40)), w));
       continue;
     }
-    if (!parse_number(fields[vcol], decimal_comma, v, w)) {
-      ++bad;
-      reporter.warn(line.number, fmt::format("{}: value '{}' is {}; skipped", text::quote_line(line.text),
-                                             text::escape_invalid_utf8(fields[vcol].substr(0, 40)), w));
+    if (!parse_number(fields_[vcol_], decimal_comma_, v, w)) {
+      ++bad_;
+      reporter_->warn(line.number, fmt::format("{}: value '{}' is {}; skipped", text::quote_line(line.text),
+                                               text::escape_invalid_utf8(fields_[vcol_].substr(0, 40)), w));
       continue;
     }
-    raw.add(line.number, line.text.data(), t, v * value_scale, false);
+    raw_.add(line.number, line.text.data(), t, v * value_scale_, false);
   }
+}
 
-  // Time unit.
+// The time unit (given, from the header, else from the values, said), the timeline, and the
+// summary of what was read.
+void DelimitedReader::choose_time_unit_and_finish() {
   TimeUnit unit = TimeUnit::s;
   std::string unit_from = "given";
-  if (options.time_unit) {
-    unit = *options.time_unit;
-  } else if (auto u = implied_time_unit(cols[tcol])) {
+  if (o_.time_unit) {
+    unit = *o_.time_unit;
+  } else if (auto u = implied_time_unit(cols_[tcol_])) {
     unit = *u;
     unit_from = "from the header";
   } else {
     bool integral = false;
     double step = 0;
-    unit = time_unit_from_values(std::span<const double>(raw.t.data(), std::min<std::size_t>(raw.size(), 65)),
+    unit = time_unit_from_values(std::span<const double>(raw_.t.data(), std::min<std::size_t>(raw_.size(), 65)),
                                  &integral, &step);
     unit_from = "assumed";
-    rec.note(0, fmt::format("time unit not given: times {} with steps of ~{:g}, read as {}; name the unit if "
-                            "that is wrong",
-                            integral ? "are whole numbers" : "have fractions", step, time_unit_name(unit)));
+    rec_.note(0, fmt::format("time unit not given: times {} with steps of ~{:g}, read as {}; name the unit if that "
+                             "is wrong",
+                             integral ? "are whole numbers" : "have fractions", step, time_unit_name(unit)));
   }
 
   text::TimelineRules rules;
@@ -438,32 +471,55 @@ Recording read_delimited_text(std::string_view text, std::string source, const D
   rules.wrap = 0;
   rules.reset_min_back = rules.units_per_s;
   rules.drop_cut_first = false;
-  const text::TimelineCounts timeline = text::build_timeline(raw, rules, rec, reporter);
-  reporter.finish();
-  text::sort_by_line(rec);
-  rec.lines_skipped = rec.lines_read - rec.size();
+  const text::TimelineCounts timeline = text::build_timeline(raw_, rules, rec_, *reporter_);
+  reporter_->finish();
+  text::sort_by_line(rec_);
+  rec_.lines_skipped = rec_.lines_read - rec_.size();
 
   const std::string value_unit =
-      value_scale != 1 && !value_unit_name.empty()
-          ? fmt::format("{} read as {}", value_unit_name, quantity_unit(rec.quantity))
-          : value_scale != 1 ? fmt::format("{} x {:g}", quantity_unit(rec.quantity), value_scale)
-                             : std::string(quantity_unit(rec.quantity));
-  const std::string columns = fmt::format("time = column {} '{}' in {} ({}), value = column {} '{}' in {} ({}), "
-                                          "delimiter {}",
-                                          tcol + 1, cols[tcol].name, time_unit_name(unit), unit_from, vcol + 1,
-                                          cols[vcol].name, value_unit, quantity_from, delim_name);
-  if (rec.empty()) {
-    rec.error(0, fmt::format("no samples: {} lines, none with a usable time and value ({})", lines, columns));
-    return rec;
+      value_scale_ != 1 && !value_unit_name_.empty()
+          ? fmt::format("{} read as {}", value_unit_name_, quantity_unit(rec_.quantity))
+          : value_scale_ != 1 ? fmt::format("{} x {:g}", quantity_unit(rec_.quantity), value_scale_)
+                              : std::string(quantity_unit(rec_.quantity));
+  const std::string columns = fmt::format(
+      "time = column {} '{}' in {} ({}), value = column {} '{}' in {} ({}), delimiter {}", tcol_ + 1,
+      cols_[tcol_].name, time_unit_name(unit), unit_from, vcol_ + 1, cols_[vcol_].name, value_unit, quantity_from_,
+      delim_name_);
+  if (rec_.empty()) {
+    rec_.error(0, fmt::format("no samples: {} lines, none with a usable time and value ({})", lines_, columns));
+    return;
   }
-  rec.note(0, text::summary_with_counts(fmt::format("{} samples from {} lines; {}", rec.size(), lines, columns),
-                                        {{have_header ? 1u : 0u, "header row"},
-                                         {unit_rows, "units row"},
-                                         {headers, "PuTTY header"},
-                                         {comments, "comment"},
-                                         {blank, "blank"},
-                                         {bad, "unusable"}},
-                                        timeline));
+  rec_.note(0, text::summary_with_counts(fmt::format("{} samples from {} lines; {}", rec_.size(), lines_, columns),
+                                         {{have_header_ ? 1u : 0u, "header row"},
+                                          {unit_rows_, "units row"},
+                                          {headers_, "PuTTY header"},
+                                          {comments_, "comment"},
+                                          {blank_, "blank"},
+                                          {bad_, "unusable"}},
+                                         timeline));
+}
+
+}  // namespace
+
+Recording read_delimited_text(std::string_view text, std::string source, const DelimitedTextOptions& options) {
+  Recording rec;
+  rec.source = std::move(source);
+  if (!text::readable_text(text, options, "delimited text", rec)) return rec;
+  DelimitedReader reader(text, options, rec);
+  const auto give_up = [&](std::string message) {
+    rec.error(0, std::move(message));
+    rec.lines_skipped = rec.lines_read;
+    return rec;
+  };
+  reader.collect_lines();
+  if (reader.empty()) return give_up(reader.nothing_in_it());
+  reader.choose_delimiter();
+  reader.skip_cut_first_line();
+  reader.read_header();
+  if (auto why = reader.choose_columns()) return give_up(std::move(*why));
+  if (auto why = reader.choose_value_unit()) return give_up(std::move(*why));
+  reader.read_rows();
+  reader.choose_time_unit_and_finish();
   return rec;
 }
 
