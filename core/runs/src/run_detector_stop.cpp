@@ -120,6 +120,54 @@ std::string RunDetector::stall_reason(std::size_t at) const {
                      last.mean(), 100.0 * u1 / u0, rate0, rate1, least);
 }
 
+bool RunDetector::held_plateau(std::size_t i) {
+  // Friction slows a coast at every speed it passes, and T(ω) falls with ω no faster than
+  // windage's ω² (stall_reason): at level u the coast still falls at least ~(u/u0)² of its rate at
+  // u0. A hold window well above standstill whose slope is resolved far below that held a plateau:
+  // the drive holds a lower speed (a setpoint step down, an overshoot at power-on settling).
+  plateau_check_t_ = t(i) + hold_half_s_;
+  const std::size_t cut = run_.cut_index;
+  const WindowFit& h = hold_;
+  bool hit = false;
+  if (h.n >= 8 && h.first >= cut) {
+    if (!first_known_) {
+      // The coast's first hold window, clear of the one now.
+      std::size_t e = cut;
+      while (e < h.first && t(e) - t(cut) <= hold_.span_s) ++e;
+      if (e >= cut + 8 && e <= h.first) {
+        const WindowFit f = window_over(ring_.get(), mask_, 1e300, cut, e);
+        const double e_f = std::max(f.resid_sd(), coast_step_ * step_sd);
+        first_rate_ = -f.slope();
+        first_se_ = f.sxx() > 0 ? e_f / std::sqrt(f.sxx()) : INFINITY;
+        first_u_ = f.mean() - motor_zero();
+        first_known_ = true;
+      }
+    }
+    const double u1 = h.mean() - motor_zero(), e_raw = h.resid_sd(), sxx = h.sxx();
+    // A reading that holds one value is a frozen sensor's, not a drive's (the standstill checks
+    // judge it); a plateau under power shows its noise.
+    if (first_known_ && first_rate_ > 4.0 * first_se_ && first_u_ > 0 && u1 > 0.3 * first_u_ && e_raw > 0 && sxx > 0) {
+      const double se1 = std::max(e_raw, coast_step_ * step_sd) / std::sqrt(sxx), rate1 = -h.slope();
+      const double least = 0.25 * (u1 / first_u_) * (u1 / first_u_) * (first_rate_ - 2.0 * first_se_);
+      hit = rate1 < 0.5 * least && 2.0 * se1 <= 0.5 * least;
+      if (hit && plateau_hits_++ == 0) plateau_from_ = h.first;
+      if (hit && plateau_hits_ >= 2) {
+        not_coast_ = fmt::format(
+            "it fell from {:.4g} and then held level at {:.4g} from {} ({:.2g} a second, where friction would "
+            "still take off at least {:.2g}): a coast never holds a plateau — a drive stepping down to a lower "
+            "speed under power (a setpoint step, a start-up overshoot settling); the cut is looked for after it",
+            v0_, h.mean(), fmt_s(t(plateau_from_)), rate1, least);
+        const std::size_t from = plateau_from_;
+        close_unstopped(from, "held a plateau under power", Run::End::power_back);
+        to_idle(from, false, from);
+        return true;
+      }
+    }
+  }
+  if (!hit) plateau_hits_ = 0;
+  return false;
+}
+
 void RunDetector::power_back() {
   const std::size_t at = rise_start_, cut = run_.cut_index;
   not_coast_ = swing_reason(at);
@@ -288,9 +336,22 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
     // run) gives way to that zero: within 3 noise sd, 1 % of the cut's reading (level()'s
     // allowance for a flat window's drop) or one reading step. A floor clearly above it (an
     // offset only the coasting reading has) is kept.
+    // A per-revolution sensor keeps its last reading once the pulses stop: a floor reached by a
+    // jump and held exactly, far longer than any value before it, is that reading, not a zero to
+    // subtract (the shaft turning at that speed would have updated it long since).
+    std::size_t held_from = 0, longest = 1;
+    const bool held_jump = held_last_value(run_.cut_index, i + 1, held_from, longest, false);
+    const bool held_long = held_jump && i + 1 - held_from >= 5 * longest;
+    if (held_jump && !held_long && !at_end) return;  // wait and see how long it holds
     std::string floor_said;
     const double band = std::max({3.0 * sd_z, 0.01 * std::abs(v0_), reading_step(hold_.first, i + 1)});
-    if (std::isfinite(lead_in_zero_) && std::abs(z - lead_in_zero_) <= band * (1 + 1e-9) && z != lead_in_zero_) {
+    if (held_long) {
+      run_.zero_level = motor_zero();
+      floor_said = fmt::format(", the last reading of a sensor that holds it ({} samples from {}, where no value "
+                               "before it lasted more than {}), not a zero: zero level {:g}, the coast fitted up "
+                               "to that last update",
+                               i + 1 - held_from, fmt_s(t(held_from)), longest, run_.zero_level);
+    } else if (std::isfinite(lead_in_zero_) && std::abs(z - lead_in_zero_) <= band * (1 + 1e-9) && z != lead_in_zero_) {
       run_.zero_level = lead_in_zero_;
       floor_said = fmt::format(", not to be told from the lead-in's zero, so zero level {:g}", lead_in_zero_);
     } else if (std::isfinite(rest_level_) && z > rest_level_ &&
@@ -309,7 +370,7 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
         fmt_s(run_.t_cut_s), z, floor_said, end_rate > 0 ? 1.0 / end_rate : 0.0, fmt_s(t(i)));
     run_.stopped = false;
     run_.end = Run::End::asymptotic;
-    complete_run(i + 1);
+    complete_run(held_long ? held_from + 1 : i + 1);
     to_idle(i + 1, true);
   }
 }
