@@ -173,3 +173,36 @@ TEST(OtherRigs, AFifteenReadingFastCoarseCoastIsFound) {
   EXPECT_TRUE(seg.runs[0].stopped);
   EXPECT_NEAR(seg.runs[0].t_stop_s, t_cut + coast.stop_s, 0.33);
 }
+
+// A trainer's roller read by one magnet per revolution: the speed is 2π over the time between the
+// last two pulses, logged at 10 Hz and held between pulses, so once the roller stops the last
+// pulse's speed is held for good. That held value is no zero level to subtract: the motor's zero
+// is 0.
+TEST(OtherRigs, APerRevolutionSensorsHeldReadingAtRestIsNotTheZeroLevel) {
+  const Friction f{0.015, 2e-3, 0.015};
+  const double top = 62.83, t_cut = 8.04;
+  const Coast coast(f, top);
+  const double dt = 1e-4;
+  Recording rec;
+  rec.source = "physics";
+  double angle = 0, last_pulse = -1, prev_pulse = -1, held = top, next_log = 0.1, w = top;
+  for (double t = 0; t <= t_cut + coast.stop_s + 20; t += dt) {
+    w = t < t_cut ? top : coast.at(t - t_cut);
+    angle += w * dt;
+    if (angle >= 2 * M_PI) {
+      angle -= 2 * M_PI;
+      prev_pulse = last_pulse;
+      last_pulse = t;
+      if (prev_pulse >= 0) held = 2 * M_PI / (last_pulse - prev_pulse);
+    }
+    if (t >= next_log) {
+      rec.push(next_log, std::round(held * 100) / 100);
+      next_log += 0.1;
+    }
+  }
+  ASSERT_GT(held, 3.0);  // the roller stopped a few rad/s after its last pulse
+  const Segmentation seg = find_runs(rec);
+  ASSERT_EQ(seg.runs.size(), 1u);
+  EXPECT_NEAR(seg.runs[0].t_cut_s, t_cut, 0.2);
+  EXPECT_LT(std::abs(seg.runs[0].zero_level), 0.05 * held);
+}

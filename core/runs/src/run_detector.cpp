@@ -835,7 +835,8 @@ bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
   reset_window(hold_, run_.cut_index, i + 1);
   plateau_check_t_ = run_.t_cut_s + 2.0 * hold_.span_s;  // once the hold window is clear of the first one
   plateau_hits_ = 0;
-  first_known_ = false;
+  half_cursor_ = run_.cut_index;
+  coast_rate0_ = std::max(0.0, -sp.post_slope);
   hold_long_live_ = false;  // built when the coast gets low (saves work on the way down)
   creeping_ = false;
   coast_checks(i, ring_[i & mask_]);

@@ -147,8 +147,8 @@ std::string RunDetector::small_beside(double amp, double coast_s, double largest
 bool RunDetector::held_last_value(std::size_t cut, std::size_t end, std::size_t& held_from, std::size_t& longest,
                                   bool need_long) const {
   // The last value read up to end, held exactly, well above the motor's zero, reached by a jump of
-  // many reading steps (an rpm counter's last update, not the one step a coarse reading takes onto
-  // a real offset), and (need_long) held five times longer than any value of the coast before it.
+  // several of the reading's steps (an rpm counter's last update, not the one step a coarse reading
+  // takes onto a real offset), and (need_long) held five times longer than any value before it.
   const double z = v(end - 1);
   held_from = end - 1;
   while (held_from > cut && v(held_from - 1) == z) --held_from;
@@ -157,7 +157,6 @@ bool RunDetector::held_last_value(std::size_t cut, std::size_t end, std::size_t&
   if (held < 10 || held_from < cut + 10) return false;
   const double zero = motor_zero();
   if (!(z - zero > std::max(0.02 * (v0_ - zero), 3.0 * coast_step_))) return false;
-  if (!(v(held_from - 1) - z > 10.0 * coast_step_)) return false;
   std::size_t from = held_from, cur = 1;
   while (from > cut && t(held_from) - t(from - 1) <= 2.0) --from;
   for (std::size_t k = from + 1; k < held_from; ++k) {
@@ -165,15 +164,19 @@ bool RunDetector::held_last_value(std::size_t cut, std::size_t end, std::size_t&
     longest = std::max(longest, cur);
   }
   if ((need_long && held < 5 * longest) || held_from < from + 3) return false;
-  // The reading's resolution there (the smallest gap between the values it took): a level of a
-  // step or two above zero is a coarse reading's offset, not a frozen one.
+  // The reading's resolution over the coast (the smallest gap between the values it took; a
+  // per-revolution reading's values lie far apart near the end, close together at speed): a level
+  // of a step or two above zero is a coarse reading's offset, not a frozen one.
+  constexpr std::size_t look = 5000;
   std::vector<double> x;
-  for (std::size_t k = from; k < held_from; ++k) x.push_back(v(k));
+  for (std::size_t k = held_from > cut + look ? held_from - look : cut; k < held_from; ++k) x.push_back(v(k));
   std::sort(x.begin(), x.end());
   double resolution = std::numeric_limits<double>::infinity();
   for (std::size_t k = 1; k < x.size(); ++k)
     if (x[k] > x[k - 1]) resolution = std::min(resolution, x[k] - x[k - 1]);
-  return z - zero > 3.0 * resolution;
+  // Reached by a jump (a per-revolution counter's last update), not the one step a coarse reading
+  // takes onto a real offset.
+  return z - zero > 3.0 * resolution && v(held_from - 1) - z > 2.0 * resolution;
 }
 
 void RunDetector::warn_of_held_standstill(const Run& r) {

@@ -121,35 +121,38 @@ std::string RunDetector::stall_reason(std::size_t at) const {
 }
 
 bool RunDetector::held_plateau(std::size_t i) {
-  // Friction slows a coast at every speed it passes, and T(ω) falls with ω no faster than
-  // windage's ω² (stall_reason): at level u the coast still falls at least ~(u/u0)² of its rate at
-  // u0. A hold window well above standstill whose slope is resolved far below that held a plateau:
-  // the drive holds a lower speed (a setpoint step down, an overshoot at power-on settling).
+  // Friction slows a coast at every speed it passes, fastest at its top (T(ω) grows with ω), and
+  // T falls with ω no faster than windage's ω² (stall_reason): at level u the coast still falls at
+  // least (u/u0)² of its rate at the cut's u0, which is at least its mean rate over the first half
+  // of its fall to u. A hold window well above standstill whose slope is resolved far below a
+  // quarter of that held a plateau: the drive holds a lower speed (a setpoint step down, an
+  // overshoot at power-on settling).
   plateau_check_t_ = t(i) + hold_half_s_;
-  const std::size_t cut = run_.cut_index;
   const WindowFit& h = hold_;
   bool hit = false;
-  if (h.n >= 8 && h.first >= cut) {
-    if (!first_known_) {
-      // The coast's first hold window, clear of the one now.
-      std::size_t e = cut;
-      while (e < h.first && t(e) - t(cut) <= hold_.span_s) ++e;
-      if (e >= cut + 8 && e <= h.first) {
-        const WindowFit f = window_over(ring_.get(), mask_, 1e300, cut, e);
-        const double e_f = std::max(f.resid_sd(), coast_step_ * step_sd);
-        first_rate_ = -f.slope();
-        first_se_ = f.sxx() > 0 ? e_f / std::sqrt(f.sxx()) : INFINITY;
-        first_u_ = f.mean() - motor_zero();
-        first_known_ = true;
-      }
+  const double mu = h.mean(), zero = motor_zero(), u0 = v0_ - zero, u1 = mu - zero;
+  // The first crossing of half the fall (the cursor only moves on: a coast's level only falls, and
+  // a later crossing gives a lower rate, the safe side).
+  const double half = mu + 0.5 * (v0_ - mu);
+  half_cursor_ = std::max(half_cursor_, run_.cut_index);
+  while (half_cursor_ < h.first && v(half_cursor_) > half) ++half_cursor_;
+  const double e_raw = h.resid_sd(), sxx = h.sxx(), e = std::max(e_raw, coast_step_ * step_sd);
+  // A reading that holds one value is a frozen sensor's, not a drive's (the standstill checks
+  // judge it); a plateau under power shows its noise.
+  if (h.n >= 8 && h.first > run_.cut_index && u0 > 0 && u1 > 0.3 * u0 && e_raw > 0 && sxx > 0) {
+    // The coast's rate at its top: the line the cut search found at its start, or the mean rate over
+    // the first half of a fall that stands well out of the noise and spans a few samples (a lab
+    // motor's reading drops a step at the cut, the winding's transient, and then coasts slowly).
+    double top_rate = coast_rate0_;
+    if (half_cursor_ < h.first && half_cursor_ >= run_.cut_index + 3 && v0_ - mu > 10.0 * e) {
+      const double to_half = quarter_crossing_time(half_cursor_, run_.cut_index, half) - run_.t_cut_s;
+      if (to_half > 0) top_rate = std::max(top_rate, 0.5 * (v0_ - mu) / to_half);
     }
-    const double u1 = h.mean() - motor_zero(), e_raw = h.resid_sd(), sxx = h.sxx();
-    // A reading that holds one value is a frozen sensor's, not a drive's (the standstill checks
-    // judge it); a plateau under power shows its noise.
-    if (first_known_ && first_rate_ > 4.0 * first_se_ && first_u_ > 0 && u1 > 0.3 * first_u_ && e_raw > 0 && sxx > 0) {
-      const double se1 = std::max(e_raw, coast_step_ * step_sd) / std::sqrt(sxx), rate1 = -h.slope();
-      const double least = 0.25 * (u1 / first_u_) * (u1 / first_u_) * (first_rate_ - 2.0 * first_se_);
-      hit = rate1 < 0.5 * least && 2.0 * se1 <= 0.5 * least;
+    {
+      const double ratio = std::min(u1, u0) / u0;
+      const double se1 = e / std::sqrt(sxx), rate1 = -h.slope();
+      const double least = 0.25 * ratio * ratio * top_rate;
+      hit = least > 0 && rate1 < 0.5 * least && 2.0 * se1 <= 0.5 * least;
       if (hit && plateau_hits_++ == 0) plateau_from_ = h.first;
       if (hit && plateau_hits_ >= 2) {
         not_coast_ = fmt::format(

@@ -249,8 +249,8 @@ class RunDetector {
   double plateau_check_t_ = std::numeric_limits<double>::infinity();
   int plateau_hits_ = 0;
   std::size_t plateau_from_ = 0;  // the hold window's first sample at the first hit
-  bool first_known_ = false;      // the coast's first hold window's rate, its error and level (above zero):
-  double first_rate_ = 0, first_se_ = 0, first_u_ = 0;
+  std::size_t half_cursor_ = 0;   // the first sample of the open coast below half its fall so far
+  double coast_rate0_ = 0;        // the open coast's rate at its cut (the cut search's line), ≥ 0
   std::string not_coast_;  // set: the open run is ignored with this warning when it completes
   // A coast never rises: when the reading rose inside r's coast [cut, coast_end) by far more than its
   // noise, what came before the rise was no part of it (an open pin's swing before it was connected,
