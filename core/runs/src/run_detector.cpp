@@ -555,9 +555,12 @@ bool RunDetector::smooth_curve(const WindowFit& w, double mu, double drop) const
   // so a line misses it by more than a twentieth of its level while each reading follows the curve:
   // its sample-to-sample noise (second differences cancel the bend) is small beside what it fell.
   // An open pin's hum is rough from sample to sample.
-  // A window of a second or more: a shorter one of a coarse counter is a few readings, whose bend
-  // (the cut's kink) the cut search needs more of the coast to place.
-  return w.n >= 8 && w.span_s >= 1.0 && rough_sd(w.first, w.end) <= confirm_max_roughness * std::max(mu, drop);
+  // Only a window of a second or more (a shorter one of a coarse counter is a few readings, whose
+  // bend - the cut's kink - the cut search needs more of the coast to place) that holds few
+  // readings (a slow logger: 8-16 over the second): with more, a line follows a coast's bend
+  // within the window closely enough.
+  return w.n >= 8 && w.n <= 16 && w.span_s >= 1.0 &&
+         rough_sd(w.first, w.end) <= confirm_max_roughness * std::max(mu, drop);
 }
 
 void RunDetector::idle_step(std::size_t i, Sample s, double prev_t) {
@@ -836,7 +839,6 @@ bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
   plateau_check_t_ = run_.t_cut_s + 2.0 * hold_.span_s;  // once the hold window is clear of the first one
   plateau_hits_ = 0;
   half_cursor_ = run_.cut_index;
-  coast_rate0_ = std::max(0.0, -sp.post_slope);
   hold_long_live_ = false;  // built when the coast gets low (saves work on the way down)
   creeping_ = false;
   coast_checks(i, ring_[i & mask_]);

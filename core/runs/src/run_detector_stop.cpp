@@ -131,22 +131,23 @@ bool RunDetector::held_plateau(std::size_t i) {
   const WindowFit& h = hold_;
   bool hit = false;
   const double mu = h.mean(), zero = motor_zero(), u0 = v0_ - zero, u1 = mu - zero;
-  // The first crossing of half the fall (the cursor only moves on: a coast's level only falls, and
-  // a later crossing gives a lower rate, the safe side).
-  const double half = mu + 0.5 * (v0_ - mu);
+  // The first crossing of a quarter of the fall above the plateau (the cursor only moves on: a
+  // coast's level only falls, and a later crossing gives a lower rate, the safe side).
+  const double near = mu + 0.25 * (v0_ - mu);
   half_cursor_ = std::max(half_cursor_, run_.cut_index);
-  while (half_cursor_ < h.first && v(half_cursor_) > half) ++half_cursor_;
+  while (half_cursor_ < h.first && v(half_cursor_) > near) ++half_cursor_;
   const double e_raw = h.resid_sd(), sxx = h.sxx(), e = std::max(e_raw, coast_step_ * step_sd);
   // A reading that holds one value is a frozen sensor's, not a drive's (the standstill checks
   // judge it); a plateau under power shows its noise.
   if (h.n >= 8 && h.first > run_.cut_index && u0 > 0 && u1 > 0.3 * u0 && e_raw > 0 && sxx > 0) {
-    // The coast's rate at its top: the line the cut search found at its start, or the mean rate over
-    // the first half of a fall that stands well out of the noise and spans a few samples (a lab
-    // motor's reading drops a step at the cut, the winding's transient, and then coasts slowly).
-    double top_rate = coast_rate0_;
+    // The coast's rate at its top is at least its mean rate over the first three quarters of its
+    // fall to the plateau, a fall that stands well out of the noise and spans a few samples (a lab
+    // motor's reading drops a step at the cut, its winding's transient, and then coasts slowly: a
+    // mean over most of the fall is not misled by it).
+    double top_rate = 0;
     if (half_cursor_ < h.first && half_cursor_ >= run_.cut_index + 3 && v0_ - mu > 10.0 * e) {
-      const double to_half = quarter_crossing_time(half_cursor_, run_.cut_index, half) - run_.t_cut_s;
-      if (to_half > 0) top_rate = std::max(top_rate, 0.5 * (v0_ - mu) / to_half);
+      const double to_near = quarter_crossing_time(half_cursor_, run_.cut_index, near) - run_.t_cut_s;
+      if (to_near > 0) top_rate = 0.75 * (v0_ - mu) / to_near;
     }
     {
       const double ratio = std::min(u1, u0) / u0;
@@ -154,7 +155,7 @@ bool RunDetector::held_plateau(std::size_t i) {
       const double least = 0.25 * ratio * ratio * top_rate;
       hit = least > 0 && rate1 < 0.5 * least && 2.0 * se1 <= 0.5 * least;
       if (hit && plateau_hits_++ == 0) plateau_from_ = h.first;
-      if (hit && plateau_hits_ >= 2) {
+      if (hit && plateau_hits_ >= 3) {
         not_coast_ = fmt::format(
             "it fell from {:.4g} and then held level at {:.4g} from {} ({:.2g} a second, where friction would "
             "still take off at least {:.2g}): a coast never holds a plateau — a drive stepping down to a lower "

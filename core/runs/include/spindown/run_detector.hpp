@@ -242,15 +242,14 @@ class RunDetector {
   std::string stall_reason(std::size_t at) const;
   // A coast never holds a plateau: friction slows it at every speed it passes. Whether the open
   // coast, high above standstill at sample i, has held level (hold_) where friction would still
-  // take speed off fast, twice in a row: then its fall was a drive stepping down under power (a
+  // take speed off fast, three times in a row (a second and more): then its fall was a drive stepping down under power (a
   // setpoint step, a start-up overshoot settling), and the coast is given up (ignored, with why),
   // its plateau the next cut's lead-in. Checked every half hold window (plateau_check_t_).
   bool held_plateau(std::size_t i);
   double plateau_check_t_ = std::numeric_limits<double>::infinity();
   int plateau_hits_ = 0;
   std::size_t plateau_from_ = 0;  // the hold window's first sample at the first hit
-  std::size_t half_cursor_ = 0;   // the first sample of the open coast below half its fall so far
-  double coast_rate0_ = 0;        // the open coast's rate at its cut (the cut search's line), ≥ 0
+  std::size_t half_cursor_ = 0;   // the open coast's first sample within a quarter of its fall of the level held now
   std::string not_coast_;  // set: the open run is ignored with this warning when it completes
   // A coast never rises: when the reading rose inside r's coast [cut, coast_end) by far more than its
   // noise, what came before the rise was no part of it (an open pin's swing before it was connected,
