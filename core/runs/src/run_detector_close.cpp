@@ -187,6 +187,9 @@ void RunDetector::warn_of_held_standstill(const Run& r) {
   if (r.end_index < r.stop_index + 10 || r.stop_index < r.cut_index + 10) return;
   std::size_t held_from = 0, longest = 1;
   if (!held_last_value(r.cut_index, r.end_index, held_from, longest, true)) return;
+  // … reached by a jump of many of the coast's steps (said only then: a coarse reading's last
+  // steps onto a value held at rest are no sign of a frozen sensor).
+  if (!(v(held_from - 1) - v(r.end_index - 1) > 10.0 * coast_step_)) return;
   const std::size_t held = r.end_index - held_from;
   if (5 * held < 4 * (r.end_index - r.stop_index)) return;  // most of the standstill
   const double z = v(r.end_index - 1), zero = motor_zero();

@@ -139,7 +139,8 @@ bool RunDetector::held_plateau(std::size_t i) {
   const double e_raw = h.resid_sd(), sxx = h.sxx(), e = std::max(e_raw, coast_step_ * step_sd);
   // A reading that holds one value is a frozen sensor's, not a drive's (the standstill checks
   // judge it); a plateau under power shows its noise.
-  if (h.n >= 8 && h.first > run_.cut_index && u0 > 0 && u1 > 0.3 * u0 && e_raw > 0 && sxx > 0) {
+  const bool one_value = same_start_ <= h.first;  // every reading in the window the same (rounding aside)
+  if (h.n >= 8 && h.first > run_.cut_index && u0 > 0 && u1 > 0.3 * u0 && !one_value && e_raw > 0 && sxx > 0) {
     // The coast's rate at its top is at least its mean rate over the first three quarters of its
     // fall to the plateau, a fall that stands well out of the noise and spans a few samples (a lab
     // motor's reading drops a step at the cut, its winding's transient, and then coasts slowly: a
