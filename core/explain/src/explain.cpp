@@ -455,8 +455,9 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
       pending = nullptr;
     }
     // Lookahead: two effects together against the best one alone. The pair wins by more than the
-    // 3 in BIC within which two models cannot be told apart; between pairs within 3 of each
-    // other the one with fewer parameters.
+    // 3 in BIC within which two models cannot be told apart, its second effect adds more than
+    // min_delta_bic to its first, and it moves the model by half a reading step somewhere; between
+    // pairs within 3 of each other the one with fewer parameters.
     if (best && !forced && pool.size() >= 2) {
       struct Pair {
         const CandidateTrial *a, *b;
@@ -476,7 +477,9 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
           if (!std::isfinite(f.sse) || f.sse <= 0) continue;
           const int extra = static_cast<int>(f.theta.size()) - static_cast<int>(current.theta.size());
           const double d = n_eff * std::log(current.sse / f.sse) - extra * std::log(n_eff);
-          if (d > best->delta_bic + 3 && d > opt.min_delta_bic && largest_change(current, f, m) >= 0.5 * quantum)
+          // … and the second effect earns its place beside the first (as a step of its own would).
+          if (d > best->delta_bic + 3 && d - std::max(a.delta_bic, b.delta_bic) > opt.min_delta_bic &&
+              largest_change(current, f, m) >= 0.5 * quantum)
             pairs.push_back({&a, &b, d, f.theta.size()});
         }
       const Pair* chosen = nullptr;
