@@ -454,10 +454,12 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
       if (!best || best->effect != pending->name) best = nullptr;
       pending = nullptr;
     }
-    // Lookahead: two effects together against the best one alone. The pair wins by more than the
-    // 3 in BIC within which two models cannot be told apart, its second effect adds more than
-    // min_delta_bic to its first, and it moves the model by half a reading step somewhere; between
-    // pairs within 3 of each other the one with fewer parameters.
+    // Lookahead: two effects together against the best one alone. The pair must win by more than
+    // the 3 in BIC within which two models cannot be told apart - by min_delta_bic, as a step
+    // would, when it has more parameters than the best one alone, which must then leave a
+    // systematic disagreement (else the greedy search rightly stops there: the residual is noise);
+    // its second effect must add more than min_delta_bic to its first, and the pair move the model
+    // by half a reading step somewhere. Between pairs within 3 of each other, fewer parameters.
     if (best && !forced && pool.size() >= 2) {
       struct Pair {
         const CandidateTrial *a, *b;
@@ -465,6 +467,8 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
         std::size_t params;
       };
       std::vector<Pair> pairs;
+      const ResidualBins left = bin_residuals(residual_of(out.y, best->fit), m, noise);
+      const bool best_leaves_some = mass_significant(systematic_mass(left, bins.bin_se), left.mean.size());
       for (const auto& a : st.trials)
         for (const auto& b : st.trials) {
           if (&a >= &b || !a.impossible.empty() || !b.impossible.empty() || !std::isfinite(a.delta_bic) ||
@@ -473,12 +477,14 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
           const Effect* ea = find_effect(a.effect);
           const Effect* eb = find_effect(b.effect);
           if (!ea || !eb) continue;
+          const bool more = a.fit.theta.size() + eb->size() > best->fit.theta.size();
+          if (more && !best_leaves_some) continue;
           const EffectFit f = fit_effects(with_effect(with_effect(current.effects, ea), eb), data, &a.fit);
           if (!std::isfinite(f.sse) || f.sse <= 0) continue;
           const int extra = static_cast<int>(f.theta.size()) - static_cast<int>(current.theta.size());
           const double d = n_eff * std::log(current.sse / f.sse) - extra * std::log(n_eff);
-          // … and the second effect earns its place beside the first (as a step of its own would).
-          if (d > best->delta_bic + 3 && d - std::max(a.delta_bic, b.delta_bic) > opt.min_delta_bic &&
+          const double margin = more ? opt.min_delta_bic : 3.0;
+          if (d > best->delta_bic + margin && d - std::max(a.delta_bic, b.delta_bic) > opt.min_delta_bic &&
               largest_change(current, f, m) >= 0.5 * quantum)
             pairs.push_back({&a, &b, d, f.theta.size()});
         }
