@@ -185,6 +185,8 @@ TEST(OtherRigs, APerRevolutionSensorsHeldReadingAtRestIsNotTheZeroLevel) {
   const double dt = 1e-4;
   Recording rec;
   rec.source = "physics";
+  std::mt19937 rng(3221);
+  std::normal_distribution<double> jitter(0, 2e-4);
   double angle = 0, last_pulse = -1, prev_pulse = -1, held = top, next_log = 0.1, w = top;
   for (double t = 0; t <= t_cut + coast.stop_s + 20; t += dt) {
     w = t < t_cut ? top : coast.at(t - t_cut);
@@ -192,7 +194,7 @@ TEST(OtherRigs, APerRevolutionSensorsHeldReadingAtRestIsNotTheZeroLevel) {
     if (angle >= 2 * M_PI) {
       angle -= 2 * M_PI;
       prev_pulse = last_pulse;
-      last_pulse = t;
+      last_pulse = t + jitter(rng);  // the pulse's edge, timed to ±0.2 ms
       if (prev_pulse >= 0) held = 2 * M_PI / (last_pulse - prev_pulse);
     }
     if (t >= next_log) {
