@@ -61,6 +61,15 @@ Recording sample(double period, double end_s, const std::function<double(double)
   return rec;
 }
 
+// One run, cut and stopped where the physics put them, within the tolerances given.
+void expect_one_run(const Recording& rec, double t_cut, double cut_tol, double t_stop, double stop_tol) {
+  const Segmentation seg = find_runs(rec);
+  ASSERT_EQ(seg.runs.size(), 1u);
+  EXPECT_NEAR(seg.runs[0].t_cut_s, t_cut, cut_tol);
+  EXPECT_TRUE(seg.runs[0].stopped);
+  EXPECT_NEAR(seg.runs[0].t_stop_s, t_stop, stop_tol);
+}
+
 }  // namespace
 
 // A spindle on a drive: up to 314 rad/s, the setpoint lowered to 209 rad/s at the drive's braked
@@ -110,11 +119,7 @@ TEST(OtherRigs, ASlowPoweredRampToAPlateauThenTheCut) {
   std::normal_distribution<double> noise(0, 0.05);
   const Recording rec = sample(0.05, t_cut + coast.stop_s + 4, speed,
                                [&](double w) { return w > 0 ? std::round((w + noise(rng)) * 100) / 100 : 0.0; });
-  const Segmentation seg = find_runs(rec);
-  ASSERT_EQ(seg.runs.size(), 1u);
-  EXPECT_NEAR(seg.runs[0].t_cut_s, t_cut, 0.1);
-  EXPECT_TRUE(seg.runs[0].stopped);
-  EXPECT_NEAR(seg.runs[0].t_stop_s, t_cut + coast.stop_s, 0.15);
+  expect_one_run(rec, t_cut, 0.1, t_cut + coast.stop_s, 0.15);
 }
 
 // A servo's velocity loop at power-on: 37 % overshoot (ζ = 0.3, ω_n = 25 rad/s) that rings down
@@ -135,11 +140,7 @@ TEST(OtherRigs, AStartUpOvershootThatRingsAndSettlesIsNotACut) {
   std::mt19937 rng(3203);
   std::normal_distribution<double> noise(0, 0.2);
   const Recording rec = sample(0.01, t_cut + coast.stop_s + 3, speed, [&](double w) { return w + noise(rng); });
-  const Segmentation seg = find_runs(rec);
-  ASSERT_EQ(seg.runs.size(), 1u);
-  EXPECT_NEAR(seg.runs[0].t_cut_s, t_cut, 0.02);
-  EXPECT_TRUE(seg.runs[0].stopped);
-  EXPECT_NEAR(seg.runs[0].t_stop_s, t_cut + coast.stop_s, 0.05);
+  expect_one_run(rec, t_cut, 0.02, t_cut + coast.stop_s, 0.05);
 }
 
 // A tiny drone motor with its propeller (windage 20 times its bearing friction at the top speed)
@@ -167,11 +168,7 @@ TEST(OtherRigs, AFifteenReadingFastCoarseCoastIsFound) {
     prev = a;
     rec.push(t, count * step);
   }
-  const Segmentation seg = find_runs(rec);
-  ASSERT_EQ(seg.runs.size(), 1u);
-  EXPECT_NEAR(seg.runs[0].t_cut_s, t_cut, 0.2);
-  EXPECT_TRUE(seg.runs[0].stopped);
-  EXPECT_NEAR(seg.runs[0].t_stop_s, t_cut + coast.stop_s, 0.33);
+  expect_one_run(rec, t_cut, 0.2, t_cut + coast.stop_s, 0.33);
 }
 
 // A trainer's roller read by one magnet per revolution: the speed is 2π over the time between the
