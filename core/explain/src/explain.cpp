@@ -277,7 +277,12 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
   // Noise and bins: the period from the samples, bins of ~bin_s.
   const double span_s = n > 1 ? out.tau.back() - out.tau.front() : 0.0;
   const double period = n > 1 ? span_s / static_cast<double>(n - 1) : 0.02;
-  const std::size_t m = std::max<std::size_t>(5, static_cast<std::size_t>(std::lround(opt.bin_s / std::max(period, 1e-6))));
+  // A short fast coast (a propeller's 1.5 s) gets bins of a tenth of it, so that its bend spans
+  // several bins: three bins of half a second each would hold it all, and their jumps, the misfit
+  // itself, would pass for noise.
+  const double coast_s = moving > 1 ? out.tau[std::min(moving, n) - 1] - out.tau.front() : span_s;
+  const double bin_s = std::min(opt.bin_s, std::max(coast_s, 0.0) / 10.0);
+  const std::size_t m = std::max<std::size_t>(5, static_cast<std::size_t>(std::lround(bin_s / std::max(period, 1e-6))));
   out.bin_samples = m;
   const double noise = out.reading_noise;
 
@@ -323,6 +328,11 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
     }
     return any;
   };
+  // The second of two effects that together fit better than any one effect alone (a lookahead:
+  // windage and Coulomb friction on a fan, where Stribeck alone bends the coast almost as well and
+  // the greedy choice would stop there): added at the next step whatever that step's residual says.
+  const Effect* pending = nullptr;
+  std::string pending_why;
   for (int step = 0;; ++step) {
     const std::vector<double> res = residual_of(out.y, current);
     const ResidualBins bins = bin_residuals(res, m, noise);
@@ -333,12 +343,12 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
     if (where.empty() && mass_significant(mass, bins.mean.size()))
       // Spread out rather than concentrated: show where it is largest at a lower threshold.
       where = locate(bins, bins.bin_se, 0.6 * opt.systematic_z, out.tau, res, speed, run.t_cut_s);
-    if (where.empty() && !mass_significant(mass, bins.mean.size())) {
+    if (where.empty() && !mass_significant(mass, bins.mean.size()) && !pending) {
       out.remaining = where;
       out.conclusion = fmt::format(
           "nothing significant remains: no {:.2g}-s stretch of the residual is beyond {:.0f}x a bin's noise ({:.2g} {}), "
           "and the bins together are consistent with noise",
-          opt.bin_s, opt.systematic_z, bins.bin_se, out.unit);
+          double(m) * period, opt.systematic_z, bins.bin_se, out.unit);
       break;
     }
     if (step >= opt.max_steps) {
@@ -403,16 +413,76 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
       t.change = largest_change(current, t.fit, m);
       if (t.impossible.empty() && (!best || t.delta_bic > best->delta_bic)) best = &t;
     }
+    // The pair added at the step before: its second effect now.
+    const bool forced = pending != nullptr;
+    if (forced) {
+      for (auto& t : st.trials)
+        if (t.effect == pending->name && t.impossible.empty() && std::isfinite(t.delta_bic) && t.delta_bic > 0) best = &t;
+      if (!best || best->effect != pending->name) best = nullptr;
+      pending = nullptr;
+    }
+    // Lookahead: two effects together against the best one alone. The pair must win by more than
+    // the 3 in BIC within which two models cannot be told apart - by min_delta_bic, as a step
+    // would, when it has more parameters than the best one alone, which must then leave a
+    // systematic disagreement (else the greedy search rightly stops there: the residual is noise);
+    // its second effect must add more than min_delta_bic to its first, and the pair move the model
+    // by half a reading step somewhere. Between pairs within 3 of each other, fewer parameters.
+    if (best && !forced && pool.size() >= 2) {
+      struct Pair {
+        const CandidateTrial *a, *b;
+        double bic;
+        std::size_t params;
+      };
+      std::vector<Pair> pairs;
+      const ResidualBins left = bin_residuals(residual_of(out.y, best->fit), m, noise);
+      const bool best_leaves_some = mass_significant(systematic_mass(left, bins.bin_se), left.mean.size());
+      for (const auto& a : st.trials)
+        for (const auto& b : st.trials) {
+          if (&a >= &b || !a.impossible.empty() || !b.impossible.empty() || !std::isfinite(a.delta_bic) ||
+              !std::isfinite(b.delta_bic))
+            continue;
+          const Effect* ea = find_effect(a.effect);
+          const Effect* eb = find_effect(b.effect);
+          if (!ea || !eb) continue;
+          const bool more = a.fit.theta.size() + eb->size() > best->fit.theta.size();
+          if (more && !best_leaves_some) continue;
+          const EffectFit f = fit_effects(with_effect(with_effect(current.effects, ea), eb), data, &a.fit);
+          if (!std::isfinite(f.sse) || f.sse <= 0) continue;
+          const int extra = static_cast<int>(f.theta.size()) - static_cast<int>(current.theta.size());
+          const double d = n_eff * std::log(current.sse / f.sse) - extra * std::log(n_eff);
+          const double margin = more ? opt.min_delta_bic : 3.0;
+          if (d > best->delta_bic + margin && d - std::max(a.delta_bic, b.delta_bic) > opt.min_delta_bic &&
+              largest_change(current, f, m) >= 0.5 * quantum)
+            pairs.push_back({&a, &b, d, f.theta.size()});
+        }
+      const Pair* chosen = nullptr;
+      for (const Pair& p : pairs)
+        if (!chosen || p.bic > chosen->bic) chosen = &p;
+      for (const Pair& p : pairs)
+        if (chosen && p.bic > chosen->bic - 3 && p.params < chosen->params) chosen = &p;
+      const CandidateTrial* pa = chosen ? chosen->a : nullptr;
+      const CandidateTrial* pb = chosen ? chosen->b : nullptr;
+      const double pair_bic = chosen ? chosen->bic : 0.0;
+      if (pa) {
+        if (pb->delta_bic > pa->delta_bic) std::swap(pa, pb);
+        pending = find_effect(pb->effect);
+        pending_why = fmt::format("; with {} to follow: the two together fit better than {} alone (dBIC {:.1f} vs {:.1f})",
+                                  pb->effect, best->effect, pair_bic, best->delta_bic);
+        for (auto& t : st.trials)
+          if (&t == pa) best = &t;
+      }
+    }
     // Evidence that cannot separate two effects (within 3 in BIC) goes to the simpler one.
-    for (auto& t : st.trials)
-      if (best && &t != best && t.impossible.empty() && std::isfinite(t.delta_bic) &&
-          t.delta_bic > best->delta_bic - 3 && t.fit.theta.size() < best->fit.theta.size() &&
-          t.systematic_after <= best->systematic_after + 0.05)
-        best = &t;
+    if (!pending && !forced)
+      for (auto& t : st.trials)
+        if (best && &t != best && t.impossible.empty() && std::isfinite(t.delta_bic) &&
+            t.delta_bic > best->delta_bic - 3 && t.fit.theta.size() < best->fit.theta.size() &&
+            t.systematic_after <= best->systematic_after + 0.05)
+          best = &t;
     // As many parameters and within 3 in BIC: the run cannot tell them apart. The choice is fixed
     // (friction before a sensor effect, then library order) and said, never made silently.
     std::vector<CandidateTrial*> twins;
-    if (best)
+    if (best && !pending && !forced)
       for (auto& t : st.trials)
         if (&t != best && t.impossible.empty() && std::isfinite(t.delta_bic) &&
             std::abs(t.delta_bic - best->delta_bic) < 3 && t.fit.theta.size() == best->fit.theta.size() &&
@@ -428,8 +498,11 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
       best = twins.front();
       twins.erase(twins.begin());
     }
-    const bool enough = best && best->delta_bic > opt.min_delta_bic && best->systematic_after < max_left &&
-                        best->change >= 0.5 * quantum;
+    // A pair's first effect stands on the pair's evidence and change (checked when it was chosen),
+    // its second on the step's own BIC.
+    const bool enough = best && (pending || (best->delta_bic > opt.min_delta_bic &&
+                                             (forced || (best->systematic_after < max_left && best->change >= 0.5 * quantum))));
+    if (!enough) pending = nullptr;
     for (auto& t : st.trials) {
       if (!t.verdict.empty()) continue;
       if (&t == best && enough) {
@@ -504,6 +577,7 @@ ExplainResult explain_run(std::span<const double> t_s, std::span<const double> v
                          "the systematic disagreement left",
                          best->effect, best->delta_bic, n_eff, current.rmse, best->fit.rmse, out.unit,
                          current.rmse / best->fit.rmse, 100 * best->systematic_after);
+    if (pending) st.why += pending_why;
     current = st.fit;
     drop_unneeded(current, st, n_eff);
     out.steps.push_back(std::move(st));

@@ -126,7 +126,11 @@ void RunDetector::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
 
   // Standstill: the hold window is flat and low.
   if (dur < c.hold_full_s) return {};
-  if (mu > c.standstill_ceiling) return {};  // still high: the usual case, cheap
+  if (mu > c.standstill_ceiling) {  // still high: the usual case, cheap
+    // Now and then: has the "coast" held a plateau up there (a powered step, not a coast)?
+    if (t_i >= c.plateau_check_t) [[unlikely]] return {CoastVerdict::plateau};
+    return {};
+  }
   // Low: while the coast still falls the hold window is not level, and nothing else is to do.
   if (clearly_sloped(h, c.v0, mu)) return {};  // most low samples: no division, no square root
   CoastVerdict v{CoastVerdict::level, mu};
@@ -141,6 +145,7 @@ void RunDetector::act_on(const CoastVerdict& v, std::size_t i, bool at_end) {
     case CoastVerdict::too_long: coast_too_long(i); break;
     case CoastVerdict::power_back: power_back(); break;
     case CoastVerdict::level: standstill_checks(i, at_end, v.mu, v.sxx, v.e); break;
+    case CoastVerdict::plateau: held_plateau(i); break;
   }
 }
 
@@ -539,9 +544,23 @@ void RunDetector::trim_idle() {
   const double s = w.slope();
   if (!(s < 0)) return false;
   const double sd = w.resid_sd();
-  if (sd > confirm_max_roughness * mu) return false;
   if (-s * dur < 0.002 * mu) return false;
-  return -s * std::sqrt(w.sxx()) >= confirm_t_stat * sd;
+  if (!(-s * std::sqrt(w.sxx()) >= confirm_t_stat * sd)) return false;
+  // Rough about a line: an open pin's hum, or a short fast coast's own curve (rare, so out of line).
+  return sd <= confirm_max_roughness * mu || smooth_curve(w, mu, -s * dur);
+}
+
+bool RunDetector::smooth_curve(const WindowFit& w, double mu, double drop) const {
+  // A fast coast (a propeller's, a fan's: windage) bends within a window of a few coarse readings,
+  // so a line misses it by more than a twentieth of its level while each reading follows the curve:
+  // its sample-to-sample noise (second differences cancel the bend) is small beside what it fell.
+  // An open pin's hum is rough from sample to sample.
+  // Only a window of a second or more (a shorter one of a coarse counter is a few readings, whose
+  // bend - the cut's kink - the cut search needs more of the coast to place) that holds few
+  // readings (a slow logger: 8-16 over the second): with more, a line follows a coast's bend
+  // within the window closely enough.
+  return w.n >= 8 && w.n <= 16 && w.span_s >= 1.0 &&
+         rough_sd(w.first, w.end) <= confirm_max_roughness * std::max(mu, drop);
 }
 
 void RunDetector::idle_step(std::size_t i, Sample s, double prev_t) {
@@ -818,6 +837,9 @@ bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
     events_.push_back(std::move(e));
   }
   reset_window(hold_, run_.cut_index, i + 1);
+  plateau_check_t_ = run_.t_cut_s + 2.0 * hold_.span_s;  // once the hold window is clear of the first one
+  plateau_hits_ = 0;
+  half_cursor_ = run_.cut_index;
   hold_long_live_ = false;  // built when the coast gets low (saves work on the way down)
   creeping_ = false;
   coast_checks(i, ring_[i & mask_]);

@@ -144,40 +144,55 @@ std::string RunDetector::small_beside(double amp, double coast_s, double largest
   return {};
 }
 
+bool RunDetector::held_last_value(std::size_t cut, std::size_t end, std::size_t& held_from, std::size_t& longest,
+                                  bool need_long) const {
+  // The last value read up to end, held exactly, well above the motor's zero, reached by a jump of
+  // several of the reading's steps (an rpm counter's last update, not the one step a coarse reading
+  // takes onto a real offset), and (need_long) held five times longer than any value before it.
+  const double z = v(end - 1);
+  held_from = end - 1;
+  while (held_from > cut && v(held_from - 1) == z) --held_from;
+  const std::size_t held = end - held_from;
+  longest = 1;
+  if (held < 10 || held_from < cut + 10) return false;
+  const double zero = motor_zero();
+  if (!(z - zero > std::max(0.02 * (v0_ - zero), 3.0 * coast_step_))) return false;
+  std::size_t from = held_from, cur = 1;
+  while (from > cut && t(held_from) - t(from - 1) <= 2.0) --from;
+  for (std::size_t k = from + 1; k < held_from; ++k) {
+    cur = v(k) == v(k - 1) ? cur + 1 : 1;
+    longest = std::max(longest, cur);
+  }
+  if ((need_long && held < 5 * longest) || held_from < from + 3) return false;
+  // The reading's resolution over the coast (the smallest gap between the values it took; a
+  // per-revolution reading's values lie far apart near the end, close together at speed): a level
+  // of a step or two above zero is a coarse reading's offset, not a frozen one.
+  constexpr std::size_t look = 5000;
+  std::vector<double> x;
+  for (std::size_t k = held_from > cut + look ? held_from - look : cut; k < held_from; ++k) x.push_back(v(k));
+  std::sort(x.begin(), x.end());
+  double resolution = std::numeric_limits<double>::infinity();
+  for (std::size_t k = 1; k < x.size(); ++k)
+    if (x[k] > x[k - 1]) resolution = std::min(resolution, x[k] - x[k - 1]);
+  // Reached by a jump (a per-revolution counter's last update), not the one step a coarse reading
+  // takes onto a real offset.
+  return z - zero > 3.0 * resolution && v(held_from - 1) - z > 2.0 * resolution;
+}
+
 void RunDetector::warn_of_held_standstill(const Run& r) {
   // A standstill that reads one value exactly, well above the motor's zero, held far longer than
   // any value of the coast before it: what a sensor that keeps its last reading shows (an rpm
   // counter whose pulses stopped). A real offset is reached a reading step at a time, and a
   // sensor's freeze cannot be told from a stop for sure: said, not decided.
   if (r.end_index < r.stop_index + 10 || r.stop_index < r.cut_index + 10) return;
-  // The standstill's last value, and where it began (the stop's first samples may still be the
-  // coast's last values).
-  const double z = v(r.end_index - 1);
-  std::size_t held_from = r.end_index - 1;
-  while (held_from > r.cut_index && v(held_from - 1) == z) --held_from;
+  std::size_t held_from = 0, longest = 1;
+  if (!held_last_value(r.cut_index, r.end_index, held_from, longest, true)) return;
+  // … reached by a jump of many of the coast's steps (said only then: a coarse reading's last
+  // steps onto a value held at rest are no sign of a frozen sensor).
+  if (!(v(held_from - 1) - v(r.end_index - 1) > 10.0 * coast_step_)) return;
   const std::size_t held = r.end_index - held_from;
-  if (held < 10 || 5 * held < 4 * (r.end_index - r.stop_index)) return;  // most of the standstill
-  const double zero = motor_zero();
-  if (!(z - zero > std::max(0.02 * (v0_ - zero), 3.0 * coast_step_))) return;
-  // Reached by a jump of many reading steps (an rpm counter's last update), not by the one step
-  // a coarse reading takes onto a real offset.
-  if (!(v(held_from - 1) - z > 10.0 * coast_step_)) return;
-  std::size_t from = held_from, longest = 1, cur = 1;
-  while (from > r.cut_index && t(held_from) - t(from - 1) <= 2.0) --from;
-  for (std::size_t k = from + 1; k < held_from; ++k) {
-    cur = v(k) == v(k - 1) ? cur + 1 : 1;
-    longest = std::max(longest, cur);
-  }
-  if (held < 5 * longest || held_from < from + 3) return;
-  // The reading's resolution there (the smallest gap between the values it took): a level of a
-  // step or two above zero is a coarse reading's offset, not a frozen one.
-  double* x = scratch(held_from - from);
-  for (std::size_t k = from; k < held_from; ++k) x[k - from] = v(k);
-  std::sort(x, x + (held_from - from));
-  double resolution = std::numeric_limits<double>::infinity();
-  for (std::size_t k = 1; k < held_from - from; ++k)
-    if (x[k] > x[k - 1]) resolution = std::min(resolution, x[k] - x[k - 1]);
-  if (!(z - zero > 3.0 * resolution)) return;
+  if (5 * held < 4 * (r.end_index - r.stop_index)) return;  // most of the standstill
+  const double z = v(r.end_index - 1), zero = motor_zero();
   emit_diag(Diagnostic::Severity::warning,
             fmt::format("run {}: the standstill reads exactly {:g} for its last {} samples, {:.1f} % of the reading at "
                         "the cut, where no value of the coast before it lasted more than {}: a sensor holding its "

@@ -120,6 +120,59 @@ std::string RunDetector::stall_reason(std::size_t at) const {
                      last.mean(), 100.0 * u1 / u0, rate0, rate1, least);
 }
 
+bool RunDetector::held_plateau(std::size_t i) {
+  // Friction slows a coast at every speed it passes, fastest at its top (T(ω) grows with ω), and
+  // T falls with ω no faster than windage's ω² (stall_reason): at level u the coast still falls at
+  // least (u/u0)² of its rate at the cut's u0, which is at least its mean rate over the first half
+  // of its fall to u. A hold window well above standstill whose slope is resolved far below a
+  // quarter of that held a plateau: the drive holds a lower speed (a setpoint step down, an
+  // overshoot at power-on settling).
+  plateau_check_t_ = t(i) + hold_half_s_;
+  const WindowFit& h = hold_;
+  bool hit = false;
+  const double mu = h.mean(), zero = motor_zero(), u0 = v0_ - zero, u1 = mu - zero;
+  // The first crossing of a quarter of the fall above the plateau (the cursor only moves on: a
+  // coast's level only falls, and a later crossing gives a lower rate, the safe side).
+  const double near = mu + 0.25 * (v0_ - mu);
+  half_cursor_ = std::max(half_cursor_, run_.cut_index);
+  while (half_cursor_ < h.first && v(half_cursor_) > near) ++half_cursor_;
+  const double e_raw = h.resid_sd(), sxx = h.sxx(), e = std::max(e_raw, coast_step_ * step_sd);
+  // A reading that holds one value is a frozen sensor's, not a drive's (the standstill checks
+  // judge it); a plateau under power shows its noise.
+  const bool one_value = same_start_ <= h.first;  // every reading in the window the same (rounding aside)
+  if (h.n >= 8 && h.first > run_.cut_index && u0 > 0 && u1 > 0.3 * u0 && !one_value && e_raw > 0 && sxx > 0) {
+    // The coast's rate at its top is at least its mean rate over the first three quarters of its
+    // fall to the plateau, a fall that stands well out of the noise and spans a few samples (a lab
+    // motor's reading drops a step at the cut, its winding's transient, and then coasts slowly: a
+    // mean over most of the fall is not misled by it).
+    double top_rate = 0;
+    if (half_cursor_ < h.first && half_cursor_ >= run_.cut_index + 3 && v0_ - mu > 10.0 * e) {
+      const double to_near = quarter_crossing_time(half_cursor_, run_.cut_index, near) - run_.t_cut_s;
+      if (to_near > 0) top_rate = 0.75 * (v0_ - mu) / to_near;
+    }
+    {
+      const double ratio = std::min(u1, u0) / u0;
+      const double se1 = e / std::sqrt(sxx), rate1 = -h.slope();
+      const double least = 0.25 * ratio * ratio * top_rate;
+      hit = least > 0 && rate1 < 0.5 * least && 2.0 * se1 <= 0.5 * least;
+      if (hit && plateau_hits_++ == 0) plateau_from_ = h.first;
+      if (hit && plateau_hits_ >= 3) {
+        not_coast_ = fmt::format(
+            "it fell from {:.4g} and then held level at {:.4g} from {} ({:.2g} a second, where friction would "
+            "still take off at least {:.2g}): a coast never holds a plateau — a drive stepping down to a lower "
+            "speed under power (a setpoint step, a start-up overshoot settling); the cut is looked for after it",
+            v0_, h.mean(), fmt_s(t(plateau_from_)), rate1, least);
+        const std::size_t from = plateau_from_;
+        close_unstopped(from, "held a plateau under power", Run::End::power_back);
+        to_idle(from, false, from);
+        return true;
+      }
+    }
+  }
+  if (!hit) plateau_hits_ = 0;
+  return false;
+}
+
 void RunDetector::power_back() {
   const std::size_t at = rise_start_, cut = run_.cut_index;
   not_coast_ = swing_reason(at);
@@ -288,9 +341,22 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
     // run) gives way to that zero: within 3 noise sd, 1 % of the cut's reading (level()'s
     // allowance for a flat window's drop) or one reading step. A floor clearly above it (an
     // offset only the coasting reading has) is kept.
+    // A per-revolution sensor keeps its last reading once the pulses stop: a floor reached by a
+    // jump and held exactly, far longer than any value before it, is that reading, not a zero to
+    // subtract (the shaft turning at that speed would have updated it long since).
+    std::size_t held_from = 0, longest = 1;
+    const bool held_jump = held_last_value(run_.cut_index, i + 1, held_from, longest, false);
+    const bool held_long = held_jump && i + 1 - held_from >= 5 * longest;
+    if (held_jump && !held_long && !at_end) return;  // wait and see how long it holds
     std::string floor_said;
     const double band = std::max({3.0 * sd_z, 0.01 * std::abs(v0_), reading_step(hold_.first, i + 1)});
-    if (std::isfinite(lead_in_zero_) && std::abs(z - lead_in_zero_) <= band * (1 + 1e-9) && z != lead_in_zero_) {
+    if (held_long) {
+      run_.zero_level = motor_zero();
+      floor_said = fmt::format(", the last reading of a sensor that holds it ({} samples from {}, where no value "
+                               "before it lasted more than {}), not a zero: zero level {:g}, the coast fitted up "
+                               "to that last update",
+                               i + 1 - held_from, fmt_s(t(held_from)), longest, run_.zero_level);
+    } else if (std::isfinite(lead_in_zero_) && std::abs(z - lead_in_zero_) <= band * (1 + 1e-9) && z != lead_in_zero_) {
       run_.zero_level = lead_in_zero_;
       floor_said = fmt::format(", not to be told from the lead-in's zero, so zero level {:g}", lead_in_zero_);
     } else if (std::isfinite(rest_level_) && z > rest_level_ &&
@@ -309,7 +375,7 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
         fmt_s(run_.t_cut_s), z, floor_said, end_rate > 0 ? 1.0 / end_rate : 0.0, fmt_s(t(i)));
     run_.stopped = false;
     run_.end = Run::End::asymptotic;
-    complete_run(i + 1);
+    complete_run(held_long ? held_from + 1 : i + 1);
     to_idle(i + 1, true);
   }
 }

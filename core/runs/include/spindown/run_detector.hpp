@@ -177,16 +177,16 @@ class RunDetector {
   struct CoastLimits {
     const Sample* ring;
     std::size_t mask, base, max_buffer, cut_index;
-    double max_coast_s, t_cut_s, hold_half_s, hold_full_s, rise_jump, standstill_ceiling, v0;
+    double max_coast_s, t_cut_s, hold_half_s, hold_full_s, rise_jump, standstill_ceiling, v0, plateau_check_t;
   };
   CoastLimits coast_limits() const {
     return {ring_.get(), mask_, base_, opt_.max_buffer, run_.cut_index, opt_.max_coast_s, run_.t_cut_s, hold_half_s_,
-            hold_full_s_, rise_jump_, standstill_ceiling_, v0_};
+            hold_full_s_, rise_jump_, standstill_ceiling_, v0_, plateau_check_t_};
   }
   // What the checks of a coasting sample decided: nothing (the usual case), or one of the rare
   // outcomes, which act_on() carries out.
   struct CoastVerdict {
-    enum What { go_on, too_long, power_back, level } what = go_on;
+    enum What { go_on, too_long, power_back, level, plateau } what = go_on;
     double mu = 0, sxx = 0, e = 0;  // level: the hold window's mean, Sxx and residual sd
   };
   inline CoastVerdict coast_verdict(std::size_t i, Sample s, const WindowFit& h, double& level_min, int& rising,
@@ -203,6 +203,8 @@ class RunDetector {
   // Back to coasting from the tail at sample i (s), with a note.
   void retract_stop(std::size_t i, Sample s);
   inline bool confirms_decline(const WindowFit& w) const;
+  // Whether w, rough about its line but falling drop, is a smooth curve (a short fast coast).
+  [[gnu::cold, gnu::noinline]] bool smooth_curve(const WindowFit& w, double mu, double drop) const;
   // Whether w shows a standstill: full, low, and no significant slope or drop.
   bool flat(const WindowFit& w) const;
   // The part of flat() after "full": low, no significant slope or drop, for w of duration d and
@@ -244,6 +246,16 @@ class RunDetector {
   // Why the open coast, closed by a rise at sample at, was no coast: it levelled off well above
   // standstill, where friction would still slow it; empty when it kept falling as a coast does.
   std::string stall_reason(std::size_t at) const;
+  // A coast never holds a plateau: friction slows it at every speed it passes. Whether the open
+  // coast, high above standstill at sample i, has held level (hold_) where friction would still
+  // take speed off fast, three times in a row (a second and more): then its fall was a drive stepping down under power (a
+  // setpoint step, a start-up overshoot settling), and the coast is given up (ignored, with why),
+  // its plateau the next cut's lead-in. Checked every half hold window (plateau_check_t_).
+  bool held_plateau(std::size_t i);
+  double plateau_check_t_ = std::numeric_limits<double>::infinity();
+  int plateau_hits_ = 0;
+  std::size_t plateau_from_ = 0;  // the hold window's first sample at the first hit
+  std::size_t half_cursor_ = 0;   // the open coast's first sample within a quarter of its fall of the level held now
   std::string not_coast_;  // set: the open run is ignored with this warning when it completes
   // A coast never rises: when the reading rose inside r's coast [cut, coast_end) by far more than its
   // noise, what came before the rise was no part of it (an open pin's swing before it was connected,
@@ -295,6 +307,12 @@ class RunDetector {
   void warn_of_earlier_fragments(const Run& r, double amp, double coast_s);
   // A stopped run whose standstill is one value held far longer than the coast's values: a warning.
   void warn_of_held_standstill(const Run& r);
+  // Whether the readings up to end (of a coast cut at cut) end on one value held exactly, well above
+  // the motor's zero and reached by a jump of many steps (a per-revolution counter's last update),
+  // and (need_long) held five times longer than any value of the coast before it: a sensor
+  // keeping its last reading. held_from: where it began; longest: the longest value before it.
+  bool held_last_value(std::size_t cut, std::size_t end, std::size_t& held_from, std::size_t& longest,
+                       bool need_long) const;
   struct Earlier {
     int number;
     double t_cut_s, amp, coast_s;

@@ -1,0 +1,207 @@
+// Run finding on other rigs' recordings, generated from physics (J dω/dt = −T(ω) integrated in
+// small steps, the stop where ω reaches 0, a logger's sample grid and the sensor's own reading):
+// a drive that steps down to a powered plateau before the real cut, a servo's start-up overshoot
+// that rings and settles under power, a propeller's short fast coast read by a coarse counter.
+// Each test's truth is the physics' cut and stop.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <random>
+#include <vector>
+
+#include "spindown/runs.hpp"
+
+using namespace spindown;
+
+namespace {
+
+struct Friction {
+  double inertia, viscous, coulomb, windage = 0;
+  double torque(double w) const { return viscous * w + coulomb + windage * w * w; }
+};
+
+// A free coast from w0: ω at time s after the cut (0 after the stop), and when it stops.
+struct Coast {
+  std::vector<double> w;  // on a 0.1-ms grid
+  double dt = 1e-4;
+  double stop_s = 0;
+  Coast(const Friction& f, double w0) {
+    double x = w0;
+    w.push_back(x);
+    while (x > 0) {
+      // RK4 on dω/dt = −T(ω)/J, the stop as the step where ω would cross 0.
+      const auto a = [&](double u) { return -f.torque(u) / f.inertia; };
+      const double k1 = a(x), k2 = a(x + 0.5 * dt * k1), k3 = a(x + 0.5 * dt * k2), k4 = a(x + dt * k3);
+      const double next = x + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
+      if (next <= 0) {
+        stop_s = (double(w.size()) - 1 + x / (x - next)) * dt;
+        w.push_back(0);
+        break;
+      }
+      x = next;
+      w.push_back(x);
+    }
+  }
+  double at(double s) const {
+    if (s <= 0) return w.front();
+    const std::size_t k = std::size_t(s / dt);
+    if (k + 1 >= w.size()) return 0;
+    const double f = s / dt - double(k);
+    return w[k] + f * (w[k + 1] - w[k]);
+  }
+};
+
+// Samples every period from 0 to end_s of speed(t), read by read(ω).
+Recording sample(double period, double end_s, const std::function<double(double)>& speed,
+                 const std::function<double(double)>& read) {
+  Recording rec;
+  rec.source = "physics";
+  for (double t = 0; t <= end_s + 1e-9; t += period) rec.push(t, read(speed(t)));
+  return rec;
+}
+
+// One run, cut and stopped where the physics put them, within the tolerances given.
+void expect_one_run(const Recording& rec, double t_cut, double cut_tol, double t_stop, double stop_tol) {
+  const Segmentation seg = find_runs(rec);
+  ASSERT_EQ(seg.runs.size(), 1u);
+  EXPECT_NEAR(seg.runs[0].t_cut_s, t_cut, cut_tol);
+  EXPECT_TRUE(seg.runs[0].stopped);
+  EXPECT_NEAR(seg.runs[0].t_stop_s, t_stop, stop_tol);
+}
+
+}  // namespace
+
+// A spindle on a drive: up to 314 rad/s, the setpoint lowered to 209 rad/s at the drive's braked
+// ramp (42 rad/s², six times the coast's own deceleration), held 5 s, then the supply cut: the cut
+// is the last power-off, not the step, and the plateau is no part of the coast.
+TEST(OtherRigs, APoweredStepDownToAPlateauIsNotTheCut) {
+  const Friction f{0.01, 1e-4, 0.05};
+  const double top = 314.16, low = 209.44, t_step = 10.0, ramp = 41.9, t_cut = 17.507;
+  const Coast coast(f, low);
+  const auto speed = [&](double t) {
+    if (t < 1) return 0.0;
+    if (t < 4) return top * (t - 1) / 3;
+    if (t < t_step) return top;
+    if (t < t_cut) return std::max(low, top - ramp * (t - t_step));
+    return coast.at(t - t_cut);
+  };
+  std::mt19937 rng(3201);
+  std::normal_distribution<double> noise(0, 0.3);
+  const Recording rec = sample(0.02, t_cut + coast.stop_s + 4, speed,
+                               [&](double w) { return w > 0 ? std::round((w + noise(rng)) * 10) / 10 : 0.0; });
+  const Segmentation seg = find_runs(rec);
+  ASSERT_EQ(seg.runs.size(), 1u);
+  const spindown::Run& r = seg.runs[0];
+  EXPECT_NEAR(r.t_cut_s, t_cut, 0.04);
+  EXPECT_TRUE(r.stopped);
+  EXPECT_NEAR(r.t_stop_s, t_cut + coast.stop_s, 0.25);
+  // The fall to the plateau is said, not silently dropped.
+  bool said = false;
+  for (const Diagnostic& d : seg.diagnostics) said = said || d.message.find("plateau") != std::string::npos;
+  EXPECT_TRUE(said);
+}
+
+// A conveyor ramped down under power more slowly than it would coast, to a plateau held 6 s,
+// then cut.
+TEST(OtherRigs, ASlowPoweredRampToAPlateauThenTheCut) {
+  const Friction f{0.5, 0.01, 3};
+  const double top = 157.08, low = 62.83, t_cut = 39.03;
+  const Coast coast(f, low);
+  const auto speed = [&](double t) {
+    if (t < 2) return 0.0;
+    if (t < 7) return top * (t - 2) / 5;
+    if (t < 15) return top;
+    if (t < t_cut) return std::max(low, top - 5.236 * (t - 15));
+    return coast.at(t - t_cut);
+  };
+  std::mt19937 rng(3202);
+  std::normal_distribution<double> noise(0, 0.05);
+  const Recording rec = sample(0.05, t_cut + coast.stop_s + 4, speed,
+                               [&](double w) { return w > 0 ? std::round((w + noise(rng)) * 100) / 100 : 0.0; });
+  expect_one_run(rec, t_cut, 0.1, t_cut + coast.stop_s, 0.15);
+}
+
+// A servo's velocity loop at power-on: 37 % overshoot (ζ = 0.3, ω_n = 25 rad/s) that rings down
+// to its setpoint within half a second, held under power until the drive is disabled. The fall
+// after the overshoot is powered: the one run is cut at the disable.
+TEST(OtherRigs, AStartUpOvershootThatRingsAndSettlesIsNotACut) {
+  const Friction f{5e-4, 4e-5, 0.012};
+  const double set = 150, t_on = 0.8, t_cut = 6.305, zeta = 0.3, wn = 25;
+  const Coast coast(f, set);
+  const auto speed = [&](double t) {
+    if (t < t_on) return 0.0;
+    if (t < t_cut) {
+      const double s = t - t_on, wd = wn * std::sqrt(1 - zeta * zeta);
+      return set * (1 - std::exp(-zeta * wn * s) * (std::cos(wd * s) + zeta / std::sqrt(1 - zeta * zeta) * std::sin(wd * s)));
+    }
+    return coast.at(t - t_cut);
+  };
+  std::mt19937 rng(3203);
+  std::normal_distribution<double> noise(0, 0.2);
+  const Recording rec = sample(0.01, t_cut + coast.stop_s + 3, speed, [&](double w) { return w + noise(rng); });
+  expect_one_run(rec, t_cut, 0.02, t_cut + coast.stop_s, 0.05);
+}
+
+// A tiny drone motor with its propeller (windage 20 times its bearing friction at the top speed)
+// coasts from 1200 rad/s to rest in 1.5 s, counted by a hall sensor in 0.1-s gates: 15 readings
+// in steps of 31.4 rad/s (2.6 %), the count's ±1 its noise. One run, cut and stop where the
+// physics put them.
+TEST(OtherRigs, AFifteenReadingFastCoarseCoastIsFound) {
+  const Friction f{8e-7, 0, 1.93e-4, 2.68e-9};
+  const double top = 1200, t_cut = 4.46, step = 2 * M_PI / 2 / 0.1;  // 2 magnets, 0.1-s gate
+  const Coast coast(f, top);
+  const auto angle = [&](double t) {  // the shaft's angle (rad): spun up at 0.5 s (τ = 0.1 s)
+    double a = 0;
+    for (double s = 0.5; s < std::min(t, t_cut); s += 1e-4) a += 1e-4 * top * (1 - std::exp(-(s - 0.5) / 0.1));
+    if (t > t_cut)
+      for (double s = 0; s < t - t_cut; s += 1e-4) a += 1e-4 * coast.at(s);
+    return a;
+  };
+  // The gate counts the magnets passed in the 0.1 s before each reading.
+  Recording rec;
+  rec.source = "physics";
+  double prev = 0;
+  for (int k = 1; k <= 80; ++k) {
+    const double t = 0.1 * k, a = angle(t);
+    const double count = std::floor(a / M_PI) - std::floor(prev / M_PI);
+    prev = a;
+    rec.push(t, count * step);
+  }
+  expect_one_run(rec, t_cut, 0.2, t_cut + coast.stop_s, 0.33);
+}
+
+// A trainer's roller read by one magnet per revolution: the speed is 2π over the time between the
+// last two pulses, logged at 10 Hz and held between pulses, so once the roller stops the last
+// pulse's speed is held for good. That held value is no zero level to subtract: the motor's zero
+// is 0.
+TEST(OtherRigs, APerRevolutionSensorsHeldReadingAtRestIsNotTheZeroLevel) {
+  const Friction f{0.015, 2e-3, 0.015};
+  const double top = 62.83, t_cut = 8.04;
+  const Coast coast(f, top);
+  const double dt = 1e-4;
+  Recording rec;
+  rec.source = "physics";
+  std::mt19937 rng(3221);
+  std::normal_distribution<double> jitter(0, 2e-4);
+  double angle = 0, last_pulse = -1, prev_pulse = -1, held = top, next_log = 0.1, w = top;
+  for (double t = 0; t <= t_cut + coast.stop_s + 20; t += dt) {
+    w = t < t_cut ? top : coast.at(t - t_cut);
+    angle += w * dt;
+    if (angle >= 2 * M_PI) {
+      angle -= 2 * M_PI;
+      prev_pulse = last_pulse;
+      last_pulse = t + jitter(rng);  // the pulse's edge, timed to ±0.2 ms
+      if (prev_pulse >= 0) held = 2 * M_PI / (last_pulse - prev_pulse);
+    }
+    if (t >= next_log) {
+      rec.push(next_log, std::round(held * 100) / 100);
+      next_log += 0.1;
+    }
+  }
+  ASSERT_GT(held, 3.0);  // the roller stopped a few rad/s after its last pulse
+  const Segmentation seg = find_runs(rec);
+  ASSERT_EQ(seg.runs.size(), 1u);
+  EXPECT_NEAR(seg.runs[0].t_cut_s, t_cut, 0.2);
+  EXPECT_LT(std::abs(seg.runs[0].zero_level), 0.05 * held);
+}
