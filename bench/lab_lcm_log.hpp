@@ -18,6 +18,7 @@
 #include <spindown/samples_t.hpp>
 
 #include "spindown/lcm_channels.hpp"
+#include "lab_messages.hpp"  // tests/support
 #include "spindown/synthetic_run.hpp"
 
 namespace bench_log {
@@ -65,26 +66,9 @@ void write_event(lcm::LogFile& log, const std::string& channel, std::int64_t uti
   if (log.writeEvent(&ev) != 0) throw std::runtime_error("write failed");
 }
 
+// The CONFIG each bench sends: the lab's motor and flywheel, as a bridge publishes it.
 inline spindown::config_t make_config(const std::string& bench, std::int64_t utime) {
-  spindown::config_t c{};
-  c.utime = utime;
-  c.bench = bench;
-  c.inertia_kg_m2 = 1.12687602e-5;
-  c.inertia_source = "lab flywheel + rotor";
-  c.kb_v_s_per_rad = 1.0 / 123.569311;
-  c.kb_source = "speed constant 1180 rpm/V";
-  c.quantity = spindown::samples_t::QUANTITY_BACK_EMF_V;
-  c.adc_volts_per_count = 5.0 / 1024;
-  c.adc_bits = 10;
-  c.firmware = "make_lcm_log";
-  c.protocol = "lab-tsv";
-  c.sample_period_s = 0.02;
-  c.baud = 9600;
-  c.device = "generated";
-  c.host = "localhost";
-  c.inertia_rel_error = 0;
-  c.kb_rel_error = 0;
-  return c;
+  return spindown::test::lab_config(bench, 1.12687602e-5, 1.0 / 123.569311, utime);
 }
 
 struct LabLogStats {

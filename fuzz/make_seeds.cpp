@@ -18,6 +18,7 @@
 #include <spindown/samples_t.hpp>
 #include <spindown/status_t.hpp>
 
+#include "lab_messages.hpp"  // tests/support
 #include "spindown/lab_key.hpp"
 #include "spindown/message_stamp.hpp"
 
@@ -97,22 +98,7 @@ samples_t coast_samples(std::int64_t seq, int first, int count) {
 }
 
 config_t bench_config() {
-  config_t c{};
-  c.utime = t0_us;
-  c.bench = "bench-a";
-  c.inertia_kg_m2 = 1.2e-5;
-  c.inertia_source = "lab default";
-  c.kb_v_s_per_rad = 0.0081;
-  c.kb_source = "speed constant 1180 rpm/V";
-  c.quantity = samples_t::QUANTITY_BACK_EMF_V;
-  c.adc_volts_per_count = 5.0 / 1023;
-  c.adc_bits = 10;
-  c.firmware = "lab sketch";
-  c.protocol = "lab-tsv";
-  c.sample_period_s = 0.02;
-  c.baud = 9600;
-  c.device = "/dev/ttyACM0";
-  c.host = "lab-pc-3";
+  config_t c = test::lab_config("bench-a", 1.2e-5, 0.0081, t0_us);
   c.inertia_rel_error = 0.02;
   c.kb_rel_error = 0.05;
   return c;

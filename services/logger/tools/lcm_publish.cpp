@@ -17,6 +17,7 @@
 
 #include "spindown/clock.hpp"
 #include "spindown/host_name.hpp"
+#include "lab_messages.hpp"  // tests/support: the lab's CONFIG
 #include "spindown/lcm_channels.hpp"
 #include "spindown/lcm_status.hpp"
 #include "spindown/stop_signal.hpp"
@@ -26,24 +27,8 @@ namespace {
 using spindown::wall_us;
 
 spindown::config_t make_config(const std::string& bench, std::int64_t now) {
-  spindown::config_t c{};
-  c.utime = now;
-  c.bench = bench;
-  c.inertia_kg_m2 = 1.12687602e-5;
-  c.inertia_source = "lab default";
-  c.kb_v_s_per_rad = 1.0 / 123.569311;
-  c.kb_source = "speed constant 1180 rpm/V";
-  c.quantity = spindown::samples_t::QUANTITY_BACK_EMF_V;
-  c.adc_volts_per_count = 5.0 / 1024;
-  c.adc_bits = 10;
-  c.firmware = "lab sketch";
-  c.protocol = "lab-tsv";
-  c.sample_period_s = 0.02;
-  c.baud = 9600;
-  c.device = "/dev/ttyACM0";
+  spindown::config_t c = spindown::test::lab_config(bench, 1.12687602e-5, 1.0 / 123.569311, now);
   c.host = spindown::host_name();
-  c.inertia_rel_error = 0.02;
-  c.kb_rel_error = 0.05;
   return c;
 }
 
