@@ -14,6 +14,7 @@
 #include "spindown/fit_message.hpp"
 #include "spindown/host_name.hpp"
 #include "spindown/lcm_channels.hpp"
+#include "spindown/lcm_status.hpp"
 #include "spindown/loop_watchdog.hpp"
 #include "spindown/udp_socket_drops.hpp"
 
@@ -129,37 +130,28 @@ void FitterService::publish_status(std::int64_t now_us, const char* state) {
     rate_hz_ = double(samples - last_samples_) / (1e-6 * double(now_us - last_rate_us_));
   last_rate_us_ = now_us;
   last_samples_ = samples;
-  s.counter_name.emplace_back("queue_drops");
-  s.counter_value.push_back(q.full_drops);
-  s.counter_name.emplace_back("oversize_drops");
-  s.counter_value.push_back(q.oversize_drops);
-  s.counter_name.emplace_back("publish_failures");
-  s.counter_value.push_back(publish_.failures());
-  s.counter_name.emplace_back("heartbeats_unheard");
-  s.counter_value.push_back(publish_.unheard_heartbeats());
-  s.counter_name.emplace_back("stalls");
-  s.counter_value.push_back(stalls_);
-  s.counter_name.emplace_back("explains");
-  s.counter_value.push_back(explains_);
-  s.counter_name.emplace_back("explain_failures");
-  s.counter_value.push_back(explain_failures_);
+  const std::pair<const char*, std::int64_t> counters[] = {
+      {"queue_drops", q.full_drops},
+      {"oversize_drops", q.oversize_drops},
+      {"publish_failures", publish_.failures()},
+      {"heartbeats_unheard", publish_.unheard_heartbeats()},
+      {"stalls", stalls_},
+      {"explains", explains_},
+      {"explain_failures", explain_failures_},
+  };
+  add_counters(s, counters);
   // Datagrams the kernel dropped on the fitter's own sockets (a full receive buffer): lost
   // before LCM read them, so only sequence gaps would show them otherwise.
   if (const std::int64_t kernel = own_udp_drop_count(); kernel >= 0) {
-    s.counter_name.emplace_back("udp_drops");
-    s.counter_value.push_back(kernel);
+    const std::pair<const char*, std::int64_t> udp[] = {{"udp_drops", kernel}};
+    add_counters(s, udp);
   }
-  s.ncounters = static_cast<std::int32_t>(s.counter_name.size());
   const std::pair<const char*, double> gauges[] = {
       {"sample_rate_hz", rate_hz_},               {"queue_depth", double(q.depth)},
       {"queue_high_water", double(q.high_water)}, {"last_latency_s", last_latency_s_},
       {"max_latency_s", max_latency_s_},      {"last_fit_s", last_fit_s_},
   };
-  for (const auto& [name, value] : gauges) {
-    s.gauge_name.emplace_back(name);
-    s.gauge_value.push_back(value);
-  }
-  s.ngauges = static_cast<std::int32_t>(s.gauge_name.size());
+  add_gauges(s, gauges);
   if (s.last_error.empty() && q.oversize_drops > 0)
     s.last_error = fmt::format("{} messages dropped: larger than the receive queue's limit of {} bytes (last: {} "
                                "bytes on {}; a forged LCM fragment header claims any size)",

@@ -127,16 +127,11 @@ class Heartbeat {
         {"bad_signatures", g.other_key + g.bad_signature},
         {"replays", g.replayed + g.outside_window},
     };
-    for (const auto& [name, value] : gate_counts) {
-      st.counter_name.emplace_back(name);
-      st.counter_value.push_back(value);
-    }
-    st.ncounters = static_cast<std::int32_t>(st.counter_name.size());
+    spindown::add_counters(st, gate_counts);
     if (st.last_error.empty() && !last_refusal_.empty()) st.last_error = "recorded, not this lab's own: " + last_refusal_;
     if (const std::int64_t drops = spindown::own_udp_drop_count(); drops >= 0) {
-      st.gauge_name.emplace_back("udp_drops");
-      st.gauge_value.push_back(double(drops));
-      st.ngauges = static_cast<std::int32_t>(st.gauge_name.size());
+      const std::pair<const char*, double> udp[] = {{"udp_drops", double(drops)}};
+      spindown::add_gauges(st, udp);
     }
     loop_.publish(channel_, st);
     if (st.last_error != reported_error_) {

@@ -31,9 +31,28 @@ struct StatusHeader {
   std::int64_t last_error_utime = 0;
 };
 
-// The one builder of a status_t: the header, then the named counters and gauges in the order
-// given (ranges of (name, value) pairs), so lcm-spy's rows stay put. StatusHeartbeat, the
-// fitter's and the bridge's heartbeats are all made here.
+// Appends named (name, value) counters or gauges to a status message in the order given (lcm-spy's
+// rows stay put), keeping its counts: what status_message builds from, and what a service adds
+// to the core's heartbeat (the fitter's queue, the logger's gate).
+template <class Counters>
+void add_counters(status_t& st, const Counters& counters) {
+  for (const auto& [name, value] : counters) {
+    st.counter_name.emplace_back(name);
+    st.counter_value.push_back(static_cast<std::int64_t>(value));
+  }
+  st.ncounters = static_cast<std::int32_t>(st.counter_name.size());
+}
+template <class Gauges>
+void add_gauges(status_t& st, const Gauges& gauges) {
+  for (const auto& [name, value] : gauges) {
+    st.gauge_name.emplace_back(name);
+    st.gauge_value.push_back(static_cast<double>(value));
+  }
+  st.ngauges = static_cast<std::int32_t>(st.gauge_name.size());
+}
+
+// The one builder of a status_t: the header, then the named counters and gauges (add_counters,
+// add_gauges). StatusHeartbeat, the fitter's and the bridge's heartbeats are all made here.
 template <class Counters, class Gauges>
 status_t status_message(std::int64_t utime, const StatusHeader& h, const Counters& counters, const Gauges& gauges) {
   status_t st{};
@@ -44,16 +63,8 @@ status_t status_message(std::int64_t utime, const StatusHeader& h, const Counter
   st.pid = h.pid;
   st.state = std::string(h.state);
   st.uptime_s = h.uptime_s;
-  for (const auto& [name, value] : counters) {
-    st.counter_name.emplace_back(name);
-    st.counter_value.push_back(static_cast<std::int64_t>(value));
-  }
-  st.ncounters = static_cast<std::int32_t>(st.counter_name.size());
-  for (const auto& [name, value] : gauges) {
-    st.gauge_name.emplace_back(name);
-    st.gauge_value.push_back(static_cast<double>(value));
-  }
-  st.ngauges = static_cast<std::int32_t>(st.gauge_name.size());
+  add_counters(st, counters);
+  add_gauges(st, gauges);
   st.last_error = std::string(h.last_error);
   st.last_error_utime = h.last_error_utime;
   return st;
