@@ -508,3 +508,38 @@ TEST(Explain, RejectsBadOptionsWithAReason) {
   EXPECT_FALSE(r.ok);
   EXPECT_FALSE(r.message.empty());
 }
+
+// Issue 33: fit and explain take one window (run_window.hpp). On a run with dropouts, explain's
+// samples are fit's, outliers left out, and its base viscous is fit's viscous on them; from one
+// window made once or from the arrays, the same.
+TEST(Explain, ExplainAndFitShareOneWindowWithItsDropoutsLeftOut) {
+  SyntheticRunSpec spec;
+  spec.seed = 11;
+  const SyntheticRun s = make_synthetic_run(spec);
+  Recording rec;
+  rec.quantity = Quantity::back_emf_volts;
+  for (std::size_t i = 0; i < s.t_ms.size(); ++i) {
+    rec.t_s.push_back(s.t_ms[i] / 1000.0);
+    // every 37th reading drops to 0 V (a loose wire)
+    rec.value.push_back(i % 37 == 36 && s.t_ms[i] > s.t_cut_ms + 300 ? 0.0 : s.volts[i]);
+  }
+  const Segmentation seg = find_runs(rec);
+  ASSERT_FALSE(seg.runs.empty());
+  const spindown::Run& run = seg.runs.front();
+  ASSERT_GE(run.outliers.size(), 5u) << "the dropouts are the run's outliers";
+  const RunWindow window(rec.t_s, rec.value, run, true);
+  const RunFit fit = fit_run(window, rec.quantity, run, FitOptions{});
+  const ExplainResult shared = explain_run(window, rec.quantity, run, ExplainOptions{}, lowest_reading(rec.value));
+  const ExplainResult own = explain_run(rec, run, ExplainOptions{});
+  ASSERT_TRUE(shared.ok) << shared.message;
+  ASSERT_EQ(shared.tau.size(), window.size());
+  for (std::size_t k : run.outliers) {
+    if (k < run.cut_index || k >= run.end_index) continue;
+    EXPECT_FALSE(std::binary_search(shared.tau.begin(), shared.tau.end(), rec.t_s[k] - run.t_cut_s)) << k;
+  }
+  EXPECT_EQ(shared.base.n, fit.model(ModelKind::viscous)->n);
+  EXPECT_NEAR(shared.base.rmse, fit.model(ModelKind::viscous)->rmse, 1e-6 * fit.model(ModelKind::viscous)->rmse);
+  EXPECT_EQ(shared.tau, own.tau);
+  EXPECT_EQ(shared.y, own.y);
+  EXPECT_EQ(shared.conclusion, own.conclusion);
+}

@@ -14,6 +14,7 @@
 #include "fit_refinement.hpp"
 #include "fit_start.hpp"
 #include "spindown/reading_noise.hpp"
+#include "spindown/run_window.hpp"
 #include "viscous_projection.hpp"
 
 namespace spindown {
@@ -179,52 +180,17 @@ bool FitOptions::is_valid(std::string* why) const {
   return true;
 }
 
-RunFit fit_run(std::span<const double> t_s, std::span<const double> value, Quantity q, const Run& run,
-               const FitOptions& opt) {
+RunFit fit_run(const RunWindow& window, Quantity q, const Run& run, const FitOptions& opt) {
   RunFit out;
   out.run = run;
   out.bench = opt.bench;
   out.quantity = q;
-  const std::size_t begin = std::min(run.cut_index, t_s.size());
-  const std::size_t end = std::clamp(run.end_index, begin, t_s.size());
-  const std::size_t stop = std::clamp(run.stop_index, begin, end);
   const double k = value_per_rad_per_s(q, opt.bench.kb_v_s_per_rad);
-
-  // The run's outliers (dropouts, glitches) are left out: the samples kept, and those of them moving.
-  const auto out_lo = std::lower_bound(run.outliers.begin(), run.outliers.end(), begin);
-  const auto out_hi = std::lower_bound(out_lo, run.outliers.end(), end);
-  const std::size_t n = end - begin - std::size_t(out_hi - out_lo);
-  // τ, y and the weights in one buffer, written before they are read: no zeroing.
-  const auto buffer = std::make_unique_for_overwrite<double[]>(3 * n);
-  const std::span<double> tau(buffer.get(), n), y(buffer.get() + n, n), weight(buffer.get() + 2 * n, n);
-  if (out_lo != out_hi) {
-    std::size_t j = 0;
-    auto next = out_lo;
-    for (std::size_t i = begin; i < end; ++i) {
-      if (next != out_hi && *next == i) {
-        ++next;
-        continue;
-      }
-      tau[j] = t_s[i] - run.t_cut_s, y[j] = value[i] - run.zero_level;
-      ++j;
-    }
-  } else {
-    // Restrict: the buffer is our own, so the loop vectorises without a test for overlap.
-    const double *__restrict t_in = t_s.data() + begin, *__restrict v_in = value.data() + begin;
-    double *__restrict t_out = tau.data(), *__restrict y_out = y.data();
-    const double t_cut = run.t_cut_s, zero = run.zero_level;
-#pragma omp simd
-    for (std::size_t i = 0; i < n; ++i) t_out[i] = t_in[i] - t_cut, y_out[i] = v_in[i] - zero;
-  }
-  const std::size_t moving_end = run.stopped ? stop : end;
-  const std::size_t moving =
-      moving_end - begin - std::size_t(std::lower_bound(out_lo, out_hi, moving_end) - out_lo);
+  const std::span<const double> tau = window.tau(), y = window.y(), weight = window.weight();
+  const std::size_t n = window.size(), moving = window.moving();
   const std::string_view runit = quantity_unit(q);
-  out.reading_noise = reading_noise_sigma(std::span<const double>(y).first(moving >= 3 ? moving : n));
-  // Weights from the run's own noise (σ² growing with the reading), shared by every model.
-  ReadingNoise noise;
-  if (opt.weighted) noise = weigh_by_noise_into(y, weight);
-  else std::fill(weight.begin(), weight.end(), 1.0);
+  out.reading_noise = window.reading_noise();
+  const ReadingNoise& noise = window.noise();
   Evaluator eval(tau, y, weight);  // one workspace for every model of the run
   const IntegralForm form = integral_form(tau, y, moving);
   for (ModelKind kind : opt.models)
@@ -299,8 +265,13 @@ RunFit fit_run(std::span<const double> t_s, std::span<const double> value, Quant
       out.best_reason = out.models.size() == 1 ? "the only model asked for" : "the only model that converged";
     }
   }
-  check_fit(out, tau, y, moving, std::span<const double>(value.data() + begin, end - begin), k);
+  check_fit(out, tau, y, moving, window.readings(), k);
   return out;
+}
+
+RunFit fit_run(std::span<const double> t_s, std::span<const double> value, Quantity q, const Run& run,
+               const FitOptions& opt) {
+  return fit_run(RunWindow(t_s, value, run, opt.weighted), q, run, opt);
 }
 
 RunFit fit_run(const Recording& rec, const Run& run, const FitOptions& opt) {

@@ -56,6 +56,9 @@ struct FitterCore::Bench {
   std::string channel;
   RunDetector detector;
   Mirror mirror;  // samples of a run, with the sequence numbers a published run names
+  // The lowest reading the bench has given (explain: a sensor that reads zero at rest cannot hide a
+  // negative offset), as spindown explain takes it from the whole recording.
+  double lowest_reading = std::numeric_limits<double>::infinity();
   std::uint64_t last_active = 0, arrival = 0;
   std::int64_t last_sample_utime = 0;  // host time of its last samples (poll(): silent benches)
 

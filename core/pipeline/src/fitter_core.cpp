@@ -383,6 +383,7 @@ void FitterCore::restart_clock(Bench& b, std::int64_t recv_utime) {
   if (b.pending_restart) restart_clock(b, recv_utime);
   ++counters_.samples;
   b.mirror.push_back({t_s, value, seq});
+  b.lowest_reading = std::min(b.lowest_reading, value);  // a NaN reading leaves it as it was
   try {
     b.detector.push(t_s, value);
     if (b.detector.has_events()) handle_events(b, recv_utime);

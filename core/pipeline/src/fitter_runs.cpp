@@ -162,9 +162,12 @@ void FitterCore::fit_and_publish(Bench& b, const Run& run, const std::string& wh
                                        b.id)
                          : fmt::format("default ({}): {}", opt_.default_bench.inertia_source, b.config_problem);
   }
+  // One window for the fit and its explanation (run_window.hpp): the same samples, outliers and
+  // weights as spindown fit and explain take from a file.
   const auto t0 = std::chrono::steady_clock::now();
+  const RunWindow window(scratch_t_, scratch_v_, local, fo.weighted);
   try {
-    r.fit = fit_run(scratch_t_, scratch_v_, b.stream.quantity, local, fo);
+    r.fit = fit_run(window, b.stream.quantity, local, fo);
   } catch (const std::exception& e) {
     ++counters_.internal_errors;
     error(fmt::format("{}: run {}: the fit failed: {}", b.channel, run.number, e.what()), recv_utime);
@@ -195,7 +198,8 @@ void FitterCore::fit_and_publish(Bench& b, const Run& run, const std::string& wh
       ExplainOptions eo;
       eo.bench = r.fit.bench;
       eo.base = opt_.explain_base;
-      r.explain = explain_run(scratch_t_, scratch_v_, r.fit.quantity, local, eo);
+      eo.weighted = window.weighted();
+      r.explain = explain_run(window, r.fit.quantity, local, eo, b.lowest_reading);
     } catch (const std::exception& e) {
       ++counters_.internal_errors;
       error(fmt::format("{}: run {}: the explain workflow failed: {}", b.channel, run.number, e.what()), recv_utime);

@@ -154,7 +154,8 @@ ReportRun make_report_run(const Recording& rec, const Run& run, const std::strin
   out.source = rec.source;
   FitOptions fopt = options.fit;
   fopt.bench = params;
-  out.fit = fit_run(rec, run, fopt);
+  const RunWindow window(rec.t_s, rec.value, run, fopt.weighted);  // the fit's and the explanation's
+  out.fit = fit_run(window, rec.quantity, run, fopt);
   const std::size_t end = std::min(run.end_index, rec.size());
   for (std::size_t i = std::min(run.cut_index, end); i < end; ++i) {
     out.tau.push_back(rec.t_s[i] - run.t_cut_s);
@@ -163,8 +164,9 @@ ReportRun make_report_run(const Recording& rec, const Run& run, const std::strin
   if (options.explain_runs) {
     ExplainOptions eopt = options.explain;
     eopt.bench = params;
+    eopt.weighted = window.weighted();
     try {
-      out.explain = explain_run(rec, run, eopt);
+      out.explain = explain_run(window, rec.quantity, run, eopt, lowest_reading(rec.value));
       out.explained = true;
     } catch (const std::exception& e) {
       out.explain.ok = false;

@@ -30,6 +30,7 @@
 #include "spindown/effects.hpp"
 #include "spindown/recording.hpp"
 #include "spindown/residual_bins.hpp"
+#include "spindown/run_window.hpp"
 #include "spindown/runs.hpp"
 
 namespace spindown {
@@ -119,6 +120,12 @@ ExplainResult explain_run(const Recording& rec, const Run& run, const ExplainOpt
 // The same on raw arrays (t in seconds on the recording's clock), for the live fitter.
 ExplainResult explain_run(std::span<const double> t_s, std::span<const double> value, Quantity q, const Run& run,
                           const ExplainOptions& opt);
+// The same on the run's window as fit sees it (run_window.hpp: one window for fit and explain),
+// with the lowest reading of the whole recording (a sensor that reads zero at rest, below).
+ExplainResult explain_run(const RunWindow& window, Quantity q, const Run& run, const ExplainOptions& opt,
+                          double lowest_reading);
+// The lowest finite reading of a recording (+inf when there is none).
+double lowest_reading(std::span<const double> value);
 
 // Residual analysis used by the workflow (bin_residuals: residual_bins.hpp, shared with fit's
 // misfit doubt). White noise of the readings from second differences over [0, n) (robust to smooth signal): the

@@ -16,6 +16,7 @@
 
 #include "spindown/bench.hpp"
 #include "spindown/recording.hpp"
+#include "spindown/run_window.hpp"
 #include "spindown/runs.hpp"
 
 namespace spindown {
@@ -92,5 +93,9 @@ RunFit fit_run(const Recording& rec, const Run& run, const FitOptions& opt);
 // The same on raw arrays (t in seconds on the recording's clock), for the live fitter.
 RunFit fit_run(std::span<const double> t_s, std::span<const double> value, Quantity q, const Run& run,
                const FitOptions& opt);
+
+// The same on a window already made (run_window.hpp), which explain may share: its weights are
+// used as they are (window.weighted(), not opt.weighted).
+RunFit fit_run(const RunWindow& window, Quantity q, const Run& run, const FitOptions& opt);
 
 }  // namespace spindown
