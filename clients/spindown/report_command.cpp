@@ -14,7 +14,7 @@
 #include "spindown/fit_report.hpp"
 #include "spindown/html_report.hpp"
 #include "spindown/progress.hpp"
-#include "spindown/session_report.hpp"
+#include "spindown/build_session_report.hpp"
 
 namespace spindown::cli {
 

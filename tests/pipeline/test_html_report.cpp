@@ -10,7 +10,7 @@
 
 #include "spindown/fit_report.hpp"
 #include "spindown/html_report.hpp"
-#include "spindown/session_report.hpp"
+#include "spindown/build_session_report.hpp"
 #include "spindown/svg_plot.hpp"
 #include "spindown/synthetic_run.hpp"
 
@@ -47,7 +47,7 @@ void add_run(SessionReport& report, const Recording& rec, const std::string& fil
              const SessionReportOptions& opt, std::optional<double> start_unix_s = {}) {
   ReportFile f;
   f.file = file;
-  f.format = FileFormat::arduino_text;
+  f.format = "arduino";
   f.samples = rec.size();
   f.benches = {bench};
   f.start_unix_s = start_unix_s;

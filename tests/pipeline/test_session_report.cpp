@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "spindown/lcm_log_reader.hpp"
-#include "spindown/session_report.hpp"
+#include "spindown/build_session_report.hpp"
 
 namespace spindown {
 namespace {

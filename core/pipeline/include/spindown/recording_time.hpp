@@ -8,16 +8,9 @@
 #include <string_view>
 
 #include "spindown/read_recording.hpp"
+#include "spindown/recorded_at.hpp"
 
 namespace spindown {
-
-struct RecordedAt {
-  // Seconds since the epoch. A local time is counted as if it were UTC (timegm of its fields), so
-  // that its calendar fields read back with gmtime: 14:03 local stays 14:03, never shifted by a
-  // time zone nobody knows.
-  double unix_s = 0;
-  bool local = false;  // the recording PC's local time (PuTTY), not UTC
-};
 
 // "=~=~=~ PuTTY log 2023.09.14 10:21:33 =~=~=~" → its date and time (local); nullopt when the text
 // does not start with such a header.
@@ -28,10 +21,5 @@ std::optional<double> putty_log_time(std::string_view head);
 // (FileFormat::automatic: detected here).
 std::optional<RecordedAt> recording_start(const std::string& path, FileFormat format = FileFormat::automatic,
                                           const ReadOptions& read = {});
-
-// "2024-09-14 14:03:22" (and " UTC" for a UTC time, " local time" for a local one when labelled).
-std::string recorded_at_text(const RecordedAt& at, bool labelled = true);
-// "2024-09-14".
-std::string recorded_date_text(const RecordedAt& at);
 
 }  // namespace spindown

@@ -14,8 +14,9 @@
 #include "spindown/fit_report.hpp"
 #include "spindown/lab_units.hpp"
 #include "spindown/quantity.hpp"
+#include "spindown/recorded_at.hpp"
 #include "spindown/svg_plot.hpp"
-#include "spindown/text_support.hpp"
+#include "spindown/utf8_text.hpp"
 
 namespace spindown {
 
@@ -421,7 +422,7 @@ std::string files_section(const SessionReport& report) {
     s += fmt::format("<tr{}><td>{}</td>{}<td>{}</td><td>{}</td><td class=\"num\">{}</td><td>{}</td><td>{}</td></tr>\n",
                      warnings == 0 && f.failures.empty() ? " class=\"clean\"" : "",
                      esc(f.file), students ? fmt::format("<td>{}</td>", esc(f.student)) : "",
-                     esc(file_format_name(f.format)), benches, f.samples,
+                     esc(f.format), benches, f.samples,
                      f.start_unix_s ? recorded_at_text({*f.start_unix_s, f.start_local}) : "–", problems);
   }
   s += "</table>\n";
