@@ -154,181 +154,234 @@ double median_step(const std::vector<double>& t, std::size_t from, std::size_t c
 
 }  // namespace
 
+namespace {
+
+using Severity = Diagnostic::Severity;
+
+// build_timeline's pass over the samples. Samples kept are written back at kept (never past the
+// one being looked at, so the samples ahead that the checks read are untouched), then handed to
+// rec. The arrays do not change size in the pass.
+class TimelineBuilder {
+ public:
+  TimelineBuilder(RawSamples& raw, const TimelineRules& rules, Recording& rec, LineReporter& reporter)
+      : raw_(raw), rules_(rules), rec_(rec), reporter_(reporter), u_(rules.unit), n_(raw.size()),
+        rec_base_(rec.size()), t_(raw.t.data()), values_(raw.value.data()), t_out_(raw.t.data()),
+        v_out_(raw.value.data()), next_first_(raw.blocks().empty() ? n_ : raw.blocks().front().first) {
+    const double period = median_step(raw.t, 0, 64);
+    // A step larger than this is a gap in the data, or a garbled time if the next sample
+    // continues from the previous one.
+    jump_ = period > 0 ? std::max(20 * period, 0.5 * rules.units_per_s) : rules.units_per_s;
+  }
+
+  TimelineCounts run() && {
+    for (std::size_t i = 0; i < n_; ++i) {
+      if (have_prev_ && i < next_first_) {
+        i = take_usual_steps(i);
+        if (i == n_) break;
+      }
+      if (i == next_first_ && start_block(i)) continue;  // a cut-short first sample, dropped
+      double cur_u = t_[i] + offset_;
+      const double d = cur_u - prev_u_;
+      // The usual step forward has nothing to report; anything else may be skipped.
+      if (have_prev_ && !(d > 0 && d <= jump_) && !unusual_step(i, d, cur_u)) continue;
+      keep(i, cur_u);
+    }
+    hand_over();
+    return counts_;
+  }
+
+ private:
+  void keep(std::size_t i, double cur_u) {
+    t_out_[kept_] = cur_u / rules_.units_per_s;
+    v_out_[kept_] = values_[i];
+    ++kept_;
+    have_prev_ = true;
+    prev_u_ = cur_u;
+    prev_i_ = i;
+    prev_value_ = values_[i];
+  }
+
+  // The usual samples from i, up to the next block's first: each a step forward no longer than a
+  // jump, kept with nothing to check or report. A tight loop over locals, which stay in registers;
+  // returns the first sample it did not take (a block's first, or a step that is not the usual
+  // one), which goes on to the full checks.
+  std::size_t take_usual_steps(std::size_t i) {
+    const double* const t = t_;
+    const double offset = offset_, jump = jump_, units_per_s = rules_.units_per_s;
+    double* const t_out = t_out_;
+    double* const v_out = v_out_;
+    std::size_t kept = kept_;
+    double last_u = prev_u_;
+    std::size_t j = i;
+    // Two at a time first (SSE2 pairs, the same sums and quotients lane by lane): a pair with a
+    // step that is not the usual one is left to the loop after, one sample at a time.
+    using Pair = double __attribute__((vector_size(16)));
+    for (; j + 1 < next_first_; j += 2) {
+      Pair cur;
+      std::memcpy(&cur, t + j, sizeof cur);
+      cur += offset;
+      const Pair before = {last_u, cur[0]};
+      const Pair d = cur - before;
+      const auto usual = (d > 0) & (d <= jump);
+      if (!(usual[0] && usual[1])) break;
+      const Pair seconds = cur / units_per_s;
+      std::memcpy(t_out + kept, &seconds, sizeof seconds);
+      std::memmove(v_out + kept, values_ + j, 2 * sizeof(double));
+      kept += 2;
+      last_u = cur[1];
+    }
+    for (; j < next_first_; ++j) {
+      const double cur_u = t[j] + offset;
+      const double d = cur_u - last_u;
+      if (!(d > 0 && d <= jump)) break;
+      t_out[kept] = cur_u / units_per_s;
+      v_out[kept] = values_[j];
+      ++kept;
+      last_u = cur_u;
+    }
+    if (j > i) {
+      kept_ = kept;
+      prev_u_ = last_u;
+      prev_i_ = j - 1;
+      prev_value_ = v_out[kept - 1];
+    }
+    return j;
+  }
+
+  // A block's first sample: a new session's may have been cut short (logging started mid-line).
+  // True when it is dropped.
+  bool start_block(std::size_t i) {
+    const auto& blocks = raw_.blocks();
+    const bool session_start = blocks[next_block_].session_start;
+    ++next_block_;
+    next_first_ = next_block_ < blocks.size() ? blocks[next_block_].first : n_;
+    if (!session_start || !rules_.drop_cut_first || i + 3 >= n_) return false;
+    const double local = median_step(raw_.t, i + 1, 9);
+    const double d = t_[i + 1] - t_[i];
+    if (!(local > 0 && (d <= 0 || d > std::max(4 * local, local + 0.1 * rules_.units_per_s)))) return false;
+    ++counts_.cut_first;
+    reporter_.report(Severity::note, raw_.line(i),
+                     fmt::format("first sample {} looks cut short (logging started mid-line): its "
+                                 "time {} {} does not fit the next samples ({} {}, then every ~{} {}); "
+                                 "dropped",
+                                 quote_line(raw_.text(i)), t_[i], u_, t_[i + 1], u_, local, u_));
+    return true;
+  }
+
+  // A step that is not the usual one (d from the last kept sample): a repeat, a time ahead of its
+  // neighbours, a gap, a wrap, a garbled time or a restart. False when the sample is skipped;
+  // cur_u is unwrapped or restarted in place.
+  bool unusual_step(std::size_t i, double d, double& cur_u) {
+    const double s_t = t_[i];
+    const std::int64_t line = raw_.line(i);
+    const std::int64_t prev_line = raw_.line(prev_i_);
+    const bool has_next = i + 1 < n_;
+    const double next_t = has_next ? t_[i + 1] : 0;
+    const double next_u = has_next ? next_t + offset_ : 0;
+    if (d == 0) {
+      ++counts_.duplicates;
+      reporter_.warn(line, fmt::format("{}: time {} {} repeats line {}{}; skipped", quote_line(raw_.text(i)), s_t, u_,
+                                       prev_line, values_[i] == prev_value_ ? " (duplicate line)" : ""));
+      return false;
+    }
+    if (d > 0) {
+      if (d > jump_ && has_next && next_u > prev_u_ && next_u < cur_u && next_u - prev_u_ <= jump_) {
+        ++counts_.ahead;
+        reporter_.warn(line, fmt::format("{}: time {} {} jumps ahead of its neighbours (line {} has {} {}, "
+                                         "the next sample {} {}); skipped",
+                                         quote_line(raw_.text(i)), s_t, u_, prev_line, prev_u_ - offset_, u_, next_t,
+                                         u_));
+        return false;
+      }
+      ++counts_.gaps;
+      reporter_.report(Severity::note, line,
+                       fmt::format("no samples for {:.3g} s of device time (lines {} to {})", d / rules_.units_per_s,
+                                   prev_line, line));
+      return true;
+    }
+    return went_back(i, d, cur_u, has_next, next_t, next_u);
+  }
+
+  // Time went back: the counter wrapped, a garbled time between good ones, or the clock restarted.
+  bool went_back(std::size_t i, double d, double& cur_u, bool has_next, double next_t, double next_u) {
+    const double s_t = t_[i];
+    const std::int64_t line = raw_.line(i);
+    const std::int64_t prev_line = raw_.line(prev_i_);
+    const double prev_raw = prev_u_ - offset_;
+    const double window = 600 * rules_.units_per_s;
+    const double wrap = rules_.wrap;
+    if (wrap > 0 && prev_raw > wrap - window && s_t < window && d + wrap > 0 && d + wrap <= std::max(jump_, window)) {
+      ++counts_.wraps;
+      offset_ += wrap;
+      cur_u += wrap;
+      reporter_.report(Severity::note, line,
+                       fmt::format("device clock wrapped from {} {} to {} {} (counter overflow at {} {}); unwrapped",
+                                   prev_raw, u_, s_t, u_, wrap, u_));
+      return true;
+    }
+    if (has_next && next_u > prev_u_ && next_u - prev_u_ <= jump_) {
+      ++counts_.backwards;
+      reporter_.warn(line, fmt::format("{}: time goes back from {} {} (line {}) to {} {} and the next "
+                                       "sample continues from {} {}; skipped",
+                                       quote_line(raw_.text(i)), prev_raw, u_, prev_line, s_t, u_, next_t, u_));
+      return false;
+    }
+    if (-d >= rules_.reset_min_back && has_next && next_u >= cur_u && next_u - cur_u <= jump_) {
+      ++counts_.restarts;
+      offset_ = 0;
+      cur_u = s_t;
+      rec_.clock_restarts.push_back(rec_base_ + kept_);
+      reporter_.report(Severity::note, line,
+                       fmt::format("device clock restarted (Arduino reset?): time goes back from {} {} "
+                                   "(line {}) to {} {}; a new timeline starts here and no run spans it",
+                                   prev_raw, u_, prev_line, s_t, u_));
+      return true;
+    }
+    ++counts_.backwards;
+    reporter_.warn(line, fmt::format("{}: time goes back from {} {} (line {}) to {} {}; skipped",
+                                     quote_line(raw_.text(i)), prev_raw, u_, prev_line, s_t, u_));
+    return false;
+  }
+
+  void hand_over() {
+    raw_.t.resize(kept_);
+    raw_.value.resize(kept_);
+    if (rec_base_ == 0) {
+      rec_.t_s = std::move(raw_.t);
+      rec_.value = std::move(raw_.value);
+    } else {
+      rec_.t_s.insert(rec_.t_s.end(), raw_.t.begin(), raw_.t.end());
+      rec_.value.insert(rec_.value.end(), raw_.value.begin(), raw_.value.end());
+    }
+  }
+
+  RawSamples& raw_;
+  const TimelineRules& rules_;
+  Recording& rec_;
+  LineReporter& reporter_;
+  const std::string_view u_;
+  const std::size_t n_;
+  const std::size_t rec_base_;
+  const double* const t_;
+  const double* const values_;
+  double* const t_out_;
+  double* const v_out_;
+  double jump_ = 0;
+  TimelineCounts counts_;
+  std::size_t kept_ = 0;
+  std::size_t next_block_ = 0;  // blocks[next_block_] is the next to start, at sample next_first_
+  std::size_t next_first_;
+  bool have_prev_ = false;
+  double offset_ = 0;       // wraps so far in this clock epoch, in file units
+  double prev_u_ = 0;       // unwrapped time of the last accepted sample
+  std::size_t prev_i_ = 0;  // its index (its line, for messages)
+  double prev_value_ = 0;
+};
+
+}  // namespace
+
 TimelineCounts build_timeline(RawSamples& raw, const TimelineRules& rules, Recording& rec, LineReporter& reporter) {
-  using Severity = Diagnostic::Severity;
-  TimelineCounts counts;
-  const double period = median_step(raw.t, 0, 64);
-  // A step larger than this is a gap in the data, or a garbled time if the next sample
-  // continues from the previous one.
-  const double jump = period > 0 ? std::max(20 * period, 0.5 * rules.units_per_s) : rules.units_per_s;
-  const auto u = rules.unit;
-  const double units_per_s = rules.units_per_s;
-
-  // Samples kept are written back at kept (never past the one being looked at, so the samples
-  // ahead that the checks read are untouched), then handed to rec. The arrays do not change size
-  // in the loop: plain pointers, which stay in registers.
-  const std::size_t n = raw.size();
-  const std::size_t rec_base = rec.size();
-  const double* const t = raw.t.data();
-  const double* const values = raw.value.data();
-  double* const t_out = raw.t.data();
-  double* const v_out = raw.value.data();
-  std::size_t kept = 0;
-  const auto& blocks = raw.blocks();
-  std::size_t next_block = 0;  // blocks[next_block] is the next to start, at sample next_first
-  std::size_t next_first = blocks.empty() ? n : blocks.front().first;
-
-  bool have_prev = false;
-  double offset = 0;   // wraps so far in this clock epoch, in file units
-  double prev_u = 0;   // unwrapped time of the last accepted sample
-  std::size_t prev_i = 0;  // its index (its line, for messages)
-  double prev_value = 0;
-
-  for (std::size_t i = 0; i < n; ++i) {
-    // The usual sample, up to the next block's first: a step forward no longer than a jump, kept
-    // with nothing to check or report. A tight loop; the first sample it does not take (a
-    // block's first, or a step that is not the usual one) goes on to the full checks below.
-    if (have_prev && i < next_first) {
-      double last_u = prev_u;
-      std::size_t j = i;
-      // Two at a time first (SSE2 pairs, the same sums and quotients lane by lane): a pair with
-      // a step that is not the usual one is left to the loop after, one sample at a time.
-      using Pair = double __attribute__((vector_size(16)));
-      for (; j + 1 < next_first; j += 2) {
-        Pair cur;
-        std::memcpy(&cur, t + j, sizeof cur);
-        cur += offset;
-        const Pair before = {last_u, cur[0]};
-        const Pair d = cur - before;
-        const auto usual = (d > 0) & (d <= jump);
-        if (!(usual[0] && usual[1])) break;
-        const Pair seconds = cur / units_per_s;
-        std::memcpy(t_out + kept, &seconds, sizeof seconds);
-        std::memmove(v_out + kept, values + j, 2 * sizeof(double));
-        kept += 2;
-        last_u = cur[1];
-      }
-      for (; j < next_first; ++j) {
-        const double cur_u = t[j] + offset;
-        const double d = cur_u - last_u;
-        if (!(d > 0 && d <= jump)) break;
-        t_out[kept] = cur_u / units_per_s;
-        v_out[kept] = values[j];
-        ++kept;
-        last_u = cur_u;
-      }
-      if (j > i) {
-        prev_u = last_u;
-        prev_i = j - 1;
-        prev_value = v_out[kept - 1];
-        i = j;
-        if (i == n) break;
-      }
-    }
-    const double s_t = t[i];
-    const double s_value = values[i];
-    const bool has_next = i + 1 < n;
-
-    if (i == next_first) {  // a block's first sample: a new session's may have been cut short
-      const bool session_start = blocks[next_block].session_start;
-      ++next_block;
-      next_first = next_block < blocks.size() ? blocks[next_block].first : n;
-      if (session_start && rules.drop_cut_first && i + 3 < n) {
-        const double local = median_step(raw.t, i + 1, 9);
-        const double d = t[i + 1] - s_t;
-        if (local > 0 && (d <= 0 || d > std::max(4 * local, local + 0.1 * rules.units_per_s))) {
-          ++counts.cut_first;
-          reporter.report(Severity::note, raw.line(i),
-                          fmt::format("first sample {} looks cut short (logging started mid-line): its "
-                                      "time {} {} does not fit the next samples ({} {}, then every ~{} {}); "
-                                      "dropped",
-                                      quote_line(raw.text(i)), s_t, u, t[i + 1], u, local, u));
-          continue;
-        }
-      }
-    }
-
-    double cur_u = s_t + offset;
-    const double d = cur_u - prev_u;
-    if (have_prev && !(d > 0 && d <= jump)) {  // the usual step forward has nothing to report
-      const std::int64_t line = raw.line(i);
-      const std::int64_t prev_line = raw.line(prev_i);
-      const double next_t = has_next ? t[i + 1] : 0;
-      const double next_u = has_next ? next_t + offset : 0;
-      if (d == 0) {
-        ++counts.duplicates;
-        reporter.warn(line, fmt::format("{}: time {} {} repeats line {}{}; skipped", quote_line(raw.text(i)), s_t,
-                                        u, prev_line, s_value == prev_value ? " (duplicate line)" : ""));
-        continue;
-      }
-      if (d > 0) {
-        if (d > jump && has_next && next_u > prev_u && next_u < cur_u && next_u - prev_u <= jump) {
-          ++counts.ahead;
-          reporter.warn(line, fmt::format("{}: time {} {} jumps ahead of its neighbours (line {} has {} {}, "
-                                          "the next sample {} {}); skipped",
-                                          quote_line(raw.text(i)), s_t, u, prev_line, prev_u - offset, u, next_t, u));
-          continue;
-        }
-        if (d > jump) {
-          ++counts.gaps;
-          reporter.report(Severity::note, line,
-                          fmt::format("no samples for {:.3g} s of device time (lines {} to {})",
-                                      d / rules.units_per_s, prev_line, line));
-        }
-      } else {  // time went back
-        const double prev_raw = prev_u - offset;
-        const double window = 600 * rules.units_per_s;
-        if (rules.wrap > 0 && prev_raw > rules.wrap - window && s_t < window && d + rules.wrap > 0 &&
-            d + rules.wrap <= std::max(jump, window)) {
-          ++counts.wraps;
-          offset += rules.wrap;
-          cur_u += rules.wrap;
-          reporter.report(Severity::note, line,
-                          fmt::format("device clock wrapped from {} {} to {} {} (counter overflow at {} {}); "
-                                      "unwrapped",
-                                      prev_raw, u, s_t, u, rules.wrap, u));
-        } else if (has_next && next_u > prev_u && next_u - prev_u <= jump) {
-          ++counts.backwards;
-          reporter.warn(line, fmt::format("{}: time goes back from {} {} (line {}) to {} {} and the next "
-                                          "sample continues from {} {}; skipped",
-                                          quote_line(raw.text(i)), prev_raw, u, prev_line, s_t, u, next_t, u));
-          continue;
-        } else if (-d >= rules.reset_min_back && has_next && next_u >= cur_u && next_u - cur_u <= jump) {
-          ++counts.restarts;
-          offset = 0;
-          cur_u = s_t;
-          rec.clock_restarts.push_back(rec_base + kept);
-          reporter.report(Severity::note, line,
-                          fmt::format("device clock restarted (Arduino reset?): time goes back from {} {} "
-                                      "(line {}) to {} {}; a new timeline starts here and no run spans it",
-                                      prev_raw, u, prev_line, s_t, u));
-        } else {
-          ++counts.backwards;
-          reporter.warn(line, fmt::format("{}: time goes back from {} {} (line {}) to {} {}; skipped",
-                                          quote_line(raw.text(i)), prev_raw, u, prev_line, s_t, u));
-          continue;
-        }
-      }
-    }
-    t_out[kept] = cur_u / units_per_s;
-    v_out[kept] = s_value;
-    ++kept;
-    have_prev = true;
-    prev_u = cur_u;
-    prev_i = i;
-    prev_value = s_value;
-  }
-
-  raw.t.resize(kept);
-  raw.value.resize(kept);
-  if (rec_base == 0) {
-    rec.t_s = std::move(raw.t);
-    rec.value = std::move(raw.value);
-  } else {
-    rec.t_s.insert(rec.t_s.end(), raw.t.begin(), raw.t.end());
-    rec.value.insert(rec.value.end(), raw.value.begin(), raw.value.end());
-  }
-  return counts;
+  return TimelineBuilder(raw, rules, rec, reporter).run();
 }
 
 std::string summary_with_counts(std::string head, std::initializer_list<Count> counts, const TimelineCounts& timeline) {
