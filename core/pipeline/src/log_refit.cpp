@@ -129,134 +129,156 @@ std::vector<std::vector<std::string>> log_sessions(const std::vector<std::string
   return sessions;
 }
 
-LogRefit refit_log_session(const std::vector<std::string>& paths, const FitterOptions& options, bool keep_live_fits,
-                           const std::function<void(const LcmLogEvent&)>& each_event, const RefitProgressFn& progress,
-                           const RefitRunFn& each_run) {
-  LogRefit out;
-  out.file.file = paths.empty() ? std::string() : paths.front();
-  out.session_files = paths;
-  const std::string& path = out.file.file;
-  RefitSink sink(out, path, each_run, !options.explain_base.empty());
-  FitterCore core(options, sink);
-  std::map<std::string, std::size_t, std::less<>> order;
-  std::vector<char> channel_done;  // by session channel id: its bench's place is known
-  // Each reader numbers its own channels; the core's numbering is the session's, by name.
-  std::map<std::string, std::int32_t, std::less<>> session_ids;
-  std::vector<std::uint64_t> fitter_sessions;  // of the fitters' heartbeats in the log (keep_live_fits)
-  std::int64_t last_utime = 0, next_poll = std::numeric_limits<std::int64_t>::min();
-  std::size_t file_problems = 0;
-  std::int64_t events_read = 0, bytes_before = 0, bytes_total = 0;
-  for (const auto& p : paths) {
-    struct stat st {};
-    if (::stat(p.c_str(), &st) == 0) bytes_total += st.st_size;
-  }
-  LcmLogEvent ev;
-  std::size_t opened = 0;
-  for (const std::string& file : paths) {
-    // The core reads samples in place; a caller that sees each event may want the samples_t.
-    LcmLogReader reader(file, each_event ? LcmSamples::view_and_message : LcmSamples::view_only);
-    if (!reader.good()) {
-      out.file.failures.push_back(reader.open_error());
-      continue;
+namespace {
+
+// A session's log files replayed through a FitterCore as the live fitter saw them: each event's
+// channel numbered for the session, each bench's place fixed by its first SAMPLE/CONFIG, the core
+// polled as the log's host time passes, the live fitter's own results kept for --live/--compare.
+class SessionReplay {
+ public:
+  SessionReplay(LogRefit& out, const FitterOptions& options, bool keep_live_fits,
+                const std::function<void(const LcmLogEvent&)>& each_event, const RefitProgressFn& progress,
+                const RefitRunFn& each_run)
+      : out_(out),
+        keep_live_fits_(keep_live_fits),
+        each_event_(each_event),
+        progress_(progress),
+        sink_(out, out.file.file, each_run, !options.explain_base.empty()),
+        core_(options, sink_) {}
+
+  void run(const std::vector<std::string>& paths) {
+    for (const auto& p : paths) {
+      struct stat st {};
+      if (::stat(p.c_str(), &st) == 0) bytes_total_ += st.st_size;
     }
-    ++opened;
+    std::size_t opened = 0;
+    for (const std::string& file : paths) opened += replay_file(file);
+    if (opened == 0) return;
+    core_.finish(last_utime_);
+    out_.counters = core_.counters();
+    leave_out_forged_fits();
+    summarize();
+    order_runs();
+  }
+
+ private:
+  bool replay_file(const std::string& file) {
+    // The core reads samples in place; a caller that sees each event may want the samples_t.
+    LcmLogReader reader(file, each_event_ ? LcmSamples::view_and_message : LcmSamples::view_only);
+    if (!reader.good()) {
+      out_.file.failures.push_back(reader.open_error());
+      return false;
+    }
     std::vector<std::int32_t> id_map;  // reader's channel id -> the session's
     // Progress every 256 events, counted down (one test per event, none for a caller without one).
     constexpr std::size_t progress_every = 256;
-    std::size_t until_progress = progress ? progress_every : std::numeric_limits<std::size_t>::max();
-    while (reader.next(ev)) {
-      if (each_event) each_event(ev);
+    std::size_t until_progress = progress_ ? progress_every : std::numeric_limits<std::size_t>::max();
+    while (reader.next(ev_)) {
+      if (each_event_) each_event_(ev_);
       if (--until_progress == 0) {
         until_progress = progress_every;
-        progress(bytes_before + ev.file_offset, std::max(bytes_total, bytes_before + reader.file_size()),
-                 out.runs_fitted);
+        progress_(bytes_before_ + ev_.file_offset, std::max(bytes_total_, bytes_before_ + reader.file_size()),
+                  out_.runs_fitted);
       }
-      if (ev.number > 0) last_utime = ev.log_utime;
+      if (ev_.number > 0) last_utime_ = ev_.log_utime;
       // Host time passes as the log's events do: benches gone silent mid-coast are closed as live.
-      if (ev.log_utime >= next_poll) {
-        core.poll(ev.log_utime);
-        next_poll = ev.log_utime + FitterCore::poll_period_us;
+      if (ev_.log_utime >= next_poll_) {
+        core_.poll(ev_.log_utime);
+        next_poll_ = ev_.log_utime + FitterCore::poll_period_us;
       }
-      if (ev.channel_id >= 0) {
-        const auto rid = static_cast<std::size_t>(ev.channel_id);
-        if (rid >= id_map.size()) id_map.resize(rid + 1, -1);
-        if (id_map[rid] < 0) {
-          const auto [it, added] =
-                session_ids.try_emplace(std::string(ev.channel), static_cast<std::int32_t>(session_ids.size()));
-          id_map[rid] = it->second;
-        }
-        ev.channel_id = id_map[rid];
-      }
-      // A bench's first SAMPLE/CONFIG fixes its place; checked once per channel, not per event.
-      const auto id = static_cast<std::size_t>(ev.channel_id);
-      if (ev.channel_id < 0 || id >= channel_done.size() || !channel_done[id]) {
-        if (!ev.bench.empty() && (ev.channel.ends_with(".SAMPLE") || ev.channel.ends_with(".CONFIG")) &&
-            !order.contains(ev.bench)) {
-          order.emplace(ev.bench, order.size());
-          out.bench_order.emplace_back(ev.bench);
-        }
-        if (ev.channel_id >= 0) {
-          if (id >= channel_done.size()) channel_done.resize(id + 1, 0);
-          channel_done[id] = 1;
-        }
-      }
-      switch (ev.kind) {
-        // Decoded (and checked) once, by the reader: the core takes the message as it is, once its
-        // gate let it through (the lab, and with a key its signature, as live).
-        case LcmLogEvent::Kind::samples:
-          if (core.admit_samples(ev.channel, ev.samples_view, ev.data, ev.data_size, ev.log_utime))
-            core.on_samples(ev.channel_id, ev.bench, ev.samples_view, ev.log_utime);
-          break;
-        case LcmLogEvent::Kind::config:
-          if (core.admit(ev.channel, ev.data, ev.data_size, ev.log_utime))
-            core.on_config(ev.bench, ev.config, ev.log_utime);
-          break;
-        case LcmLogEvent::Kind::problem:
-          if (ev.number > 0 && ev.data) {  // a message that does not decode: the core counts it
-            core.on_message(ev.channel, ev.data, ev.data_size, ev.log_utime);
-          } else if (++file_problems <= max_problems_listed) {
-            out.file.diagnostics.push_back({Diagnostic::Severity::warning, file, ev.number, ev.problem});
-          }
-          break;
-        case LcmLogEvent::Kind::other: {
-          const auto parts = keep_live_fits ? split_channel(ev.channel) : std::nullopt;
-          const auto kind = parts ? channel_kind(parts->suffix) : std::nullopt;
-          if (kind == ChannelKind::status) {
-            status_t st{};
-            if (core.admit(ev.channel, ev.data, ev.data_size, ev.log_utime) &&
-                decode_message(st, ev.data, ev.data_size) && st.service == "fitter" && st.source_session != 0 &&
-                std::find(fitter_sessions.begin(), fitter_sessions.end(), std::uint64_t(st.source_session)) ==
-                    fitter_sessions.end() &&
-                fitter_sessions.size() < 1024)
-              fitter_sessions.push_back(static_cast<std::uint64_t>(st.source_session));
-            break;
-          }
-          // The live fitter's results as recorded (for --live and --compare): its own only when the
-          // gate lets them through (the lab, and with a key their signature): a forged one is
-          // counted and named, never compared.
-          if ((kind == ChannelKind::fit || kind == ChannelKind::explain) &&
-              core.admit(ev.channel, ev.data, ev.data_size, ev.log_utime)) {
-            if (kind == ChannelKind::fit) keep_recorded(ev, file, out.live, "fit_t", out.file.diagnostics);
-            else keep_recorded(ev, file, out.live_explains, "explain_t", out.file.diagnostics);
-          }
-          break;
-        }
-      }
+      number_channel(id_map);
+      place_bench();
+      dispatch(file);
     }
-    events_read += reader.events_read();
-    bytes_before += reader.file_size();
+    events_read_ += reader.events_read();
+    bytes_before_ += reader.file_size();
+    return true;
   }
-  if (opened == 0) return out;
-  core.finish(last_utime);
-  out.counters = core.counters();
+
+  // Each reader numbers its own channels; the core's numbering is the session's, by name.
+  void number_channel(std::vector<std::int32_t>& id_map) {
+    if (ev_.channel_id < 0) return;
+    const auto rid = static_cast<std::size_t>(ev_.channel_id);
+    if (rid >= id_map.size()) id_map.resize(rid + 1, -1);
+    if (id_map[rid] < 0) {
+      const auto [it, added] =
+          session_ids_.try_emplace(std::string(ev_.channel), static_cast<std::int32_t>(session_ids_.size()));
+      id_map[rid] = it->second;
+    }
+    ev_.channel_id = id_map[rid];
+  }
+
+  // A bench's first SAMPLE/CONFIG fixes its place; checked once per channel, not per event.
+  void place_bench() {
+    const auto id = static_cast<std::size_t>(ev_.channel_id);
+    if (ev_.channel_id >= 0 && id < channel_done_.size() && channel_done_[id]) return;
+    if (!ev_.bench.empty() && (ev_.channel.ends_with(".SAMPLE") || ev_.channel.ends_with(".CONFIG")) &&
+        !order_.contains(ev_.bench)) {
+      order_.emplace(ev_.bench, order_.size());
+      out_.bench_order.emplace_back(ev_.bench);
+    }
+    if (ev_.channel_id >= 0) {
+      if (id >= channel_done_.size()) channel_done_.resize(id + 1, 0);
+      channel_done_[id] = 1;
+    }
+  }
+
+  void dispatch(const std::string& file) {
+    switch (ev_.kind) {
+      // Decoded (and checked) once, by the reader: the core takes the message as it is, once its
+      // gate let it through (the lab, and with a key its signature, as live).
+      case LcmLogEvent::Kind::samples:
+        if (core_.admit_samples(ev_.channel, ev_.samples_view, ev_.data, ev_.data_size, ev_.log_utime))
+          core_.on_samples(ev_.channel_id, ev_.bench, ev_.samples_view, ev_.log_utime);
+        break;
+      case LcmLogEvent::Kind::config:
+        if (core_.admit(ev_.channel, ev_.data, ev_.data_size, ev_.log_utime))
+          core_.on_config(ev_.bench, ev_.config, ev_.log_utime);
+        break;
+      case LcmLogEvent::Kind::problem:
+        if (ev_.number > 0 && ev_.data) {  // a message that does not decode: the core counts it
+          core_.on_message(ev_.channel, ev_.data, ev_.data_size, ev_.log_utime);
+        } else if (++file_problems_ <= max_problems_listed) {
+          out_.file.diagnostics.push_back({Diagnostic::Severity::warning, file, ev_.number, ev_.problem});
+        }
+        break;
+      case LcmLogEvent::Kind::other: keep_live_result(file); break;
+    }
+  }
+
+  // The fitters heard (their heartbeats), and the live fitter's results as recorded (for --live and
+  // --compare): its own only when the gate lets them through (the lab, and with a key their
+  // signature): a forged one is counted and named, never compared.
+  void keep_live_result(const std::string& file) {
+    const auto parts = keep_live_fits_ ? split_channel(ev_.channel) : std::nullopt;
+    const auto kind = parts ? channel_kind(parts->suffix) : std::nullopt;
+    if (kind == ChannelKind::status) {
+      status_t st{};
+      if (core_.admit(ev_.channel, ev_.data, ev_.data_size, ev_.log_utime) &&
+          decode_message(st, ev_.data, ev_.data_size) && st.service == "fitter" && st.source_session != 0 &&
+          std::find(fitter_sessions_.begin(), fitter_sessions_.end(), std::uint64_t(st.source_session)) ==
+              fitter_sessions_.end() &&
+          fitter_sessions_.size() < 1024)
+        fitter_sessions_.push_back(static_cast<std::uint64_t>(st.source_session));
+      return;
+    }
+    if ((kind == ChannelKind::fit || kind == ChannelKind::explain) &&
+        core_.admit(ev_.channel, ev_.data, ev_.data_size, ev_.log_utime)) {
+      if (kind == ChannelKind::fit) keep_recorded(ev_, file, out_.live, "fit_t", out_.file.diagnostics);
+      else keep_recorded(ev_, file, out_.live_explains, "explain_t", out_.file.diagnostics);
+    }
+  }
+
   // A FIT whose source is no fitter heard in the log is not a live result (a forged one): left out.
-  if (!fitter_sessions.empty()) {
-    std::erase_if(out.live, [&](const fit_t& m) {
+  void leave_out_forged_fits() {
+    if (fitter_sessions_.empty()) return;
+    const std::string& path = out_.file.file;
+    std::erase_if(out_.live, [&](const fit_t& m) {
       const auto session = static_cast<std::uint64_t>(m.source_session);
-      if (session == 0 || std::find(fitter_sessions.begin(), fitter_sessions.end(), session) != fitter_sessions.end())
+      if (session == 0 || std::find(fitter_sessions_.begin(), fitter_sessions_.end(), session) != fitter_sessions_.end())
         return false;
-      ++out.live_left_out;
-      out.file.diagnostics.push_back(
+      ++out_.live_left_out;
+      out_.file.diagnostics.push_back(
           {Diagnostic::Severity::warning, path, 0,
            fmt::format("SPINDOWN.{}.FIT: run {} from {}: no fitter heard in this log has that session (a forged "
                        "FIT?); not taken as a live result",
@@ -264,49 +286,84 @@ LogRefit refit_log_session(const std::vector<std::string>& paths, const FitterOp
       return true;
     });
   }
-  const FitterCounters& c = out.counters;
-  if (file_problems > max_problems_listed)
-    out.file.diagnostics.push_back({Diagnostic::Severity::warning, path, 0,
-                                    fmt::format("{} damaged parts of the file in all", file_problems)});
-  if (sink.problems() > max_problems_listed)
-    out.file.diagnostics.push_back({Diagnostic::Severity::warning, path, 0,
-                                    fmt::format("{} unusable messages or samples in all (first {} listed)",
-                                                sink.problems(), max_problems_listed)});
-  if (sink.notes() > max_detector_notes)
-    out.file.diagnostics.push_back({Diagnostic::Severity::note, path, 0,
-                                    fmt::format("{} run detector notes in all (first {} listed)", sink.notes(),
-                                                max_detector_notes)});
-  out.file.diagnostics.push_back(
-      {Diagnostic::Severity::note, path, 0,
-       fmt::format("{} events: {} sample messages, {} config messages, {} samples used; {} decode errors, {} sequence "
-                   "gaps ({} samples lost), {} repeated messages, {} NaN values, {} samples with time going back, "
-                   "{} clock restarts",
-                   events_read, c.sample_messages, c.config_messages, c.samples, c.decode_errors, c.seq_gaps,
-                   c.samples_lost, c.duplicates, c.nan_values, c.time_backwards, c.clock_restarts)});
+
+  void summarize() {
+    const std::string& path = out_.file.file;
+    const FitterCounters& c = out_.counters;
+    auto& diagnostics = out_.file.diagnostics;
+    if (file_problems_ > max_problems_listed)
+      diagnostics.push_back({Diagnostic::Severity::warning, path, 0,
+                             fmt::format("{} damaged parts of the file in all", file_problems_)});
+    if (sink_.problems() > max_problems_listed)
+      diagnostics.push_back({Diagnostic::Severity::warning, path, 0,
+                             fmt::format("{} unusable messages or samples in all (first {} listed)", sink_.problems(),
+                                         max_problems_listed)});
+    if (sink_.notes() > max_detector_notes)
+      diagnostics.push_back({Diagnostic::Severity::note, path, 0,
+                             fmt::format("{} run detector notes in all (first {} listed)", sink_.notes(),
+                                         max_detector_notes)});
+    diagnostics.push_back(
+        {Diagnostic::Severity::note, path, 0,
+         fmt::format("{} events: {} sample messages, {} config messages, {} samples used; {} decode errors, {} "
+                     "sequence gaps ({} samples lost), {} repeated messages, {} NaN values, {} samples with time "
+                     "going back, {} clock restarts",
+                     events_read_, c.sample_messages, c.config_messages, c.samples, c.decode_errors, c.seq_gaps,
+                     c.samples_lost, c.duplicates, c.nan_values, c.time_backwards, c.clock_restarts)});
+  }
 
   // Runs in the order `spindown fit` lists them: by bench (first appearance), then number.
-  auto rank = [&](const std::string& bench) {
-    auto it = order.find(bench);
-    return it == order.end() ? order.size() : it->second;
-  };
-  std::stable_sort(out.runs.begin(), out.runs.end(), [&](const RefitRun& a, const RefitRun& b) {
-    const auto ra = rank(a.bench), rb = rank(b.bench);
-    return ra != rb ? ra < rb : a.fit.run.number < b.fit.run.number;
-  });
-  out.file.samples = static_cast<std::size_t>(c.samples);
-  out.file.lines_read = static_cast<std::size_t>(c.sample_messages);
-  out.file.lines_skipped = static_cast<std::size_t>(c.decode_errors + c.duplicates + c.quantity_errors);
-  const bool any_health = std::any_of(out.runs.begin(), out.runs.end(), [](const RefitRun& r) { return r.health.has_value(); });
-  for (const RefitRun& r : out.runs) {
-    out.file.runs.push_back(r.fit);
-    if (any_health) out.file.health.push_back(r.health);
-    if (r.fit.best.empty())
-      out.file.failures.push_back(fmt::format("SPINDOWN.{}.SAMPLE: run {}: no model converged", r.bench,
-                                              r.fit.run.number));
+  void order_runs() {
+    const FitterCounters& c = out_.counters;
+    auto rank = [&](const std::string& bench) {
+      auto it = order_.find(bench);
+      return it == order_.end() ? order_.size() : it->second;
+    };
+    std::stable_sort(out_.runs.begin(), out_.runs.end(), [&](const RefitRun& a, const RefitRun& b) {
+      const auto ra = rank(a.bench), rb = rank(b.bench);
+      return ra != rb ? ra < rb : a.fit.run.number < b.fit.run.number;
+    });
+    out_.file.samples = static_cast<std::size_t>(c.samples);
+    out_.file.lines_read = static_cast<std::size_t>(c.sample_messages);
+    out_.file.lines_skipped = static_cast<std::size_t>(c.decode_errors + c.duplicates + c.quantity_errors);
+    const bool any_health =
+        std::any_of(out_.runs.begin(), out_.runs.end(), [](const RefitRun& r) { return r.health.has_value(); });
+    for (const RefitRun& r : out_.runs) {
+      out_.file.runs.push_back(r.fit);
+      if (any_health) out_.file.health.push_back(r.health);
+      if (r.fit.best.empty())
+        out_.file.failures.push_back(fmt::format("SPINDOWN.{}.SAMPLE: run {}: no model converged", r.bench,
+                                                 r.fit.run.number));
+    }
+    if (out_.runs_fitted == 0)
+      out_.file.failures.push_back(c.samples > 0 ? fmt::format("no spin-down run found in {} samples", c.samples)
+                                                 : std::string("no samples on SPINDOWN.<bench>.SAMPLE channels"));
   }
-  if (out.runs_fitted == 0)
-    out.file.failures.push_back(c.samples > 0 ? fmt::format("no spin-down run found in {} samples", c.samples)
-                                              : std::string("no samples on SPINDOWN.<bench>.SAMPLE channels"));
+
+  LogRefit& out_;
+  const bool keep_live_fits_;
+  const std::function<void(const LcmLogEvent&)>& each_event_;
+  const RefitProgressFn& progress_;
+  RefitSink sink_;
+  FitterCore core_;
+  LcmLogEvent ev_;
+  std::map<std::string, std::size_t, std::less<>> order_;
+  std::vector<char> channel_done_;  // by session channel id: its bench's place is known
+  std::map<std::string, std::int32_t, std::less<>> session_ids_;
+  std::vector<std::uint64_t> fitter_sessions_;  // of the fitters' heartbeats in the log (keep_live_fits)
+  std::int64_t last_utime_ = 0, next_poll_ = std::numeric_limits<std::int64_t>::min();
+  std::size_t file_problems_ = 0;
+  std::int64_t events_read_ = 0, bytes_before_ = 0, bytes_total_ = 0;
+};
+
+}  // namespace
+
+LogRefit refit_log_session(const std::vector<std::string>& paths, const FitterOptions& options, bool keep_live_fits,
+                           const std::function<void(const LcmLogEvent&)>& each_event, const RefitProgressFn& progress,
+                           const RefitRunFn& each_run) {
+  LogRefit out;
+  out.file.file = paths.empty() ? std::string() : paths.front();
+  out.session_files = paths;
+  SessionReplay(out, options, keep_live_fits, each_event, progress, each_run).run(paths);
   return out;
 }
 
