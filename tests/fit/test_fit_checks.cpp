@@ -47,6 +47,18 @@ TEST(FitChecks, ATachometerInRpmReadAsVoltsIsDoubtedWithTheFix) {
   EXPECT_TRUE(fit_of(c, rpm, Quantity::rpm).doubts.empty());
 }
 
+// Issue 32 (a vehicle's km/h in a headerless file): readings of a few tens, read as volts by
+// default, give a speed far beyond a flywheel's; the doubt says they were taken as volts.
+TEST(FitChecks, ASpeedReadAsVoltsSaysTheReadingsWereTakenAsVolts) {
+  const Case c = make_case(SyntheticRunSpec{});
+  std::vector<double> kmh;
+  for (double v : c.run.volts) kmh.push_back(v * 9.5);  // up to ~27: below the volts limit, above any flywheel
+  const RunFit f = fit_of(c, kmh);
+  ASSERT_TRUE(mentions(f.doubts, "faster than a teaching flywheel")) << (f.doubts.empty() ? "" : f.doubts.front());
+  EXPECT_TRUE(mentions(f.doubts, "the readings were taken as back-EMF in volts")) << f.doubts.front();
+  EXPECT_TRUE(mentions(f.doubts, "--value-unit")) << f.doubts.front();
+}
+
 TEST(FitChecks, VoltsReadAsRpmAreDoubtedToo) {
   const Case c = make_case(SyntheticRunSpec{});
   const RunFit f = fit_of(c, c.run.volts, Quantity::rpm);

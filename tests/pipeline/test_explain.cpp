@@ -543,3 +543,30 @@ TEST(Explain, ExplainAndFitShareOneWindowWithItsDropoutsLeftOut) {
   EXPECT_EQ(shared.y, own.y);
   EXPECT_EQ(shared.conclusion, own.conclusion);
 }
+
+// Issue 32: where the model and the data disagree is named by the data's speed there, not the
+// model's (a viscous model on a Coulomb coast starts far above the measured speed).
+TEST(Explain, ADisagreementIsPlacedAtTheMeasuredSpeed) {
+  SyntheticRunSpec spec;
+  spec.friction.viscous = 0;
+  spec.friction.coulomb = 4e-4;
+  spec.seed = 5;
+  const SyntheticRun s = make_synthetic_run(spec);
+  Recording rec;
+  rec.quantity = Quantity::back_emf_volts;
+  for (std::size_t i = 0; i < s.t_ms.size(); ++i) rec.t_s.push_back(s.t_ms[i] / 1000.0), rec.value.push_back(s.volts[i]);
+  const Segmentation seg = find_runs(rec);
+  ASSERT_FALSE(seg.runs.empty());
+  const ExplainResult r = explain_run(rec, seg.runs.front(), ExplainOptions{});
+  ASSERT_TRUE(r.ok) << r.message;
+  ASSERT_FALSE(r.steps.empty());
+  ASSERT_FALSE(r.steps.front().where.empty());
+  const double k = spec.bench.kb_v_s_per_rad;
+  for (const Disagreement& d : r.steps.front().where) {
+    // The readings at the stretch's first time, as a speed: within a few bins' travel of the label.
+    std::size_t i = 0;
+    while (i + 1 < r.tau.size() && r.tau[i] < d.tau_from_s) ++i;
+    const double measured = (r.y[i] - r.zero_level) / k;
+    EXPECT_NEAR(d.omega_from, measured, 0.05 * std::max(measured, 20.0)) << d.tau_from_s;
+  }
+}

@@ -84,6 +84,7 @@ class Explainer {
   double lowest_reading_ = 0;  // the lowest reading the sensor gave at all
   double quantum_ = 0;         // the reading's resolution
   std::size_t n_ = 0, moving_ = 0;
+  std::vector<double> speed_;  // the measured speed at each sample (rad/s), where the story says it is
   std::size_t m_ = 5;          // samples per bin
   double period_ = 0.02;
   std::vector<const Effect*> pool_;
@@ -121,6 +122,7 @@ void Explainer::take_window() {
   out_.weight.assign(window_.weight().begin(), window_.weight().end());
   out_.reading_noise = std::max(window_.reading_noise(), 1e-12);
   quantum_ = reading_quantum(out_.y);
+  speed_ = measured_speed(out_.y, out_.zero_level, k_);
 }
 
 // The reading's zero is measured when the run shows a standstill: an offset lies between 0 and
@@ -203,13 +205,12 @@ bool Explainer::step(int number) {
   const std::vector<double> res = residual_of(out_.y, current_);
   const ResidualBins bins = bin_residuals(res, m_, out_.reading_noise);
   if (number == 0) out_.bin_noise = bins.bin_se;
-  const std::vector<double> speed = model_speed(current_, out_.tau, k_);
   std::vector<Disagreement> where =
-      locate(bins, bins.bin_se, opt_.systematic_z, out_.tau, res, speed, run_.t_cut_s);
+      locate(bins, bins.bin_se, opt_.systematic_z, out_.tau, res, speed_, run_.t_cut_s);
   const double mass = systematic_mass(bins, bins.bin_se);
   if (where.empty() && mass_significant(mass, bins.mean.size()))
     // Spread out rather than concentrated: show where it is largest at a lower threshold.
-    where = locate(bins, bins.bin_se, 0.6 * opt_.systematic_z, out_.tau, res, speed, run_.t_cut_s);
+    where = locate(bins, bins.bin_se, 0.6 * opt_.systematic_z, out_.tau, res, speed_, run_.t_cut_s);
   if (where.empty() && !mass_significant(mass, bins.mean.size()) && !pending_) {
     out_.remaining = where;
     out_.conclusion = fmt::format(

@@ -4,7 +4,6 @@
 #include <cmath>
 #include <limits>
 
-#include "spindown/effect_simulator.hpp"
 
 namespace spindown::explain_detail {
 
@@ -22,10 +21,10 @@ double systematic_mass(const ResidualBins& b, double bin_se) {
 
 bool mass_significant(double mass, std::size_t bins) { return mass > 3.0 * std::sqrt(2.0 * static_cast<double>(bins)); }
 
-std::vector<double> model_speed(const EffectFit& f, std::span<const double> tau, double k) {
-  if (f.theta.empty() || !std::isfinite(f.theta[0])) return std::vector<double>(tau.size(), std::numeric_limits<double>::quiet_NaN());
-  const EffectSimulator sim(f.effects, k);
-  return sim.omega(f.theta, tau);
+std::vector<double> measured_speed(std::span<const double> y, double zero_level, double k) {
+  std::vector<double> out(y.size());
+  for (std::size_t i = 0; i < y.size(); ++i) out[i] = (y[i] - zero_level) / k;
+  return out;
 }
 
 std::vector<Disagreement> locate(const ResidualBins& b, double bin_se, double z_thr, std::span<const double> tau,
@@ -48,8 +47,19 @@ std::vector<Disagreement> locate(const ResidualBins& b, double bin_se, double z_
     d.tau_to_s = tau[i1 - 1];
     d.t_from_s = d.tau_from_s + t_cut;
     d.t_to_s = d.tau_to_s + t_cut;
-    d.omega_from = speed[i0];
-    d.omega_to = speed[i1 - 1];
+    // The measured speed at the ends: a line through the end bin's readings, at the end's time (not
+    // the model's speed: where the model misses, its speed is not where the coast was).
+    const auto speed_at = [&](std::size_t from, std::size_t to, double at) {
+      const double n = static_cast<double>(std::max<std::size_t>(to - from, 1));
+      double st = 0, sv = 0;
+      for (std::size_t i = from; i < to; ++i) st += tau[i], sv += speed[i];
+      const double tm = st / n, vm = sv / n;
+      double stt = 0, stv = 0;
+      for (std::size_t i = from; i < to; ++i) stt += (tau[i] - tm) * (tau[i] - tm), stv += (tau[i] - tm) * (speed[i] - vm);
+      return stt > 0 ? vm + stv / stt * (at - tm) : vm;
+    };
+    d.omega_from = speed_at(i0, e > k + 1 ? b.first[k + 1] : i1, d.tau_from_s);
+    d.omega_to = speed_at(b.first[e - 1], i1, d.tau_to_s);
     double sum = 0;
     for (std::size_t i = i0; i < i1; ++i) sum += residual[i];
     d.mean_residual = sum / static_cast<double>(i1 - i0);

@@ -18,10 +18,10 @@ std::vector<double> residual_of(std::span<const double> y, const EffectFit& f);
 double systematic_mass(const ResidualBins& b, double bin_se);
 // A chi-square excess beyond 3 standard deviations (2K variance) is not noise.
 bool mass_significant(double mass, std::size_t bins);
-// Model speed (rad/s) at each sample, sensor terms removed.
-std::vector<double> model_speed(const EffectFit& f, std::span<const double> tau, double k);
+// The measured speed (rad/s) at each reading y: (y − zero level)/k.
+std::vector<double> measured_speed(std::span<const double> y, double zero_level, double k);
 // The stretches of bins beyond z_thr bin noises, the few that carry most of the disagreement, in
-// time order.
+// time order, with the measured speed (speed: per reading) at their ends.
 std::vector<Disagreement> locate(const ResidualBins& b, double bin_se, double z_thr, std::span<const double> tau,
                                  std::span<const double> residual, const std::vector<double>& speed, double t_cut);
 // The reading's resolution: the smallest step between distinct values (2-decimal prints:

@@ -72,10 +72,22 @@ std::vector<std::string> unit_doubts(const RunFit& fit, double peak) {
     case Quantity::rad_per_s:
       break;
   }
+  // Said with what the readings were taken as: a speed in km/h or m/s read as volts by default
+  // (a file that names no unit) is found here, and the reader must see it was taken as volts.
   if (std::isfinite(omega0) && omega0 > plausible_max_omega)
-    out.push_back(fmt::format("a speed at the cut of {:.6g} rad/s ({:.0f} rpm): faster than a teaching flywheel "
-                              "turns — check the value's unit (--value-unit) and K_b",
-                              omega0, omega0 * 60 / (2 * M_PI)));
+    out.push_back(fmt::format(
+        "a speed at the cut of {:.6g} rad/s ({:.0f} rpm): faster than a teaching flywheel turns — the readings were "
+        "taken as {}{}; if that is not their unit, give it (--value-unit V, rpm or rad/s; a vehicle's km/h or m/s "
+        "is not a shaft speed){}",
+        omega0, omega0 * 60 / (2 * M_PI),
+        fit.quantity == Quantity::back_emf_volts ? "back-EMF in volts"
+        : fit.quantity == Quantity::rpm          ? "a speed in rpm"
+                                                 : "a speed in rad/s",
+        fit.quantity == Quantity::back_emf_volts
+            ? fmt::format(" ({:.4g} V at the cut ÷ K_b {:.4g} V·s/rad)", omega0 * fit.bench.kb_v_s_per_rad,
+                          fit.bench.kb_v_s_per_rad)
+            : std::string(),
+        fit.quantity == Quantity::back_emf_volts ? "; else check K_b" : ""));
   return out;
 }
 

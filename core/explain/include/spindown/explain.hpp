@@ -51,7 +51,7 @@ struct ExplainOptions {
 struct Disagreement {
   double t_from_s = 0, t_to_s = 0;      // device time (s), the file's clock
   double tau_from_s = 0, tau_to_s = 0;  // seconds after the cut
-  double omega_from = 0, omega_to = 0;  // model speed (rad/s) at the ends
+  double omega_from = 0, omega_to = 0;  // measured speed (rad/s) at the ends: their bins' mean reading
   double mean_residual = 0;             // measurement − model, reading unit
   double peak_residual = 0;             // largest bin mean (signed)
   double z = 0;                         // peak bin mean / its noise SE
