@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "spindown/fit.hpp"
+#include "spindown/phi_function.hpp"
 
 namespace spindown::friction {
 
@@ -42,18 +43,6 @@ inline Theta unpack(const Family& f, const double* x) {
   if (f.alpha_free) th.alpha = x[i++];
   if (f.beta_free) th.beta = x[i++];
   return th;
-}
-
-// φ(x) = (1 − e^(−x))/x and dφ/dx from the one exponential already computed; a series where
-// 1 − e would cancel.
-inline void phi(double x, double e, double& p, double& dp) {
-  if (x < 1e-3) {
-    p = 1.0 - x / 2 + x * x / 6 - x * x * x / 24;
-    dp = -0.5 + x / 3 - x * x / 8;
-  } else {
-    p = (1.0 - e) / x;
-    dp = (e * (1.0 + x) - 1.0) / (x * x);
-  }
 }
 
 // Model reading at τ and, when grad is given, its partial derivatives (zero once stopped).

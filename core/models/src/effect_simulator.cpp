@@ -5,22 +5,13 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "spindown/phi_function.hpp"
+
 namespace spindown {
 namespace {
 
 constexpr double inf = std::numeric_limits<double>::infinity();
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
-
-// φ(x) = (1 − e^(−x))/x and dφ/dx, a series where 1 − e would cancel (as in fit.cpp).
-inline void phi(double x, double e, double& p, double& dp) {
-  if (x < 1e-3) {
-    p = 1.0 - x / 2 + x * x / 6 - x * x * x / 24;
-    dp = -0.5 + x / 3 - x * x / 8;
-  } else {
-    p = (1.0 - e) / x;
-    dp = (e * (1.0 + x) - 1.0) / (x * x);
-  }
-}
 
 // 8-point Gauss–Legendre nodes/weights on [−1, 1] (positive half).
 constexpr std::array<double, 4> gl_x = {0.1834346424956498, 0.5255324099163290, 0.7966664774136267,
