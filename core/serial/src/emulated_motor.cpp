@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "physics_truth.hpp"
+
 namespace spindown {
 
 bool EmulatedMotorOptions::is_valid(std::string* why) const {
@@ -97,13 +99,7 @@ int EmulatedMotor::convert(double t_s) {
 
 nlohmann::json EmulatedMotor::truth_json(const std::vector<double>& boots_s, const nlohmann::json& extra) const {
   nlohmann::json t;
-  t["inertia_kg_m2"] = o_.bench.inertia_kg_m2;
-  t["kb_v_s_per_rad"] = o_.bench.kb_v_s_per_rad;
-  t["c_v"] = o_.friction.viscous;
-  t["c_c"] = o_.friction.coulomb;
-  t["c_s"] = o_.friction.stribeck_static;
-  t["w_s"] = o_.friction.stribeck_speed;
-  t["c_w"] = o_.friction.windage;
+  write_physics_truth(t, o_.bench, o_.friction);
   t["offset"] = 0.0;
   t["lead_in"] = o_.lead_in_supply ? "supply" : "zeros";
   t["supply_v"] = o_.supply_v;

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "physics_truth.hpp"
 #include "spindown/spindown_protocol.hpp"
 
 namespace spindown {
@@ -136,13 +137,7 @@ class Schedule {
     const SyntheticRunSpec& spec = o_.spec;
     truth_["protocol"] = v1_ ? "spindown-v1" : "lab-tsv";
     truth_["baud"] = o_.effective_baud();
-    truth_["inertia_kg_m2"] = spec.bench.inertia_kg_m2;
-    truth_["kb_v_s_per_rad"] = spec.bench.kb_v_s_per_rad;
-    truth_["c_v"] = spec.friction.viscous;
-    truth_["c_c"] = spec.friction.coulomb;
-    truth_["c_s"] = spec.friction.stribeck_static;
-    truth_["w_s"] = spec.friction.stribeck_speed;
-    truth_["c_w"] = spec.friction.windage;
+    write_physics_truth(truth_, spec.bench, spec.friction);
     truth_["offset"] = spec.offset_v;
     // What the pin reads before each cut (the runs' lead-in), and the supply it reads with "supply".
     truth_["lead_in"] = spec.lead_in == LeadIn::zeros      ? "zeros"
