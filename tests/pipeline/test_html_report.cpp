@@ -295,6 +295,29 @@ TEST(RunFigure, TheWholeRecordingWithTheFittedWindowShaded) {
   EXPECT_DOUBLE_EQ(r.context_tau.back(), rec.t_s[rec.size() - 11] - seg.runs[0].t_cut_s);
 }
 
+// Issue 33: the figure's fitted samples are the fit's window (run_window.hpp): a dropout the run
+// leaves out is not drawn as fitted (nor its residual), and the count is the fit's.
+TEST(RunFigure, TheFittedSamplesAreTheFitsWindow) {
+  Recording rec = synthetic(1.0, 5, "r.tsv");
+  Segmentation seg = find_runs(rec);
+  ASSERT_EQ(seg.runs.size(), 1u);
+  // Three single-sample dropouts to 0 V in the coast, then found again as the run's outliers.
+  const std::size_t cut = seg.runs[0].cut_index;
+  for (std::size_t k : {cut + 40, cut + 90, cut + 140}) rec.value[k] = 0.0;
+  seg = find_runs(rec);
+  ASSERT_EQ(seg.runs.size(), 1u);
+  ASSERT_GE(seg.runs[0].outliers.size(), 3u);
+  SessionReportOptions opt;
+  opt.explain_runs = false;
+  const ReportRun r = make_report_run(rec, seg.runs[0], "b", BenchParams{}, opt);
+  const ModelFit* combined = r.fit.model(ModelKind::combined);
+  ASSERT_NE(combined, nullptr);
+  EXPECT_EQ(r.tau.size(), combined->n);
+  const double coasting_s = seg.runs[0].t_stop_s - seg.runs[0].t_cut_s - 0.5;  // before the standstill
+  for (std::size_t i = 0; i < r.tau.size() && r.tau[i] < coasting_s; ++i)
+    EXPECT_GT(r.y[i], 0.0) << "a dropout drawn as a fitted sample at " << r.tau[i] << " s";
+}
+
 // A semester prints on a few pages: a print stylesheet leaves the per-run figures to the screen
 // and keeps a one-line-per-run table.
 TEST(HtmlReport, PrintsCompactly) {

@@ -50,11 +50,10 @@ ReportRun make_report_run(const Recording& rec, const Run& run, const std::strin
   fopt.bench = params;
   const RunWindow window(rec.t_s, rec.value, run, fopt.weighted);  // the fit's and the explanation's
   out.fit = fit_run(window, rec.quantity, run, fopt);
-  const std::size_t end = std::min(run.end_index, rec.size());
-  for (std::size_t i = std::min(run.cut_index, end); i < end; ++i) {
-    out.tau.push_back(rec.t_s[i] - run.t_cut_s);
-    out.y.push_back(rec.value[i]);
-  }
+  // The figure's samples are the fit's (outliers left out: the context around the run shows them).
+  out.tau.assign(window.tau().begin(), window.tau().end());
+  out.y.reserve(window.size());
+  for (double y : window.y()) out.y.push_back(y + window.zero_level());
   if (options.explain_runs) {
     ExplainOptions eopt = options.explain;
     eopt.bench = params;
