@@ -75,6 +75,198 @@ std::optional<std::string> read_text(const std::string& path, std::string* why) 
   return s.str();
 }
 
+// The bench file text of a new file: the bench's id and its [baseline] section.
+std::string new_bench_file(const std::string& bench, const std::string& section) {
+  return fmt::format("bench_id = \"{}\"\n\n{}", bench, section);
+}
+
+// The command line's checks that need no file read: a valid bench id, no -o over a file.
+void check_usage(const BaselineCommandOptions& o) {
+  std::string why;
+  if (!is_valid_bench_id(o.bench, &why)) bad_usage(fmt::format("--bench: {}", why));
+  if (!o.output.empty() && std::filesystem::exists(o.output))
+    bad_usage(fmt::format("-o {}: the file exists; use --update {} to replace its [baseline]", o.output, o.output));
+}
+
+// --update's bench file, its warnings on stderr (none without --update; bad usage when unreadable).
+std::optional<BenchFile> load_update_file(const BaselineCommandOptions& o) {
+  if (o.update.empty()) return std::nullopt;
+  std::optional<BenchFile> file;
+  try {
+    file = load_bench_file(o.update);
+    print_bench_file_warnings(*file, std::cerr);
+    if (file->bench != o.bench)
+      std::cerr << fmt::format("{}: warning: the file describes bench '{}', the baseline is for --bench {}\n",
+                               o.update, file->bench, o.bench);
+  } catch (const std::exception& e) {
+    bad_usage(fmt::format("--update: {}", e.what()));
+  }
+  return file;
+}
+
+// Each run of the bench as read: what the baseline can be made of, and what not.
+struct Seen {
+  std::string source;
+  std::optional<BaselineRun> run;  // a whole coast with a combined fit
+  std::string why;                 // else why not
+  std::optional<RecordedAt> at;    // when its cut was, as the file tells
+};
+
+// The offline path's sink for the bench's recordings: each run fitted (combined model) and kept
+// as Seen; the reader's errors and the CONFIG's problems on stderr.
+struct BaselineSink : OfflineSink {
+  const FitOptions& fit_opt;
+  std::vector<Seen> seen;
+  bool all_read = true, bench_found = false;
+  std::optional<RecordedAt> start;  // the current file's
+  std::string current;              // the current file
+  explicit BaselineSink(const FitOptions& f) : fit_opt(f) {}
+  void recording(const OfflineRecording&) override { bench_found = true; }
+  void diagnostics(const OfflineRecording&, From from, std::span<const Diagnostic> diags) override {
+    // The reader's errors and the CONFIG's problems.
+    for (const auto& d : diags)
+      if (from == From::config || (from == From::reader && d.severity == Diagnostic::Severity::error))
+        std::cerr << d.to_string() << '\n';
+  }
+  void failure(const OfflineRecording* r, std::string why) override {
+    if (!r || r->recording.empty()) {
+      all_read = false;  // the reader's error is already on stderr
+      if (!r) std::cerr << fmt::format("{}: error: {}\n", current, why);
+      return;
+    }
+    std::cerr << fmt::format("{}: {}\n", r->path, why);
+  }
+  void run(const OfflineRecording& r, const Run& run) override {
+    FitOptions this_fit = fit_opt;
+    this_fit.bench = r.params;
+    const RunFit fit = fit_run(r.recording, run, this_fit);
+    Seen s{fmt::format("{} run {}", r.path, run.number), std::nullopt, {}, std::nullopt};
+    s.run = baseline_run(fit, s.source, &s.why);
+    if (start && !r.recording.t_s.empty())
+      s.at = RecordedAt{start->unix_s + (run.t_cut_s - r.recording.t_s.front()), start->local};
+    seen.push_back(std::move(s));
+  }
+};
+
+// The offline path (offline_pipeline.hpp) over the files, for this bench's recordings only.
+void read_bench_runs(const BaselineCommandOptions& o, const BenchChoice& choice,
+                     const std::optional<BenchFile>& update_file, BaselineSink& sink) {
+  OfflinePlan plan{read_options_from(o.input), choice, {}, {}, {}};
+  const BenchNaming naming = naming_from(o.input);
+  plan.naming = &naming;
+  plan.bench_file = [&update_file](const OfflineRecording&) { return update_file ? &*update_file : nullptr; };
+  plan.wanted = [&o](const OfflineRecording& r) { return r.bench.empty() || r.bench == o.bench; };
+  for (const auto& path : o.files) {
+    // A class's files: those the roster or --bench-pattern gives to another bench are not this one's.
+    if (naming.active()) {
+      const BenchName name = naming.name(path, file_stem(path));
+      if (name.bench != o.bench) {
+        std::cout << fmt::format("  {:<8} {}: bench {} ({})\n", "skipped", path, name.bench,
+                                 name.problem.empty() ? name.from : name.problem);
+        continue;
+      }
+    }
+    sink.bench_found = false;
+    sink.current = path;
+    sink.start = recording_start(path, FileFormat::automatic, plan.read);
+    walk_file(path, plan, sink);
+    if (!sink.bench_found) {
+      std::cerr << fmt::format("{}: error: no samples of bench '{}' in this file\n", path, o.bench);
+      sink.all_read = false;
+    }
+  }
+}
+
+// When the runs the baseline uses were recorded, the first and the last (as their files tell).
+struct UsedSpan {
+  std::optional<RecordedAt> first, last;
+};
+
+// Every run once, in the order read: what the baseline is made of, and what not.
+UsedSpan list_runs(const std::vector<Seen>& seen, const std::vector<SetAsideRun>& set_aside, bool made) {
+  const auto set_aside_why = [&set_aside](const std::string& source) -> const std::string* {
+    for (const auto& r : set_aside)
+      if (r.source == source) return &r.why;
+    return nullptr;
+  };
+  UsedSpan used;
+  for (const auto& s : seen) {
+    if (!s.run) {
+      std::cout << fmt::format("  {:<8} {}: {}\n", "not used", s.source, s.why);
+    } else if (const std::string* aside = set_aside_why(s.source)) {
+      std::cout << fmt::format("  set aside {}: {}\n", s.source, *aside);
+    } else {
+      std::cout << fmt::format("  {:<8} {}: c3 = {} N·m·s/rad, c4 = {} N·m\n", made ? "used" : "candidate", s.source,
+                               format_value_error(s.run->c_viscous, s.run->c_viscous_stderr),
+                               format_value_error(s.run->c_coulomb, s.run->c_coulomb_stderr));
+      if (s.at) {
+        if (!used.first || s.at->unix_s < used.first->unix_s) used.first = s.at;
+        if (!used.last || s.at->unix_s > used.last->unix_s) used.last = s.at;
+      }
+    }
+  }
+  return used;
+}
+
+// Dated by the recordings (the last run used, as its file tells it), never by the day this runs;
+// today only when no file tells.
+void date_baseline(HealthBaseline& baseline, const UsedSpan& used) {
+  if (used.last) {
+    baseline.date = recorded_date_text(*used.last);
+    if (recorded_date_text(*used.first) != baseline.date)
+      std::cout << fmt::format("  the runs used were recorded {} to {}: the baseline is dated by the last\n",
+                               recorded_date_text(*used.first), baseline.date);
+  } else {
+    baseline.date = today_utc();
+    std::cerr << fmt::format("spindown baseline: warning: no recording date in these files (no PuTTY header, not an "
+                             "LCM log): the baseline is dated today, {}; give the recordings' date with --date\n",
+                             baseline.date);
+  }
+}
+
+// The baseline where the command line says: --update's file (or a new file beside it when its
+// [baseline] cannot be replaced cleanly), -o's new file, else stdout. False when a file could not
+// be written (why on stderr).
+bool write_baseline(const BaselineCommandOptions& o, const HealthBaseline& baseline) {
+  const std::string section = baseline_toml_section(baseline);
+  std::string why;
+  if (!o.update.empty()) {
+    const auto text = read_text(o.update, &why);
+    std::optional<std::string> updated;
+    if (text) updated = with_baseline_section(*text, baseline, &why);
+    if (updated) {
+      if (!write_file(o.update, *updated, &why)) {
+        std::cerr << "spindown baseline: error: " << why << '\n';
+        return false;
+      }
+      std::cout << fmt::format("[baseline] of {} updated in place (other keys and comments kept)\n", o.update);
+      return true;
+    }
+    // Not cleanly replaceable: the original stays untouched, the section goes beside it.
+    const std::string beside = o.update + ".baseline.toml";
+    std::string werr;
+    if (!write_file(beside, new_bench_file(o.bench, section), &werr)) {
+      std::cerr << "spindown baseline: error: " << werr << '\n';
+      return false;
+    }
+    std::cerr << fmt::format(
+        "spindown baseline: warning: {} not changed ({}); the baseline is in a new file {}: copy its "
+        "[baseline] section into the bench file\n",
+        o.update, why, beside);
+    return true;
+  }
+  if (!o.output.empty()) {
+    if (!write_file(o.output, new_bench_file(o.bench, section), &why)) {
+      std::cerr << "spindown baseline: error: " << why << '\n';
+      return false;
+    }
+    std::cout << fmt::format("baseline written to {} (a new bench file with bench_id and [baseline])\n", o.output);
+    return true;
+  }
+  std::cout << '\n' << section;
+  return true;
+}
+
 }  // namespace
 
 void setup_baseline(CLI::App& app) {
@@ -105,145 +297,34 @@ void setup_baseline(CLI::App& app) {
 }
 
 int run_baseline(const BaselineCommandOptions& o) {
-  std::string why;
-  if (!is_valid_bench_id(o.bench, &why)) bad_usage(fmt::format("--bench: {}", why));
-  if (!o.output.empty() && std::filesystem::exists(o.output))
-    bad_usage(fmt::format("-o {}: the file exists; use --update {} to replace its [baseline]", o.output, o.output));
-
+  check_usage(o);
   // J and K_b by the one rule (choose_bench_params): flags, else the bench file being updated,
   // else an LCM log's CONFIG, else the lab's.
+  const BenchChoice choice = bench_choice_from(o.input);
   FitOptions fit_opt;
   fit_opt.models = {ModelKind::combined};
-  const BenchChoice choice = bench_choice_from(o.input);
   fit_opt.bench = choice.given;
-  std::optional<BenchFile> update_file;
-  if (!o.update.empty()) {
-    try {
-      update_file = load_bench_file(o.update);
-      print_bench_file_warnings(*update_file, std::cerr);
-      if (update_file->bench != o.bench)
-        std::cerr << fmt::format("{}: warning: the file describes bench '{}', the baseline is for --bench {}\n",
-                                 o.update, update_file->bench, o.bench);
-    } catch (const std::exception& e) {
-      bad_usage(fmt::format("--update: {}", e.what()));
-    }
-  }
-  // The offline path (offline_pipeline.hpp) over the files, for this bench's recordings only.
+  const std::optional<BenchFile> update_file = load_update_file(o);
   // Each run is listed once the baseline is made: used, set aside (and why) or not used (and why).
-  struct Seen {
-    std::string source;
-    std::optional<BaselineRun> run;  // a whole coast with a combined fit
-    std::string why;                 // else why not
-    std::optional<RecordedAt> at;    // when its cut was, as the file tells
-  };
-  struct Sink : OfflineSink {
-    const FitOptions& fit_opt;
-    std::vector<Seen> seen;
-    bool all_read = true, bench_found = false;
-    std::optional<RecordedAt> start;  // the current file's
-    explicit Sink(const FitOptions& f) : fit_opt(f) {}
-    void recording(const OfflineRecording&) override { bench_found = true; }
-    void diagnostics(const OfflineRecording&, From from, std::span<const Diagnostic> diags) override {
-      // The reader's errors and the CONFIG's problems.
-      for (const auto& d : diags)
-        if (from == From::config || (from == From::reader && d.severity == Diagnostic::Severity::error))
-          std::cerr << d.to_string() << '\n';
-    }
-    void failure(const OfflineRecording* r, std::string why) override {
-      if (!r || r->recording.empty()) {
-        all_read = false;  // the reader's error is already on stderr
-        if (!r) std::cerr << fmt::format("{}: error: {}\n", current, why);
-        return;
-      }
-      std::cerr << fmt::format("{}: {}\n", r->path, why);
-    }
-    void run(const OfflineRecording& r, const Run& run) override {
-      FitOptions this_fit = fit_opt;
-      this_fit.bench = r.params;
-      const RunFit fit = fit_run(r.recording, run, this_fit);
-      Seen s{fmt::format("{} run {}", r.path, run.number), std::nullopt, {}, std::nullopt};
-      s.run = baseline_run(fit, s.source, &s.why);
-      if (start && !r.recording.t_s.empty())
-        s.at = RecordedAt{start->unix_s + (run.t_cut_s - r.recording.t_s.front()), start->local};
-      seen.push_back(std::move(s));
-    }
-    std::string current;
-  } sink(fit_opt);
-  OfflinePlan plan{read_options_from(o.input), choice, {}, {}, {}};
-  const BenchNaming naming = naming_from(o.input);
-  plan.naming = &naming;
-  plan.bench_file = [&update_file](const OfflineRecording&) { return update_file ? &*update_file : nullptr; };
-  plan.wanted = [&o](const OfflineRecording& r) { return r.bench.empty() || r.bench == o.bench; };
-  for (const auto& path : o.files) {
-    // A class's files: those the roster or --bench-pattern gives to another bench are not this one's.
-    if (naming.active()) {
-      const BenchName name = naming.name(path, file_stem(path));
-      if (name.bench != o.bench) {
-        std::cout << fmt::format("  {:<8} {}: bench {} ({})\n", "skipped", path, name.bench,
-                                 name.problem.empty() ? name.from : name.problem);
-        continue;
-      }
-    }
-    sink.bench_found = false;
-    sink.current = path;
-    sink.start = recording_start(path, FileFormat::automatic, plan.read);
-    walk_file(path, plan, sink);
-    if (!sink.bench_found) {
-      std::cerr << fmt::format("{}: error: no samples of bench '{}' in this file\n", path, o.bench);
-      sink.all_read = false;
-    }
-  }
+  BaselineSink sink(fit_opt);
+  read_bench_runs(o, choice, update_file, sink);
   std::vector<BaselineRun> good;
   for (const auto& s : sink.seen)
     if (s.run) good.push_back(*s.run);
   const std::size_t runs_seen = sink.seen.size();
-  const bool all_read = sink.all_read;
 
   std::string source = fmt::format("bench {}:", o.bench);
   for (const auto& f : o.files) source += " " + std::filesystem::path(f).filename().string();
+  std::string why;
   std::vector<SetAsideRun> set_aside;
   auto baseline = make_baseline(good, o.date, source, &why, &set_aside);
-  const auto set_aside_why = [&set_aside](const std::string& source) -> const std::string* {
-    for (const auto& r : set_aside)
-      if (r.source == source) return &r.why;
-    return nullptr;
-  };
-  // Every run once, in the order read: what the baseline is made of, and what not.
-  std::optional<RecordedAt> first_used, last_used;
-  for (const auto& s : sink.seen) {
-    if (!s.run) {
-      std::cout << fmt::format("  {:<8} {}: {}\n", "not used", s.source, s.why);
-    } else if (const std::string* aside = set_aside_why(s.source)) {
-      std::cout << fmt::format("  set aside {}: {}\n", s.source, *aside);
-    } else {
-      std::cout << fmt::format("  {:<8} {}: c3 = {} N·m·s/rad, c4 = {} N·m\n", baseline ? "used" : "candidate", s.source,
-                               format_value_error(s.run->c_viscous, s.run->c_viscous_stderr),
-                               format_value_error(s.run->c_coulomb, s.run->c_coulomb_stderr));
-      if (s.at) {
-        if (!first_used || s.at->unix_s < first_used->unix_s) first_used = s.at;
-        if (!last_used || s.at->unix_s > last_used->unix_s) last_used = s.at;
-      }
-    }
-  }
+  const UsedSpan used = list_runs(sink.seen, set_aside, baseline.has_value());
   if (!baseline) {
     std::cerr << fmt::format("spindown baseline: error: {} ({} run{} seen)\n", why, runs_seen,
                              runs_seen == 1 ? "" : "s");
     return exit_unusable;
   }
-  // Dated by the recordings (the last run used, as its file tells it), never by the day this runs.
-  if (o.date.empty()) {
-    if (last_used) {
-      baseline->date = recorded_date_text(*last_used);
-      if (recorded_date_text(*first_used) != baseline->date)
-        std::cout << fmt::format("  the runs used were recorded {} to {}: the baseline is dated by the last\n",
-                                 recorded_date_text(*first_used), baseline->date);
-    } else {
-      baseline->date = today_utc();
-      std::cerr << fmt::format("spindown baseline: warning: no recording date in these files (no PuTTY header, not an "
-                               "LCM log): the baseline is dated today, {}; give the recordings' date with --date\n",
-                               baseline->date);
-    }
-  }
+  if (o.date.empty()) date_baseline(*baseline, used);
   std::cout << fmt::format(
       "baseline of bench {} from {} of {} run{} (recorded {}): c3 = {} N·m·s/rad (spread {:.2g}), c4 = {} N·m "
       "(spread {:.2g}), J = {:.6g} kg·m²\n",
@@ -251,41 +332,8 @@ int run_baseline(const BaselineCommandOptions& o) {
       format_value_error(baseline->c_viscous, baseline->c_viscous_stderr), baseline->c_viscous_spread,
       format_value_error(baseline->c_coulomb, baseline->c_coulomb_stderr), baseline->c_coulomb_spread,
       baseline->inertia_kg_m2);
-
-  const std::string section = baseline_toml_section(*baseline);
-  if (!o.update.empty()) {
-    const auto text = read_text(o.update, &why);
-    std::optional<std::string> updated;
-    if (text) updated = with_baseline_section(*text, *baseline, &why);
-    if (updated) {
-      if (!write_file(o.update, *updated, &why)) {
-        std::cerr << "spindown baseline: error: " << why << '\n';
-        return exit_unusable;
-      }
-      std::cout << fmt::format("[baseline] of {} updated in place (other keys and comments kept)\n", o.update);
-    } else {
-      // Not cleanly replaceable: the original stays untouched, the section goes beside it.
-      const std::string beside = o.update + ".baseline.toml";
-      std::string werr;
-      if (!write_file(beside, fmt::format("bench_id = \"{}\"\n\n{}", o.bench, section), &werr)) {
-        std::cerr << "spindown baseline: error: " << werr << '\n';
-        return exit_unusable;
-      }
-      std::cerr << fmt::format(
-          "spindown baseline: warning: {} not changed ({}); the baseline is in a new file {}: copy its "
-          "[baseline] section into the bench file\n",
-          o.update, why, beside);
-    }
-  } else if (!o.output.empty()) {
-    if (!write_file(o.output, fmt::format("bench_id = \"{}\"\n\n{}", o.bench, section), &why)) {
-      std::cerr << "spindown baseline: error: " << why << '\n';
-      return exit_unusable;
-    }
-    std::cout << fmt::format("baseline written to {} (a new bench file with bench_id and [baseline])\n", o.output);
-  } else {
-    std::cout << '\n' << section;
-  }
-  return all_read ? exit_ok : exit_unusable;
+  if (!write_baseline(o, *baseline)) return exit_unusable;
+  return sink.all_read ? exit_ok : exit_unusable;
 }
 
 }  // namespace spindown::cli

@@ -267,6 +267,366 @@ std::string why_they_differ(const Run& ours, std::int64_t ours_samples, const Js
   return {};
 }
 
+
+// One session's name in the output: its file, or its first file and how many more.
+std::string session_name(const std::vector<std::string>& session) {
+  return session.size() == 1
+             ? session.front()
+             : fmt::format("{} + {} more (one session, in time order)", session.front(), session.size() - 1);
+}
+
+// Each bench's runs of one session, formatted as they are fitted; printed by bench (first
+// appearance) once the log is done, as the order contract wants.
+class SessionSpools {
+ public:
+  SessionSpools(const RefitCommandOptions& o, const ReportOptions& report) : o_(o), report_(report) {}
+
+  void add(RefitRun&& run) {
+    if (run.explain) explains_.push_back(Json::parse(explain_run_json(*run.explain, run.bench, report_).dump()));
+    RunSpool& spool = spool_of(run.bench);
+    if (o_.json) {
+      // The run as refit_file_json() lists it, written straight to text (no document).
+      const RunTags tags{run.bench, run.first_seq, run.last_seq};
+      run_text_.assign(",\n        ");
+      append_run_fit_json_text(run_text_, run.fit, report_, 8, &tags, run.health ? &*run.health : nullptr);
+      spool.add(run_text_);
+    } else {
+      spool.add(fmt::format("\n-- bench {} (J/K_b: {})\n", run.bench, run.bench_source) +
+                format_run_fit(run.fit, report_) + (run.health ? format_health_verdict(*run.health) : std::string()));
+    }
+  }
+
+  // The spools by bench in order of first appearance (a bench never seen on SAMPLE/CONFIG last).
+  std::vector<RunSpool*> in_order(const std::vector<std::string>& bench_order) {
+    std::vector<RunSpool*> ordered;
+    for (const auto& id : bench_order)
+      for (auto& [bench, sp] : spools_)
+        if (bench == id) ordered.push_back(sp.get());
+    for (auto& [bench, sp] : spools_)
+      if (std::find(bench_order.begin(), bench_order.end(), bench) == bench_order.end()) ordered.push_back(sp.get());
+    return ordered;
+  }
+
+  // --explain: each run's EXPLAIN, as spindown explain --json gives a run.
+  Json take_explains() { return std::move(explains_); }
+
+ private:
+  RunSpool& spool_of(const std::string& bench) {
+    for (auto& [id, sp] : spools_)
+      if (id == bench) return *sp;
+    return *spools_.emplace_back(bench, std::make_unique<RunSpool>()).second;
+  }
+
+  const RefitCommandOptions& o_;
+  const ReportOptions& report_;
+  std::vector<std::pair<std::string, std::unique_ptr<RunSpool>>> spools_;
+  std::string run_text_;  // reused: one run's JSON at a time
+  Json explains_ = Json::array();
+};
+
+// The recorded FIT messages of the wanted benches as JSON without the timing fields, in log
+// order, each with its bench id; one the report cannot read is a warning on stderr.
+using LiveFits = std::vector<std::pair<std::string, Json>>;
+
+LiveFits recorded_fits(const std::string& path, const LogRefit& r, const std::string& bench_regex,
+                       const ReportOptions& report) {
+  LiveFits live;
+  const std::regex wanted(bench_regex);
+  for (const fit_t& m : r.live) {
+    if (!std::regex_match(m.bench, wanted)) continue;
+    std::string why;
+    if (auto jf = fit_message_json(m, report, &why))
+      live.emplace_back(m.bench, without_timing_fields(std::move(*jf)));
+    else
+      std::cerr << path << ": warning: " << why << '\n';
+  }
+  return live;
+}
+
+// --compare for one session: a live FIT and a refitted run are the same run when they are on the
+// same bench and their fitted windows overlap (run numbers restart with the fitter; the device
+// time does not), the largest overlap first. Each difference is a line on stdout, then a line of
+// counts.
+class FitComparison {
+ public:
+  FitComparison(const std::string& path, const LogRefit& r, const LiveFits& live, const ReportOptions& report)
+      : path_(path), r_(r), live_(live), report_(report), live_paired_(live.size(), false) {}
+
+  // False when a run differs or is on one side only, or nothing was recorded.
+  bool run() {
+    const Json refit = refit_file_json(r_, report_);
+    for (std::size_t i = 0; i < r_.runs.size(); ++i) {
+      const RefitRun& ours = r_.runs[i];
+      const std::string name =
+          fmt::format("{} run {} (cut at {:.3f} s)", ours.bench, ours.fit.run.number, ours.fit.run.t_cut_s);
+      const std::size_t k = live_partner(ours);
+      if (k == live_.size()) {
+        refit_only(ours, name);
+        continue;
+      }
+      live_paired_[k] = true;
+      compare_pair(ours, without_timing_fields(refit["runs"][i]), live_[k].second, name);
+    }
+    for (std::size_t k = 0; k < live_.size(); ++k)
+      if (!live_paired_[k]) live_only(k);
+    print_counts();
+    return !(differ_ || verdict_differ_ || missing_live_ || missing_refit_ || live_.empty());
+  }
+
+ private:
+  // The unpaired live FIT of the run's bench whose window overlaps the run's most; none: size().
+  std::size_t live_partner(const RefitRun& ours) const {
+    std::size_t best = live_.size();
+    double best_overlap = 0;
+    for (std::size_t k = 0; k < live_.size(); ++k) {
+      if (live_paired_[k] || live_[k].first != ours.bench) continue;
+      const double overlap = window_overlap_s(ours.fit.run, live_[k].second);
+      if (overlap > best_overlap) best = k, best_overlap = overlap;
+    }
+    return best;
+  }
+
+  void refit_only(const RefitRun& ours, const std::string& name) {
+    ++missing_live_;
+    std::string why;
+    for (const auto& [bench, theirs] : live_)
+      if (bench == ours.bench && window_overlap_s(ours.fit.run, theirs) > 0) {
+        why = fmt::format(" (split: it lies inside live run {} (cut at {:.3f} s), which the refit splits here)",
+                          theirs.value("run", 0), number_in(theirs, "t_cut_s"));
+        break;
+      }
+    if (why.empty() && ours.fit.run.end == Run::End::end_of_data)
+      why = " (split: the log ends during this run, and its live FIT, published when it ended, is in the log "
+            "after it: refit the session's files together)";
+    std::cout << fmt::format("{}: {}: refit found it, no live FIT recorded{}\n", path_, name, why);
+  }
+
+  void compare_pair(const RefitRun& ours, const Json& jr, const Json& theirs, const std::string& name) {
+    // The run number is the fitter's count since it started, not the run's identity. The
+    // numbers first; a health verdict is compared on its own, since one side may have had a
+    // bench file and the other not.
+    Json a = jr, b = theirs;
+    a.erase("run");
+    b.erase("run");
+    const std::string ours_level = level_of(a), live_level = level_of(b);
+    Json ours_health = a.contains("health") ? a["health"] : Json(), live_health = b.contains("health") ? b["health"] : Json();
+    a.erase("health");
+    b.erase("health");
+    const std::string d = first_difference(a, b, "run");
+    if (!d.empty()) {
+      ++differ_;
+      const std::string why = why_they_differ(ours.fit.run, jr.value("samples", std::int64_t{0}), b);
+      std::cout << fmt::format("{}: {}: differs: {}{}\n", path_, name, d, why.empty() ? "" : " (" + why + ")");
+      return;
+    }
+    ++same_;
+    compare_health(ours, ours_health, live_health, ours_level, live_level, name);
+  }
+
+  // Identical numbers: a health verdict on one side only, or another one, says the bench files differ.
+  void compare_health(const RefitRun& ours, const Json& ours_health, const Json& live_health,
+                      const std::string& ours_level, const std::string& live_level, const std::string& name) {
+    if (live_health.is_null() && ours_health.is_null()) return;
+    if (ours_health.is_null()) {
+      ++verdict_live_only_;
+      std::cout << fmt::format("{}: {}: identical numbers; health {} live, none here: the live fitter had a "
+                               "bench file for bench {}, this refit has none (give it with --bench-config)\n",
+                               path_, name, live_level, ours.bench);
+    } else if (live_health.is_null()) {
+      ++verdict_refit_only_;
+      std::cout << fmt::format("{}: {}: identical numbers; health {} here, none live: the live fitter had no "
+                               "bench file for bench {}\n",
+                               path_, name, ours_level, ours.bench);
+    } else if (const std::string hd = first_difference(ours_health, live_health, "run.health"); !hd.empty()) {
+      ++verdict_differ_;
+      std::cout << fmt::format("{}: {}: identical numbers, but health {} here against {} live ({}): this "
+                               "bench file is not the one the live fitter had\n",
+                               path_, name, ours_level, live_level, hd);
+    }
+  }
+
+  void live_only(std::size_t k) {
+    const auto& [bench, theirs] = live_[k];
+    ++missing_refit_;
+    // Part of a refitted run already paired: live split that run in two.
+    std::string why;
+    for (const RefitRun& ours : r_.runs)
+      if (ours.bench == bench && window_overlap_s(ours.fit.run, theirs) > 0) {
+        const bool partial = theirs.value("lead_in", "") == "none";
+        why = fmt::format(" (split: it lies inside refit run {} (cut at {:.3f} s); live {}", ours.fit.run.number,
+                          ours.fit.run.t_cut_s,
+                          partial ? "published this part of it as a partial run of its own)"
+                                  : "gave this part of it a cut of its own: an invented cut)");
+        break;
+      }
+    std::cout << fmt::format("{}: {} live run {} (cut at {:.3f} s): live FIT recorded, the refit did not find "
+                             "this run{}\n",
+                             path_, bench, theirs.value("run", 0), number_in(theirs, "t_cut_s"), why);
+  }
+
+  void print_counts() const {
+    std::string verdicts;
+    if (verdict_live_only_)
+      verdicts += fmt::format("; {} with a health verdict live only (the live fitter had a bench file, this refit "
+                              "none)",
+                              verdict_live_only_);
+    if (verdict_refit_only_)
+      verdicts += fmt::format("; {} with a health verdict here only (the live fitter had no bench file)",
+                              verdict_refit_only_);
+    if (verdict_differ_) verdicts += fmt::format("; {} with another health verdict (another bench file)", verdict_differ_);
+    std::cout << fmt::format("{}: {} runs refitted, {} live FIT messages: {} identical, {} different, {} only "
+                             "refitted, {} only live{}\n",
+                             path_, r_.runs.size(), live_.size(), same_, differ_, missing_live_, missing_refit_, verdicts);
+  }
+
+  const std::string& path_;
+  const LogRefit& r_;
+  const LiveFits& live_;
+  const ReportOptions& report_;
+  std::vector<bool> live_paired_;
+  std::size_t same_ = 0, differ_ = 0, missing_live_ = 0, missing_refit_ = 0;
+  std::size_t verdict_live_only_ = 0, verdict_refit_only_ = 0, verdict_differ_ = 0;
+};
+
+// `spindown refit`: each session refitted (or its recorded FITs listed, or compared), printed as
+// it is done; the state the sessions share (the options, whether all went well, the JSON's files).
+class RefitCommand {
+ public:
+  explicit RefitCommand(const RefitCommandOptions& o)
+      : o_(o),
+        bench_files_(bench_files_from(o.input, std::cerr)),
+        fopt_(fitter_options(o, bench_files_)),
+        show_progress_(!o.no_progress && ProgressReporter::is_terminal(STDERR_FILENO)),
+        stream_(!o.live && !o.compare) {  // runs formatted as fitted, not kept (memory flat)
+    if (o.compare && names_bench(o, bench_files_))
+      std::cerr << "spindown refit --compare: J and K_b as the live fitter chose them (the log's CONFIG, else the "
+                   "command line's as its defaults), so that like is compared with like; a bench file gives the "
+                   "health references only\n";
+    report_.lab_units = o.lab_units;
+    report_.max_diagnostics = o.verbose ? 0 : 8;
+    report_.diagnostics_in_text = false;
+  }
+
+  int run() {
+    // Logs given together are read as sessions in time order: a logger's rotated files are one
+    // session, so a run across a file boundary is whole, as it was live.
+    const std::vector<std::vector<std::string>> sessions =
+        o_.logs.size() > 1 ? log_sessions(o_.logs) : std::vector<std::vector<std::string>>{o_.logs};
+    for (const auto& session : sessions) refit_session(session);
+    // replace: bytes that are not UTF-8 (a config string in the log) never abort the output.
+    if (o_.json && o_.live)
+      std::cout << Json{{"files", std::move(live_files_)}}.dump(2, ' ', false, Json::error_handler_t::replace)
+                << std::endl;
+    else if (o_.json && stream_ && !first_file_)
+      std::cout << "\n  ]\n}" << std::endl;
+    return ok_ ? exit_ok : exit_unusable;
+  }
+
+ private:
+  void refit_session(const std::vector<std::string>& session) {
+    const std::string path = session_name(session);
+    SessionSpools spools(o_, report_);
+    const LogRefit r = read_session(session, path, spools);
+    // Problems on stderr, as `spindown fit` says them; with --live or --compare the file's failures
+    // are not the point (the comparison's counts are).
+    report_file_problems(std::cerr, path, r.file.diagnostics,
+                         o_.live || o_.compare ? std::vector<std::string>{} : r.file.failures, o_.verbose,
+                         report_.max_diagnostics);
+    if (o_.live) {
+      print_recorded(path, r, recorded_fits(path, r, o_.bench_regex, report_));
+      return;
+    }
+    if (o_.compare) {
+      // Recorded results in log order; the refit's likewise.
+      const LiveFits live = recorded_fits(path, r, o_.bench_regex, report_);
+      if (!FitComparison(path, r, live, report_).run()) ok_ = false;
+      if (!compare_explains(path, r, std::regex(o_.bench_regex))) ok_ = false;
+      return;
+    }
+    ok_ = ok_ && r.file.usable();
+    const std::vector<RunSpool*> ordered = spools.in_order(r.bench_order);
+    if (o_.json)
+      print_refit_json(r, ordered, spools.take_explains());
+    else
+      print_refit_text(path, r, ordered);
+    std::cout.flush();
+  }
+
+  // The session through the live fitter's core, its runs spooled as they are fitted (when streaming).
+  LogRefit read_session(const std::vector<std::string>& session, const std::string& path, SessionSpools& spools) {
+    // On a terminal only (never in pipes or files), throttled, erased before anything is printed.
+    ProgressReporter progress(STDERR_FILENO, show_progress_);
+    LogRefit r = refit_log_session(
+        session, fopt_, o_.live || o_.compare, {},
+        [&](std::int64_t done, std::int64_t total, std::size_t runs) {
+          progress.update(done, total, "refit", fmt::format("{} run{} fitted  {}", runs, runs == 1 ? "" : "s", path));
+        },
+        stream_ ? RefitRunFn([&spools](RefitRun&& run) { spools.add(std::move(run)); }) : RefitRunFn());
+    progress.finish();
+    return r;
+  }
+
+  // --live: the FIT messages recorded in the session, as text or as the JSON's next file.
+  void print_recorded(const std::string& path, const LogRefit& r, const LiveFits& live) {
+    if (live.empty()) {
+      std::cerr << path << ": error: no SPINDOWN.<bench>.FIT messages recorded in this log\n";
+      ok_ = false;
+    }
+    if (o_.json) {
+      Json runs = Json::array();
+      for (const auto& [bench, jr] : live) runs.push_back(jr);
+      live_files_.push_back(Json{{"file", path}, {"runs", std::move(runs)}});
+      return;
+    }
+    std::cout << fmt::format("== {}: {} FIT messages recorded\n", path, live.size());
+    for (const fit_t& m : r.live)
+      if (auto f = from_fit_message(m))
+        std::cout << fmt::format("\n-- bench {} (live, latency {:.1f} ms, J/K_b: {})\n", m.bench, 1e3 * m.latency_s,
+                                 m.bench_source)
+                  << format_run_fit(*f, report_);
+  }
+
+  // The file's object as refit_file_json() gives it, its runs spliced in from the spools; the
+  // same bytes as dumping the whole document at once.
+  void print_refit_json(const LogRefit& r, const std::vector<RunSpool*>& ordered, Json explains) {
+    constexpr std::string_view hole = "(runs spliced here)";  // printed by dump() as it is
+    Json file = refit_file_json(r, report_);
+    if (o_.explain) file["explains"] = std::move(explains);
+    file["runs"] = hole;
+    const std::string text = indented(dump_json(file), 4);
+    const std::string key = fmt::format("\n      \"runs\": \"{}\"", hole);
+    const std::size_t at = text.find(key);
+    std::cout << (first_file_ ? "{\n  \"files\": [\n" : ",\n") << std::string_view(text).substr(0, at);
+    first_file_ = false;
+    if (ordered.empty()) {
+      std::cout << "\n      \"runs\": []";
+    } else {
+      std::cout << "\n      \"runs\": [\n";
+      for (std::size_t i = 0; i < ordered.size(); ++i) ordered[i]->copy_to(std::cout, i == 0 ? 2 : 0);
+      std::cout << "\n      ]";
+    }
+    std::cout << std::string_view(text).substr(at + key.size());
+  }
+
+  void print_refit_text(const std::string& path, const LogRefit& r, const std::vector<RunSpool*>& ordered) {
+    const std::size_t runs = r.runs_fitted, benches = ordered.size();
+    std::cout << fmt::format("== {}: {} samples from {} messages ({} skipped), {} run{} fitted on {} bench{}\n", path,
+                             r.file.samples, r.file.lines_read, r.file.lines_skipped, runs, runs == 1 ? "" : "s",
+                             benches, benches == 1 ? "" : "es");
+    for (RunSpool* spool : ordered) spool->copy_to(std::cout, 0);
+  }
+
+  const RefitCommandOptions& o_;
+  const BenchFiles bench_files_;
+  const FitterOptions fopt_;
+  ReportOptions report_;
+  const bool show_progress_;
+  const bool stream_;
+  bool ok_ = true;
+  bool first_file_ = true;          // the streamed JSON's first file is still to come
+  Json live_files_ = Json::array();  // --live --json: the files' recorded FITs
+};
+
 }  // namespace
 
 void setup_refit(CLI::App& app) {
@@ -329,250 +689,6 @@ void setup_refit(CLI::App& app) {
   });
 }
 
-int run_refit(const RefitCommandOptions& o) {
-  const BenchFiles bench_files = bench_files_from(o.input, std::cerr);
-  const FitterOptions fopt = fitter_options(o, bench_files);
-  if (o.compare && names_bench(o, bench_files))
-    std::cerr << "spindown refit --compare: J and K_b as the live fitter chose them (the log's CONFIG, else the "
-                 "command line's as its defaults), so that like is compared with like; a bench file gives the "
-                 "health references only\n";
-  ReportOptions report;
-  report.lab_units = o.lab_units;
-  report.max_diagnostics = o.verbose ? 0 : 8;
-  report.diagnostics_in_text = false;
-  bool ok = true;
-  Json files = Json::array();
-  const bool show_progress = !o.no_progress && ProgressReporter::is_terminal(STDERR_FILENO);
-  const bool stream = !o.live && !o.compare;  // runs formatted as fitted, not kept (memory flat)
-  bool first_file = true;
-  // Logs given together are read as sessions in time order: a logger's rotated files are one
-  // session, so a run across a file boundary is whole, as it was live.
-  const std::vector<std::vector<std::string>> sessions =
-      o.logs.size() > 1 ? log_sessions(o.logs) : std::vector<std::vector<std::string>>{o.logs};
-  for (const auto& session : sessions) {
-    const std::string path =
-        session.size() == 1 ? session.front()
-                            : fmt::format("{} + {} more (one session, in time order)", session.front(),
-                                          session.size() - 1);
-    // On a terminal only (never in pipes or files), throttled, erased before anything is printed.
-    ProgressReporter progress(STDERR_FILENO, show_progress);
-    // Each bench's runs, formatted as they are fitted; printed by bench (first appearance) once
-    // the log is done, as the order contract wants.
-    std::vector<std::pair<std::string, std::unique_ptr<RunSpool>>> spools;
-    std::string run_text;  // reused: one run's JSON at a time
-    Json explains = Json::array();  // --explain: each run's EXPLAIN, as spindown explain --json gives a run
-    auto each_run = [&](RefitRun&& run) {
-      if (run.explain) explains.push_back(Json::parse(explain_run_json(*run.explain, run.bench, report).dump()));
-      RunSpool* spool = nullptr;
-      for (auto& [bench, sp] : spools)
-        if (bench == run.bench) spool = sp.get();
-      if (!spool) spool = spools.emplace_back(run.bench, std::make_unique<RunSpool>()).second.get();
-      if (o.json) {
-        // The run as refit_file_json() lists it, written straight to text (no document).
-        const RunTags tags{run.bench, run.first_seq, run.last_seq};
-        run_text.assign(",\n        ");
-        append_run_fit_json_text(run_text, run.fit, report, 8, &tags, run.health ? &*run.health : nullptr);
-        spool->add(run_text);
-      } else {
-        spool->add(fmt::format("\n-- bench {} (J/K_b: {})\n", run.bench, run.bench_source) +
-                   format_run_fit(run.fit, report) + (run.health ? format_health_verdict(*run.health) : std::string()));
-      }
-    };
-    LogRefit r = refit_log_session(
-        session, fopt, o.live || o.compare, {},
-        [&](std::int64_t done, std::int64_t total, std::size_t runs) {
-          progress.update(done, total, "refit", fmt::format("{} run{} fitted  {}", runs, runs == 1 ? "" : "s", path));
-        },
-        stream ? RefitRunFn(each_run) : RefitRunFn());
-    progress.finish();
-    // Problems on stderr, as `spindown fit` says them; with --live or --compare the file's failures
-    // are not the point (the comparison's counts are).
-    report_file_problems(std::cerr, path, r.file.diagnostics,
-                         o.live || o.compare ? std::vector<std::string>{} : r.file.failures, o.verbose,
-                         report.max_diagnostics);
-
-    if (o.live || o.compare) {
-      // Recorded results in log order; the refit's likewise.
-      std::vector<std::pair<std::string, Json>> live;
-      const std::regex wanted(o.bench_regex);
-      for (const fit_t& m : r.live) {
-        if (!std::regex_match(m.bench, wanted)) continue;
-        std::string why;
-        if (auto jf = fit_message_json(m, report, &why))
-          live.emplace_back(m.bench, without_timing_fields(std::move(*jf)));
-        else
-          std::cerr << path << ": warning: " << why << '\n';
-      }
-      if (o.live) {
-        if (live.empty()) {
-          std::cerr << path << ": error: no SPINDOWN.<bench>.FIT messages recorded in this log\n";
-          ok = false;
-        }
-        Json runs = Json::array();
-        for (auto& [bench, jr] : live) runs.push_back(jr);
-        if (o.json) {
-          files.push_back(Json{{"file", path}, {"runs", std::move(runs)}});
-        } else {
-          std::cout << fmt::format("== {}: {} FIT messages recorded\n", path, live.size());
-          for (const fit_t& m : r.live)
-            if (auto f = from_fit_message(m))
-              std::cout << fmt::format("\n-- bench {} (live, latency {:.1f} ms, J/K_b: {})\n", m.bench,
-                                       1e3 * m.latency_s, m.bench_source)
-                        << format_run_fit(*f, report);
-        }
-        continue;
-      }
-      // --compare: a live FIT and a refitted run are the same run when they are on the same bench
-      // and their fitted windows overlap (run numbers restart with the fitter; the device time
-      // does not), the largest overlap first.
-      const Json refit = refit_file_json(r, report);
-      std::size_t same = 0, differ = 0, missing_live = 0, missing_refit = 0;
-      std::size_t verdict_live_only = 0, verdict_refit_only = 0, verdict_differ = 0;
-      std::vector<bool> live_paired(live.size(), false);
-      for (std::size_t i = 0; i < r.runs.size(); ++i) {
-        const RefitRun& ours = r.runs[i];
-        const Json jr = without_timing_fields(refit["runs"][i]);
-        std::size_t best = live.size();
-        double best_overlap = 0;
-        for (std::size_t k = 0; k < live.size(); ++k) {
-          if (live_paired[k] || live[k].first != ours.bench) continue;
-          const double overlap = window_overlap_s(ours.fit.run, live[k].second);
-          if (overlap > best_overlap) best = k, best_overlap = overlap;
-        }
-        const std::string name = fmt::format("{} run {} (cut at {:.3f} s)", ours.bench, ours.fit.run.number,
-                                             ours.fit.run.t_cut_s);
-        if (best == live.size()) {
-          ++missing_live;
-          std::string why;
-          for (std::size_t k = 0; k < live.size(); ++k)
-            if (live[k].first == ours.bench && window_overlap_s(ours.fit.run, live[k].second) > 0) {
-              why = fmt::format(" (split: it lies inside live run {} (cut at {:.3f} s), which the refit splits here)",
-                                live[k].second.value("run", 0), number_in(live[k].second, "t_cut_s"));
-              break;
-            }
-          if (why.empty() && ours.fit.run.end == Run::End::end_of_data)
-            why = " (split: the log ends during this run, and its live FIT, published when it ended, is in the log "
-                  "after it: refit the session's files together)";
-          std::cout << fmt::format("{}: {}: refit found it, no live FIT recorded{}\n", path, name, why);
-          continue;
-        }
-        live_paired[best] = true;
-        // The run number is the fitter's count since it started, not the run's identity. The
-        // numbers first; a health verdict is compared on its own, since one side may have had a
-        // bench file and the other not.
-        Json a = jr, b = live[best].second;
-        a.erase("run");
-        b.erase("run");
-        const std::string ours_level = level_of(a), live_level = level_of(b);
-        Json ours_health = a.contains("health") ? a["health"] : Json(), live_health = b.contains("health") ? b["health"] : Json();
-        a.erase("health");
-        b.erase("health");
-        const std::string d = first_difference(a, b, "run");
-        if (d.empty()) {
-          ++same;
-          if (live_health.is_null() && ours_health.is_null()) continue;
-          if (ours_health.is_null()) {
-            ++verdict_live_only;
-            std::cout << fmt::format("{}: {}: identical numbers; health {} live, none here: the live fitter had a "
-                                     "bench file for bench {}, this refit has none (give it with --bench-config)\n",
-                                     path, name, live_level, ours.bench);
-          } else if (live_health.is_null()) {
-            ++verdict_refit_only;
-            std::cout << fmt::format("{}: {}: identical numbers; health {} here, none live: the live fitter had no "
-                                     "bench file for bench {}\n",
-                                     path, name, ours_level, ours.bench);
-          } else if (const std::string hd = first_difference(ours_health, live_health, "run.health"); !hd.empty()) {
-            ++verdict_differ;
-            std::cout << fmt::format("{}: {}: identical numbers, but health {} here against {} live ({}): this "
-                                     "bench file is not the one the live fitter had\n",
-                                     path, name, ours_level, live_level, hd);
-          }
-          continue;
-        }
-        ++differ;
-        const std::string why = why_they_differ(ours.fit.run, jr.value("samples", std::int64_t{0}), b);
-        std::cout << fmt::format("{}: {}: differs: {}{}\n", path, name, d, why.empty() ? "" : " (" + why + ")");
-      }
-      for (std::size_t k = 0; k < live.size(); ++k)
-        if (!live_paired[k]) {
-          ++missing_refit;
-          // Part of a refitted run already paired: live split that run in two.
-          std::string why;
-          for (const RefitRun& ours : r.runs)
-            if (ours.bench == live[k].first && window_overlap_s(ours.fit.run, live[k].second) > 0) {
-              const bool partial = live[k].second.value("lead_in", "") == "none";
-              why = fmt::format(" (split: it lies inside refit run {} (cut at {:.3f} s); live {}", ours.fit.run.number,
-                                ours.fit.run.t_cut_s,
-                                partial ? "published this part of it as a partial run of its own)"
-                                        : "gave this part of it a cut of its own: an invented cut)");
-              break;
-            }
-          std::cout << fmt::format("{}: {} live run {} (cut at {:.3f} s): live FIT recorded, the refit did not find "
-                                   "this run{}\n",
-                                   path, live[k].first, live[k].second.value("run", 0),
-                                   number_in(live[k].second, "t_cut_s"), why);
-        }
-      std::string verdicts;
-      if (verdict_live_only)
-        verdicts += fmt::format("; {} with a health verdict live only (the live fitter had a bench file, this refit "
-                                "none)",
-                                verdict_live_only);
-      if (verdict_refit_only)
-        verdicts += fmt::format("; {} with a health verdict here only (the live fitter had no bench file)",
-                                verdict_refit_only);
-      if (verdict_differ) verdicts += fmt::format("; {} with another health verdict (another bench file)", verdict_differ);
-      std::cout << fmt::format("{}: {} runs refitted, {} live FIT messages: {} identical, {} different, {} only "
-                               "refitted, {} only live{}\n",
-                               path, r.runs.size(), live.size(), same, differ, missing_live, missing_refit, verdicts);
-      if (differ || verdict_differ || missing_live || missing_refit || live.empty()) ok = false;
-      if (!compare_explains(path, r, std::regex(o.bench_regex))) ok = false;
-      continue;
-    }
-
-    ok = ok && r.file.usable();
-    // Spools by bench in order of first appearance (a bench never seen on SAMPLE/CONFIG last).
-    std::vector<RunSpool*> ordered;
-    for (const auto& id : r.bench_order)
-      for (auto& [bench, sp] : spools)
-        if (bench == id) ordered.push_back(sp.get());
-    for (auto& [bench, sp] : spools)
-      if (std::find(r.bench_order.begin(), r.bench_order.end(), bench) == r.bench_order.end())
-        ordered.push_back(sp.get());
-    if (o.json) {
-      // The file's object as refit_file_json() gives it, its runs spliced in from the spools;
-      // the same bytes as dumping the whole document at once.
-      constexpr std::string_view hole = "(runs spliced here)";  // printed by dump() as it is
-      Json file = refit_file_json(r, report);
-      if (o.explain) file["explains"] = std::move(explains);
-      file["runs"] = hole;
-      const std::string text = indented(dump_json(file), 4);
-      const std::string key = fmt::format("\n      \"runs\": \"{}\"", hole);
-      const std::size_t at = text.find(key);
-      std::cout << (first_file ? "{\n  \"files\": [\n" : ",\n") << std::string_view(text).substr(0, at);
-      first_file = false;
-      if (ordered.empty()) {
-        std::cout << "\n      \"runs\": []";
-      } else {
-        std::cout << "\n      \"runs\": [\n";
-        for (std::size_t i = 0; i < ordered.size(); ++i) ordered[i]->copy_to(std::cout, i == 0 ? 2 : 0);
-        std::cout << "\n      ]";
-      }
-      std::cout << std::string_view(text).substr(at + key.size());
-    } else {
-      const std::size_t runs = r.runs_fitted, benches = ordered.size();
-      std::cout << fmt::format("== {}: {} samples from {} messages ({} skipped), {} run{} fitted on {} bench{}\n",
-                               path, r.file.samples, r.file.lines_read, r.file.lines_skipped, runs,
-                               runs == 1 ? "" : "s", benches, benches == 1 ? "" : "es");
-      for (RunSpool* spool : ordered) spool->copy_to(std::cout, 0);
-    }
-    std::cout.flush();
-  }
-  // replace: bytes that are not UTF-8 (a config string in the log) never abort the output.
-  if (o.json && o.live)
-    std::cout << Json{{"files", std::move(files)}}.dump(2, ' ', false, Json::error_handler_t::replace) << std::endl;
-  else if (o.json && stream && !first_file)
-    std::cout << "\n  ]\n}" << std::endl;
-  return ok ? exit_ok : exit_unusable;
-}
+int run_refit(const RefitCommandOptions& o) { return RefitCommand(o).run(); }
 
 }  // namespace spindown::cli

@@ -155,11 +155,12 @@ double quantile(std::vector<double> v, double p) {
   return i + 1 < v.size() ? v[i] + (x - double(i)) * (v[i + 1] - v[i]) : v[i];
 }
 
-}  // namespace
+// The median, the 95th percentile and the largest of v (NaN when empty).
+nlohmann::json quantiles(const std::vector<double>& v) {
+  return {{"p50", quantile(v, 0.5)}, {"p95", quantile(v, 0.95)}, {"max", quantile(v, 1.0)}};
+}
 
-int main(int argc, char** argv) {
-  CLI::App app{"spindown-run-publisher: generated runs -> SPINDOWN.<bench>.SAMPLE|CONFIG; FIT latency report"};
-  Options o;
+void add_options(CLI::App& app, Options& o) {
   app.add_option("--lcm-url", o.lcm_url, "LCM URL (use a private one: udpm://239.255.76.67:7667?ttl=0 in a netns)")
       ->required();
   app.add_option("--benches", o.benches, "number of benches")->check(CLI::Range(1, 10000));
@@ -183,6 +184,221 @@ int main(int argc, char** argv) {
   app.add_option("--backwards-every", o.backwards_every, "fault: a stale sample (time going back) in every N-th");
   app.add_option("--new-bench-every", o.new_bench_every, "fault: a message from a never-seen bench id after every N-th");
   app.add_option("--invalid-bench-every", o.invalid_bench_every, "fault: a message on an invalid bench id");
+}
+
+// Every bench's plan, their starts staggered.
+std::vector<BenchPlan> make_plans(const Options& o) {
+  std::vector<BenchPlan> plans;
+  for (int b = 0; b < o.benches; ++b) plans.push_back(make_plan(o, b));
+  const double stagger = o.stagger_s >= 0 ? o.stagger_s : 20.0 / o.benches / o.speed;
+  for (int b = 0; b < o.benches; ++b) plans[b].host_offset_s = 0.2 + b * stagger;
+  return plans;
+}
+
+// The runs' true cut and stop times by bench.
+nlohmann::json truth_json(const std::vector<BenchPlan>& plans) {
+  nlohmann::json truth = nlohmann::json::object();
+  for (const BenchPlan& p : plans) {
+    nlohmann::json runs = nlohmann::json::array();
+    for (const TruthRun& t : p.truth)
+      runs.push_back({{"t_cut_s", t.t_cut_s}, {"t_stop_s", t.t_stop_s}, {"stopped", t.stopped}});
+    truth[p.id] = std::move(runs);
+  }
+  return truth;
+}
+
+// The true run a FIT is of: the nearest cut on its bench, if within a second.
+const TruthRun* true_run_of(const BenchPlan& p, const FitSeen& f) {
+  const TruthRun* best = nullptr;
+  for (const TruthRun& t : p.truth)
+    if (!best || std::abs(t.t_cut_s - f.t_cut_s) < std::abs(best->t_cut_s - f.t_cut_s)) best = &t;
+  return best && std::abs(best->t_cut_s - f.t_cut_s) < 1.0 ? best : nullptr;
+}
+
+// The benches' plans published on LCM as spindown-bridge would (each bench's CONFIG, then its
+// samples in batches at their host times, with the faults asked for), and the FITs that came
+// back matched with the true runs.
+class RunPublisher {
+ public:
+  RunPublisher(lcm::LCM& lcm, const Options& o) : lcm_(lcm), o_(o), plans_(make_plans(o)) {
+    for (const BenchPlan& p : plans_) expected_ += p.truth.size();
+  }
+  std::size_t expected_fits() const { return expected_; }
+  const std::vector<BenchPlan>& plans() const { return plans_; }
+
+  void publish() {
+    start_ = Clock::now();
+    send_configs();
+    auto next_config = start_ + std::chrono::seconds(3);
+    // Benches in order of their next message's host time.
+    using Item = std::pair<double, int>;
+    std::priority_queue<Item, std::vector<Item>, std::greater<>> due;
+    for (int b = 0; b < o_.benches; ++b) due.push({next_due(plans_[b]), b});
+    while (!due.empty()) {
+      const auto [when, b] = due.top();
+      due.pop();
+      std::this_thread::sleep_until(start_ + std::chrono::nanoseconds(static_cast<std::int64_t>(when * 1e9)));
+      if (Clock::now() >= next_config) {
+        send_configs();
+        next_config += std::chrono::seconds(3);
+      }
+      BenchPlan& p = plans_[b];
+      publish_next_batch(p);
+      if (p.next < p.samples.size()) due.push({next_due(p), b});
+    }
+    publish_s_ = std::chrono::duration<double>(Clock::now() - start_).count();
+    fmt::print(stderr, "spindown-run-publisher: {} messages for {} benches ({} runs) in {:.1f} s\n", messages_,
+               o_.benches, expected_, publish_s_);
+  }
+
+  // Each FIT with its true run (nearest cut on the same bench): how long after the true stop it
+  // arrived, and the latencies' quantiles.
+  nlohmann::json report(const std::vector<FitSeen>& fits) const {
+    nlohmann::json list = nlohmann::json::array();
+    std::vector<double> after_stop, latency;
+    std::map<std::string, int> plan_of;
+    for (int b = 0; b < o_.benches; ++b) plan_of[plans_[b].id] = b;
+    std::size_t matched = 0;
+    for (const FitSeen& f : fits) {
+      nlohmann::json j = {{"bench", f.bench}, {"run", f.run}, {"t_cut_s", f.t_cut_s}, {"latency_s", f.latency_s},
+                          {"best", f.best}, {"bench_source", f.bench_source}, {"samples", f.samples}};
+      if (auto it = plan_of.find(f.bench); it != plan_of.end()) {
+        const BenchPlan& p = plans_[it->second];
+        if (const TruthRun* truth = true_run_of(p, f)) {
+          ++matched;
+          const double host_stop = p.host_at(static_cast<std::int64_t>(truth->t_stop_s * 1e6), o_.speed);
+          const double arrived = std::chrono::duration<double>(f.recv - start_).count();
+          const double after = arrived - host_stop;
+          j["true_t_cut_s"] = truth->t_cut_s;
+          j["true_t_stop_s"] = truth->t_stop_s;
+          j["after_true_stop_s"] = after;
+          j["after_true_stop_device_s"] = after * o_.speed;
+          after_stop.push_back(after);
+        }
+      }
+      latency.push_back(f.latency_s);
+      list.push_back(std::move(j));
+    }
+    nlohmann::json report;
+    report["expected_fits"] = expected_;
+    report["fits"] = list.size();
+    report["matched"] = matched;
+    report["messages"] = messages_;
+    report["benches"] = o_.benches;
+    report["publish_s"] = publish_s_;
+    report["speed"] = o_.speed;
+    report["latency_s"] = quantiles(latency);
+    report["after_true_stop_s"] = quantiles(after_stop);
+    report["fit_list"] = std::move(list);
+    return report;
+  }
+
+ private:
+  // The host time (seconds after the start) of the bench's next message: when its last sample is due.
+  double next_due(const BenchPlan& p) const {
+    const std::size_t last = std::min(p.samples.size(), p.next + std::size_t(o_.batch)) - 1;
+    return p.host_at(p.samples[last].t_us, o_.speed);
+  }
+
+  void send_configs() {
+    for (int b = 0; b < o_.benches; ++b) {
+      if (o_.config_benches >= 0 && b >= o_.config_benches) continue;
+      const spindown::config_t c = config_of(plans_[b]);
+      lcm_.publish(spindown::channel_name(plans_[b].id, spindown::ChannelKind::config), &c);
+    }
+  }
+
+  spindown::config_t config_of(const BenchPlan& p) const {
+    spindown::config_t c{};
+    c.utime = wall_us();
+    c.bench = p.id;
+    c.inertia_kg_m2 = o_.config_inertia > 0 ? o_.config_inertia : 1.12687602e-5;
+    c.inertia_source = o_.config_inertia > 0 ? "run-publisher --config-inertia" : "lab flywheel + rotor";
+    c.kb_v_s_per_rad = 1.0 / 123.569311;
+    c.kb_source = "speed constant 1180 rpm/V";
+    c.quantity = spindown::samples_t::QUANTITY_BACK_EMF_V;
+    c.adc_volts_per_count = 5.0 / 1024;
+    c.adc_bits = 10;
+    c.firmware = "run-publisher";
+    c.protocol = "lab-tsv";
+    c.sample_period_s = o_.period_s;
+    c.baud = 9600;
+    c.device = "generated";
+    c.host = "localhost";
+    c.inertia_rel_error = 0;
+    c.kb_rel_error = 0;
+    return c;
+  }
+
+  // The bench's next batch of samples as one samples_t, published with the faults due.
+  void publish_next_batch(BenchPlan& p) {
+    const std::size_t end = std::min(p.samples.size(), p.next + std::size_t(o_.batch));
+    msg_ = {};
+    msg_.utime = wall_us();
+    msg_.bench = p.id;
+    msg_.seq = p.seq;
+    msg_.clock_epoch = 0;
+    msg_.quantity = spindown::samples_t::QUANTITY_BACK_EMF_V;
+    for (std::size_t i = p.next; i < end; ++i) {
+      msg_.device_time_us.push_back(p.samples[i].t_us);
+      msg_.host_time_us.push_back(msg_.utime);
+      msg_.value.push_back(p.samples[i].value);
+      msg_.raw_adc.push_back(p.samples[i].adc);
+    }
+    msg_.n = static_cast<std::int32_t>(end - p.next);
+    p.seq += msg_.n;
+    p.next = end;
+    ++messages_;
+    publish_with_faults(p);
+  }
+
+  void publish_with_faults(const BenchPlan& p) {
+    const auto every = [&](long n) { return n > 0 && messages_ % n == 0; };
+    if (every(o_.nan_every)) msg_.value[0] = std::nan("");
+    if (every(o_.backwards_every) && msg_.n > 0) msg_.device_time_us[0] -= 5'000'000;
+    const std::string channel = spindown::channel_name(p.id, spindown::ChannelKind::sample);
+    if (!every(o_.gap_every)) lcm_.publish(channel, &msg_);
+    if (every(o_.dup_every)) lcm_.publish(channel, &msg_);
+    if (every(o_.garbage_every)) {
+      const std::string junk = "this is not a samples_t message";
+      lcm_.publish(channel, junk.data(), static_cast<unsigned>(junk.size()));
+    }
+    if (every(o_.truncate_every)) {
+      std::vector<unsigned char> buf(static_cast<std::size_t>(msg_.getEncodedSize()));
+      msg_.encode(buf.data(), 0, static_cast<int>(buf.size()));
+      lcm_.publish(channel, buf.data(), static_cast<unsigned>(buf.size() / 2));
+    }
+    if (every(o_.new_bench_every)) {
+      spindown::samples_t other = msg_;
+      other.bench = fmt::format("stray{}", ++new_bench_counter_);
+      lcm_.publish(spindown::channel_name(other.bench, spindown::ChannelKind::sample), &other);
+    }
+    if (every(o_.invalid_bench_every)) lcm_.publish("SPINDOWN.bad!bench.SAMPLE", &msg_);
+  }
+
+  lcm::LCM& lcm_;
+  const Options& o_;
+  std::vector<BenchPlan> plans_;
+  std::size_t expected_ = 0;  // FITs: one per run
+  Clock::time_point start_;
+  double publish_s_ = 0;
+  long messages_ = 0, new_bench_counter_ = 0;
+  spindown::samples_t msg_{};  // reused: one message at a time
+};
+
+// Until every expected FIT came, or wait_s passed.
+void wait_for_fits(FitListener& listener, double wait_s, std::size_t expected) {
+  const auto deadline = Clock::now() + std::chrono::milliseconds(static_cast<std::int64_t>(wait_s * 1000));
+  while (Clock::now() < deadline && listener.count() < expected)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"spindown-run-publisher: generated runs -> SPINDOWN.<bench>.SAMPLE|CONFIG; FIT latency report"};
+  Options o;
+  add_options(app, o);
   CLI11_PARSE(app, argc, argv);
 
   lcm::LCM lcm(o.lcm_url);
@@ -192,168 +408,13 @@ int main(int argc, char** argv) {
     return 1;
   }
   listener.start();
-
-  std::vector<BenchPlan> plans;
-  std::size_t expected = 0;
-  for (int b = 0; b < o.benches; ++b) {
-    plans.push_back(make_plan(o, b));
-    expected += plans.back().truth.size();
-  }
-  const double stagger = o.stagger_s >= 0 ? o.stagger_s : 20.0 / o.benches / o.speed;
-  for (int b = 0; b < o.benches; ++b) plans[b].host_offset_s = 0.2 + b * stagger;
-
-  auto send_config = [&](const BenchPlan& p, int b) {
-    if (o.config_benches >= 0 && b >= o.config_benches) return;
-    spindown::config_t c{};
-    c.utime = wall_us();
-    c.bench = p.id;
-    c.inertia_kg_m2 = o.config_inertia > 0 ? o.config_inertia : 1.12687602e-5;
-    c.inertia_source = o.config_inertia > 0 ? "run-publisher --config-inertia" : "lab flywheel + rotor";
-    c.kb_v_s_per_rad = 1.0 / 123.569311;
-    c.kb_source = "speed constant 1180 rpm/V";
-    c.quantity = spindown::samples_t::QUANTITY_BACK_EMF_V;
-    c.adc_volts_per_count = 5.0 / 1024;
-    c.adc_bits = 10;
-    c.firmware = "run-publisher";
-    c.protocol = "lab-tsv";
-    c.sample_period_s = o.period_s;
-    c.baud = 9600;
-    c.device = "generated";
-    c.host = "localhost";
-    c.inertia_rel_error = 0;
-    c.kb_rel_error = 0;
-    lcm.publish(spindown::channel_name(p.id, spindown::ChannelKind::config), &c);
-  };
-
-  const auto start = Clock::now();
-  const auto host_time = [&](double s) { return start + std::chrono::nanoseconds(static_cast<std::int64_t>(s * 1e9)); };
-  for (int b = 0; b < o.benches; ++b) send_config(plans[b], b);
-  auto next_config = start + std::chrono::seconds(3);
-
-  // Benches in order of their next message's host time.
-  using Item = std::pair<double, int>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<>> due;
-  for (int b = 0; b < o.benches; ++b) {
-    const BenchPlan& p = plans[b];
-    const std::size_t last = std::min(p.samples.size(), std::size_t(o.batch)) - 1;
-    due.push({p.host_at(p.samples[last].t_us, o.speed), b});
-  }
-  long messages = 0, new_bench_counter = 0;
-  spindown::samples_t msg{};
-  while (!due.empty()) {
-    const auto [when, b] = due.top();
-    due.pop();
-    std::this_thread::sleep_until(host_time(when));
-    if (Clock::now() >= next_config) {
-      for (int k = 0; k < o.benches; ++k) send_config(plans[k], k);
-      next_config += std::chrono::seconds(3);
-    }
-    BenchPlan& p = plans[b];
-    const std::size_t end = std::min(p.samples.size(), p.next + std::size_t(o.batch));
-    msg = {};
-    msg.utime = wall_us();
-    msg.bench = p.id;
-    msg.seq = p.seq;
-    msg.clock_epoch = 0;
-    msg.quantity = spindown::samples_t::QUANTITY_BACK_EMF_V;
-    for (std::size_t i = p.next; i < end; ++i) {
-      msg.device_time_us.push_back(p.samples[i].t_us);
-      msg.host_time_us.push_back(msg.utime);
-      msg.value.push_back(p.samples[i].value);
-      msg.raw_adc.push_back(p.samples[i].adc);
-    }
-    msg.n = static_cast<std::int32_t>(end - p.next);
-    p.seq += msg.n;
-    p.next = end;
-    ++messages;
-    const auto every = [&](long n) { return n > 0 && messages % n == 0; };
-    if (every(o.nan_every)) msg.value[0] = std::nan("");
-    if (every(o.backwards_every) && msg.n > 0) msg.device_time_us[0] -= 5'000'000;
-    const std::string channel = spindown::channel_name(p.id, spindown::ChannelKind::sample);
-    if (!every(o.gap_every)) lcm.publish(channel, &msg);
-    if (every(o.dup_every)) lcm.publish(channel, &msg);
-    if (every(o.garbage_every)) {
-      const std::string junk = "this is not a samples_t message";
-      lcm.publish(channel, junk.data(), static_cast<unsigned>(junk.size()));
-    }
-    if (every(o.truncate_every)) {
-      std::vector<unsigned char> buf(static_cast<std::size_t>(msg.getEncodedSize()));
-      msg.encode(buf.data(), 0, static_cast<int>(buf.size()));
-      lcm.publish(channel, buf.data(), static_cast<unsigned>(buf.size() / 2));
-    }
-    if (every(o.new_bench_every)) {
-      spindown::samples_t other = msg;
-      other.bench = fmt::format("stray{}", ++new_bench_counter);
-      lcm.publish(spindown::channel_name(other.bench, spindown::ChannelKind::sample), &other);
-    }
-    if (every(o.invalid_bench_every)) lcm.publish("SPINDOWN.bad!bench.SAMPLE", &msg);
-    if (p.next < p.samples.size()) {
-      const std::size_t last = std::min(p.samples.size(), p.next + std::size_t(o.batch)) - 1;
-      due.push({p.host_at(p.samples[last].t_us, o.speed), b});
-    }
-  }
-  const double publish_s = std::chrono::duration<double>(Clock::now() - start).count();
-  fmt::print(stderr, "spindown-run-publisher: {} messages for {} benches ({} runs) in {:.1f} s\n", messages,
-             o.benches, expected, publish_s);
-
-  const auto deadline = Clock::now() + std::chrono::milliseconds(static_cast<std::int64_t>(o.wait_fits_s * 1000));
-  while (Clock::now() < deadline && listener.count() < expected)
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  RunPublisher publisher(lcm, o);
+  publisher.publish();
+  wait_for_fits(listener, o.wait_fits_s, publisher.expected_fits());
   listener.stop();
 
-  // Match each FIT with its true run (nearest cut on the same bench).
-  nlohmann::json report;
-  nlohmann::json list = nlohmann::json::array();
-  std::vector<double> after_stop, latency;
-  std::map<std::string, int> plan_of;
-  for (int b = 0; b < o.benches; ++b) plan_of[plans[b].id] = b;
-  std::size_t matched = 0;
-  for (const FitSeen& f : listener.fits()) {
-    nlohmann::json j = {{"bench", f.bench}, {"run", f.run}, {"t_cut_s", f.t_cut_s}, {"latency_s", f.latency_s},
-                        {"best", f.best}, {"bench_source", f.bench_source}, {"samples", f.samples}};
-    if (auto it = plan_of.find(f.bench); it != plan_of.end()) {
-      const BenchPlan& p = plans[it->second];
-      const TruthRun* best = nullptr;
-      for (const TruthRun& t : p.truth)
-        if (!best || std::abs(t.t_cut_s - f.t_cut_s) < std::abs(best->t_cut_s - f.t_cut_s)) best = &t;
-      if (best && std::abs(best->t_cut_s - f.t_cut_s) < 1.0) {
-        ++matched;
-        const double host_stop = p.host_at(static_cast<std::int64_t>(best->t_stop_s * 1e6), o.speed);
-        const double arrived = std::chrono::duration<double>(f.recv - start).count();
-        const double after = arrived - host_stop;
-        j["true_t_cut_s"] = best->t_cut_s;
-        j["true_t_stop_s"] = best->t_stop_s;
-        j["after_true_stop_s"] = after;
-        j["after_true_stop_device_s"] = after * o.speed;
-        after_stop.push_back(after);
-      }
-    }
-    latency.push_back(f.latency_s);
-    list.push_back(std::move(j));
-  }
-  report["expected_fits"] = expected;
-  report["fits"] = list.size();
-  report["matched"] = matched;
-  report["messages"] = messages;
-  report["benches"] = o.benches;
-  report["publish_s"] = publish_s;
-  report["speed"] = o.speed;
-  report["latency_s"] = {{"p50", quantile(latency, 0.5)}, {"p95", quantile(latency, 0.95)},
-                         {"max", quantile(latency, 1.0)}};
-  report["after_true_stop_s"] = {{"p50", quantile(after_stop, 0.5)},
-                                 {"p95", quantile(after_stop, 0.95)},
-                                 {"max", quantile(after_stop, 1.0)}};
-  report["fit_list"] = std::move(list);
-  if (!o.truth_path.empty()) {
-    nlohmann::json truth = nlohmann::json::object();
-    for (const BenchPlan& p : plans) {
-      nlohmann::json runs = nlohmann::json::array();
-      for (const TruthRun& t : p.truth)
-        runs.push_back({{"t_cut_s", t.t_cut_s}, {"t_stop_s", t.t_stop_s}, {"stopped", t.stopped}});
-      truth[p.id] = std::move(runs);
-    }
-    std::ofstream(o.truth_path) << truth.dump(1) << '\n';
-  }
+  const nlohmann::json report = publisher.report(listener.fits());
+  if (!o.truth_path.empty()) std::ofstream(o.truth_path) << truth_json(publisher.plans()).dump(1) << '\n';
   if (!o.report_path.empty()) std::ofstream(o.report_path) << report.dump(1) << '\n';
   nlohmann::json summary = report;
   summary.erase("fit_list");
