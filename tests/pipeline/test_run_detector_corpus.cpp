@@ -10,7 +10,9 @@
 // (runs found differently), not a speed-up. If it fails after a change to the generator
 // (synthetic_run.cpp, the simulator) or the sample data only, check the detector against a copy
 // of itself from before the change (the corpus header takes any detector class), then record the
-// new hash: SPINDOWN_PRINT_CORPUS_HASH=1 prints it.
+// new hash: SPINDOWN_PRINT_CORPUS_HASH=1 prints it. SPINDOWN_DUMP_CORPUS=FILE writes each
+// recording's runs and diagnostics (find_runs) to FILE, one block per recording, so that two
+// detectors' files can be compared recording by recording with diff.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -84,11 +86,15 @@ TEST(RunDetectorCorpus, FindsTheRecordedRunsBitForBit) {
   ASSERT_GT(cases.size(), std::size_t(generated_recordings));
   std::uint64_t h = 1469598103934665603ull;
   std::size_t runs = 0;
+  const char* dump_path = std::getenv("SPINDOWN_DUMP_CORPUS");
+  std::FILE* dump = dump_path ? std::fopen(dump_path, "w") : nullptr;
   for (const auto& c : cases) {
     const Segmentation seg = find_runs(c.rec, c.opt);
     runs += seg.runs.size();
+    if (dump) std::fprintf(dump, "== %s\n%s\n", c.name.c_str(), corpus::describe(seg).c_str());
     h = corpus::fnv1a(h, corpus::describe(seg) + corpus::stream_events<RunDetector>(c.rec, c.opt));
   }
+  if (dump) std::fclose(dump);
   if (std::getenv("SPINDOWN_PRINT_CORPUS_HASH")) std::printf("corpus hash %016llx\n", (unsigned long long)h);
   EXPECT_GT(runs, cases.size() / 2);  // the corpus is mostly real runs, not noise
   EXPECT_EQ(h, recorded_hash) << "the run detector's output changed (see the comment at the top of this file)";

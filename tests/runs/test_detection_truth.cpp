@@ -15,7 +15,12 @@ namespace {
 // Before the truth corpus (2026-11-25, 12 recordings each): ramp cut 318, hand spin 16,
 // per-revolution sensor 22 (cut) and 100 (end), long coast 2139 (end, cut at 600 s), 7 of 12
 // slow viscous coasts stopped while still falling, 12 of 12 resets gave an invented run, 11 of
-// 12 recordings starting mid-coast a lead-in, no dropout left out.
+// 12 recordings starting mid-coast a lead-in, no dropout left out. The slow logger (issue 32: the
+// heavy flywheel logged once a second) was added when the windows began to follow the sample rate:
+// before, all 12 were missed (a 4-s window held 5 readings). Its stops are still rough (end p90
+// 67.5 periods, 2026-11-28): on the 2-decimal print a few come early (the long hold window, 3 % of
+// the coast, holds 15 readings, too few to see the end's slope) or are not found before the
+// recording ends; its limit records that, to be tightened.
 struct Limits {
   const char* pattern;
   double cut_p90, end_p90;
@@ -28,7 +33,7 @@ constexpr Limits limits[] = {
     {"slow viscous", 1.0, 1.0}, {"starts mid-coast", 1.0, 6.0},
     {"uneven sampling", 1.0, 6.0}, {"three runs", 1.0, 6.0},
     {"nudge after a run", 1.0, 6.0},  {"nudge before a run", 1.0, 6.0},
-    {"floating pin", 1.0, 6.0},
+    {"floating pin", 1.0, 6.0},   {"slow logger", 1.0, 70.0},
 };
 
 TEST(DetectionTruth, ScoresEachPattern) {

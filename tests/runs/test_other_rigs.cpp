@@ -205,3 +205,26 @@ TEST(OtherRigs, APerRevolutionSensorsHeldReadingAtRestIsNotTheZeroLevel) {
   EXPECT_NEAR(seg.runs[0].t_cut_s, t_cut, 0.2);
   EXPECT_LT(std::abs(seg.runs[0].zero_level), 0.05 * held);
 }
+
+// A flywheel store in vacuum (eddy drag c_v = J/1000 s, bearing friction for 0.15 rpm/s at
+// standstill) coasts from 2800 rpm for about an hour, logged once a second in integer rpm (σ 0.3
+// count): at its end the reading falls one count every ~7 s. The windows that confirm a coast and
+// a standstill must hold enough of those readings (a 4-s window holds 5, the 1-s hold window one
+// or two, and no run was found at all): one run, cut within 2 periods, stopped within 2 periods and
+// the time the last 1.4 counts take at the standstill's deceleration.
+TEST(OtherRigs, AnHourLongCoastLoggedOnceASecondInWholeRpmIsOneStoppedRun) {
+  constexpr double rpm = 2 * M_PI / 60;
+  const double b = 1.0 / 1000, c = 0.15 * rpm;  // dω/dt = −b·ω − c: c_v/J and c_c/J
+  const double w0 = 2800 * rpm, t_cut = 45.6;
+  const double coast_s = std::log(1 + w0 * b / c) / b;  // the closed form's stop
+  const auto speed = [&](double t) {
+    if (t < t_cut) return w0 * (1 + 2e-4 * std::sin(t / 7.0));
+    return t - t_cut >= coast_s ? 0.0 : (w0 + c / b) * std::exp(-b * (t - t_cut)) - c / b;
+  };
+  std::mt19937 rng(3232);
+  std::normal_distribution<double> noise(0, 0.3);
+  const Recording rec = sample(1.0, t_cut + coast_s + 240, speed, [&](double w) {
+    return w <= 0 ? 0.0 : std::max(0.0, std::round(w / rpm + noise(rng)));
+  });
+  expect_one_run(rec, t_cut, 2.0, t_cut + coast_s, 2.0 + 1.4 / 0.15);
+}

@@ -140,6 +140,17 @@ inline std::vector<Case> make_cases(int per_pattern) {
       s.max_coast_s = 1200;
       cases.push_back(single("long coast", s));
     }
+    {  // the heavy flywheel logged once a second: the windows must hold enough of its readings
+      SyntheticRunSpec s = base;
+      s.bench.inertia_kg_m2 = base.bench.inertia_kg_m2 * (20.0 + 2.0 * (k % 5));
+      s.friction = {1.822e-7, 1.1389e-4};
+      s.period_s = 1.0;
+      s.jitter_s = 0.01;
+      s.lead_in_s = 20.0;
+      s.tail_s = 60.0;
+      s.max_coast_s = 1200;
+      cases.push_back(single("slow logger", s));
+    }
     {  // single dropouts (0) and glitches (half the value) inside the coast
       SyntheticRunSpec s = base;
       s.glitches = 3 + k % 5;

@@ -157,12 +157,38 @@ void RunDetector::act_on(const CoastVerdict& v, std::size_t i, bool at_end) {
 // ---- detector ----------------------------------------------------------------------------
 
 RunDetector::RunDetector(RunOptions opt, std::string source) : opt_(std::move(opt)), source_(std::move(source)) {
-  hold_.span_s = opt_.stop_hold_s;
-  hold_long_.span_s = 3.0 * opt_.stop_hold_s;
-  hold_half_s_ = 0.5 * hold_.span_s;
-  hold_full_s_ = 0.9 * hold_.span_s;
+  set_spans(0.0);
   ring_ = std::make_unique_for_overwrite<Sample[]>(initial_ring_size);
   mask_ = initial_ring_size - 1;
+}
+
+// The windows' spans for a stream sampled every period_s (0: fast enough for the spans in seconds):
+// each holds its least number of samples, n of them spanning n − 1 periods. A tenth more keeps
+// them when the clock jitters by up to that, and still lets them count as full (a window is
+// judged once it spans 0.9 of its span, a confirming one 0.8); it keeps no more for n < 11.
+void RunDetector::set_spans(double period_s) {
+  const auto periods = [](std::size_t samples) { return 1.1 * double(samples - 1); };
+  vlong_.span_s = std::max(4.0, periods(confirm_min_samples) * period_s);
+  hold_.span_s = std::max(opt_.stop_hold_s, periods(hold_min_samples) * period_s);
+  hold_long_.span_s = 3.0 * hold_.span_s;
+  hold_half_s_ = 0.5 * hold_.span_s;
+  hold_full_s_ = 0.9 * hold_.span_s;
+  // The shortest period that would widen a window.
+  slow_period_ = std::min(vlong_.span_s / periods(confirm_min_samples), hold_.span_s / periods(hold_min_samples));
+}
+
+void RunDetector::follow_slow_period(std::size_t i, double dt) {
+  if (slow_last_ + 1 != i) slow_count_ = 0, slow_longest_ = 0;  // a new run of slow periods
+  slow_last_ = i;
+  slow_longest_ = std::max(slow_longest_, dt);
+  // A single late sample (a fast logger's hiccup, samples lost) is no rate: a run of them is.
+  if (++slow_count_ >= confirm_min_samples) set_spans(slow_longest_);
+}
+
+double RunDetector::shortest_period(const WindowFit& w) const {
+  double p = std::numeric_limits<double>::infinity();
+  for (std::size_t k = w.first + 1; k < w.end; ++k) p = std::min(p, t(k) - t(k - 1));
+  return std::isfinite(p) ? p : 0.0;
 }
 
 void RunDetector::grow_ring() {
@@ -430,6 +456,8 @@ void RunDetector::restart_stream(const std::string& why, Run::End reason) {
   long_.clear(next_index_, 0.0);
   vlong_.clear(next_index_, 0.0);
   hold_long_.clear(next_index_, 0.0);
+  set_spans(0.0);  // a new stream: its rate is learnt afresh
+  slow_last_ = SIZE_MAX;
   quiet_until_s_ = -std::numeric_limits<double>::infinity();
   hold_.clear(next_index_, 0.0);
 }
@@ -533,7 +561,7 @@ void RunDetector::trim_idle() {
 
 [[gnu::always_inline]] inline bool RunDetector::confirms_decline(const WindowFit& w) const {
   // Cheapest tests first: an idle lead-in (zeros, a steady supply) fails one of them.
-  if (w.n < 6 || w.first < lo_) return false;
+  if (w.n < double(confirm_min_samples) || w.first < lo_) return false;
   // The slope's sign is Sxy's (Sxx > 0, else the slope is 0): a level or rising window, half of
   // an idle lead-in, is out before the divisions.
   if (!(w.stv - w.st() * w.sv() / w.n < 0)) return false;
@@ -569,9 +597,11 @@ void RunDetector::idle_step(std::size_t i, Sample s, double prev_t) {
   if (block_band_ > 0) [[unlikely]]
     rise_level_ = std::min(rise_level_, s.v + block_band_);
   // A pause in the recording (over 2 s): what follows may be a coast whose cut it hid.
-  if (s.t - prev_t > 2.0) [[unlikely]] {
+  if (s.t - prev_t > pause_s) [[unlikely]] {
     resume_index_ = i;
     resume_pause_s_ = s.t - prev_t;
+  } else if (s.t - prev_t > slow_period_) [[unlikely]] {
+    follow_slow_period(i, s.t - prev_t);
   }
   advance(short_, i, s);
   advance(long_, i, s);
@@ -836,6 +866,8 @@ bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
     e.run = run_;
     events_.push_back(std::move(e));
   }
+  // The coast's hold windows follow its own sample rate (a stream may change its rate between runs).
+  set_spans(shortest_period(w));  // lost samples only lengthen periods: the shortest is the rate
   reset_window(hold_, run_.cut_index, i + 1);
   plateau_check_t_ = run_.t_cut_s + 2.0 * hold_.span_s;  // once the hold window is clear of the first one
   plateau_hits_ = 0;

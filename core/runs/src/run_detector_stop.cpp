@@ -214,7 +214,7 @@ void RunDetector::standstill_checks(std::size_t i, bool at_end, double mu, doubl
     if (!hold_long_live_) {
       // Three hold windows, or 3 % of the coast so far if longer: a heavy flywheel's coast falls a
       // few mV a second near its end, which a 3 s window of noisy readings can take for level.
-      hold_long_.span_s = std::max(3.0 * opt_.stop_hold_s, long_hold_fraction * (t(i) - run_.t_cut_s));
+      hold_long_.span_s = std::max(3.0 * hold_.span_s, long_hold_fraction * (t(i) - run_.t_cut_s));
       reset_window(hold_long_, run_.cut_index, i + 1);
       hold_long_live_ = true;
     }

@@ -40,6 +40,16 @@ inline constexpr double quiet_floor_sd = 0.3;
 inline constexpr double step_sd = 0.2886751345948129;
 // The long hold window spans at least this fraction of the coast before it.
 inline constexpr double long_hold_fraction = 0.03;
+// A slow logger's windows hold at least this many samples, whatever their spans in seconds say
+// (set_spans). The longest window that confirms a coast: confirms_decline's own minimum (a slope
+// t-statistic of 6 on 4 degrees of freedom). At one reading a second its 4 s would hold 5.
+inline constexpr std::size_t confirm_min_samples = 6;
+// The hold windows that find a standstill: a slope and its residual on 3 degrees of freedom. At
+// one reading a second the 1-s hold window would hold one or two, and no stop could be found; at
+// 10 Hz and faster the spans in seconds hold more, and are kept.
+inline constexpr std::size_t hold_min_samples = 5;
+// A period longer than this between two samples is a pause in the recording, not its rate.
+inline constexpr double pause_s = 2.0;
 // Recompute sliding sums from scratch this often (rounding drift).
 inline constexpr unsigned refresh_every = 4096;
 

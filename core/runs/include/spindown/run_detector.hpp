@@ -5,8 +5,9 @@
 // during a coast at most RunOptions::max_buffer samples.
 //
 // How it decides (all thresholds relative to the data's own level and noise):
-//  * a coast is confirmed when a trailing window (0.25 s or 1 s) shows a smooth, significant
-//    decline (slope t-statistic, roughness relative to the level);
+//  * a coast is confirmed when a trailing window (0.25 s, 1 s or 4 s; a slow logger's 4-s window
+//    and hold windows widened to hold enough readings) shows a smooth, significant decline (slope
+//    t-statistic, roughness relative to the level);
 //  * the cut is then located by a two-segment least-squares split of the last seconds
 //    (constant lead-in | linear coast start), which finds both steps (zeros, floating pin,
 //    supply) and kinks (powered motor at steady speed); a reading pinned at its maximum
@@ -374,6 +375,17 @@ class RunDetector {
   WindowFit short_{0.25}, long_{1.0}, vlong_{4.0};  // confirm a decline
   WindowFit hold_{1.0}, hold_long_{3.0};            // confirm a standstill
   double hold_half_s_ = 0.5, hold_full_s_ = 0.9;     // hold_ durations: 0.5 and 0.9 of its span
+  // A slow logger: when confirm_min_samples periods in a row are longer than slow_period_, the
+  // windows' spans are widened to hold enough samples (set_spans), and slow_period_ becomes the
+  // period that would widen them further. slow_last_: the last sample after such a period. A coast
+  // sets the spans from its confirming window's shortest period (a stream may change its rate).
+  double slow_period_ = 0;
+  double slow_longest_ = 0;
+  std::size_t slow_count_ = 0, slow_last_ = SIZE_MAX;
+  void set_spans(double period_s);
+  double shortest_period(const WindowFit& w) const;  // between two of w's samples (0: fewer than two)
+  // Sample i came dt after the one before, longer than slow_period_ (and no pause).
+  [[gnu::cold, gnu::noinline]] void follow_slow_period(std::size_t i, double dt);
   bool hold_long_live_ = false;
   bool creeping_ = false;
   double rest_level_ = std::numeric_limits<double>::infinity();  // the lowest level held while idle (idle_step)
