@@ -228,3 +228,28 @@ TEST(OtherRigs, AnHourLongCoastLoggedOnceASecondInWholeRpmIsOneStoppedRun) {
   });
   expect_one_run(rec, t_cut, 2.0, t_cut + coast_s, 2.0 + 1.4 / 0.15);
 }
+
+// A belt-drive turntable's speed servo at power-on (ζ = 0.45, ω_n = 3 rad/s) overshoots to 40 rpm,
+// rings and settles at 33.3 rpm (0.1 % wow at 0.56 Hz), where it is held for 16 s before the power is
+// cut: a 15-s coast. Read in rpm to two decimals at 10 Hz (σ 0.02 rpm). The fall after the
+// overshoot's peak looks like a coast, and the ringing takes the reading back up to the setpoint
+// too little for power coming back; but it then holds that level for 16 s, where a coast falling as
+// this one falls after the cut crosses it in a tenth of a second: one run, cut at the power-off.
+TEST(OtherRigs, AServoOvershootThatSettlesOnItsSetpointIsNoCoast) {
+  constexpr double rpm = 2 * M_PI / 60;
+  const Friction f{0.0225, 1.5e-3, 3e-3};
+  const double set = 33.333 * rpm, t_on = 1.0, t_cut = 19.04, zeta = 0.45, wn = 3;
+  const auto servo = [&](double t) {
+    const double s = t - t_on, wd = wn * std::sqrt(1 - zeta * zeta);
+    const double wow = 1 + 0.001 * std::sin(2 * M_PI * 0.5556 * t);
+    return set * wow * (1 - std::exp(-zeta * wn * s) * (std::cos(wd * s) + zeta / std::sqrt(1 - zeta * zeta) * std::sin(wd * s)));
+  };
+  const Coast coast(f, servo(t_cut));
+  const auto speed = [&](double t) { return t < t_on ? 0.0 : t < t_cut ? servo(t) : coast.at(t - t_cut); };
+  std::mt19937 rng(3240);
+  std::normal_distribution<double> noise(0, 0.02);
+  const Recording rec = sample(0.1, t_cut + coast.stop_s + 5, speed, [&](double w) {
+    return w <= 0 ? 0.0 : std::max(0.0, std::round((w / rpm + noise(rng)) * 100) / 100);
+  });
+  expect_one_run(rec, t_cut, 0.2, t_cut + coast.stop_s, 0.25);
+}

@@ -50,6 +50,13 @@ inline constexpr std::size_t confirm_min_samples = 6;
 inline constexpr std::size_t hold_min_samples = 5;
 // A period longer than this between two samples is a pause in the recording, not its rate.
 inline constexpr double pause_s = 2.0;
+// A coast crosses a band of its noise (2h wide) in about 2h over its rate there, and falls
+// dwell_fall_bands more bands after it in about that many times as long, or less (friction grows
+// with speed; Stribeck's rise at low speed is at most a few times the Coulomb level). A reading that
+// held a band more than dwell_max_ratio times as long as the coast then took for those bands did
+// not coast while it held.
+inline constexpr double dwell_fall_bands = 4.0;
+inline constexpr double dwell_max_ratio = 20.0;
 // Recompute sliding sums from scratch this often (rounding drift).
 inline constexpr unsigned refresh_every = 4096;
 

@@ -262,6 +262,18 @@ class RunDetector {
   // noise, what came before the rise was no part of it (an open pin's swing before it was connected,
   // a coast the power came back on unseen). r then starts at the last such rise, with a warning.
   void recut_after_rise(Run& r, std::size_t coast_end);
+  // A coast never dwells (run_detector_dwell.cpp): when the reading inside r's coast [cut, coast_end)
+  // held a level far longer than the coast then took to fall through it, r starts after that dwell,
+  // with a warning.
+  void recut_after_dwell(Run& r, std::size_t coast_end);
+  bool falls_faster_later(std::size_t c, std::size_t e, double margin) const;
+  // One past the last sample of the last such dwell in [c, e) (bands of half-width h), or 0; from:
+  // where that dwell began.
+  std::size_t dwell_end(std::size_t c, std::size_t e, double h, std::size_t& from);
+  // Whether [from, to) repeats one value for half its samples or more (a frozen reading).
+  bool frozen(std::size_t from, std::size_t to) const;
+  // rough_sd() from a few hundred second differences spread over [from, to).
+  double sampled_rough_sd(std::size_t from, std::size_t to) const;
   // Why the coast in sp has no recorded cut (the stream begins on it, or a pause hides it), with
   // sp moved to the coast's first sample; empty when its cut is in the data.
   std::string start_not_seen(CutSplit& sp);
