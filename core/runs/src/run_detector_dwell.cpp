@@ -23,11 +23,7 @@ std::size_t RunDetector::dwell_end(std::size_t c, std::size_t e, double h, std::
   const std::size_t n = e - c;
   double* lo = scratch(2 * n);
   double* hi = lo + n;
-  const auto med3 = [&](std::size_t k) {
-    if (k == c || k + 1 == e) return v(k);
-    const double a = v(k - 1), b = v(k), d = v(k + 1);
-    return std::max(std::min(a, b), std::min(std::max(a, b), d));
-  };
+  const auto med3 = [&](std::size_t k) { return median3(k, c, e); };
   for (std::size_t k = 0; k < n; ++k) lo[k] = std::min(k ? lo[k - 1] : med3(c), med3(c + k));
   for (std::size_t k = n; k-- > 0;) hi[k] = std::max(k + 1 < n ? hi[k + 1] : med3(e - 1), med3(c + k));
   // For each new low (level L = lo(k) − h, the band [L − h, L + h]): the dwell D from k to the last
@@ -76,17 +72,19 @@ bool RunDetector::frozen(std::size_t from, std::size_t to) const {
   return 2 * longest >= to - from;
 }
 
+double RunDetector::median3(std::size_t k, std::size_t c, std::size_t e) const {
+  if (k <= c || k + 1 >= e) return v(k);  // the span's ends have one neighbour inside it
+  const double a = v(k - 1), b = v(k), d = v(k + 1);
+  return std::max(std::min(a, b), std::min(std::max(a, b), d));
+}
+
 bool RunDetector::falls_faster_later(std::size_t c, std::size_t e, double margin) const {
   // A free coast falls at least as far in each third of its time as in the next: friction takes
   // more speed off at a higher speed (viscous, windage) or as much (Coulomb). A dwell makes an
   // earlier third fall less than a later one; only then is the coast searched for it (the search
   // would cost every run's detection a tenth more time). Stribeck friction near standstill also
   // passes here; the search then finds no dwell. Medians of three: one glitch decides nothing.
-  const auto med3 = [&](std::size_t k) {
-    if (k <= c || k + 1 >= e) return v(k);
-    const double a = v(k - 1), b = v(k), d = v(k + 1);
-    return std::max(std::min(a, b), std::min(std::max(a, b), d));
-  };
+  const auto med3 = [&](std::size_t k) { return median3(k, c, e); };
   const std::size_t n = e - c;
   const double v0 = med3(c), v1 = med3(c + n / 3), v2 = med3(c + 2 * n / 3), v3 = med3(e - 1);
   const double d1 = v0 - v1, d2 = v1 - v2, d3 = v2 - v3;

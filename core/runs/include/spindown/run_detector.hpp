@@ -266,7 +266,11 @@ class RunDetector {
   // held a level far longer than the coast then took to fall through it, r starts after that dwell,
   // with a warning.
   void recut_after_dwell(Run& r, std::size_t coast_end);
+  // Whether a later third of the coast [c, e) falls more than an earlier one by over margin (the
+  // cheap look before the dwell search).
   bool falls_faster_later(std::size_t c, std::size_t e, double margin) const;
+  // The median of readings k-1, k, k+1 inside [c, e) (the reading itself at its ends).
+  double median3(std::size_t k, std::size_t c, std::size_t e) const;
   // One past the last sample of the last such dwell in [c, e) (bands of half-width h), or 0; from:
   // where that dwell began.
   std::size_t dwell_end(std::size_t c, std::size_t e, double h, std::size_t& from);
