@@ -1,4 +1,4 @@
-#include "spindown/run_detector.hpp"
+#include "run_detector_impl.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -17,7 +17,7 @@ using namespace detector_tuning;
 
 // ---- sliding least-squares line ----------------------------------------------------------
 
-void RunDetector::WindowFit::clear(std::size_t at, double t_origin) {
+void RunDetector::Impl::WindowFit::clear(std::size_t at, double t_origin) {
   first = end = at;
   t0 = t_origin;
   n = stv = 0;
@@ -25,11 +25,11 @@ void RunDetector::WindowFit::clear(std::size_t at, double t_origin) {
   updates = 0;
 }
 
-double RunDetector::duration(const WindowFit& w) const {
+double RunDetector::Impl::duration(const WindowFit& w) const {
   return w.end > w.first ? t(w.end - 1) - t(w.first) : 0.0;
 }
 
-RunDetector::WindowFit RunDetector::window_over(const Sample* ring, std::size_t mask, double span, std::size_t from,
+RunDetector::Impl::WindowFit RunDetector::Impl::window_over(const Sample* ring, std::size_t mask, double span, std::size_t from,
                                                 std::size_t to) {
   WindowFit w;
   w.span_s = span;
@@ -40,11 +40,11 @@ RunDetector::WindowFit RunDetector::window_over(const Sample* ring, std::size_t 
   return w;
 }
 
-void RunDetector::rebuild(WindowFit& w, std::size_t from, std::size_t to) {
+void RunDetector::Impl::rebuild(WindowFit& w, std::size_t from, std::size_t to) {
   w = window_over(ring_.get(), mask_, w.span_s, from, to);
 }
 
-void RunDetector::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
+void RunDetector::Impl::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
   lo = std::max(lo, base_);
   if (lo >= end) {
     w.clear(end, 0.0);
@@ -58,7 +58,7 @@ void RunDetector::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
 // Per sample for every live window, so inlined into its callers; the usual step (sample i
 // follows the window's last, exactly one old sample expires) is one slide(). s is sample i,
 // passed in so that it is not reloaded from the ring after the stores to the sums.
-[[gnu::always_inline]] inline void RunDetector::advance(WindowFit& w, const Sample* ring, const std::size_t mask,
+[[gnu::always_inline]] inline void RunDetector::Impl::advance(WindowFit& w, const Sample* ring, const std::size_t mask,
                                                        std::size_t i, Sample s) {
   // w.n always equals w.end - w.first: an empty window contiguous with i has first == i.
   if (w.end != i || w.first == i) [[unlikely]] {
@@ -87,11 +87,11 @@ void RunDetector::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
   if (w.updates > refresh_every) [[unlikely]] w = window_over(ring, mask, span, w.first, w.end);
 }
 
-[[gnu::always_inline]] inline void RunDetector::advance(WindowFit& w, std::size_t i, Sample s) {
+[[gnu::always_inline]] inline void RunDetector::Impl::advance(WindowFit& w, std::size_t i, Sample s) {
   advance(w, ring_.get(), mask_, i, s);
 }
 
-[[gnu::always_inline]] inline void RunDetector::coast_step(std::size_t i, Sample s, double prev_t) {
+[[gnu::always_inline]] inline void RunDetector::Impl::coast_step(std::size_t i, Sample s, double prev_t) {
   advance(hold_, i, s);
   if (hold_long_live_) [[unlikely]] advance(hold_long_, i, s);
   if (long_silence(prev_t, s.t, run_.t_cut_s)) [[unlikely]] {
@@ -104,7 +104,7 @@ void RunDetector::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
 // Per coasting sample; kept small (the rare outcomes are the caller's calls) since it runs for
 // every sample. s is sample i, and h (hold_, or push_many's copy of it) ends at i; level_min and
 // rising are the coast's lowest level and rise count, updated here.
-[[gnu::always_inline]] inline RunDetector::CoastVerdict RunDetector::coast_verdict(std::size_t i, Sample s,
+[[gnu::always_inline]] inline RunDetector::Impl::CoastVerdict RunDetector::Impl::coast_verdict(std::size_t i, Sample s,
                                                                                  const WindowFit& h,
                                                                                  double& level_min,
                                                                                  int& rising, const CoastLimits& c) {
@@ -139,7 +139,7 @@ void RunDetector::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
 }
 
 // What a verdict asks for; the state it read must be the detector's own again.
-void RunDetector::act_on(const CoastVerdict& v, std::size_t i, bool at_end) {
+void RunDetector::Impl::act_on(const CoastVerdict& v, std::size_t i, bool at_end) {
   switch (v.what) {
     case CoastVerdict::go_on: break;
     case CoastVerdict::too_long: coast_too_long(i); break;
@@ -149,14 +149,14 @@ void RunDetector::act_on(const CoastVerdict& v, std::size_t i, bool at_end) {
   }
 }
 
-[[gnu::always_inline]] inline void RunDetector::coast_checks(std::size_t i, Sample s, bool at_end) {
+[[gnu::always_inline]] inline void RunDetector::Impl::coast_checks(std::size_t i, Sample s, bool at_end) {
   const CoastVerdict v = coast_verdict(i, s, hold_, level_min_, rising_, coast_limits());
   if (v.what != CoastVerdict::go_on) [[unlikely]] act_on(v, i, at_end);
 }
 
 // ---- detector ----------------------------------------------------------------------------
 
-RunDetector::RunDetector(RunOptions opt, std::string source) : opt_(std::move(opt)), source_(std::move(source)) {
+RunDetector::Impl::Impl(RunOptions opt, std::string source) : opt_(std::move(opt)), source_(std::move(source)) {
   set_spans(0.0);
   ring_ = std::make_unique_for_overwrite<Sample[]>(initial_ring_size);
   mask_ = initial_ring_size - 1;
@@ -166,7 +166,7 @@ RunDetector::RunDetector(RunOptions opt, std::string source) : opt_(std::move(op
 // each holds its least number of samples, n of them spanning n − 1 periods. A tenth more keeps
 // them when the clock jitters by up to that, and still lets them count as full (a window is
 // judged once it spans 0.9 of its span, a confirming one 0.8); it keeps no more for n < 11.
-void RunDetector::set_spans(double period_s) {
+void RunDetector::Impl::set_spans(double period_s) {
   const auto periods = [](std::size_t samples) { return 1.1 * double(samples - 1); };
   vlong_.span_s = std::max(4.0, periods(confirm_min_samples) * period_s);
   hold_.span_s = std::max(opt_.stop_hold_s, periods(hold_min_samples) * period_s);
@@ -177,7 +177,7 @@ void RunDetector::set_spans(double period_s) {
   slow_period_ = std::min(vlong_.span_s / periods(confirm_min_samples), hold_.span_s / periods(hold_min_samples));
 }
 
-void RunDetector::follow_slow_period(std::size_t i, double dt) {
+void RunDetector::Impl::follow_slow_period(std::size_t i, double dt) {
   if (slow_last_ + 1 != i) slow_count_ = 0, slow_longest_ = 0;  // a new run of slow periods
   slow_last_ = i;
   slow_longest_ = std::max(slow_longest_, dt);
@@ -185,13 +185,13 @@ void RunDetector::follow_slow_period(std::size_t i, double dt) {
   if (++slow_count_ >= confirm_min_samples) set_spans(slow_longest_);
 }
 
-double RunDetector::shortest_period(const WindowFit& w) const {
+double RunDetector::Impl::shortest_period(const WindowFit& w) const {
   double p = std::numeric_limits<double>::infinity();
   for (std::size_t k = w.first + 1; k < w.end; ++k) p = std::min(p, t(k) - t(k - 1));
   return std::isfinite(p) ? p : 0.0;
 }
 
-void RunDetector::grow_ring() {
+void RunDetector::Impl::grow_ring() {
   // Keep [base_, next_index_) at the same positions modulo the new, doubled size.
   const std::size_t size = 2 * ring_size();
   auto bigger = std::make_unique_for_overwrite<Sample[]>(size);
@@ -201,13 +201,13 @@ void RunDetector::grow_ring() {
   mask_ = mask;
 }
 
-std::vector<RunEvent> RunDetector::take_events() {
+std::vector<RunEvent> RunDetector::Impl::take_events() {
   std::vector<RunEvent> out;
   out.swap(events_);
   return out;
 }
 
-void RunDetector::emit_diag(Diagnostic::Severity sev, std::string msg) {
+void RunDetector::Impl::emit_diag(Diagnostic::Severity sev, std::string msg) {
   RunEvent e;
   e.kind = RunEvent::Kind::diagnostic;
   e.diagnostic = {sev, source_, 0, std::move(msg)};
@@ -215,7 +215,7 @@ void RunDetector::emit_diag(Diagnostic::Severity sev, std::string msg) {
   events_.push_back(std::move(e));
 }
 
-double* RunDetector::scratch(std::size_t size) {
+double* RunDetector::Impl::scratch(std::size_t size) {
   if (size > scratch_size_) {
     scratch_size_ = std::max(size, 2 * scratch_size_);
     scratch_ = std::make_unique_for_overwrite<double[]>(scratch_size_);
@@ -223,7 +223,7 @@ double* RunDetector::scratch(std::size_t size) {
   return scratch_.get();
 }
 
-double RunDetector::median_of(std::size_t from, std::size_t to) {
+double RunDetector::Impl::median_of(std::size_t from, std::size_t to) {
   if (to <= from) return 0.0;
   const std::size_t n = to - from;
   double* x = scratch(n);
@@ -235,7 +235,7 @@ double RunDetector::median_of(std::size_t from, std::size_t to) {
   return m;
 }
 
-double RunDetector::median_period(std::size_t from, std::size_t to) {
+double RunDetector::Impl::median_period(std::size_t from, std::size_t to) {
   const std::size_t n = to - from - 1, h = n / 2;
   // A steady clock gives few distinct periods (timestamps on a grid, rounded), one of them most
   // of the time, so the median of a few periods spread over the coast usually is the median of
@@ -273,7 +273,7 @@ double RunDetector::median_period(std::size_t from, std::size_t to) {
   return dt[h];
 }
 
-void RunDetector::count_periods(const Sample* p, std::size_t m, double guess, double& prev, std::size_t& below,
+void RunDetector::Impl::count_periods(const Sample* p, std::size_t m, double guess, double& prev, std::size_t& below,
                                 std::size_t& at_or_below) {
   std::size_t j = 0;
 #if defined(__SSE2__)  // elsewhere (arm64 benches) the plain loop below counts them all
@@ -315,7 +315,7 @@ void RunDetector::count_periods(const Sample* p, std::size_t m, double guess, do
 // long clip is still buffered when the coast leaves it. last_v is v(i - 1) when i > base_, NaN
 // when i == base_ (so a new reading there starts a run of its own). A changed reading is a run
 // of one: only a repeated one can make a plateau.
-[[gnu::always_inline]] inline void RunDetector::track_repeats(std::size_t i, double value, std::size_t& same_start,
+[[gnu::always_inline]] inline void RunDetector::Impl::track_repeats(std::size_t i, double value, std::size_t& same_start,
                                                               double& last_v) {
   if (value != last_v) {
     same_start = i;
@@ -327,7 +327,7 @@ void RunDetector::count_periods(const Sample* p, std::size_t m, double guess, do
   }
 }
 
-void RunDetector::push(double t_s, double value) {
+void RunDetector::Impl::push(double t_s, double value) {
   if (!std::isfinite(t_s) || !std::isfinite(value)) [[unlikely]] {
     ++non_finite_;  // reported by finish(); not a sample, so it takes no index
     return;
@@ -347,7 +347,7 @@ void RunDetector::push(double t_s, double value) {
   }
 }
 
-void RunDetector::push_many(const double* t_s, const double* value, std::size_t n) {
+void RunDetector::Impl::push_many(const double* t_s, const double* value, std::size_t n) {
   std::size_t k = 0;
   while (k < n) {
     if (state_ == State::coasting) {
@@ -366,14 +366,14 @@ void RunDetector::push_many(const double* t_s, const double* value, std::size_t 
 // order, on local copies of the state push() would read and write for them, put back into the
 // detector once instead of through its members per sample. A sample push() would treat
 // otherwise (not finite, time going back, the ring full) is left to push().
-std::size_t RunDetector::coast_run(const double* t_s, const double* value, std::size_t k, const std::size_t n) {
+std::size_t RunDetector::Impl::coast_run(const double* t_s, const double* value, std::size_t k, const std::size_t n) {
   return hold_long_live_ ? coast_loop<true>(t_s, value, k, n) : coast_loop<false>(t_s, value, k, n);
 }
 
 // The loop for a coast with (LongLive) or without the long hold window: without it, the loop
 // has no trace of that window, and fewer values compete for registers.
 template <bool LongLive>
-std::size_t RunDetector::coast_loop(const double* t_s, const double* value, std::size_t k, const std::size_t n) {
+std::size_t RunDetector::Impl::coast_loop(const double* t_s, const double* value, std::size_t k, const std::size_t n) {
   const CoastLimits c = coast_limits();
   Sample* const ring = ring_.get();  // c.ring, writable: the loop stores each sample
   const std::size_t mask = c.mask, capacity = ring_size();
@@ -416,23 +416,23 @@ std::size_t RunDetector::coast_loop(const double* t_s, const double* value, std:
 }
 
 // Out of line and cold: formatting the note inside push() would cost every sample a stack frame.
-[[gnu::cold, gnu::noinline]] void RunDetector::time_went_back(double t_s) {
+[[gnu::cold, gnu::noinline]] void RunDetector::Impl::time_went_back(double t_s) {
   emit_diag(Diagnostic::Severity::note,
             fmt::format("time went back from {} to {} at sample {}: taken as a clock restart", fmt_s(last_t_),
                         fmt_s(t_s), next_index_));
   clock_restart();
 }
 
-void RunDetector::clock_restart() {
+void RunDetector::Impl::clock_restart() {
   restart_stream("the device clock restarted mid-coast (an Arduino reset?): the coast is cut short there",
                  Run::End::clock_restart);
 }
 
-void RunDetector::new_source(const std::string& why) {
+void RunDetector::Impl::new_source(const std::string& why) {
   restart_stream(why + ": the coast is cut short there", Run::End::new_source);
 }
 
-void RunDetector::restart_stream(const std::string& why, Run::End reason) {
+void RunDetector::Impl::restart_stream(const std::string& why, Run::End reason) {
   restarted_mid_coast_ = state_ == State::coasting;
   after_silence_ = false;  // a new timeline: nothing on it continues the silenced coast
   if (state_ == State::coasting) {
@@ -462,7 +462,7 @@ void RunDetector::restart_stream(const std::string& why, Run::End reason) {
   hold_.clear(next_index_, 0.0);
 }
 
-void RunDetector::finish() {
+void RunDetector::Impl::finish() {
   // A recording that ends soon after the stop: the hold window alone decides.
   if (state_ == State::coasting && next_index_ > base_)
     coast_checks(next_index_ - 1, ring_[(next_index_ - 1) & mask_], true);
@@ -476,7 +476,7 @@ void RunDetector::finish() {
   }
 }
 
-void RunDetector::went_silent(double silent_s) {
+void RunDetector::Impl::went_silent(double silent_s) {
   if (state_ == State::coasting && next_index_ > base_) coast_checks(next_index_ - 1, ring_[(next_index_ - 1) & mask_], true);
   if (state_ == State::coasting) {
     // Where the coast was when the samples stopped: what resumes below it is the same coast.
@@ -501,7 +501,7 @@ void RunDetector::went_silent(double silent_s) {
   }
 }
 
-void RunDetector::watch_after_silence(double v) {
+void RunDetector::Impl::watch_after_silence(double v) {
   // A rise above where the silence began: the motor was powered again (a new run's lead-in).
   if (v > silence_level_ + silence_band_) {
     after_silence_ = false;
@@ -514,7 +514,7 @@ void RunDetector::watch_after_silence(double v) {
   }
 }
 
-void RunDetector::to_idle(std::size_t lo, bool need_quiet, std::size_t search_from) {
+void RunDetector::Impl::to_idle(std::size_t lo, bool need_quiet, std::size_t search_from) {
   // After a stop, a new coast must start above the standstill: a slow coast's last creep
   // after a premature stop is not a new run.
   need_rise_ = state_ == State::tail && run_.stopped;
@@ -531,7 +531,7 @@ void RunDetector::to_idle(std::size_t lo, bool need_quiet, std::size_t search_fr
   trim_idle();
 }
 
-void RunDetector::trim_idle() {
+void RunDetector::Impl::trim_idle() {
   if (next_index_ == base_) return;
   // Enough for the longest window and a few doublings of the back-search.
   const double keep_s = idle_keep_s;
@@ -559,7 +559,7 @@ void RunDetector::trim_idle() {
   if (vlong_.first < base_) reset_window(vlong_, base_, next_index_);
 }
 
-[[gnu::always_inline]] inline bool RunDetector::confirms_decline(const WindowFit& w) const {
+[[gnu::always_inline]] inline bool RunDetector::Impl::confirms_decline(const WindowFit& w) const {
   // Cheapest tests first: an idle lead-in (zeros, a steady supply) fails one of them.
   if (w.n < double(confirm_min_samples) || w.first < lo_) return false;
   // The slope's sign is Sxy's (Sxx > 0, else the slope is 0): a level or rising window, half of
@@ -578,7 +578,7 @@ void RunDetector::trim_idle() {
   return sd <= confirm_max_roughness * mu || smooth_curve(w, mu, -s * dur);
 }
 
-bool RunDetector::smooth_curve(const WindowFit& w, double mu, double drop) const {
+bool RunDetector::Impl::smooth_curve(const WindowFit& w, double mu, double drop) const {
   // A fast coast (a propeller's, a fan's: windage) bends within a window of a few coarse readings,
   // so a line misses it by more than a twentieth of its level while each reading follows the curve:
   // its sample-to-sample noise (second differences cancel the bend) is small beside what it fell.
@@ -591,7 +591,7 @@ bool RunDetector::smooth_curve(const WindowFit& w, double mu, double drop) const
          rough_sd(w.first, w.end) <= confirm_max_roughness * std::max(mu, drop);
 }
 
-void RunDetector::idle_step(std::size_t i, Sample s, double prev_t) {
+void RunDetector::Impl::idle_step(std::size_t i, Sample s, double prev_t) {
   // A coast closed before its stop (cap, signal lost) blocks new runs until the reading rises
   // well above the lowest it has shown since: a new spin-up does, the rest of that coast never.
   if (block_band_ > 0) [[unlikely]]
@@ -639,7 +639,7 @@ void RunDetector::idle_step(std::size_t i, Sample s, double prev_t) {
   trim_idle();
 }
 
-bool RunDetector::flat(const WindowFit& w) const {
+bool RunDetector::Impl::flat(const WindowFit& w) const {
   if (w.n < 3 || w.first < run_.cut_index) return false;
   const double d = duration(w);
   if (d < 0.9 * w.span_s) return false;
@@ -662,7 +662,7 @@ inline double level_tiny(double v0, double m) {
 // (10⁻⁹ of the terms it is the difference of, and of the coast's scale: a constant reading's n·Syy
 // rounds to ±10⁻¹², not 0), and a further 10⁻⁴ is asked for, so it never turns away a window
 // level() would accept. A coast still falling (t ≫ 4) it turns away: most of the low samples.
-[[gnu::always_inline]] inline bool RunDetector::clearly_sloped(const WindowFit& w, double v0, double m) {
+[[gnu::always_inline]] inline bool RunDetector::Impl::clearly_sloped(const WindowFit& w, double v0, double m) {
   constexpr double band = 1e-9;
   const double n = w.n;
   const double st = w.st(), stt = w.stt(), sv = w.sv(), svv = w.svv(), stv = w.stv;
@@ -681,7 +681,7 @@ inline double level_tiny(double v0, double m) {
   return lhs > rhs * (1 + 1e-4);
 }
 
-[[gnu::always_inline]] inline bool RunDetector::level(const WindowFit& w, double d, double m, const double v0, double& sxx,
+[[gnu::always_inline]] inline bool RunDetector::Impl::level(const WindowFit& w, double d, double m, const double v0, double& sxx,
                                                       double& e) {
   const bool low = v0 > 0 ? m <= standstill_max_fraction * v0 : true;
   if (!low) return false;
@@ -698,7 +698,7 @@ inline double level_tiny(double v0, double m) {
   return no_slope && small_drop;
 }
 
-double RunDetector::reading_step(std::size_t from, std::size_t to) const {
+double RunDetector::Impl::reading_step(std::size_t from, std::size_t to) const {
   double step = std::numeric_limits<double>::infinity();
   for (std::size_t k = from + 1; k < to; ++k) {
     const double d = std::abs(v(k) - v(k - 1));
@@ -709,7 +709,7 @@ double RunDetector::reading_step(std::size_t from, std::size_t to) const {
 
 // ---- calls of the per-sample path from the cut and the stop (inlined here) ----------------
 
-void RunDetector::tail_step(std::size_t i, Sample s) {
+void RunDetector::Impl::tail_step(std::size_t i, Sample s) {
   if (buffered() > opt_.max_buffer) {
     complete_run(i);
     to_idle(i, false);
@@ -757,7 +757,7 @@ void RunDetector::tail_step(std::size_t i, Sample s) {
   }
 }
 
-void RunDetector::retract_stop(std::size_t i, Sample s) {
+void RunDetector::Impl::retract_stop(std::size_t i, Sample s) {
   emit_diag(Diagnostic::Severity::note,
             fmt::format("run cut at {}: standstill at {} retracted, the reading kept falling", fmt_s(run_.t_cut_s),
                         fmt_s(run_.t_stop_s)));
@@ -769,7 +769,7 @@ void RunDetector::retract_stop(std::size_t i, Sample s) {
   coast_checks(i, s);
 }
 
-bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
+bool RunDetector::Impl::try_start_coast(std::size_t i, const WindowFit& w) {
   const std::size_t b = i;
   const std::size_t w0 = w.first;
   const std::size_t lower = std::max(search_lo_, base_);
@@ -877,5 +877,24 @@ bool RunDetector::try_start_coast(std::size_t i, const WindowFit& w) {
   coast_checks(i, ring_[i & mask_]);
   return true;
 }
+
+// ---- the contract, forwarded ---------------------------------------------------------------
+
+RunDetector::RunDetector(RunOptions opt, std::string source)
+    : impl_(std::make_unique<Impl>(std::move(opt), std::move(source))) {}
+RunDetector::~RunDetector() = default;
+RunDetector::RunDetector(RunDetector&&) noexcept = default;
+RunDetector& RunDetector::operator=(RunDetector&&) noexcept = default;
+void RunDetector::push(double t_s, double value) { impl_->push(t_s, value); }
+void RunDetector::push_many(const double* t_s, const double* value, std::size_t n) { impl_->push_many(t_s, value, n); }
+void RunDetector::clock_restart() { impl_->clock_restart(); }
+void RunDetector::new_source(const std::string& why) { impl_->new_source(why); }
+void RunDetector::finish() { impl_->finish(); }
+void RunDetector::went_silent(double silent_s) { impl_->went_silent(silent_s); }
+std::vector<RunEvent> RunDetector::take_events() { return impl_->take_events(); }
+bool RunDetector::has_events() const { return impl_->has_events(); }
+RunDetector::State RunDetector::state() const { return impl_->state(); }
+std::size_t RunDetector::samples_seen() const { return impl_->samples_seen(); }
+std::size_t RunDetector::buffered() const { return impl_->buffered(); }
 
 }  // namespace spindown

@@ -1,5 +1,5 @@
 // Closing a run: its scan (gaps, held values), the warnings a student sees, the run itself.
-#include "spindown/run_detector.hpp"
+#include "run_detector_impl.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -21,7 +21,7 @@ using namespace detector_tuning;
 // take the times as given (a note). A device clock that jumped while the readings went on
 // leaves the reading where it was: the fit's times are then wrong by the jump, and so is its
 // friction (a warning). Said once per run, for the longest gap.
-void RunDetector::warn_of_gap_in_coast(int number, std::size_t from, std::size_t at, double longest, double period_s) {
+void RunDetector::Impl::warn_of_gap_in_coast(int number, std::size_t from, std::size_t at, double longest, double period_s) {
   if (at == 0 || !(longest > std::max(1.0, 25.0 * period_s))) return;
   WindowFit before{1.0};  // the coast's slope over the second before the gap
   reset_window(before, from, at);
@@ -38,7 +38,7 @@ void RunDetector::warn_of_gap_in_coast(int number, std::size_t from, std::size_t
               fmt::format("{}: the reading fell across it as the coast would, taken as samples lost", gap));
 }
 
-void RunDetector::scan_coast(Run& r, std::size_t coast_end) {
+void RunDetector::Impl::scan_coast(Run& r, std::size_t coast_end) {
   // One pass over the coast for its longest silence and its outliers. An outlier is a single
   // sample far off its two neighbours' midpoint, which agree with each other (|b - a| well
   // below the offset, so the time interpolation differs little from the midpoint): a dropout
@@ -117,12 +117,12 @@ void RunDetector::scan_coast(Run& r, std::size_t coast_end) {
                         r.outliers.size() - before, where, shown > 10 ? ", …" : ""));
 }
 
-std::string RunDetector::gap_before(std::size_t i) const {
+std::string RunDetector::Impl::gap_before(std::size_t i) const {
   return fmt::format("no samples for {:.3g} s mid-coast (from {} to {})", t(i) - t(i - 1), fmt_s(t(i - 1)),
                      fmt_s(t(i)));
 }
 
-std::string RunDetector::fragment_reason(const Run& r, double amp, double coast_s) const {
+std::string RunDetector::Impl::fragment_reason(const Run& r, double amp, double coast_s) const {
   // How far the reading fell in this coast, against what the reading can resolve and against the
   // runs already found in this stream (a nudge, a few samples at a crawl, a piece of a coast).
   if (amp <= 0)
@@ -135,7 +135,7 @@ std::string RunDetector::fragment_reason(const Run& r, double amp, double coast_
   return small_beside(amp, coast_s, largest_amp_, longest_coast_s_);
 }
 
-std::string RunDetector::small_beside(double amp, double coast_s, double largest_amp, double longest_s) {
+std::string RunDetector::Impl::small_beside(double amp, double coast_s, double largest_amp, double longest_s) {
   if (amp < 0.03 * largest_amp)
     return fmt::format("it falls {:.3g}, under 3 % of the largest run's {:.3g}", amp, largest_amp);
   if (coast_s < 0.25 * longest_s && amp < 0.1 * largest_amp)
@@ -144,7 +144,7 @@ std::string RunDetector::small_beside(double amp, double coast_s, double largest
   return {};
 }
 
-bool RunDetector::held_last_value(std::size_t cut, std::size_t end, std::size_t& held_from, std::size_t& longest,
+bool RunDetector::Impl::held_last_value(std::size_t cut, std::size_t end, std::size_t& held_from, std::size_t& longest,
                                   bool need_long) const {
   // The last value read up to end, held exactly, well above the motor's zero, reached by a jump of
   // several of the reading's steps (an rpm counter's last update, not the one step a coarse reading
@@ -179,7 +179,7 @@ bool RunDetector::held_last_value(std::size_t cut, std::size_t end, std::size_t&
   return z - zero > 3.0 * resolution && v(held_from - 1) - z > 2.0 * resolution;
 }
 
-void RunDetector::warn_of_held_standstill(const Run& r) {
+void RunDetector::Impl::warn_of_held_standstill(const Run& r) {
   // A standstill that reads one value exactly, well above the motor's zero, held far longer than
   // any value of the coast before it: what a sensor that keeps its last reading shows (an rpm
   // counter whose pulses stopped). A real offset is reached a reading step at a time, and a
@@ -200,7 +200,7 @@ void RunDetector::warn_of_held_standstill(const Run& r) {
                         r.number, z, held, 100.0 * (z - zero) / (v0_ - zero), longest));
 }
 
-void RunDetector::warn_of_earlier_fragments(const Run& r, double amp, double coast_s) {
+void RunDetector::Impl::warn_of_earlier_fragments(const Run& r, double amp, double coast_s) {
   // A nudge before the real spin was a run when it came (nothing larger was known): it stays one,
   // live and offline alike, but the user hears what it looks like now.
   for (Earlier& e : earlier_) {
@@ -217,7 +217,7 @@ void RunDetector::warn_of_earlier_fragments(const Run& r, double amp, double coa
   earlier_.push_back({r.number, r.t_cut_s, amp, coast_s, r.stopped, false});
 }
 
-void RunDetector::complete_run(std::size_t end) {
+void RunDetector::Impl::complete_run(std::size_t end) {
   Run r = run_;
   end = std::max(end, r.cut_index);
   r.end_index = end;

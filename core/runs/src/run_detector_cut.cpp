@@ -1,5 +1,5 @@
 // Finding a coast's cut: where the lead-in ends and the decline starts, and what came before it.
-#include "spindown/run_detector.hpp"
+#include "run_detector_impl.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -15,12 +15,17 @@ namespace spindown {
 
 using namespace detector_tuning;
 
-RunDetector::CutSplit RunDetector::split_at_cut(std::size_t a, std::size_t b, const WindowFit& w) {
-  const std::size_t lower = std::max(search_lo_, base_);
+RunDetector::Impl::CutSplit RunDetector::Impl::split_at_cut(std::size_t a, std::size_t b, const WindowFit& w) {
   CutSplit sp;
   sp.a = a;
+  if (!split_at_top(sp, a, b, w)) split_two_segments(sp, a, b, w);
+  describe_lead_in(sp);
+  return sp;
+}
 
+bool RunDetector::Impl::split_at_top(CutSplit& sp, std::size_t a, std::size_t b, const WindowFit& w) {
   // A reading pinned at its maximum and left without a step: the converter's top.
+  const std::size_t lower = std::max(search_lo_, base_);
   double m = v(a);
   for (std::size_t k = a; k <= b; ++k) m = std::max(m, v(k));
   std::size_t p = b + 1;  // last pinned sample
@@ -30,104 +35,118 @@ RunDetector::CutSplit RunDetector::split_at_cut(std::size_t a, std::size_t b, co
       break;
     }
   }
-  if (p < b) {
-    std::size_t q = p;  // first pinned sample
-    while (q > lower && v(q - 1) == m) --q;
-    // Quantized data plateaus too; a clipped reading is pinned much longer than the longest
-    // plateau of the coast after it.
-    std::size_t longest = 1, cur = 1;
-    for (std::size_t k = p + 2; k <= b; ++k) {
-      cur = v(k) == v(k - 1) ? cur + 1 : 1;
-      longest = std::max(longest, cur);
-    }
-    const std::size_t pinned = p - q + 1;
-    const double leave = m - v(p + 1);
-    // … and much longer than one step of the reading lasts at the coast's start: a heavy
-    // flywheel's coast holds its first printed value for a second, unclipped.
-    const double slope = w.slope(), step = std::max(reading_step(p + 1, b + 1), leave);
-    const double period = b > p + 1 ? (t(b) - t(p + 1)) / double(b - p - 1) : 0.0;
-    const double step_lasts = slope < 0 && period > 0 && step > 0 ? step / -slope / period : 0.0;
-    if (q > lower && pinned >= 5 && pinned >= 3 * longest && pinned >= 3.0 * step_lasts && leave > 0 &&
-        leave <= 0.02 * std::abs(m) + 3.0 * w.resid_sd()) {
-      sp.clipped = true;
-      sp.pin_first = q;
-      sp.pin_last = p;
-      sp.pin_level = m;
-      sp.a = std::max(lower, std::min(a, q >= back_search_min_samples ? q - back_search_min_samples : 0));
-      sp.cut_index = p + 1;
-      sp.t_cut_s = 0.5 * (t(q - 1) + t(q));
-      sp.pre_end = q;
-      sp.v0 = m;
-      sp.sd_post = w.resid_sd();
-    }
+  if (p >= b) return false;
+  std::size_t q = p;  // first pinned sample
+  while (q > lower && v(q - 1) == m) --q;
+  // Quantized data plateaus too; a clipped reading is pinned much longer than the longest
+  // plateau of the coast after it.
+  std::size_t longest = 1, cur = 1;
+  for (std::size_t k = p + 2; k <= b; ++k) {
+    cur = v(k) == v(k - 1) ? cur + 1 : 1;
+    longest = std::max(longest, cur);
   }
+  const std::size_t pinned = p - q + 1;
+  const double leave = m - v(p + 1);
+  // … and much longer than one step of the reading lasts at the coast's start: a heavy
+  // flywheel's coast holds its first printed value for a second, unclipped.
+  const double slope = w.slope(), step = std::max(reading_step(p + 1, b + 1), leave);
+  const double period = b > p + 1 ? (t(b) - t(p + 1)) / double(b - p - 1) : 0.0;
+  const double step_lasts = slope < 0 && period > 0 && step > 0 ? step / -slope / period : 0.0;
+  if (!(q > lower && pinned >= 5 && pinned >= 3 * longest && pinned >= 3.0 * step_lasts && leave > 0 &&
+        leave <= 0.02 * std::abs(m) + 3.0 * w.resid_sd()))
+    return false;
+  sp.clipped = true;
+  sp.pin_first = q;
+  sp.pin_last = p;
+  sp.pin_level = m;
+  sp.a = std::max(lower, std::min(a, q >= back_search_min_samples ? q - back_search_min_samples : 0));
+  sp.cut_index = p + 1;
+  sp.t_cut_s = 0.5 * (t(q - 1) + t(q));
+  sp.pre_end = q;
+  sp.v0 = m;
+  sp.sd_post = w.resid_sd();
+  return true;
+}
 
-  if (!sp.clipped) {
-    // Two-segment least squares over [a, b]: constant lead-in [a, c), linear coast [c, b].
-    const std::size_t n = b - a + 1;
-    double* pv = scratch(6 * (n + 1));  // prefix Σv, Σv² of [a, a+k)
-    double* pvv = pv + (n + 1);
-    double* ss = pvv + (n + 1);  // suffix Σt, Σt², Σv, Σtv of [a+k, b] (t relative to t(b))
-    double* stt_ = ss + (n + 1);
-    double* sv_ = stt_ + (n + 1);
-    double* stv_ = sv_ + (n + 1);
+// The sums of a two-segment least-squares split of [a, b]: a constant lead-in [a, a+k) and a
+// linear coast [a+k, b], for every k at once (prefix sums of the lead-in, suffix sums of the line,
+// t relative to t(b)), in the detector's scratch space.
+struct RunDetector::Impl::SplitSums {
+  struct Line {
+    double v0 = 0, slope = 0, sd = 0;
+  };
+  const Impl& d;
+  std::size_t a, n;
+  double tr;
+  double *pv, *pvv;                // prefix Σv, Σv² of [a, a+k)
+  double *ss, *stt_, *sv_, *stv_;  // suffix Σt, Σt², Σv, Σtv of [a+k, b]
+  double svv_all;
+
+  SplitSums(Impl& det, std::size_t a_, std::size_t b) : d(det), a(a_), n(b - a_ + 1), tr(det.t(b)) {
+    pv = det.scratch(6 * (n + 1));
+    pvv = pv + (n + 1);
+    ss = pvv + (n + 1);
+    stt_ = ss + (n + 1);
+    sv_ = stt_ + (n + 1);
+    stv_ = sv_ + (n + 1);
     pv[0] = pvv[0] = 0.0;
     ss[n] = stt_[n] = sv_[n] = stv_[n] = 0.0;
     for (std::size_t k = 0; k < n; ++k) {
-      const double x = v(a + k);
+      const double x = d.v(a + k);
       pv[k + 1] = pv[k] + x;
       pvv[k + 1] = pvv[k] + x * x;
     }
-    const double tr = t(b);
     for (std::size_t k = n; k-- > 0;) {
-      const double tt = t(a + k) - tr, x = v(a + k);
+      const double tt = d.t(a + k) - tr, x = d.v(a + k);
       ss[k] = ss[k + 1] + tt;
       stt_[k] = stt_[k + 1] + tt * tt;
       sv_[k] = sv_[k + 1] + x;
       stv_[k] = stv_[k + 1] + tt * x;
     }
-    const double svv_all = pvv[n];
-    struct Line {
-      double v0 = 0, slope = 0, sd = 0;
-    };
-    auto post_line = [&](std::size_t k) {
+    svv_all = pvv[n];
+  }
+
+  // The coast's line from a+k on: its reading at a+k, slope and residual sd.
+  Line post_line(std::size_t k) const {
+    const double np = double(n - k);
+    const double sxx = stt_[k] - ss[k] * ss[k] / np;
+    const double sxy = stv_[k] - ss[k] * sv_[k] / np;
+    const double syy = (svv_all - pvv[k]) - sv_[k] * sv_[k] / np;
+    Line l;
+    l.slope = sxx > 0 ? sxy / sxx : 0.0;
+    l.v0 = sv_[k] / np + l.slope * ((d.t(a + k) - tr) - ss[k] / np);
+    l.sd = np > 2 ? std::sqrt(std::max(syy - l.slope * sxy, 0.0) / (np - 2)) : 0.0;
+    return l;
+  }
+
+  // Best split with the lead-in starting at kb. The confirming window may straddle a small
+  // step (supply → back-EMF), so the split may fall anywhere that leaves a few samples for
+  // the line.
+  std::size_t best_split(std::size_t kb) const {
+    double best = std::numeric_limits<double>::infinity();
+    std::size_t best_k = kb;
+    for (std::size_t k = kb; k + 3 <= n; ++k) {
+      const double m = double(k - kb);
+      const double sp_ = pv[k] - pv[kb];
+      const double sse_pre = k > kb ? (pvv[k] - pvv[kb]) - sp_ * sp_ / m : 0.0;
       const double np = double(n - k);
       const double sxx = stt_[k] - ss[k] * ss[k] / np;
       const double sxy = stv_[k] - ss[k] * sv_[k] / np;
       const double syy = (svv_all - pvv[k]) - sv_[k] * sv_[k] / np;
-      Line l;
-      l.slope = sxx > 0 ? sxy / sxx : 0.0;
-      l.v0 = sv_[k] / np + l.slope * ((t(a + k) - tr) - ss[k] / np);
-      l.sd = np > 2 ? std::sqrt(std::max(syy - l.slope * sxy, 0.0) / (np - 2)) : 0.0;
-      return l;
-    };
-    // Best split with the lead-in starting at kb. The confirming window may straddle a small
-    // step (supply → back-EMF), so the split may fall anywhere that leaves a few samples for
-    // the line.
-    auto best_split = [&](std::size_t kb) {
-      double best = std::numeric_limits<double>::infinity();
-      std::size_t best_k = kb;
-      for (std::size_t k = kb; k + 3 <= n; ++k) {
-        const double m = double(k - kb);
-        const double sp_ = pv[k] - pv[kb];
-        const double sse_pre = k > kb ? (pvv[k] - pvv[kb]) - sp_ * sp_ / m : 0.0;
-        const double np = double(n - k);
-        const double sxx = stt_[k] - ss[k] * ss[k] / np;
-        const double sxy = stv_[k] - ss[k] * sv_[k] / np;
-        const double syy = (svv_all - pvv[k]) - sv_[k] * sv_[k] / np;
-        const double sse_post = sxx > 0 ? syy - sxy * sxy / sxx : syy;
-        const double sse = std::max(sse_pre, 0.0) + std::max(sse_post, 0.0);
-        if (sse < best) {
-          best = sse;
-          best_k = k;
-        }
+      const double sse_post = sxx > 0 ? syy - sxy * sxy / sxx : syy;
+      const double sse = std::max(sse_pre, 0.0) + std::max(sse_post, 0.0);
+      if (sse < best) {
+        best = sse;
+        best_k = k;
       }
-      return best_k;
-    };
-    std::size_t kb = 0;
-    std::size_t k = best_split(0);
-    // Two steps in reach (zeros → supply → back-EMF): the coast follows the later one, taken
-    // when it splits a flat plateau from the coast by a clear step.
+    }
+    return best_k;
+  }
+
+  // Two steps in reach (zeros → supply → back-EMF): the coast follows the later one, taken when
+  // it splits a flat plateau from the coast by a clear step. From the split k (lead-in from kb),
+  // the split the coast follows; kb becomes where its lead-in starts.
+  std::size_t later_step(std::size_t& kb, std::size_t k) const {
     for (int again = 0; again < 3; ++again) {
       const std::size_t k2 = best_split(k);
       if (k2 < k + 3) break;
@@ -141,64 +160,71 @@ RunDetector::CutSplit RunDetector::split_at_cut(std::size_t a, std::size_t b, co
       kb = k;
       k = k2;
     }
-    // A rough lead-in (an open pin's hum) fits the coast's line about as badly as a constant, so
-    // the split may give the coast some of it. The coast itself is smooth, as the window that
-    // confirmed it shows: its first sample is the earliest from which the readings keep to that
-    // window's line, drawn back.
-    if (const double e = w.resid_sd();
-        w.n >= 6 && w.first >= a + k + 4 && post_line(k).sd > 2.0 * e + 1e-12 &&
-        rough_sd(a + k, w.first) > 3.0 * std::max(rough_sd(w.first, b + 1), 0.5 * e) &&
-        rough_sd(a, a + k) > 3.0 * std::max(rough_sd(w.first, b + 1), 0.5 * e)) {
-      const double tol = std::max(4.0 * e, 2.0 * reading_step(w.first, b + 1));
-      const double slope = w.slope(), t_mid = w.t0 + w.st() / w.n, mid = w.mean();
-      std::size_t j = w.first;
-      while (j > a + k && std::abs(v(j - 1) - (mid + slope * (t(j - 1) - t_mid))) <= tol) --j;
-      k = j - a;
-    }
-    const Line l = post_line(k);
-    const std::size_t c = a + k;
-    sp.a = a + kb;
-    sp.v0 = l.v0;
-    sp.post_slope = l.slope;
-    sp.sd_post = l.sd;
-    sp.post_rough = rough_sd(c, b + 1);
-    sp.cut_index = c;
-    sp.pre_end = c;
-    const bool sample_before = c > base_ && c > stream_start_ && c - 1 >= search_lo_;
-    sp.t_cut_s = sample_before ? 0.5 * (t(c - 1) + t(c)) : t(c);
+    return k;
   }
+};
 
-  // The lead-in [a, pre_end): level, roughness, maximum and trend.
-  sp.npre = sp.pre_end - sp.a;
-  if (sp.npre >= 3) {
-    WindowFit f;
-    f.clear(sp.a, t(sp.a));
-    sp.pre_max = v(sp.a);
-    for (std::size_t k = sp.a; k < sp.pre_end; ++k) {
-      f.add(t(k), v(k));
-      sp.pre_max = std::max(sp.pre_max, v(k));
-    }
-    sp.pre_mean = f.mean();
-    sp.pre_rough = rough_sd(sp.a, sp.pre_end);
-    sp.pre_sd = std::sqrt(std::max(f.svv() / f.n - sp.pre_mean * sp.pre_mean, 0.0));
-    // A lead-in falling at a good part of the coast's own rate is more coast: the cut lies
-    // further back.
-    const double s = f.slope(), sd = f.resid_sd();
-    const double s_err = f.sxx() > 0 ? sd / std::sqrt(f.sxx()) : 0.0;
-    const bool smooth = sd <= std::max(3.0 * sp.sd_post, 0.02 * std::abs(sp.v0));  // not a wandering pin
-    // … and runs into the coast's start without a step: a decline that ends below the coast's
-    // start, the reading then jumping up to it (a floating pin's swing, then its connection to the
-    // motor), is another signal's, and the cut is the jump.
-    const double at_cut = f.mean() + s * (t(sp.pre_end) - f.t0 - f.st() / f.n);
-    const bool joins = sp.clipped || std::abs(at_cut - sp.v0) <= std::max({5.0 * sp.sd_post, 3.0 * sd, 0.03 * std::abs(sp.v0)});
-    sp.pre_declining = sp.npre >= 8 && smooth && joins && s < 0 && -s > 3.0 * s_err &&
-                       (sp.clipped || sp.post_slope >= 0 || s <= 0.3 * sp.post_slope);
-    sp.pre_flat = sp.npre >= 8 && std::abs(s) + 2.0 * s_err <= 0.3 * std::abs(sp.post_slope);
+void RunDetector::Impl::split_two_segments(CutSplit& sp, std::size_t a, std::size_t b, const WindowFit& w) {
+  const SplitSums sums(*this, a, b);
+  std::size_t kb = 0;
+  std::size_t k = sums.later_step(kb, sums.best_split(0));
+  // A rough lead-in (an open pin's hum) fits the coast's line about as badly as a constant, so
+  // the split may give the coast some of it. The coast itself is smooth, as the window that
+  // confirmed it shows: its first sample is the earliest from which the readings keep to that
+  // window's line, drawn back.
+  if (const double e = w.resid_sd();
+      w.n >= 6 && w.first >= a + k + 4 && sums.post_line(k).sd > 2.0 * e + 1e-12 &&
+      rough_sd(a + k, w.first) > 3.0 * std::max(rough_sd(w.first, b + 1), 0.5 * e) &&
+      rough_sd(a, a + k) > 3.0 * std::max(rough_sd(w.first, b + 1), 0.5 * e)) {
+    const double tol = std::max(4.0 * e, 2.0 * reading_step(w.first, b + 1));
+    const double slope = w.slope(), t_mid = w.t0 + w.st() / w.n, mid = w.mean();
+    std::size_t j = w.first;
+    while (j > a + k && std::abs(v(j - 1) - (mid + slope * (t(j - 1) - t_mid))) <= tol) --j;
+    k = j - a;
   }
-  return sp;
+  const SplitSums::Line l = sums.post_line(k);
+  const std::size_t c = a + k;
+  sp.a = a + kb;
+  sp.v0 = l.v0;
+  sp.post_slope = l.slope;
+  sp.sd_post = l.sd;
+  sp.post_rough = rough_sd(c, b + 1);
+  sp.cut_index = c;
+  sp.pre_end = c;
+  const bool sample_before = c > base_ && c > stream_start_ && c - 1 >= search_lo_;
+  sp.t_cut_s = sample_before ? 0.5 * (t(c - 1) + t(c)) : t(c);
 }
 
-void RunDetector::take_bounce(CutSplit& sp, const WindowFit& w) {
+void RunDetector::Impl::describe_lead_in(CutSplit& sp) const {
+  // The lead-in [a, pre_end): level, roughness, maximum and trend.
+  sp.npre = sp.pre_end - sp.a;
+  if (sp.npre < 3) return;
+  WindowFit f;
+  f.clear(sp.a, t(sp.a));
+  sp.pre_max = v(sp.a);
+  for (std::size_t k = sp.a; k < sp.pre_end; ++k) {
+    f.add(t(k), v(k));
+    sp.pre_max = std::max(sp.pre_max, v(k));
+  }
+  sp.pre_mean = f.mean();
+  sp.pre_rough = rough_sd(sp.a, sp.pre_end);
+  sp.pre_sd = std::sqrt(std::max(f.svv() / f.n - sp.pre_mean * sp.pre_mean, 0.0));
+  // A lead-in falling at a good part of the coast's own rate is more coast: the cut lies
+  // further back.
+  const double s = f.slope(), sd = f.resid_sd();
+  const double s_err = f.sxx() > 0 ? sd / std::sqrt(f.sxx()) : 0.0;
+  const bool smooth = sd <= std::max(3.0 * sp.sd_post, 0.02 * std::abs(sp.v0));  // not a wandering pin
+  // … and runs into the coast's start without a step: a decline that ends below the coast's
+  // start, the reading then jumping up to it (a floating pin's swing, then its connection to the
+  // motor), is another signal's, and the cut is the jump.
+  const double at_cut = f.mean() + s * (t(sp.pre_end) - f.t0 - f.st() / f.n);
+  const bool joins = sp.clipped || std::abs(at_cut - sp.v0) <= std::max({5.0 * sp.sd_post, 3.0 * sd, 0.03 * std::abs(sp.v0)});
+  sp.pre_declining = sp.npre >= 8 && smooth && joins && s < 0 && -s > 3.0 * s_err &&
+                     (sp.clipped || sp.post_slope >= 0 || s <= 0.3 * sp.post_slope);
+  sp.pre_flat = sp.npre >= 8 && std::abs(s) + 2.0 * s_err <= 0.3 * std::abs(sp.post_slope);
+}
+
+void RunDetector::Impl::take_bounce(CutSplit& sp, const WindowFit& w) {
   // Up to three samples around the coast's first that lie neither on the coast's course (a line
   // through the samples that follow them) nor on the lead-in's course before them: a contact
   // bouncing as a wire is pushed in (the handout's step 6 connects the pin to the motor by hand).
@@ -241,7 +267,7 @@ void RunDetector::take_bounce(CutSplit& sp, const WindowFit& w) {
   sp.t_cut_s = first > base_ && first > stream_start_ ? 0.5 * (t(first - 1) + t(first)) : t(first);
 }
 
-void RunDetector::refine_plateau_cut(CutSplit& sp, std::size_t b) {
+void RunDetector::Impl::refine_plateau_cut(CutSplit& sp, std::size_t b) {
   // Up to 50 samples of the plateau and of the coast on either side of the split (the coast's
   // curve is a line that near its start), then y = level + slope·max(0, t − tc) by least squares
   // for each tc on a grid of a tenth of a period over ±4 samples of the split.
@@ -276,7 +302,7 @@ void RunDetector::refine_plateau_cut(CutSplit& sp, std::size_t b) {
   sp.npre = first > sp.a ? first - sp.a : 0;
 }
 
-void RunDetector::recut_after_rise(Run& r, std::size_t coast_end) {
+void RunDetector::Impl::recut_after_rise(Run& r, std::size_t coast_end) {
   const std::size_t c = r.cut_index;
   if (coast_end < c + 16) return;
   const double zero = r.stopped ? r.zero_level : motor_zero();
@@ -354,7 +380,7 @@ void RunDetector::recut_after_rise(Run& r, std::size_t coast_end) {
   }
 }
 
-double RunDetector::rough_sd(std::size_t from, std::size_t to) const {
+double RunDetector::Impl::rough_sd(std::size_t from, std::size_t to) const {
   // Second differences cancel a smooth curve (a coast, a rise, a slow swing) and keep the
   // sample-to-sample noise: σ = 1.4826·median|Δ²v| / √6. Its own space: the cut search's
   // prefix sums live in scratch().
@@ -365,14 +391,14 @@ double RunDetector::rough_sd(std::size_t from, std::size_t to) const {
   return 1.4826 * d[d.size() / 2] / std::sqrt(6.0);
 }
 
-double RunDetector::smoothed(std::size_t k, std::size_t lo, std::size_t hi) const {
+double RunDetector::Impl::smoothed(std::size_t k, std::size_t lo, std::size_t hi) const {
   const std::size_t from = k > lo ? k - 1 : k, to = std::min(k + 2, hi + 1);
   double sum = 0;
   for (std::size_t j = from; j < to; ++j) sum += v(j);
   return sum / double(to - from);
 }
 
-bool RunDetector::at_peak(CutSplit& sp, std::size_t b) {
+bool RunDetector::Impl::at_peak(CutSplit& sp, std::size_t b) {
   if (sp.clipped || b < sp.cut_index + 3) return false;
   const double thr = std::max(4.0 * sp.sd_post, 0.02 * std::abs(sp.v0));
   // The highest reading (a 3-sample mean, so one noisy sample does not make the peak) from the
@@ -406,7 +432,7 @@ bool RunDetector::at_peak(CutSplit& sp, std::size_t b) {
   return last > before + thr && last >= sp.v0 - thr && before < sp.v0 - 2.0 * thr;
 }
 
-std::string RunDetector::start_not_seen(CutSplit& sp) {
+std::string RunDetector::Impl::start_not_seen(CutSplit& sp) {
   const std::size_t c = sp.cut_index;
   // The first sample after the stream's start or the last pause, whichever came last.
   const bool after_pause = resume_index_ > stream_start_;
@@ -446,7 +472,7 @@ std::string RunDetector::start_not_seen(CutSplit& sp) {
                      fmt_s(t(a)));
 }
 
-std::string RunDetector::rest_after_silence(CutSplit& sp) {
+std::string RunDetector::Impl::rest_after_silence(CutSplit& sp) {
   // The coast that went silent goes on: taken from the first sample after the silence (or the
   // oldest still held), its cut long before and not in this stream.
   const std::size_t a = std::max({resume_index_, base_, lo_});
@@ -464,7 +490,7 @@ std::string RunDetector::rest_after_silence(CutSplit& sp) {
                      silence_s_, fmt_s(t(a)), silenced_run_);
 }
 
-std::string RunDetector::classify_lead_in(const CutSplit& sp) const {
+std::string RunDetector::Impl::classify_lead_in(const CutSplit& sp) const {
   if (sp.npre < 3) return "none";
   const double scale = std::abs(sp.v0);
   const double step = sp.v0 - sp.pre_mean;

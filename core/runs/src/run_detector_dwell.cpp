@@ -3,7 +3,7 @@
 // fall that far. A "coast" whose reading held a level (or came back to it) far longer than that,
 // and then fell through the same span fast, was under power while it held: the coast begins at the
 // end of the dwell (a start-up overshoot that settled on the setpoint, taken for a cut at its peak).
-#include "spindown/run_detector.hpp"
+#include "run_detector_impl.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -16,7 +16,7 @@ namespace spindown {
 
 using namespace detector_tuning;
 
-std::size_t RunDetector::dwell_end(std::size_t c, std::size_t e, double h, std::size_t& from) {
+std::size_t RunDetector::Impl::dwell_end(std::size_t c, std::size_t e, double h, std::size_t& from) {
   // Envelopes of the readings (medians of three: a single glitch makes no dwell): the lowest so far
   // from the cut (lo) and the highest from here to the coast's end (hi). A coast's level L is first
   // reached at the first k with lo(k) <= L + h and left for good after the last j with hi(j) >= L - h.
@@ -44,7 +44,7 @@ std::size_t RunDetector::dwell_end(std::size_t c, std::size_t e, double h, std::
   return found;
 }
 
-double RunDetector::sampled_rough_sd(std::size_t from, std::size_t to) const {
+double RunDetector::Impl::sampled_rough_sd(std::size_t from, std::size_t to) const {
   // rough_sd's estimate (σ = 1.4826·median|Δ²v|/√6) from at most 255 second differences spread
   // evenly over [from, to): a median of that many is as good a scale, and a whole coast's would
   // cost a lab run's fit a tenth more time.
@@ -60,7 +60,7 @@ double RunDetector::sampled_rough_sd(std::size_t from, std::size_t to) const {
   return 1.4826 * d[m / 2] / std::sqrt(6.0);
 }
 
-bool RunDetector::frozen(std::size_t from, std::size_t to) const {
+bool RunDetector::Impl::frozen(std::size_t from, std::size_t to) const {
   // A reading that repeats one value exactly for half the dwell or more is a sensor or converter
   // that stopped updating (a stall of the stream), not a drive holding a speed: under power the
   // reading shows its noise (held_plateau's one_value, the same judgement).
@@ -72,13 +72,13 @@ bool RunDetector::frozen(std::size_t from, std::size_t to) const {
   return 2 * longest >= to - from;
 }
 
-double RunDetector::median3(std::size_t k, std::size_t c, std::size_t e) const {
+double RunDetector::Impl::median3(std::size_t k, std::size_t c, std::size_t e) const {
   if (k <= c || k + 1 >= e) return v(k);  // the span's ends have one neighbour inside it
   const double a = v(k - 1), b = v(k), d = v(k + 1);
   return std::max(std::min(a, b), std::min(std::max(a, b), d));
 }
 
-bool RunDetector::falls_faster_later(std::size_t c, std::size_t e, double margin) const {
+bool RunDetector::Impl::falls_faster_later(std::size_t c, std::size_t e, double margin) const {
   // A free coast falls at least as far in each third of its time as in the next: friction takes
   // more speed off at a higher speed (viscous, windage) or as much (Coulomb). A dwell makes an
   // earlier third fall less than a later one; only then is the coast searched for it (the search
@@ -91,7 +91,7 @@ bool RunDetector::falls_faster_later(std::size_t c, std::size_t e, double margin
   return d2 > d1 + margin || d3 > d2 + margin || d3 > d1 + margin;
 }
 
-void RunDetector::recut_after_dwell(Run& r, std::size_t coast_end) {
+void RunDetector::Impl::recut_after_dwell(Run& r, std::size_t coast_end) {
   const std::size_t c = r.cut_index;
   if (coast_end < c + 16) return;
   // First the cheap look (the noise near the cut for a margin), then the coast's own noise.

@@ -1,5 +1,5 @@
 // A coast's end: the standstill (or why there is none), the tail after it, a stop retracted.
-#include "spindown/run_detector.hpp"
+#include "run_detector_impl.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -13,7 +13,7 @@ namespace spindown {
 
 using namespace detector_tuning;
 
-void RunDetector::coast_too_long(std::size_t i) {
+void RunDetector::Impl::coast_too_long(std::size_t i) {
   if (buffered() > opt_.max_buffer) {
     RunEvent e;
     e.kind = RunEvent::Kind::ignored;
@@ -54,7 +54,7 @@ void RunDetector::coast_too_long(std::size_t i) {
   block_until_rise(v(i));
 }
 
-std::string RunDetector::swing_reason(std::size_t at) const {
+std::string RunDetector::Impl::swing_reason(std::size_t at) const {
   // The coast fell from v0_ to its lowest level, then rose again. Before its cut, over up to 10 s
   // (or three times the coast), did the reading already swing as far both ways? A motor's lead-in
   // (at rest, powered, spun up) rises at most once, into the cut; an open analog pin whose jumper
@@ -88,7 +88,7 @@ std::string RunDetector::swing_reason(std::size_t at) const {
                      turns, h, t(cut) - t(from), lo, hi);
 }
 
-std::string RunDetector::stall_reason(std::size_t at) const {
+std::string RunDetector::Impl::stall_reason(std::size_t at) const {
   // Friction slows a coast at every speed it passes: the deceleration at speed ω is T(ω)/J, and
   // T falls with ω no faster than windage's ω² (Coulomb holds it, viscous ∝ ω, Stribeck raises it).
   // A decline that levels off while the reading is still well above standstill, then rises, was
@@ -120,7 +120,7 @@ std::string RunDetector::stall_reason(std::size_t at) const {
                      last.mean(), 100.0 * u1 / u0, rate0, rate1, least);
 }
 
-bool RunDetector::held_plateau(std::size_t i) {
+bool RunDetector::Impl::held_plateau(std::size_t i) {
   // Friction slows a coast at every speed it passes, fastest at its top (T(ω) grows with ω), and
   // T falls with ω no faster than windage's ω² (stall_reason): at level u the coast still falls at
   // least (u/u0)² of its rate at the cut's u0, which is at least its mean rate over the first half
@@ -173,7 +173,7 @@ bool RunDetector::held_plateau(std::size_t i) {
   return false;
 }
 
-void RunDetector::power_back() {
+void RunDetector::Impl::power_back() {
   const std::size_t at = rise_start_, cut = run_.cut_index;
   not_coast_ = swing_reason(at);
   if (not_coast_.empty()) not_coast_ = stall_reason(at);
@@ -195,7 +195,7 @@ void RunDetector::power_back() {
   to_idle(at, false, cut);
 }
 
-void RunDetector::standstill_checks(std::size_t i, bool at_end, double mu, double sxx, double e) {
+void RunDetector::Impl::standstill_checks(std::size_t i, bool at_end, double mu, double sxx, double e) {
   // The hold window is flat and low (coast_checks has shown it: mu is its mean, sxx and e its
   // Sxx and residual sd), and either its slope is resolved well below the coast's mean rate or
   // a three times longer window is flat too (noisy, slow coasts).
@@ -223,7 +223,7 @@ void RunDetector::standstill_checks(std::size_t i, bool at_end, double mu, doubl
   found_standstill(i, at_end);
 }
 
-void RunDetector::found_standstill(std::size_t i, bool at_end) {
+void RunDetector::Impl::found_standstill(std::size_t i, bool at_end) {
   const std::size_t h0 = hold_.first;
   const double z = median_of(h0, i + 1);
   double var = 0;
@@ -232,6 +232,35 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
   const double amp = v0_ - z;
   const double band = std::max(3.0 * sd_z, 1e-9 * std::max(std::abs(amp), 1e-300));
 
+  const std::size_t first_in = standstill_start(i, z, band);
+  if (signal_lost(i, first_in, z, amp)) return;
+
+  // Where the coast crossed the last quarter of its amplitude.
+  const std::size_t k = last_quarter_index(run_.cut_index, first_in, z + 0.25 * amp);
+  const double t_quarter = quarter_crossing_time(k, run_.cut_index, z + 0.25 * amp);
+  const std::size_t stop = first_sample_from(approach_meets_zero(first_in, k, z, t_quarter, i), i);
+  note_stop_in_pause(stop);
+
+  // A real stop arrives with a finite slope; an exponential creeps in.
+  const double t_stop = t(stop);
+  run_.zero_level = z;
+  run_.noise_level = sd_z;
+  // … and right before it the reading still falls clearly (an exponential has flattened).
+  stop_approach_t_ = approach_t_stat(stop);
+  if (!creeps_in(run_.t_cut_s, t_quarter, t_stop) || amp <= 0) {
+    stop_at(i, stop, z, sd_z, amp);
+  } else if (!creeping_ && !at_end) {
+    // Keep the coast until the decay is lost in the noise even over the long window: the
+    // exponential's tail still carries information for the fit.
+    creeping_ = true;
+  } else {
+    const double coast = t_stop - run_.t_cut_s, last_quarter = t_stop - t_quarter;
+    const double end_rate = last_quarter > 0 ? 0.25 * coast / last_quarter : std::numeric_limits<double>::infinity();
+    close_asymptotic(i, at_end, z, sd_z, amp, end_rate);
+  }
+}
+
+std::size_t RunDetector::Impl::standstill_start(std::size_t i, double z, double band) const {
   // First sample of the standstill that contains the hold window (an isolated sample outside
   // the band is noise; two in a row are the coast).
   std::size_t first_in = i + 1;
@@ -244,30 +273,30 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
       break;
     }
   }
-  first_in = std::min(first_in, i);
-  if (signal_lost(i, first_in, z, amp)) return;
+  return std::min(first_in, i);
+}
 
-  // Where the coast crossed the last quarter of its amplitude.
-  const std::size_t k = last_quarter_index(run_.cut_index, first_in, z + 0.25 * amp);
-  const double t_quarter = quarter_crossing_time(k, run_.cut_index, z + 0.25 * amp);
-
+double RunDetector::Impl::approach_meets_zero(std::size_t first_in, std::size_t k, double z, double t_quarter,
+                                              std::size_t i) const {
   // Stop time: the approach line (the last ≤2 s above the band) meets the zero level.
   double t_hit = t(first_in);
-  {
-    std::size_t from = first_in;
-    while (from > k && t(first_in) - t(from - 1) <= 2.0) --from;
-    if (first_in >= from + 3) {
-      WindowFit f;
-      f.clear(from, t(from));
-      for (std::size_t j = from; j < first_in; ++j) f.add(t(j), v(j));
-      const double sl = f.slope();
-      if (sl < 0) {
-        const double tb = f.st() / f.n, vb = f.mean();
-        const double th = f.t0 + tb + (z - vb) / sl;
-        if (std::isfinite(th)) t_hit = std::clamp(th, t_quarter, t(i));
-      }
+  std::size_t from = first_in;
+  while (from > k && t(first_in) - t(from - 1) <= 2.0) --from;
+  if (first_in >= from + 3) {
+    WindowFit f;
+    f.clear(from, t(from));
+    for (std::size_t j = from; j < first_in; ++j) f.add(t(j), v(j));
+    const double sl = f.slope();
+    if (sl < 0) {
+      const double tb = f.st() / f.n, vb = f.mean();
+      const double th = f.t0 + tb + (z - vb) / sl;
+      if (std::isfinite(th)) t_hit = std::clamp(th, t_quarter, t(i));
     }
   }
+  return t_hit;
+}
+
+std::size_t RunDetector::Impl::first_sample_from(double t_hit, std::size_t i) const {
   // The first sample at or after t_hit (times never decrease within a stream), at most i.
   std::size_t lo = run_.cut_index + 1, hi = std::max(lo, i);
   while (lo < hi) {
@@ -275,134 +304,129 @@ void RunDetector::found_standstill(std::size_t i, bool at_end) {
     if (t(mid) < t_hit) lo = mid + 1;
     else hi = mid;
   }
-  const std::size_t stop = lo;
+  return lo;
+}
+
+void RunDetector::Impl::note_stop_in_pause(std::size_t stop) {
   // A stop that falls in a pause of the recording is known only to lie in it.
-  if (stop > run_.cut_index + 2) {
-    const double pause = t(stop) - t(stop - 1);
-    const double period = (t(stop - 1) - t(run_.cut_index)) / double(stop - 1 - run_.cut_index);
-    if (pause > 1.0 && pause > 25.0 * period) {
-      run_note_ = fmt::format("the stop falls in a pause of the recording ({:.3g} s, from {} to {}): it lies somewhere "
-                              "in it, and the stop time is the pause's end",
-                              pause, fmt_s(t(stop - 1)), fmt_s(t(stop)));
-      run_note_severity_ = Diagnostic::Severity::warning;
-    }
-  }
-
-  // A real stop arrives with a finite slope; an exponential creeps in.
-  const double t_stop = t(stop);
-  const double coast = t_stop - run_.t_cut_s;
-  const double last_quarter = t_stop - t_quarter;
-  const double end_rate = last_quarter > 0 ? 0.25 * coast / last_quarter : std::numeric_limits<double>::infinity();
-
-  run_.zero_level = z;
-  run_.noise_level = sd_z;
-  // … and right before it the reading still falls clearly (an exponential has flattened).
-  double approach_t = std::numeric_limits<double>::infinity();
-  {
-    std::size_t from = stop;
-    while (from > run_.cut_index && t_stop - t(from - 1) <= opt_.stop_hold_s) --from;
-    if (stop >= from + 3) {
-      WindowFit f;
-      f.clear(from, t(from));
-      for (std::size_t j = from; j < stop; ++j) f.add(t(j), v(j));
-      const double e = f.resid_sd();
-      approach_t = e > 0 ? -f.slope() * std::sqrt(f.sxx()) / e : (f.slope() < 0 ? approach_t : 0.0);
-    }
-  }
-  stop_approach_t_ = approach_t;
-  if (!creeps_in(run_.t_cut_s, t_quarter, t_stop) || amp <= 0) {
-    run_.stopped = true;
-    run_.stop_index = stop;
-    run_.t_stop_s = t_stop;
-    // A standstill that sits on one value of a quantized reading (a quiet converter) a step or
-    // more above the lowest the motor read at rest may be a slow exponential's dwell on that value
-    // (a viscous coast near its end takes seconds per step of the print): the tail is watched
-    // longer, and a step down held retracts the stop (tail_step).
-    floor_doubt_ = quiet_dwell_above_rest(z, sd_z, amp);
-    tail_until_s_ = t_stop + (floor_doubt_ ? std::max(opt_.tail_s, 0.25 * (t_stop - run_.t_cut_s)) : opt_.tail_s);
-    depart_band_ = std::max(6.0 * sd_z, 0.05 * std::abs(amp));
-    departing_ = 0;
-    state_ = State::tail;
-    RunEvent e;
-    e.kind = RunEvent::Kind::stop;
-    e.run = run_;
-    events_.push_back(std::move(e));
-    tail_ends_by_time(i);
-  } else if (!creeping_ && !at_end) {
-    // Keep the coast until the decay is lost in the noise even over the long window: the
-    // exponential's tail still carries information for the fit.
-    creeping_ = true;
-  } else {
-    // The floor an asymptotic coast shows is where its decay was lost in the noise or the print,
-    // not where it is heading (an exponential heads for the true zero): 0.01 V on the lab's
-    // 2-decimal print long before the motor stops, and subtracting that from every reading
-    // bends the viscous curve into Coulomb friction that is not there. A floor the detector's
-    // own flatness test cannot tell from the lead-in's zero (the motor at rest, read before the
-    // run) gives way to that zero: within 3 noise sd, 1 % of the cut's reading (level()'s
-    // allowance for a flat window's drop) or one reading step. A floor clearly above it (an
-    // offset only the coasting reading has) is kept.
-    // A per-revolution sensor keeps its last reading once the pulses stop: a floor reached by a
-    // jump and held exactly, far longer than any value before it, is that reading, not a zero to
-    // subtract (the shaft turning at that speed would have updated it long since).
-    std::size_t held_from = 0, longest = 1;
-    const bool held_jump = held_last_value(run_.cut_index, i + 1, held_from, longest, false);
-    const bool held_long = held_jump && i + 1 - held_from >= 5 * longest;
-    if (held_jump && !held_long && !at_end) return;  // wait and see how long it holds
-    std::string floor_said;
-    const double band = std::max({3.0 * sd_z, 0.01 * std::abs(v0_), reading_step(hold_.first, i + 1)});
-    if (held_long) {
-      run_.zero_level = motor_zero();
-      floor_said = fmt::format(", the last reading of a sensor that holds it ({} samples from {}, where no value "
-                               "before it lasted more than {}), not a zero: zero level {:g}, the coast fitted up "
-                               "to that last update",
-                               i + 1 - held_from, fmt_s(t(held_from)), longest, run_.zero_level);
-    } else if (std::isfinite(lead_in_zero_) && std::abs(z - lead_in_zero_) <= band * (1 + 1e-9) && z != lead_in_zero_) {
-      run_.zero_level = lead_in_zero_;
-      floor_said = fmt::format(", not to be told from the lead-in's zero, so zero level {:g}", lead_in_zero_);
-    } else if (std::isfinite(rest_level_) && z > rest_level_ &&
-               (z - rest_level_ <= band * (1 + 1e-9) || quiet_dwell_above_rest(z, sd_z, amp))) {
-      // No zeros before this cut (the supply's lead-in), but the stream held the motor's reading
-      // at rest before (rest_level_): a floor that cannot be told from it, or a quiet print's last
-      // value a few steps above it, is where the decay was lost, and the exponential heads on to
-      // the rest reading.
-      run_.zero_level = rest_level_;
-      floor_said = fmt::format(", {:g} above the motor's reading at rest, where the decay heads: zero level {:g}",
-                               z - rest_level_, rest_level_);
-    }
-    run_note_ = fmt::format(
-        "run cut at {}: the coast approaches its floor ({:g}{}) asymptotically (last quarter {:.2f}x slower than "
-        "the mean rate), as pure viscous friction does: treated as never stopped, coast closed at {}",
-        fmt_s(run_.t_cut_s), z, floor_said, end_rate > 0 ? 1.0 / end_rate : 0.0, fmt_s(t(i)));
-    run_.stopped = false;
-    run_.end = Run::End::asymptotic;
-    complete_run(held_long ? held_from + 1 : i + 1);
-    to_idle(i + 1, true);
+  if (stop <= run_.cut_index + 2) return;
+  const double pause = t(stop) - t(stop - 1);
+  const double period = (t(stop - 1) - t(run_.cut_index)) / double(stop - 1 - run_.cut_index);
+  if (pause > 1.0 && pause > 25.0 * period) {
+    run_note_ = fmt::format("the stop falls in a pause of the recording ({:.3g} s, from {} to {}): it lies somewhere "
+                            "in it, and the stop time is the pause's end",
+                            pause, fmt_s(t(stop - 1)), fmt_s(t(stop)));
+    run_note_severity_ = Diagnostic::Severity::warning;
   }
 }
 
-bool RunDetector::quiet_dwell_above_rest(double z, double sd_z, double amp) const {
+double RunDetector::Impl::approach_t_stat(std::size_t stop) const {
+  double approach_t = std::numeric_limits<double>::infinity();
+  const double t_stop = t(stop);
+  std::size_t from = stop;
+  while (from > run_.cut_index && t_stop - t(from - 1) <= opt_.stop_hold_s) --from;
+  if (stop >= from + 3) {
+    WindowFit f;
+    f.clear(from, t(from));
+    for (std::size_t j = from; j < stop; ++j) f.add(t(j), v(j));
+    const double e = f.resid_sd();
+    approach_t = e > 0 ? -f.slope() * std::sqrt(f.sxx()) / e : (f.slope() < 0 ? approach_t : 0.0);
+  }
+  return approach_t;
+}
+
+void RunDetector::Impl::stop_at(std::size_t i, std::size_t stop, double z, double sd_z, double amp) {
+  const double t_stop = t(stop);
+  run_.stopped = true;
+  run_.stop_index = stop;
+  run_.t_stop_s = t_stop;
+  // A standstill that sits on one value of a quantized reading (a quiet converter) a step or
+  // more above the lowest the motor read at rest may be a slow exponential's dwell on that value
+  // (a viscous coast near its end takes seconds per step of the print): the tail is watched
+  // longer, and a step down held retracts the stop (tail_step).
+  floor_doubt_ = quiet_dwell_above_rest(z, sd_z, amp);
+  tail_until_s_ = t_stop + (floor_doubt_ ? std::max(opt_.tail_s, 0.25 * (t_stop - run_.t_cut_s)) : opt_.tail_s);
+  depart_band_ = std::max(6.0 * sd_z, 0.05 * std::abs(amp));
+  departing_ = 0;
+  state_ = State::tail;
+  RunEvent e;
+  e.kind = RunEvent::Kind::stop;
+  e.run = run_;
+  events_.push_back(std::move(e));
+  tail_ends_by_time(i);
+}
+
+void RunDetector::Impl::close_asymptotic(std::size_t i, bool at_end, double z, double sd_z, double amp,
+                                         double end_rate) {
+  // The floor an asymptotic coast shows is where its decay was lost in the noise or the print,
+  // not where it is heading (an exponential heads for the true zero): 0.01 V on the lab's
+  // 2-decimal print long before the motor stops, and subtracting that from every reading
+  // bends the viscous curve into Coulomb friction that is not there. A floor the detector's
+  // own flatness test cannot tell from the lead-in's zero (the motor at rest, read before the
+  // run) gives way to that zero: within 3 noise sd, 1 % of the cut's reading (level()'s
+  // allowance for a flat window's drop) or one reading step. A floor clearly above it (an
+  // offset only the coasting reading has) is kept.
+  // A per-revolution sensor keeps its last reading once the pulses stop: a floor reached by a
+  // jump and held exactly, far longer than any value before it, is that reading, not a zero to
+  // subtract (the shaft turning at that speed would have updated it long since).
+  std::size_t held_from = 0, longest = 1;
+  const bool held_jump = held_last_value(run_.cut_index, i + 1, held_from, longest, false);
+  const bool held_long = held_jump && i + 1 - held_from >= 5 * longest;
+  if (held_jump && !held_long && !at_end) return;  // wait and see how long it holds
+  std::string floor_said;
+  const double band = std::max({3.0 * sd_z, 0.01 * std::abs(v0_), reading_step(hold_.first, i + 1)});
+  if (held_long) {
+    run_.zero_level = motor_zero();
+    floor_said = fmt::format(", the last reading of a sensor that holds it ({} samples from {}, where no value "
+                             "before it lasted more than {}), not a zero: zero level {:g}, the coast fitted up "
+                             "to that last update",
+                             i + 1 - held_from, fmt_s(t(held_from)), longest, run_.zero_level);
+  } else if (std::isfinite(lead_in_zero_) && std::abs(z - lead_in_zero_) <= band * (1 + 1e-9) && z != lead_in_zero_) {
+    run_.zero_level = lead_in_zero_;
+    floor_said = fmt::format(", not to be told from the lead-in's zero, so zero level {:g}", lead_in_zero_);
+  } else if (std::isfinite(rest_level_) && z > rest_level_ &&
+             (z - rest_level_ <= band * (1 + 1e-9) || quiet_dwell_above_rest(z, sd_z, amp))) {
+    // No zeros before this cut (the supply's lead-in), but the stream held the motor's reading
+    // at rest before (rest_level_): a floor that cannot be told from it, or a quiet print's last
+    // value a few steps above it, is where the decay was lost, and the exponential heads on to
+    // the rest reading.
+    run_.zero_level = rest_level_;
+    floor_said = fmt::format(", {:g} above the motor's reading at rest, where the decay heads: zero level {:g}",
+                             z - rest_level_, rest_level_);
+  }
+  run_note_ = fmt::format(
+      "run cut at {}: the coast approaches its floor ({:g}{}) asymptotically (last quarter {:.2f}x slower than "
+      "the mean rate), as pure viscous friction does: treated as never stopped, coast closed at {}",
+      fmt_s(run_.t_cut_s), z, floor_said, end_rate > 0 ? 1.0 / end_rate : 0.0, fmt_s(t(i)));
+  run_.stopped = false;
+  run_.end = Run::End::asymptotic;
+  complete_run(held_long ? held_from + 1 : i + 1);
+  to_idle(i + 1, true);
+}
+
+bool RunDetector::Impl::quiet_dwell_above_rest(double z, double sd_z, double amp) const {
   const double step = coast_step_;
   return std::isfinite(rest_level_) && step > 0 && sd_z < quiet_floor_sd * step && z - rest_level_ >= 0.99 * step &&
          z - rest_level_ < 0.25 * amp;
 }
 
-std::size_t RunDetector::last_quarter_index(std::size_t cut, std::size_t first_in, double quarter) const {
+std::size_t RunDetector::Impl::last_quarter_index(std::size_t cut, std::size_t first_in, double quarter) const {
   std::size_t k = first_in;
   while (k > cut && v(k - 1) <= quarter) --k;
   return k;
 }
 
-double RunDetector::quarter_crossing_time(std::size_t k, std::size_t cut, double quarter) const {
+double RunDetector::Impl::quarter_crossing_time(std::size_t k, std::size_t cut, double quarter) const {
   if (k == cut) return t(k);
   const double va = v(k - 1), vb = v(k);
   return va > vb ? t(k - 1) + (t(k) - t(k - 1)) * (va - quarter) / (va - vb) : t(k);
 }
 
-double RunDetector::last_quarter_time(std::size_t cut, std::size_t first_in, double quarter) const {
+double RunDetector::Impl::last_quarter_time(std::size_t cut, std::size_t first_in, double quarter) const {
   return quarter_crossing_time(last_quarter_index(cut, first_in, quarter), cut, quarter);
 }
 
-bool RunDetector::creeps_in(double t_cut, double t_quarter, double t_stop) const {
+bool RunDetector::Impl::creeps_in(double t_cut, double t_quarter, double t_stop) const {
   // A real stop arrives with a finite slope; an exponential creeps in: its last quarter of the
   // amplitude takes far more than a quarter of the coast, and right before it the reading no
   // longer falls clearly.
@@ -411,13 +435,13 @@ bool RunDetector::creeps_in(double t_cut, double t_quarter, double t_stop) const
   return end_rate < stop_min_end_rate && stop_approach_t_ < stop_min_approach_t;
 }
 
-void RunDetector::block_until_rise(double level) {
+void RunDetector::Impl::block_until_rise(double level) {
   need_rise_ = true;
   block_band_ = rise_jump_;  // as far above as power coming back
   rise_level_ = level + block_band_;
 }
 
-bool RunDetector::signal_lost(std::size_t i, std::size_t first_in, double z, double amp) {
+bool RunDetector::Impl::signal_lost(std::size_t i, std::size_t first_in, double z, double amp) {
   if (first_in < run_.cut_index + 8 || !(amp > 0)) return false;
   const double zero = motor_zero();
   // The coast's last reading before the standstill, and the first sample that held it.
@@ -459,7 +483,7 @@ bool RunDetector::signal_lost(std::size_t i, std::size_t first_in, double z, dou
   return true;
 }
 
-void RunDetector::tail_ends_by_time(std::size_t upto) {
+void RunDetector::Impl::tail_ends_by_time(std::size_t upto) {
   const double t_end = tail_until_s_;
   for (std::size_t e = run_.stop_index + 1; e <= upto; ++e) {
     if (t(e) >= t_end) {
@@ -470,7 +494,7 @@ void RunDetector::tail_ends_by_time(std::size_t upto) {
   }
 }
 
-bool RunDetector::still_falling(std::size_t i) const {
+bool RunDetector::Impl::still_falling(std::size_t i) const {
   // Over the whole tail, a slope many standard errors below zero, lower than the quantization
   // allows a level reading, and at least a third of the approach's: the "standstill" was a slow
   // exponential's stretch (a viscous coast at a fraction of its start), not a stop.
@@ -484,7 +508,7 @@ bool RunDetector::still_falling(std::size_t i) const {
   return slope < 0 && -slope * std::sqrt(sxx) > 6.0 * e && -slope > 0.1 * mean_rate;
 }
 
-void RunDetector::close_unstopped(std::size_t end, const std::string& why, Run::End reason) {
+void RunDetector::Impl::close_unstopped(std::size_t end, const std::string& why, Run::End reason) {
   run_.stopped = false;
   run_.end = reason;
   run_.zero_level = 0;
