@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <limits>
 
+#include "spindown/fail_why.hpp"
 #include "spindown/quantity.hpp"
 
 namespace spindown {
@@ -12,11 +13,6 @@ namespace spindown {
 namespace {
 
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
-
-bool fail(std::string* why, std::string text) {
-  if (why) *why = std::move(text);
-  return false;
-}
 
 }  // namespace
 
@@ -128,8 +124,8 @@ std::optional<RunFit> from_fit_message(const fit_t& m, std::string* why) {
       m.model_samples.size() != nm || m.model_message.size() != nm || m.param_model.size() != np ||
       m.param_name.size() != np || m.param_value.size() != np || m.param_stderr.size() != np ||
       m.param_unit.size() != np || m.param_bench_error.size() != np) {
-    fail(why, fmt::format("FIT of bench {} run {}: array sizes do not match nmodels {} / nparams {}", m.bench, m.run,
-                          m.nmodels, m.nparams));
+    fail_why(why, fmt::format("FIT of bench {} run {}: array sizes do not match nmodels {} / nparams {}", m.bench, m.run,
+                              m.nmodels, m.nparams));
     return std::nullopt;
   }
   RunFit fit;
@@ -154,14 +150,14 @@ std::optional<RunFit> from_fit_message(const fit_t& m, std::string* why) {
   fit.bench.kb_rel_error = m.kb_rel_error;
   const auto q = parse_quantity(m.residual_unit);
   if (!q) {
-    fail(why, fmt::format("FIT of bench {} run {}: unknown residual unit '{}'", m.bench, m.run, m.residual_unit));
+    fail_why(why, fmt::format("FIT of bench {} run {}: unknown residual unit '{}'", m.bench, m.run, m.residual_unit));
     return std::nullopt;
   }
   fit.quantity = *q;
   for (std::size_t i = 0; i < nm; ++i) {
     const auto kind = parse_model(m.model[i]);
     if (!kind) {
-      fail(why, fmt::format("FIT of bench {} run {}: unknown model '{}'", m.bench, m.run, m.model[i]));
+      fail_why(why, fmt::format("FIT of bench {} run {}: unknown model '{}'", m.bench, m.run, m.model[i]));
       return std::nullopt;
     }
     ModelFit f;
@@ -179,8 +175,8 @@ std::optional<RunFit> from_fit_message(const fit_t& m, std::string* why) {
   for (std::size_t k = 0; k < np; ++k) {
     const std::int32_t i = m.param_model[k];
     if (i < 0 || static_cast<std::size_t>(i) >= nm) {
-      fail(why, fmt::format("FIT of bench {} run {}: parameter {} belongs to model {} of {}", m.bench, m.run,
-                            m.param_name[k], i, nm));
+      fail_why(why, fmt::format("FIT of bench {} run {}: parameter {} belongs to model {} of {}", m.bench, m.run,
+                                m.param_name[k], i, nm));
       return std::nullopt;
     }
     ModelFit& f = fit.models[static_cast<std::size_t>(i)];
@@ -203,8 +199,8 @@ std::optional<RunFit> from_fit_message(const fit_t& m, std::string* why) {
   const auto nc = static_cast<std::size_t>(std::max(m.ncorrelations, 0));
   if (m.doubts.size() != nd || m.model_reduced_chi2.size() != nm || m.corr_model.size() != nc ||
       m.corr_a.size() != nc || m.corr_b.size() != nc || m.corr_value.size() != nc) {
-    fail(why, fmt::format("FIT of bench {} run {}: array sizes do not match ndoubts {} / ncorrelations {}", m.bench,
-                          m.run, m.ndoubts, m.ncorrelations));
+    fail_why(why, fmt::format("FIT of bench {} run {}: array sizes do not match ndoubts {} / ncorrelations {}", m.bench,
+                              m.run, m.ndoubts, m.ncorrelations));
     return std::nullopt;
   }
   fit.doubts = m.doubts;
@@ -215,8 +211,8 @@ std::optional<RunFit> from_fit_message(const fit_t& m, std::string* why) {
   for (std::size_t c = 0; c < nc; ++c) {
     const std::int32_t i = m.corr_model[c];
     if (i < 0 || static_cast<std::size_t>(i) >= nm) {
-      fail(why, fmt::format("FIT of bench {} run {}: correlation {} belongs to model {} of {}", m.bench, m.run, c, i,
-                            nm));
+      fail_why(why, fmt::format("FIT of bench {} run {}: correlation {} belongs to model {} of {}", m.bench, m.run, c, i,
+                                nm));
       return std::nullopt;
     }
     auto& names = fit.models[static_cast<std::size_t>(i)].correlated;
@@ -247,13 +243,13 @@ std::optional<HealthVerdict> health_from_fit_message(const fit_t& m, std::string
       m.finding_value.size() != n || m.finding_stderr.size() != n || m.finding_reference.size() != n ||
       m.finding_reference_stderr.size() != n || m.finding_reference_name.size() != n || m.finding_ratio.size() != n ||
       m.finding_ratio_stderr.size() != n || m.finding_unit.size() != n) {
-    fail(why, fmt::format("FIT of bench {} run {}: health finding arrays do not match nfindings {}", m.bench, m.run,
-                          m.nfindings));
+    fail_why(why, fmt::format("FIT of bench {} run {}: health finding arrays do not match nfindings {}", m.bench, m.run,
+                              m.nfindings));
     return std::nullopt;
   }
   const auto level = parse_health_level(m.verdict);
   if (!level) {
-    fail(why, fmt::format("FIT of bench {} run {}: unknown health verdict '{}'", m.bench, m.run, m.verdict));
+    fail_why(why, fmt::format("FIT of bench {} run {}: unknown health verdict '{}'", m.bench, m.run, m.verdict));
     return std::nullopt;
   }
   HealthVerdict v;
@@ -263,8 +259,8 @@ std::optional<HealthVerdict> health_from_fit_message(const fit_t& m, std::string
   for (std::size_t i = 0; i < n; ++i) {
     const auto fl = parse_health_level(m.finding_level[i]);
     if (!fl) {
-      fail(why, fmt::format("FIT of bench {} run {}: unknown health level '{}' of finding '{}'", m.bench, m.run,
-                            m.finding_level[i], m.finding_what[i]));
+      fail_why(why, fmt::format("FIT of bench {} run {}: unknown health level '{}' of finding '{}'", m.bench, m.run,
+                                m.finding_level[i], m.finding_what[i]));
       return std::nullopt;
     }
     HealthFinding f;

@@ -9,16 +9,12 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "spindown/fail_why.hpp"
 #include "spindown/trim.hpp"
 
 namespace spindown {
 
 namespace {
-
-bool fail(std::string* why, std::string text) {
-  if (why) *why = std::move(text);
-  return false;
-}
 
 bool sodium_ready() {
   static const bool ok = ::sodium_init() >= 0;
@@ -55,18 +51,18 @@ LabKey lab_key_from_bytes(const std::array<unsigned char, lab_key_bytes>& bytes)
 
 std::optional<LabKey> load_lab_key(const std::string& path, std::string* why) {
   if (!sodium_ready()) {
-    fail(why, "libsodium could not be initialized");
+    fail_why(why, "libsodium could not be initialized");
     return std::nullopt;
   }
   const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOCTTY | O_NONBLOCK);
   if (fd < 0) {
-    fail(why, fmt::format("lab key {}: {}", path, std::strerror(errno)));
+    fail_why(why, fmt::format("lab key {}: {}", path, std::strerror(errno)));
     return std::nullopt;
   }
   struct stat st {};
   if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
     ::close(fd);
-    fail(why, fmt::format("lab key {}: not a regular file", path));
+    fail_why(why, fmt::format("lab key {}: not a regular file", path));
     return std::nullopt;
   }
   char buf[160];
@@ -94,10 +90,10 @@ std::optional<LabKey> load_lab_key(const std::string& path, std::string* why) {
   }
   ::sodium_memzero(buf, sizeof buf);
   if (!ok) {
-    fail(why, fmt::format("lab key {}: {} bytes; a key is {} bytes (spindown keygen -o FILE, or head -c 32 "
-                          "/dev/urandom > FILE) or {} hex digits",
-                          path, got >= sizeof buf ? std::string("more than 160") : std::to_string(got), lab_key_bytes,
-                          2 * lab_key_bytes));
+    fail_why(why, fmt::format("lab key {}: {} bytes; a key is {} bytes (spindown keygen -o FILE, or head -c 32 "
+                              "/dev/urandom > FILE) or {} hex digits",
+                              path, got >= sizeof buf ? std::string("more than 160") : std::to_string(got), lab_key_bytes,
+                              2 * lab_key_bytes));
     return std::nullopt;
   }
   LabKey k = lab_key_from_bytes(bytes);
@@ -136,13 +132,13 @@ LabKeyChoice choose_lab_key(const std::string& option_path) {
 }
 
 bool write_new_lab_key(const std::string& path, std::string* why) {
-  if (!sodium_ready()) return fail(why, "libsodium could not be initialized");
+  if (!sodium_ready()) return fail_why(why, "libsodium could not be initialized");
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0600);
   if (fd < 0)
-    return fail(why, errno == EEXIST ? fmt::format("{} exists: a key is never overwritten (remove it first, and "
-                                                   "give every lab PC the new one)",
-                                                   path)
-                                     : fmt::format("cannot create {}: {}", path, std::strerror(errno)));
+    return fail_why(why, errno == EEXIST ? fmt::format("{} exists: a key is never overwritten (remove it first, and "
+                                                       "give every lab PC the new one)",
+                                                       path)
+                                         : fmt::format("cannot create {}: {}", path, std::strerror(errno)));
   std::array<unsigned char, lab_key_bytes> bytes{};
   ::randombytes_buf(bytes.data(), bytes.size());
   std::size_t done = 0;
@@ -162,7 +158,7 @@ bool write_new_lab_key(const std::string& path, std::string* why) {
   ::close(fd);
   if (!ok) {
     ::unlink(path.c_str());
-    return fail(why, fmt::format("cannot write {}: {}", path, std::strerror(err)));
+    return fail_why(why, fmt::format("cannot write {}: {}", path, std::strerror(err)));
   }
   return true;
 }

@@ -11,6 +11,8 @@
 #include <string_view>
 #include <vector>
 
+#include "spindown/fail_why.hpp"
+
 namespace spindown {
 
 namespace {
@@ -55,11 +57,6 @@ std::uint64_t be64u(const unsigned char* p) { return SamplesView::load_be64(p); 
 constexpr std::int64_t hash_bytes = 8;
 constexpr std::int64_t string_min_bytes = 5;  // length word and the terminating NUL
 
-bool fail(std::string* why, std::string text) {
-  if (why) *why = std::move(text);
-  return false;
-}
-
 constexpr std::size_t max_fields = 96;
 
 // Offsets of a walk: each field's, then the end of the last one.
@@ -69,15 +66,15 @@ using Positions = std::array<std::int64_t, max_fields + 1>;
 // then the end of the last one (at index fields.size()).
 bool walk(std::string_view type, std::uint64_t expected_hash, std::span<const WireField> fields,
           const void* data, std::int64_t size, std::string* why, Positions* positions = nullptr) {
-  if (data == nullptr && size != 0) return fail(why, fmt::format("{}: no data", type));
-  if (size < hash_bytes) return fail(why, fmt::format("{} bytes, too short for {}", size, type));
+  if (data == nullptr && size != 0) return fail_why(why, fmt::format("{}: no data", type));
+  if (size < hash_bytes) return fail_why(why, fmt::format("{} bytes, too short for {}", size, type));
   if (size > std::numeric_limits<int>::max())
-    return fail(why, fmt::format("{}: {} bytes, more than an LCM message can hold", type, size));
+    return fail_why(why, fmt::format("{}: {} bytes, more than an LCM message can hold", type, size));
   const auto* d = static_cast<const unsigned char*>(data);
   const std::uint64_t hash = be64u(d);
   if (hash != expected_hash)
-    return fail(why, fmt::format("not a {} (type fingerprint {:#018x}, expected {:#018x})", type, hash,
-                                 expected_hash));
+    return fail_why(why, fmt::format("not a {} (type fingerprint {:#018x}, expected {:#018x})", type, hash,
+                                     expected_hash));
 
   std::array<std::int64_t, max_fields> ints{};  // int32 scalars by field index (array counts)
   std::int64_t pos = hash_bytes;
@@ -88,18 +85,18 @@ bool walk(std::string_view type, std::uint64_t expected_hash, std::span<const Wi
     if (f.count_of >= 0) {
       n = ints[static_cast<std::size_t>(f.count_of)];
       if (n < 0)
-        return fail(why, fmt::format("{}: {} = {} is negative (array {})", type, fields[f.count_of].name, n,
-                                     f.name));
+        return fail_why(why, fmt::format("{}: {} = {} is negative (array {})", type, fields[f.count_of].name, n,
+                                         f.name));
     }
     const std::int64_t left = size - pos;
     if (f.wire != Wire::string) {
       const std::int64_t need = n * fixed_bytes(f.wire);
       if (need > left) {
         if (f.count_of >= 0)
-          return fail(why, fmt::format("{}: {} = {} needs {} bytes for {}, {} left at byte {} (truncated or "
-                                       "damaged)",
-                                       type, fields[f.count_of].name, n, need, f.name, left, pos));
-        return fail(why, fmt::format("{}: ends inside {} at byte {} (truncated)", type, f.name, pos));
+          return fail_why(why, fmt::format("{}: {} = {} needs {} bytes for {}, {} left at byte {} (truncated or "
+                                           "damaged)",
+                                           type, fields[f.count_of].name, n, need, f.name, left, pos));
+        return fail_why(why, fmt::format("{}: ends inside {} at byte {} (truncated)", type, f.name, pos));
       }
       if (f.wire == Wire::i32 && f.count_of < 0) ints[i] = be32(d + pos);
       pos += need;
@@ -107,21 +104,21 @@ bool walk(std::string_view type, std::uint64_t expected_hash, std::span<const Wi
     }
     // Strings: a big-endian int32 length that counts the NUL, then the bytes.
     if (f.count_of < 0 && left < string_min_bytes)
-      return fail(why, fmt::format("{}: ends inside {} at byte {} (truncated)", type, f.name, pos));
+      return fail_why(why, fmt::format("{}: ends inside {} at byte {} (truncated)", type, f.name, pos));
     if (n * string_min_bytes > left)
-      return fail(why, fmt::format("{}: {} = {} strings for {} need at least {} bytes, {} left at byte {} "
-                                   "(truncated or damaged)",
-                                   type, fields[f.count_of].name, n, f.name, n * string_min_bytes, left, pos));
+      return fail_why(why, fmt::format("{}: {} = {} strings for {} need at least {} bytes, {} left at byte {} "
+                                       "(truncated or damaged)",
+                                       type, fields[f.count_of].name, n, f.name, n * string_min_bytes, left, pos));
     for (std::int64_t k = 0; k < n; ++k) {
       auto name = [&] { return f.count_of >= 0 ? fmt::format("{}[{}]", f.name, k) : std::string(f.name); };
       if (size - pos < 4)
-        return fail(why, fmt::format("{}: ends inside {} at byte {} (truncated)", type, name(), pos));
+        return fail_why(why, fmt::format("{}: ends inside {} at byte {} (truncated)", type, name(), pos));
       const std::int64_t len = be32(d + pos);
       pos += 4;
       if (len < 1 || len > size - pos)
-        return fail(why, fmt::format("{}: string {} has length {} with {} bytes left at byte {} (truncated or "
-                                     "damaged)",
-                                     type, name(), len, size - pos, pos - 4));
+        return fail_why(why, fmt::format("{}: string {} has length {} with {} bytes left at byte {} (truncated or "
+                                         "damaged)",
+                                         type, name(), len, size - pos, pos - 4));
       pos += len;
     }
   }
@@ -370,9 +367,9 @@ bool decode_impl(Msg& msg, const void* data, std::int64_t size, std::string* why
   }
   try {
     if (msg.decode(data, 0, static_cast<int>(size)) < 0)
-      return fail(why, fmt::format("{}: {} bytes do not decode", Msg::getTypeName(), size));
+      return fail_why(why, fmt::format("{}: {} bytes do not decode", Msg::getTypeName(), size));
   } catch (const std::exception& e) {  // not expected after the walk; never let it escape
-    return fail(why, fmt::format("{}: does not decode ({})", Msg::getTypeName(), e.what()));
+    return fail_why(why, fmt::format("{}: does not decode ({})", Msg::getTypeName(), e.what()));
   }
   return true;
 }
@@ -389,36 +386,36 @@ bool view_samples_message_worded(SamplesView& view, const void* data, std::int64
     return false;
   }
   // samples_t's strings and arrays all sit in this prefix: checking it checks the whole layout.
-  if (size < 20) return fail(why, fmt::format("{} bytes, too short for samples_t", size));
+  if (size < 20) return fail_why(why, fmt::format("{} bytes, too short for samples_t", size));
   const std::int64_t bench_len = be32(d + 16);
   if (bench_len < 1 || bench_len > size - 20)
-    return fail(why, fmt::format("bench string length {} does not fit in {} bytes", bench_len, size));
+    return fail_why(why, fmt::format("bench string length {} does not fit in {} bytes", bench_len, size));
   const std::int64_t n_at = 20 + bench_len + 8 + 4 + 1;
-  if (n_at + 4 > size) return fail(why, fmt::format("truncated: {} bytes end before the sample count", size));
+  if (n_at + 4 > size) return fail_why(why, fmt::format("truncated: {} bytes end before the sample count", size));
   const std::int64_t n = be32(d + n_at);
   constexpr std::int64_t bytes_per_sample = 8 + 8 + 8 + 4;
   if (n < 0 || n * bytes_per_sample > size - n_at - 4)
-    return fail(why, fmt::format("sample count {} does not fit in {} bytes (truncated or damaged)", n, size));
+    return fail_why(why, fmt::format("sample count {} does not fit in {} bytes (truncated or damaged)", n, size));
   const std::int64_t trailer_at = n_at + 4 + n * bytes_per_sample;
   if (legacy) {
     fill_samples_view(view, d, bench_len, n_at, n, -1, 0, 0, 0);
     return true;
   }
   if (trailer_at + 4 > size)
-    return fail(why, fmt::format("truncated: {} bytes end before the source fields (lab, host, session)", size));
+    return fail_why(why, fmt::format("truncated: {} bytes end before the source fields (lab, host, session)", size));
   const std::int64_t lab_len = be32(d + trailer_at);
   if (lab_len < 1 || lab_len > size - trailer_at - 8)
-    return fail(why, fmt::format("lab string length {} does not fit in {} bytes", lab_len, size));
+    return fail_why(why, fmt::format("lab string length {} does not fit in {} bytes", lab_len, size));
   const std::int64_t to_at = trailer_at + 4 + lab_len;
   const std::int64_t to_len = be32(d + to_at);
   if (to_len < 1 || to_len > size - to_at - 8)
-    return fail(why, fmt::format("sent_to string length {} does not fit in {} bytes", to_len, size));
+    return fail_why(why, fmt::format("sent_to string length {} does not fit in {} bytes", to_len, size));
   const std::int64_t host_at = to_at + 4 + to_len;
   const std::int64_t host_len = be32(d + host_at);
   constexpr std::int64_t trailer_fixed = 8 + 8 + 4 + message_auth_bytes;
   if (host_len < 1 || host_len > size - host_at - 4 - trailer_fixed)
-    return fail(why, fmt::format("source_host string length {} does not fit in {} bytes (truncated or damaged)",
-                                 host_len, size));
+    return fail_why(why, fmt::format("source_host string length {} does not fit in {} bytes (truncated or damaged)",
+                                     host_len, size));
   fill_samples_view(view, d, bench_len, n_at, n, trailer_at, lab_len, to_len, host_len);
   return true;
 }
@@ -456,11 +453,11 @@ void samples_from_view(const SamplesView& view, samples_t& m) {
 bool read_message_trailer(const void* data, std::int64_t size, MessageTrailer& out, std::string* why) {
   out = MessageTrailer{};
   if (data == nullptr || size < hash_bytes)
-    return fail(why, fmt::format("{} bytes, too short for a spindown message", std::max<std::int64_t>(size, 0)));
+    return fail_why(why, fmt::format("{} bytes, too short for a spindown message", std::max<std::int64_t>(size, 0)));
   bool legacy = false;
   const TypeInfo* t = type_of_hash(hash_of(data, size), &legacy);
   if (!t)
-    return fail(why, fmt::format("not a spindown message (type fingerprint {:#018x})", hash_of(data, size)));
+    return fail_why(why, fmt::format("not a spindown message (type fingerprint {:#018x})", hash_of(data, size)));
   Positions at;  // each field's offset, then the end
   if (!walk_type(*t, data, size, why, &legacy, &at)) return false;
   const auto* d = static_cast<const unsigned char*>(data);

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <toml++/toml.h>
 
+#include "spindown/fail_why.hpp"
 #include "spindown/lcm_channels.hpp"
 #include "spindown/serial_port.hpp"
 #include "spindown/toml_file.hpp"
@@ -14,25 +15,21 @@
 namespace spindown {
 
 bool BridgeSettings::is_valid(std::string* why) const {
-  auto fail = [&](std::string reason) {
-    if (why) *why = std::move(reason);
-    return false;
-  };
   std::string r;
-  if (!is_valid_bench_id(bench, &r)) return fail(r);
-  if (device.empty()) return fail("no serial device given");
-  if (!is_supported_baud(baud)) return fail(fmt::format("unsupported baud rate {}", baud));
-  if (!params.is_valid(&r)) return fail(r);
-  if (adc_bits < 1 || adc_bits > 16) return fail(fmt::format("adc bits {} not in 1-16", adc_bits));
-  if (!(adc_ref_v > 0 && adc_ref_v <= 100)) return fail(fmt::format("adc ref_v {} not in (0, 100] V", adc_ref_v));
-  if (!(lab_period_s > 0 && lab_period_s <= 10)) return fail(fmt::format("lab period_s {} not in (0, 10] s", lab_period_s));
+  if (!is_valid_bench_id(bench, &r)) return fail_why(why, r);
+  if (device.empty()) return fail_why(why, "no serial device given");
+  if (!is_supported_baud(baud)) return fail_why(why, fmt::format("unsupported baud rate {}", baud));
+  if (!params.is_valid(&r)) return fail_why(why, r);
+  if (adc_bits < 1 || adc_bits > 16) return fail_why(why, fmt::format("adc bits {} not in 1-16", adc_bits));
+  if (!(adc_ref_v > 0 && adc_ref_v <= 100)) return fail_why(why, fmt::format("adc ref_v {} not in (0, 100] V", adc_ref_v));
+  if (!(lab_period_s > 0 && lab_period_s <= 10)) return fail_why(why, fmt::format("lab period_s {} not in (0, 10] s", lab_period_s));
   if (max_line_bytes < 16 || max_line_bytes > (1u << 20))
-    return fail(fmt::format("max_line_bytes {} not in 16-1048576", max_line_bytes));
-  if (max_batch < 1 || max_batch > 1000) return fail(fmt::format("max_batch {} not in 1-1000", max_batch));
+    return fail_why(why, fmt::format("max_line_bytes {} not in 16-1048576", max_line_bytes));
+  if (max_batch < 1 || max_batch > 1000) return fail_why(why, fmt::format("max_batch {} not in 1-1000", max_batch));
   if (!(config_interval_s >= 0.1 && config_interval_s <= 60))
-    return fail(fmt::format("config_interval_s {} not in [0.1, 60]", config_interval_s));
+    return fail_why(why, fmt::format("config_interval_s {} not in [0.1, 60]", config_interval_s));
   if (!(status_interval_s >= 0.1 && status_interval_s <= 60))
-    return fail(fmt::format("status_interval_s {} not in [0.1, 60]", status_interval_s));
+    return fail_why(why, fmt::format("status_interval_s {} not in [0.1, 60]", status_interval_s));
   return true;
 }
 

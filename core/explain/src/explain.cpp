@@ -41,8 +41,6 @@ double ExplainResult::bin_noise_white() const {
 
 namespace {
 
-constexpr double nan = std::numeric_limits<double>::quiet_NaN();
-
 // A named effect must remove at least half of the systematic disagreement (chi-square excess
 // of the binned residual), not just shave the noise.
 constexpr double max_left = 0.5;
@@ -323,7 +321,7 @@ CandidateTrial* Explainer::score(ExplainStep& st, const ResidualBins& bins, doub
   CandidateTrial* best = nullptr;
   for (auto& t : st.trials) {
     if (!std::isfinite(t.fit.sse) || t.fit.sse <= 0) {
-      t.delta_bic = nan;
+      t.delta_bic = std::numeric_limits<double>::quiet_NaN();
       t.verdict = fmt::format("could not be fitted ({})", t.fit.message);
       continue;
     }

@@ -181,7 +181,7 @@ DoctorCheck check_serial_device(const std::string& bench, const std::string& dev
   return c;
 }
 
-std::vector<BenchFile> read_bench_files(const std::vector<std::string>& files_or_dirs) {
+std::vector<BridgeBenchFile> read_bench_files(const std::vector<std::string>& files_or_dirs) {
   std::vector<std::string> paths;
   for (const auto& p : files_or_dirs) {
     std::error_code ec;
@@ -195,9 +195,9 @@ std::vector<BenchFile> read_bench_files(const std::vector<std::string>& files_or
       paths.push_back(p);
     }
   }
-  std::vector<BenchFile> out;
+  std::vector<BridgeBenchFile> out;
   for (const auto& path : paths) {
-    BenchFile b;
+    BridgeBenchFile b;
     b.path = path;
     b.stem = fs::path(path).stem().string();
     try {
@@ -212,7 +212,7 @@ std::vector<BenchFile> read_bench_files(const std::vector<std::string>& files_or
   return out;
 }
 
-std::vector<DoctorCheck> check_bench_files(const std::vector<BenchFile>& files, const std::string& where) {
+std::vector<DoctorCheck> check_bench_files(const std::vector<BridgeBenchFile>& files, const std::string& where) {
   std::vector<DoctorCheck> out;
   if (files.empty()) {
     out.push_back({"bench files", CheckLevel::warn, fmt::format("no bench file in {}", where),

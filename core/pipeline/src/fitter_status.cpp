@@ -9,6 +9,7 @@
 #include <limits>
 #include <regex>
 
+#include "spindown/fail_why.hpp"
 #include "spindown/fit_message.hpp"
 #include "spindown/lab_name.hpp"
 #include "spindown/lcm_channels.hpp"
@@ -19,34 +20,30 @@
 namespace spindown {
 
 bool FitterOptions::is_valid(std::string* why) const {
-  auto fail = [&](std::string text) {
-    if (why) *why = std::move(text);
-    return false;
-  };
   std::string inner;
-  if (!runs.is_valid(&inner)) return fail("run options: " + inner);
+  if (!runs.is_valid(&inner)) return fail_why(why, "run options: " + inner);
   FitOptions fo;
   fo.bench = default_bench;
   fo.models = models;
-  if (!fo.is_valid(&inner)) return fail("fit options: " + inner);
-  if (max_benches < 1) return fail("max_benches must be at least 1");
+  if (!fo.is_valid(&inner)) return fail_why(why, "fit options: " + inner);
+  if (max_benches < 1) return fail_why(why, "max_benches must be at least 1");
   if (!(std::isfinite(admit_rate_hz) && admit_rate_hz > 0))
-    return fail(fmt::format("admit_rate_hz must be > 0 (got {})", admit_rate_hz));
-  if (!(silent_s > 0)) return fail(fmt::format("silent_s must be > 0 (got {})", silent_s));
+    return fail_why(why, fmt::format("admit_rate_hz must be > 0 (got {})", admit_rate_hz));
+  if (!(silent_s > 0)) return fail_why(why, fmt::format("silent_s must be > 0 (got {})", silent_s));
   if (!(std::isfinite(max_rate_hz) && max_rate_hz >= 0))
-    return fail(fmt::format("max_rate_hz must be >= 0 (got {})", max_rate_hz));
-  if (!(std::isfinite(burst_s) && burst_s > 0)) return fail(fmt::format("burst_s must be > 0 (got {})", burst_s));
+    return fail_why(why, fmt::format("max_rate_hz must be >= 0 (got {})", max_rate_hz));
+  if (!(std::isfinite(burst_s) && burst_s > 0)) return fail_why(why, fmt::format("burst_s must be > 0 (got {})", burst_s));
   if (!(std::isfinite(gate.replay_window_s) && gate.replay_window_s > 0))
-    return fail(fmt::format("replay window must be > 0 s (got {})", gate.replay_window_s));
-  if (!gate.lab.empty() && !is_valid_lab_name(gate.lab, &inner)) return fail(inner);
+    return fail_why(why, fmt::format("replay window must be > 0 s (got {})", gate.replay_window_s));
+  if (!gate.lab.empty() && !is_valid_lab_name(gate.lab, &inner)) return fail_why(why, inner);
   if (!(std::isfinite(stream.takeover_s) && stream.takeover_s >= 0))
-    return fail(fmt::format("takeover must be >= 0 s (got {})", stream.takeover_s));
+    return fail_why(why, fmt::format("takeover must be >= 0 s (got {})", stream.takeover_s));
   if (!(std::isfinite(stream.confirm_s) && stream.confirm_s >= 0))
-    return fail(fmt::format("confirm must be >= 0 s (got {})", stream.confirm_s));
+    return fail_why(why, fmt::format("confirm must be >= 0 s (got {})", stream.confirm_s));
   try {
     std::regex re(bench_regex);
   } catch (const std::regex_error& e) {
-    return fail(fmt::format("bench regex '{}' is not a valid regular expression ({})", bench_regex, e.what()));
+    return fail_why(why, fmt::format("bench regex '{}' is not a valid regular expression ({})", bench_regex, e.what()));
   }
   return true;
 }

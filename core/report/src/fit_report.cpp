@@ -122,12 +122,6 @@ const ModelFit* runner_up(const RunFit& fit, const ModelFit* best) {
   return second;
 }
 
-const ModelFit* best_model(const RunFit& fit) {
-  for (const auto& m : fit.models)
-    if (model_name(m.kind) == fit.best) return &m;
-  return nullptr;
-}
-
 // Kass & Raftery's reading of a BIC difference.
 std::string_view evidence(double delta_bic) {
   if (delta_bic > 10) return "very strong";

@@ -1,6 +1,6 @@
 #pragma once
-// Shared by the fit report's text (fit_report.cpp) and its JSON (fit_json.cpp). Private to the
-// report module.
+// Shared by the fit report's text (fit_report.cpp), its JSON (fit_json.cpp) and the run table
+// (run_table.cpp). Private to the report module.
 #include <cstddef>
 
 #include "spindown/fit.hpp"
@@ -15,6 +15,13 @@ inline const char* severity_name(Diagnostic::Severity s) {
     case Diagnostic::Severity::note: return "note";
   }
   return "warning";
+}
+
+// The run's best model (fit.best), or nullptr when none was chosen.
+inline const ModelFit* best_model(const RunFit& fit) {
+  for (const auto& m : fit.models)
+    if (model_name(m.kind) == fit.best) return &m;
+  return nullptr;
 }
 
 // Samples from the cut to the run's end.

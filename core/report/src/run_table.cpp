@@ -8,6 +8,7 @@
 
 #include "spindown/csv_cells.hpp"
 #include "spindown/quantity.hpp"
+#include "fit_report_support.hpp"
 #include "pretty_json_writer.hpp"
 
 namespace spindown {
@@ -20,12 +21,6 @@ struct Column {
   std::string name;
   Cell value;
 };
-
-const ModelFit* best_model(const RunFit& fit) {
-  for (const auto& m : fit.models)
-    if (model_name(m.kind) == fit.best) return &m;
-  return nullptr;
-}
 
 // One run's row, in the header's order.
 std::vector<Column> row(const FileFit& file, std::size_t i) {

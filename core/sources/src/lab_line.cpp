@@ -72,7 +72,7 @@ LabLine sample_line(std::uint64_t ticks, double value) {
   return sample;
 }
 
-LabLine garbled(std::string_view why) {
+LabLine garbled_lab_line(std::string_view why) {
   LabLine line;
   line.kind = LabLine::Kind::garbled;
   line.why = why;
@@ -90,22 +90,22 @@ LabLine parse_lab_line(std::string_view line) {
     blank.kind = LabLine::Kind::blank;
     return blank;
   }
-  if (e - b > max_sample_line) return garbled("line too long to be a millis<TAB>volts sample");
+  if (e - b > max_sample_line) return garbled_lab_line("line too long to be a millis<TAB>volts sample");
 
   const char* p = line.data() + b;
   const char* const end = line.data() + e;
-  if (*p == '-') return garbled("negative time");
+  if (*p == '-') return garbled_lab_line("negative time");
 
   std::uint64_t ticks = 0;
   auto [after_time, time_ec] = std::from_chars(p, end, ticks);
-  if (time_ec == std::errc::invalid_argument) return garbled("time is not a number");
+  if (time_ec == std::errc::invalid_argument) return garbled_lab_line("time is not a number");
   if (time_ec == std::errc::result_out_of_range || ticks > max_device_ticks)
-    return garbled("time beyond the range of millis() (2^32 ms)");
-  if (after_time == end) return garbled("missing value (only one field)");
+    return garbled_lab_line("time beyond the range of millis() (2^32 ms)");
+  if (after_time == end) return garbled_lab_line("missing value (only one field)");
   if (!is_space(*after_time)) {
     if (*after_time == '.' || *after_time == 'e' || *after_time == 'E')
-      return garbled("time is not a whole number of milliseconds");
-    return garbled("time is not a number");
+      return garbled_lab_line("time is not a whole number of milliseconds");
+    return garbled_lab_line("time is not a number");
   }
 
   const char* q = after_time;
@@ -113,14 +113,14 @@ LabLine parse_lab_line(std::string_view line) {
   double value = 0;
   if (parse_plain_decimal(q, end, value) && std::fabs(value) <= max_printable_value) return sample_line(ticks, value);
   auto [after_value, value_ec] = std::from_chars(q, end, value);
-  if (value_ec == std::errc::invalid_argument) return garbled("value is not a number");
-  if (value_ec == std::errc::result_out_of_range) return garbled("value out of range");
+  if (value_ec == std::errc::invalid_argument) return garbled_lab_line("value is not a number");
+  if (value_ec == std::errc::result_out_of_range) return garbled_lab_line("value out of range");
   if (after_value != end) {
-    if (is_space(*after_value)) return garbled("extra field after the value");
-    return garbled("value is not a number");
+    if (is_space(*after_value)) return garbled_lab_line("extra field after the value");
+    return garbled_lab_line("value is not a number");
   }
-  if (!std::isfinite(value)) return garbled("value is NaN or infinite");
-  if (std::fabs(value) > max_printable_value) return garbled("value larger than an Arduino can print");
+  if (!std::isfinite(value)) return garbled_lab_line("value is NaN or infinite");
+  if (std::fabs(value) > max_printable_value) return garbled_lab_line("value larger than an Arduino can print");
 
   return sample_line(ticks, value);
 }

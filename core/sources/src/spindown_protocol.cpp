@@ -49,7 +49,7 @@ bool check_crc(std::string_view line, std::string_view& body, std::string_view& 
   return true;
 }
 
-SpindownLine garbled(std::string_view why) {
+SpindownLine garbled_spindown_line(std::string_view why) {
   SpindownLine l;
   l.kind = SpindownLine::Kind::garbled;
   l.why = why;
@@ -63,19 +63,19 @@ SpindownLine parse_sample(std::string_view body) {
   for (int i = 0; i < 3; ++i) {
     const auto comma = body.find(',');
     if (i < 2) {
-      if (comma == std::string_view::npos) return garbled("sample has fewer than 3 fields");
+      if (comma == std::string_view::npos) return garbled_spindown_line("sample has fewer than 3 fields");
       f[i] = body.substr(0, comma);
       body.remove_prefix(comma + 1);
     } else {
-      if (comma != std::string_view::npos) return garbled("sample has more than 3 fields");
+      if (comma != std::string_view::npos) return garbled_spindown_line("sample has more than 3 fields");
       f[i] = body;
     }
   }
   SpindownLine l;
   std::uint32_t adc = 0;
-  if (!parse_u32(f[0], l.seq)) return garbled("sequence number is not a uint32");
-  if (!parse_u32(f[1], l.time_us)) return garbled("micros is not a uint32");
-  if (!parse_u32(f[2], adc) || adc > 65535) return garbled("ADC count is not 0-65535");
+  if (!parse_u32(f[0], l.seq)) return garbled_spindown_line("sequence number is not a uint32");
+  if (!parse_u32(f[1], l.time_us)) return garbled_spindown_line("micros is not a uint32");
+  if (!parse_u32(f[2], adc) || adc > 65535) return garbled_spindown_line("ADC count is not 0-65535");
   l.adc = static_cast<std::int32_t>(adc);
   l.kind = SpindownLine::Kind::sample;
   return l;
@@ -95,41 +95,41 @@ SpindownLine parse_banner(std::string_view body) {
     const auto kv = body.substr(0, sp);
     body.remove_prefix(sp == std::string_view::npos ? body.size() : sp);
     const auto eq = kv.find('=');
-    if (eq == std::string_view::npos || eq == 0) return garbled("banner field is not key=value");
+    if (eq == std::string_view::npos || eq == 0) return garbled_spindown_line("banner field is not key=value");
     const auto key = kv.substr(0, eq);
     const auto val = kv.substr(eq + 1);
     std::uint32_t u = 0;
     if (key == "firmware") {
-      if (val.empty()) return garbled("banner firmware is empty");
+      if (val.empty()) return garbled_spindown_line("banner firmware is empty");
       b.firmware = val, have_fw = true;
     } else if (key == "version") {
-      if (val.empty()) return garbled("banner version is empty");
+      if (val.empty()) return garbled_spindown_line("banner version is empty");
       b.version = val, have_ver = true;
     } else if (key == "time") {
-      if (val != "us") return garbled("banner time unit is not 'us'");
+      if (val != "us") return garbled_spindown_line("banner time unit is not 'us'");
       have_time = true;
     } else if (key == "value") {
-      if (val != "adc") return garbled("banner value unit is not 'adc'");
+      if (val != "adc") return garbled_spindown_line("banner value unit is not 'adc'");
       have_value = true;
     } else if (key == "adc_bits") {
-      if (!parse_u32(val, u) || u < 1 || u > 16) return garbled("banner adc_bits is not 1-16");
+      if (!parse_u32(val, u) || u < 1 || u > 16) return garbled_spindown_line("banner adc_bits is not 1-16");
       b.adc_bits = int(u), have_bits = true;
     } else if (key == "adc_ref_v") {
       double v = 0;
       const auto r = std::from_chars(val.data(), val.data() + val.size(), v);
       if (r.ec != std::errc{} || r.ptr != val.data() + val.size() || !std::isfinite(v) || v <= 0 || v > 100)
-        return garbled("banner adc_ref_v is not a voltage in (0, 100]");
+        return garbled_spindown_line("banner adc_ref_v is not a voltage in (0, 100]");
       b.adc_ref_v = v, have_ref = true;
     } else if (key == "period_us") {
-      if (!parse_u32(val, u) || u == 0) return garbled("banner period_us is not a positive integer");
+      if (!parse_u32(val, u) || u == 0) return garbled_spindown_line("banner period_us is not a positive integer");
       b.period_us = u, have_period = true;
     } else if (key == "baud") {
-      if (!parse_u32(val, u) || u == 0 || u > 10'000'000) return garbled("banner baud is not a baud rate");
+      if (!parse_u32(val, u) || u == 0 || u > 10'000'000) return garbled_spindown_line("banner baud is not a baud rate");
       b.baud = std::int32_t(u), have_baud = true;
     }  // unknown keys: later firmware may add fields
   }
   if (!(have_fw && have_ver && have_time && have_value && have_bits && have_ref && have_period && have_baud))
-    return garbled("banner lacks a required field");
+    return garbled_spindown_line("banner lacks a required field");
   l.kind = SpindownLine::Kind::banner;
   return l;
 }
@@ -156,9 +156,9 @@ SpindownLine parse_spindown_line(std::string_view line) {
     l.kind = SpindownLine::Kind::blank;
     return l;
   }
-  if (!looks_like_spindown_line(line)) return garbled("not a spindown-v1 line (want 'S,' or '#')");
+  if (!looks_like_spindown_line(line)) return garbled_spindown_line("not a spindown-v1 line (want 'S,' or '#')");
   std::string_view body, why;
-  if (!check_crc(line, body, why)) return garbled(why);
+  if (!check_crc(line, body, why)) return garbled_spindown_line(why);
   if (line.front() == 'S') return parse_sample(body);
   if (body.substr(1).starts_with(spindown_protocol_name) &&
       (body.size() == 1 + spindown_protocol_name.size() || body[1 + spindown_protocol_name.size()] == ' '))

@@ -11,9 +11,6 @@ namespace spindown {
 
 namespace {
 
-// A finite number, or null (JSON has no NaN or infinity).
-Json number(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
-
 std::size_t model_index(const fit_t& msg, std::string_view name) {
   const auto n = static_cast<std::size_t>(std::max(0, msg.nmodels));
   for (std::size_t i = 0; i < n && i < msg.model.size(); ++i)
@@ -42,15 +39,15 @@ Json param_json(const fit_t& msg, std::string_view model_name, std::string_view 
        ++k) {
     if (msg.param_model[k] != static_cast<std::int32_t>(i) || msg.param_name[k] != param) continue;
     Json j;
-    j["value"] = number(msg.param_value[k]);
-    j["stderr"] = number(msg.param_stderr[k]);
+    j["value"] = json_number(msg.param_value[k]);
+    j["stderr"] = json_number(msg.param_stderr[k]);
     j["unit"] = msg.param_unit[k];
     j["model"] = std::string(model_name);
     j["text"] = value_text(msg.param_value[k], msg.param_stderr[k], msg.param_unit[k], lab_units);
     const double bench_error = k < msg.param_bench_error.size() ? msg.param_bench_error[k] : 0.0;
     if (bench_error > 0) {
       const double total = std::hypot(msg.param_stderr[k], bench_error);
-      j["total_stderr"] = number(total);
+      j["total_stderr"] = json_number(total);
       j["total_text"] = value_text(msg.param_value[k], total, msg.param_unit[k], lab_units);
     }
     return j;
@@ -99,8 +96,10 @@ double round_significant(double v, int digits) {
 
 }  // namespace
 
+Json json_number(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+
 Json plot_point(double x, double y) {
-  return Json::array({std::isfinite(x) ? Json(std::round(x * 1e4) / 1e4) : Json(nullptr), number(round_significant(y, 7))});
+  return Json::array({std::isfinite(x) ? Json(std::round(x * 1e4) / 1e4) : Json(nullptr), json_number(round_significant(y, 7))});
 }
 
 std::string health_text(const fit_t& msg) {
@@ -125,11 +124,11 @@ Json fit_summary_json(const fit_t& msg, bool lab_units) {
     doubts.push_back(msg.doubts[i]);
   j["doubts"] = std::move(doubts);
   const std::size_t best = model_index(msg, msg.best);
-  j["rmse"] = best < msg.rmse.size() ? number(msg.rmse[best]) : Json(nullptr);
+  j["rmse"] = best < msg.rmse.size() ? json_number(msg.rmse[best]) : Json(nullptr);
   j["residual_unit"] = msg.residual_unit;
-  j["t_cut_s"] = number(msg.t_cut_s);
-  j["t_stop_s"] = number(msg.t_stop_s);
-  j["t_end_s"] = number(msg.t_end_s);
+  j["t_cut_s"] = json_number(msg.t_cut_s);
+  j["t_stop_s"] = json_number(msg.t_stop_s);
+  j["t_end_s"] = json_number(msg.t_end_s);
   j["end"] = msg.end;
   j["bench_source"] = msg.bench_source;
   j["samples"] = msg.samples;
@@ -156,8 +155,8 @@ std::optional<Json> fit_curves_json(const fit_t& msg, const RunTrace* trace, std
     Json mj;
     mj["name"] = std::string(model_name(m.kind));
     mj["converged"] = m.converged;
-    mj["rmse"] = number(m.rmse);
-    mj["t_stop_pred_s"] = number(m.t_stop_pred_s);
+    mj["rmse"] = json_number(m.rmse);
+    mj["t_stop_pred_s"] = json_number(m.t_stop_pred_s);
     mj["message"] = m.message;
     mj["curve"] = m.converged ? curve_json(*fit, m, tau_end, curve_points) : Json::array();
     models.push_back(std::move(mj));
@@ -179,7 +178,7 @@ std::optional<Json> fit_curves_json(const fit_t& msg, const RunTrace* trace, std
     Json r;
     r["model"] = fit->best;
     r["unit"] = msg.residual_unit;
-    r["noise"] = number(msg.reading_noise);
+    r["noise"] = json_number(msg.reading_noise);
     r["points"] = std::move(pts);
     j["residuals"] = std::move(r);
   }
@@ -190,9 +189,9 @@ Json explain_json(const explain_t& msg, bool lab_units) {
   Json j;
   j["run"] = msg.run;
   j["base"] = msg.base;
-  j["rmse_base"] = number(msg.rmse_base);
-  j["rmse_final"] = number(msg.rmse_final);
-  j["noise_level"] = number(msg.noise_level);
+  j["rmse_base"] = json_number(msg.rmse_base);
+  j["rmse_final"] = json_number(msg.rmse_final);
+  j["noise_level"] = json_number(msg.noise_level);
   Json steps = Json::array();
   const auto ns = static_cast<std::size_t>(std::max(0, msg.nsteps));
   for (std::size_t i = 0; i < ns && i < msg.step_added.size() && i < msg.step_rmse_before.size() &&
@@ -201,17 +200,17 @@ Json explain_json(const explain_t& msg, bool lab_units) {
     Json s;
     s["added"] = msg.step_added[i];
     s["why"] = msg.step_why[i];
-    s["rmse_before"] = number(msg.step_rmse_before[i]);
-    s["rmse_after"] = number(msg.step_rmse_after[i]);
+    s["rmse_before"] = json_number(msg.step_rmse_before[i]);
+    s["rmse_after"] = json_number(msg.step_rmse_after[i]);
     Json where = Json::array();
     const auto nw = static_cast<std::size_t>(std::max(0, msg.nwhere));
     for (std::size_t w = 0; w < nw && w < msg.where_step.size() && w < msg.where_t_from_s.size() &&
                             w < msg.where_t_to_s.size() && w < msg.where_mean_residual.size();
          ++w)
       if (msg.where_step[w] == static_cast<std::int32_t>(i))
-        where.push_back({{"t_from_s", number(msg.where_t_from_s[w])},
-                         {"t_to_s", number(msg.where_t_to_s[w])},
-                         {"mean_residual", number(msg.where_mean_residual[w])}});
+        where.push_back({{"t_from_s", json_number(msg.where_t_from_s[w])},
+                         {"t_to_s", json_number(msg.where_t_to_s[w])},
+                         {"mean_residual", json_number(msg.where_mean_residual[w])}});
     s["where"] = std::move(where);
     steps.push_back(std::move(s));
   }
@@ -223,8 +222,8 @@ Json explain_json(const explain_t& msg, bool lab_units) {
                           k < msg.param_stderr.size() && k < msg.param_unit.size();
        ++k)
     params.push_back({{"name", msg.param_name[k]},
-                      {"value", number(msg.param_value[k])},
-                      {"stderr", number(msg.param_stderr[k])},
+                      {"value", json_number(msg.param_value[k])},
+                      {"stderr", json_number(msg.param_stderr[k])},
                       {"unit", msg.param_unit[k]},
                       {"text", value_text(msg.param_value[k], msg.param_stderr[k], msg.param_unit[k], lab_units)}});
   j["params"] = std::move(params);

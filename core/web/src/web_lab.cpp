@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <limits>
 
+#include "spindown/fail_why.hpp"
 #include "spindown/fit_message.hpp"
 #include "spindown/fit_view.hpp"
 #include "spindown/lcm_channels.hpp"
@@ -17,7 +18,6 @@ namespace {
 constexpr double nan = std::numeric_limits<double>::quiet_NaN();
 constexpr std::size_t tile_curve_points = 60;
 
-Json number(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 
 std::string_view unit_of(std::int8_t quantity) {
   const auto q = quantity_from_samples_code(quantity);
@@ -45,17 +45,13 @@ double WebRun::x0() const {
 }
 
 bool WebLabOptions::is_valid(std::string* why) const {
-  const auto fail = [&](std::string text) {
-    if (why) *why = std::move(text);
-    return false;
-  };
-  if (!(silent_after_s > 0)) return fail("the silence limit must be positive");
-  if (max_benches < 1) return fail("at least one bench must be kept");
-  if (runs_kept < 1) return fail("at least one run per bench must be kept");
-  if (max_run_samples < 2 || max_display_points < 2) return fail("a run needs at least 2 samples and 2 points");
+  if (!(silent_after_s > 0)) return fail_why(why, "the silence limit must be positive");
+  if (max_benches < 1) return fail_why(why, "at least one bench must be kept");
+  if (runs_kept < 1) return fail_why(why, "at least one run per bench must be kept");
+  if (max_run_samples < 2 || max_display_points < 2) return fail_why(why, "a run needs at least 2 samples and 2 points");
   for (const auto& id : expected_benches) {
     std::string bad;
-    if (!is_valid_bench_id(id, &bad)) return fail(fmt::format("bench '{}': {}", id, bad));
+    if (!is_valid_bench_id(id, &bad)) return fail_why(why, fmt::format("bench '{}': {}", id, bad));
   }
   return true;
 }
@@ -242,8 +238,8 @@ Json WebLab::run_summary_json(const Bench& b, const WebRun& r, bool counts) cons
   j["partial"] = r.partial;
   j["open"] = r.open;
   j["note"] = r.note;
-  j["t_cut_s"] = number(r.t_cut_s);
-  j["t_stop_s"] = number(r.t_stop_s);
+  j["t_cut_s"] = json_number(r.t_cut_s);
+  j["t_stop_s"] = json_number(r.t_stop_s);
   if (counts) {  // not in a tile's pushed summary: it would change with every sample
     j["samples"] = r.trace.received();
     j["truncated"] = r.trace.truncated();
@@ -277,7 +273,7 @@ Json WebLab::summary_json(const Bench& b, std::int64_t now_us, bool counters) co
   j["last_fit"] = b.last_fit;
   j["last_fit_curve"] = b.last_fit_curve;
   if (counters) {
-    j["value"] = number(b.activity.last_value);
+    j["value"] = json_number(b.activity.last_value);
     j["last_sample_age_s"] = b.activity.last_sample_us > 0 ? Json(1e-6 * double(now_us - b.activity.last_sample_us))
                                                           : Json(nullptr);
     j["samples"] = row ? row->samples : 0;
@@ -308,7 +304,7 @@ Json WebLab::points_json(const Bench& b, std::size_t first, std::size_t step, bo
     j["x0"] = x0;
     j["p"] = std::move(p);
   }
-  j["live"] = number(b.activity.last_value);
+  j["live"] = json_number(b.activity.last_value);
   return j;
 }
 

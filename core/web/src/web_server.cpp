@@ -13,6 +13,7 @@
 #include <httplib.h>
 
 #include "spindown/clock.hpp"
+#include "spindown/fail_why.hpp"
 #include "spindown/lcm_channels.hpp"
 #include "spindown/web_assets.hpp"
 
@@ -50,12 +51,6 @@ std::optional<std::int32_t> run_number(const std::string& text) {
   return n;
 }
 
-// cpp-httplib's server, able to serve on a listening socket it did not open (one inherited from
-// deploy/run-lab, which opens it outside the lab's private network namespace).
-class AdoptingServer : public httplib::Server {
- public:
-  void adopt(int fd) { svr_sock_ = fd; }
-};
 
 // The address and port a socket is bound to; false when fd is not a listening TCP socket.
 bool listening_address(int fd, std::string& host, int& port) {
@@ -84,24 +79,28 @@ bool listening_address(int fd, std::string& host, int& port) {
 }  // namespace
 
 bool parse_listen_address(std::string_view text, std::string& host, int& port, std::string* why) {
-  const auto fail = [&](std::string w) {
-    if (why) *why = std::move(w);
-    return false;
-  };
   const std::size_t colon = text.rfind(':');
   if (colon == std::string_view::npos || colon == 0)
-    return fail(fmt::format("'{}' is not ADDR:PORT (e.g. 0.0.0.0:8080, 127.0.0.1:8080, [::]:8080)", text));
+    return fail_why(why, fmt::format("'{}' is not ADDR:PORT (e.g. 0.0.0.0:8080, 127.0.0.1:8080, [::]:8080)", text));
   std::string_view h = text.substr(0, colon), p = text.substr(colon + 1);
   if (h.size() >= 2 && h.front() == '[' && h.back() == ']') h = h.substr(1, h.size() - 2);
   int value = -1;
   const auto [end, ec] = std::from_chars(p.data(), p.data() + p.size(), value);
   if (ec != std::errc() || end != p.data() + p.size() || value < 0 || value > 65535)
-    return fail(fmt::format("'{}': the port '{}' is not a number from 0 to 65535", text, p));
-  if (h.empty()) return fail(fmt::format("'{}': no address before the port", text));
+    return fail_why(why, fmt::format("'{}': the port '{}' is not a number from 0 to 65535", text, p));
+  if (h.empty()) return fail_why(why, fmt::format("'{}': no address before the port", text));
   host = std::string(h);
   port = value;
   return true;
 }
+
+// cpp-httplib's server, able to serve on a listening socket it did not open (one inherited from
+// deploy/run-lab, which opens it outside the lab's private network namespace). Not in the anonymous
+// namespace: Impl, which holds one, has external linkage.
+class AdoptingServer : public httplib::Server {
+ public:
+  void adopt(int fd) { svr_sock_ = fd; }
+};
 
 struct WebServer::Impl {
   WebLab& lab;

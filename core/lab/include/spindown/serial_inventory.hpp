@@ -64,19 +64,19 @@ DoctorCheck check_serial_device(const std::string& bench, const std::string& dev
                                 const ServiceUser& user, bool bridge_enabled_here);
 
 // A bench file as the doctor found it: its name, and the settings or why they did not load.
-struct BenchFile {
+struct BridgeBenchFile {
   std::string path;
   std::string stem;                        // file name without .toml = the unit's instance (bench id)
   std::optional<BridgeSettings> settings;  // nullopt: error says why
   std::string error;
 };
 // Reads every *.toml of a directory (sorted), or the files given. A file that does not load
-// becomes a BenchFile with its error.
-std::vector<BenchFile> read_bench_files(const std::vector<std::string>& files_or_dirs);
+// becomes a BridgeBenchFile with its error.
+std::vector<BridgeBenchFile> read_bench_files(const std::vector<std::string>& files_or_dirs);
 
 // The bench files together: fail for a file that does not load, for two benches on one device;
 // warn when bench_id in a file differs from its file name (the unit's instance wins, so the
 // bench would publish under the file name), or when no bench is configured.
-std::vector<DoctorCheck> check_bench_files(const std::vector<BenchFile>& files, const std::string& where);
+std::vector<DoctorCheck> check_bench_files(const std::vector<BridgeBenchFile>& files, const std::string& where);
 
 }  // namespace spindown

@@ -16,6 +16,9 @@
 
 namespace spindown {
 
+// A finite number, or null (JSON has no NaN or infinity).
+Json json_number(double v);
+
 // A point of a plot, [x, y] to the plots' resolution (x to 0.1 ms, y to 7 significant digits,
 // each the decimal's nearest double): shorter JSON for the pages; the CSV keeps every digit.
 Json plot_point(double x, double y);
