@@ -21,7 +21,9 @@ TEST(SessionId, RandomNeverZeroAndPrintedAsSixteenHexDigits) {
   EXPECT_EQ(source_text("pc-1", 0xab), "host pc-1 (session 00000000000000ab)");
   EXPECT_NE(source_text("", 0).find("an unnamed source"), std::string::npos);
   // A hostile host name is printed safely: cut, control characters and non-UTF-8 escaped.
-  const std::string shown = shown_name(std::string("evil\nline\x01\xff") + std::string(100, 'x'));
+  std::string hostile = "evil\nline\x01\xff";
+  hostile.append(100, 'x');
+  const std::string shown = shown_name(hostile);
   EXPECT_EQ(shown.find('\n'), std::string::npos);
   EXPECT_NE(shown.find("\\xff"), std::string::npos);
   EXPECT_LT(shown.size(), 80u);

@@ -87,165 +87,223 @@ inline Case single(std::string pattern, const SyntheticRunSpec& spec) {
   return c;
 }
 
-// per_pattern recordings of each kind, varied in seed, noise, level and friction.
+// The spec every pattern of round k starts from: varied in seed, noise, level and friction.
+inline SyntheticRunSpec base_spec(int k) {
+  SyntheticRunSpec base;
+  base.seed = 7000 + std::uint64_t(k);
+  base.e0_v = 1.5 + 0.25 * (k % 7);
+  base.noise_v = (k % 3 == 0) ? 0.003 : (k % 3 == 1 ? 0.01 : 0.001);
+  if (k % 4 == 1) base.friction = {6e-7, 0.6e-4};  // more viscous, less Coulomb
+  if (k % 4 == 3) base.friction = {1e-7, 8e-5, 0, 0, 2e-9};  // windage
+  return base;
+}
+
+// The lab's own rig, as a control
+inline Case lab_case(const SyntheticRunSpec& base, int k) {
+  SyntheticRunSpec s = base;
+  s.lead_in = LeadIn(k % 3);
+  return single("lab", s);
+}
+
+// The handout's step 6: A0 floats (mains hum, 0.5-2.5 V) until it is connected after the cut
+inline Case floating_pin_case(const SyntheticRunSpec& base, int k) {
+  SyntheticRunSpec s = base;
+  s.lead_in = LeadIn::floating;
+  s.lead_in_s = 3.0 + 2.0 * (k % 6);
+  s.e0_v = 2.6 + 0.1 * (k % 9);
+  return single("floating pin", s);
+}
+
+// A motor ramp straight into the peak, read by a speed sensor
+inline Case ramp_case(const SyntheticRunSpec& base, int k) {
+  SyntheticRunSpec s = base;
+  s.lead_in = LeadIn::spin_up;
+  s.lead_in_s = 4.0 + k % 5;
+  s.spin_up_s = s.lead_in_s * (0.5 + 0.1 * (k % 5));
+  return single("ramp", s);
+}
+
+// Spun by hand: a fraction of a second's push
+inline Case hand_spin_case(const SyntheticRunSpec& base, int k) {
+  SyntheticRunSpec s = base;
+  s.lead_in = LeadIn::spin_up;
+  s.spin_up_s = 0.2 + 0.05 * (k % 5);
+  return single("hand spin", s);
+}
+
+// The logger paused for minutes; the coast begins at the first sample after it
+inline Case pause_before_the_coast_case(const SyntheticRunSpec& base, int k) {
+  SyntheticRunSpec s = base;
+  s.lead_in = k % 2 ? LeadIn::supply : LeadIn::zeros;
+  s.gap_s = 30.0 + 15.0 * (k % 8);
+  s.lead_in_s = s.gap_s + 5.0;
+  s.gap_from_s = -(s.gap_s - 0.2 - 0.3 * (k % 6));
+  return single("pause before the coast", s);
+}
+
+// A heavy flywheel coasting for 10-14 minutes
+inline Case long_coast_case(const SyntheticRunSpec& base, int k) {
+  SyntheticRunSpec s = base;
+  s.bench.inertia_kg_m2 = base.bench.inertia_kg_m2 * (20.0 + 2.0 * (k % 5));
+  s.friction = {1.822e-7, 1.1389e-4};
+  s.period_s = 0.1;
+  s.jitter_s = 0.002;
+  s.max_coast_s = 1200;
+  return single("long coast", s);
+}
+
+// The heavy flywheel logged once a second: the windows must hold enough of its readings
+inline Case slow_logger_case(const SyntheticRunSpec& base, int k) {
+  SyntheticRunSpec s = base;
+  s.bench.inertia_kg_m2 = base.bench.inertia_kg_m2 * (20.0 + 2.0 * (k % 5));
+  s.friction = {1.822e-7, 1.1389e-4};
+  s.period_s = 1.0;
+  s.jitter_s = 0.01;
+  s.lead_in_s = 20.0;
+  s.tail_s = 60.0;
+  s.max_coast_s = 1200;
+  return single("slow logger", s);
+}
+
+// Single dropouts (0) and glitches (half the value) inside the coast
+inline Case dropouts_case(const SyntheticRunSpec& base, int k) {
+  SyntheticRunSpec s = base;
+  s.glitches = 3 + k % 5;
+  return single("dropouts", s);
+}
+
+// A per-revolution sensor that gives up (reads 0) at low speed
+inline Case per_rev_sensor_case(const SyntheticRunSpec& base, int k) {
+  SyntheticRunSpec s = base;
+  s.pulses_per_rev = 1 + k % 4;
+  s.pulse_timeout_s = 0.5 + 0.25 * (k % 4);
+  s.lead_in = LeadIn::spin_up;
+  s.spin_up_s = 2.0;
+  return single("per-rev sensor", s);
+}
+
+// A run, then a nudge: a small, short coast that is no run
+inline Case nudge_after_a_run_case(const SyntheticRunSpec& base, int k) {
+  Case c = single("nudge after a run", base);
+  SyntheticRunSpec s = base;
+  s.seed = base.seed + 99;
+  s.e0_v = base.e0_v * (0.04 + 0.01 * (k % 4));  // a 1-2 s nudge beside a 15-30 s coast
+  s.lead_in = LeadIn::zeros;
+  s.t0_ms = c.rec.t_s.back() * 1000.0 + 20;
+  append(c.rec, make_synthetic_run(s));
+  return c;
+}
+
+// A nudge, then the real spin: the nudge came first, so it stays a run, with a warning
+inline Case nudge_before_a_run_case(const SyntheticRunSpec& base, int k) {
+  SyntheticRunSpec s = base;
+  s.seed = base.seed + 77;
+  s.e0_v = base.e0_v * (0.04 + 0.01 * (k % 4));
+  s.lead_in_s = 1.0;
+  s.tail_s = 1.0;
+  const SyntheticRun nudge = make_synthetic_run(s);
+  Case c;
+  c.pattern = "nudge before a run";
+  append(c.rec, nudge);
+  SyntheticRunSpec real = base;
+  real.t0_ms = nudge.t_ms.back() + 20;
+  add_run(c, make_synthetic_run(real));
+  return c;
+}
+
+// An Arduino reset mid-coast: the device clock restarts, the coast goes on
+inline Case reset_mid_coast_case(const SyntheticRunSpec& base, int k) {
+  SyntheticRunSpec s = base;
+  Case c = single("reset mid-coast", s);
+  const SyntheticRun sim = make_synthetic_run(s);
+  const double t_reset = sim.t_cut_ms / 1000.0 + sim.t_stop_s * (0.3 + 0.08 * (k % 5));
+  Recording out;
+  out.source = c.rec.source;
+  std::size_t at = 0;
+  for (std::size_t i = 0; i < c.rec.size(); ++i) {
+    const double t = c.rec.t_s[i];
+    if (t < t_reset) {
+      out.push(t, c.rec.value[i]);
+    } else if (t >= t_reset + 0.3) {  // the bootloader's silence, then millis() from 0
+      if (at == 0) at = out.size();
+      out.push(t - t_reset, c.rec.value[i]);
+    }
+  }
+  out.clock_restarts.push_back(at);
+  c.rec = std::move(out);
+  c.runs[0].end = TruthRun::End::goes_on;
+  c.runs[0].t_end_s = c.rec.t_s[at - 1];
+  return c;
+}
+
+// Pure viscous friction, slow: an exponential that never stops within the recording
+inline Case slow_viscous_case(const SyntheticRunSpec& base, int k) {
+  SyntheticRunSpec s = base;
+  s.friction = {3e-7 + 1e-7 * (k % 3), 0.0};
+  s.max_coast_s = 90.0 + 10.0 * (k % 4);
+  s.lead_in = LeadIn(k % 3);
+  return single("slow viscous", s);
+}
+
+// A recording started after the cut
+inline Case starts_mid_coast_case(const SyntheticRunSpec& base, int k) {
+  SyntheticRunSpec s = base;
+  s.start_s = 2.0 + 1.5 * (k % 6);
+  return single("starts mid-coast", s);
+}
+
+// Three runs back to back, as a lab session records them (each lead-in in turn)
+inline Case three_runs_case(const SyntheticRunSpec& base, int k) {
+  Case c;
+  c.pattern = "three runs";
+  double t0_ms = 5234;
+  for (int r = 0; r < 3; ++r) {
+    SyntheticRunSpec s = base;
+    s.seed = base.seed * 3 + std::uint64_t(r);
+    s.lead_in = LeadIn((k + r) % 3);
+    s.e0_v = base.e0_v + 0.3 * r;
+    s.t0_ms = t0_ms;
+    const SyntheticRun sim = make_synthetic_run(s);
+    add_run(c, sim);
+    t0_ms = sim.t_ms.back() + 20;
+  }
+  return c;
+}
+
+// An uneven loop: periods from 11 to 29 ms
+inline Case uneven_sampling_case(const SyntheticRunSpec& base, int k) {
+  SyntheticRunSpec s = base;
+  s.lead_in = LeadIn(k % 3);
+  s.jitter_s = 0.009;
+  return single("uneven sampling", s);
+}
+
+// per_pattern recordings of each kind, varied in seed, noise, level and friction: each round k
+// makes one of every pattern, in this order.
 inline std::vector<Case> make_cases(int per_pattern) {
+  using Pattern = Case (*)(const SyntheticRunSpec& base, int k);
+  static constexpr Pattern patterns[] = {
+      lab_case,
+      floating_pin_case,
+      ramp_case,
+      hand_spin_case,
+      pause_before_the_coast_case,
+      long_coast_case,
+      slow_logger_case,
+      dropouts_case,
+      per_rev_sensor_case,
+      nudge_after_a_run_case,
+      nudge_before_a_run_case,
+      reset_mid_coast_case,
+      slow_viscous_case,
+      starts_mid_coast_case,
+      three_runs_case,
+      uneven_sampling_case,
+  };
   std::vector<Case> cases;
   for (int k = 0; k < per_pattern; ++k) {
-    SyntheticRunSpec base;
-    base.seed = 7000 + std::uint64_t(k);
-    base.e0_v = 1.5 + 0.25 * (k % 7);
-    base.noise_v = (k % 3 == 0) ? 0.003 : (k % 3 == 1 ? 0.01 : 0.001);
-    if (k % 4 == 1) base.friction = {6e-7, 0.6e-4};  // more viscous, less Coulomb
-    if (k % 4 == 3) base.friction = {1e-7, 8e-5, 0, 0, 2e-9};  // windage
-
-    {  // the lab's own rig, as a control
-      SyntheticRunSpec s = base;
-      s.lead_in = LeadIn(k % 3);
-      cases.push_back(single("lab", s));
-    }
-    {  // the handout's step 6: A0 floats (mains hum, 0.5-2.5 V) until it is connected after the cut
-      SyntheticRunSpec s = base;
-      s.lead_in = LeadIn::floating;
-      s.lead_in_s = 3.0 + 2.0 * (k % 6);
-      s.e0_v = 2.6 + 0.1 * (k % 9);
-      cases.push_back(single("floating pin", s));
-    }
-    {  // a motor ramp straight into the peak, read by a speed sensor
-      SyntheticRunSpec s = base;
-      s.lead_in = LeadIn::spin_up;
-      s.lead_in_s = 4.0 + k % 5;
-      s.spin_up_s = s.lead_in_s * (0.5 + 0.1 * (k % 5));
-      cases.push_back(single("ramp", s));
-    }
-    {  // spun by hand: a fraction of a second's push
-      SyntheticRunSpec s = base;
-      s.lead_in = LeadIn::spin_up;
-      s.spin_up_s = 0.2 + 0.05 * (k % 5);
-      cases.push_back(single("hand spin", s));
-    }
-    {  // the logger paused for minutes; the coast begins at the first sample after it
-      SyntheticRunSpec s = base;
-      s.lead_in = k % 2 ? LeadIn::supply : LeadIn::zeros;
-      s.gap_s = 30.0 + 15.0 * (k % 8);
-      s.lead_in_s = s.gap_s + 5.0;
-      s.gap_from_s = -(s.gap_s - 0.2 - 0.3 * (k % 6));
-      cases.push_back(single("pause before the coast", s));
-    }
-    {  // a heavy flywheel coasting for 10-14 minutes
-      SyntheticRunSpec s = base;
-      s.bench.inertia_kg_m2 = base.bench.inertia_kg_m2 * (20.0 + 2.0 * (k % 5));
-      s.friction = {1.822e-7, 1.1389e-4};
-      s.period_s = 0.1;
-      s.jitter_s = 0.002;
-      s.max_coast_s = 1200;
-      cases.push_back(single("long coast", s));
-    }
-    {  // the heavy flywheel logged once a second: the windows must hold enough of its readings
-      SyntheticRunSpec s = base;
-      s.bench.inertia_kg_m2 = base.bench.inertia_kg_m2 * (20.0 + 2.0 * (k % 5));
-      s.friction = {1.822e-7, 1.1389e-4};
-      s.period_s = 1.0;
-      s.jitter_s = 0.01;
-      s.lead_in_s = 20.0;
-      s.tail_s = 60.0;
-      s.max_coast_s = 1200;
-      cases.push_back(single("slow logger", s));
-    }
-    {  // single dropouts (0) and glitches (half the value) inside the coast
-      SyntheticRunSpec s = base;
-      s.glitches = 3 + k % 5;
-      cases.push_back(single("dropouts", s));
-    }
-    {  // a per-revolution sensor that gives up (reads 0) at low speed
-      SyntheticRunSpec s = base;
-      s.pulses_per_rev = 1 + k % 4;
-      s.pulse_timeout_s = 0.5 + 0.25 * (k % 4);
-      s.lead_in = LeadIn::spin_up;
-      s.spin_up_s = 2.0;
-      cases.push_back(single("per-rev sensor", s));
-    }
-    {  // a run, then a nudge: a small, short coast that is no run
-      Case c = single("nudge after a run", base);
-      SyntheticRunSpec s = base;
-      s.seed = base.seed + 99;
-      s.e0_v = base.e0_v * (0.04 + 0.01 * (k % 4));  // a 1-2 s nudge beside a 15-30 s coast
-      s.lead_in = LeadIn::zeros;
-      s.t0_ms = c.rec.t_s.back() * 1000.0 + 20;
-      append(c.rec, make_synthetic_run(s));
-      cases.push_back(std::move(c));
-    }
-    {  // a nudge, then the real spin: the nudge came first, so it stays a run, with a warning
-      SyntheticRunSpec s = base;
-      s.seed = base.seed + 77;
-      s.e0_v = base.e0_v * (0.04 + 0.01 * (k % 4));
-      s.lead_in_s = 1.0;
-      s.tail_s = 1.0;
-      const SyntheticRun nudge = make_synthetic_run(s);
-      Case c;
-      c.pattern = "nudge before a run";
-      append(c.rec, nudge);
-      SyntheticRunSpec real = base;
-      real.t0_ms = nudge.t_ms.back() + 20;
-      add_run(c, make_synthetic_run(real));
-      cases.push_back(std::move(c));
-    }
-    {  // an Arduino reset mid-coast: the device clock restarts, the coast goes on
-      SyntheticRunSpec s = base;
-      Case c = single("reset mid-coast", s);
-      const SyntheticRun sim = make_synthetic_run(s);
-      const double t_reset = sim.t_cut_ms / 1000.0 + sim.t_stop_s * (0.3 + 0.08 * (k % 5));
-      Recording out;
-      out.source = c.rec.source;
-      std::size_t at = 0;
-      for (std::size_t i = 0; i < c.rec.size(); ++i) {
-        const double t = c.rec.t_s[i];
-        if (t < t_reset) {
-          out.push(t, c.rec.value[i]);
-        } else if (t >= t_reset + 0.3) {  // the bootloader's silence, then millis() from 0
-          if (at == 0) at = out.size();
-          out.push(t - t_reset, c.rec.value[i]);
-        }
-      }
-      out.clock_restarts.push_back(at);
-      c.rec = std::move(out);
-      c.runs[0].end = TruthRun::End::goes_on;
-      c.runs[0].t_end_s = c.rec.t_s[at - 1];
-      cases.push_back(std::move(c));
-    }
-    {  // pure viscous friction, slow: an exponential that never stops within the recording
-      SyntheticRunSpec s = base;
-      s.friction = {3e-7 + 1e-7 * (k % 3), 0.0};
-      s.max_coast_s = 90.0 + 10.0 * (k % 4);
-      s.lead_in = LeadIn(k % 3);
-      cases.push_back(single("slow viscous", s));
-    }
-    {  // a recording started after the cut
-      SyntheticRunSpec s = base;
-      s.start_s = 2.0 + 1.5 * (k % 6);
-      cases.push_back(single("starts mid-coast", s));
-    }
-    {  // three runs back to back, as a lab session records them (each lead-in in turn)
-      Case c;
-      c.pattern = "three runs";
-      double t0_ms = 5234;
-      for (int r = 0; r < 3; ++r) {
-        SyntheticRunSpec s = base;
-        s.seed = base.seed * 3 + std::uint64_t(r);
-        s.lead_in = LeadIn((k + r) % 3);
-        s.e0_v = base.e0_v + 0.3 * r;
-        s.t0_ms = t0_ms;
-        const SyntheticRun sim = make_synthetic_run(s);
-        add_run(c, sim);
-        t0_ms = sim.t_ms.back() + 20;
-      }
-      cases.push_back(std::move(c));
-    }
-    {  // an uneven loop: periods from 11 to 29 ms
-      SyntheticRunSpec s = base;
-      s.lead_in = LeadIn(k % 3);
-      s.jitter_s = 0.009;
-      cases.push_back(single("uneven sampling", s));
-    }
+    const SyntheticRunSpec base = base_spec(k);
+    for (Pattern make : patterns) cases.push_back(make(base, k));
   }
   for (Case& c : cases) c.rec.source = c.pattern;
   return cases;
