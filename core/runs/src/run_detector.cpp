@@ -207,6 +207,13 @@ std::vector<RunEvent> RunDetector::Impl::take_events() {
   return out;
 }
 
+void RunDetector::Impl::emit_run_event(RunEvent::Kind kind) {
+  RunEvent e;
+  e.kind = kind;
+  e.run = run_;
+  events_.push_back(std::move(e));
+}
+
 void RunDetector::Impl::emit_diag(Diagnostic::Severity sev, std::string msg) {
   RunEvent e;
   e.kind = RunEvent::Kind::diagnostic;
@@ -860,12 +867,7 @@ bool RunDetector::Impl::try_start_coast(std::size_t i, const WindowFit& w) {
   level_min_ = std::numeric_limits<double>::infinity();
   rising_ = 0;
   state_ = State::coasting;
-  {
-    RunEvent e;
-    e.kind = RunEvent::Kind::cut;
-    e.run = run_;
-    events_.push_back(std::move(e));
-  }
+  emit_run_event(RunEvent::Kind::cut);
   // The coast's hold windows follow its own sample rate (a stream may change its rate between runs).
   set_spans(shortest_period(w));  // lost samples only lengthen periods: the shortest is the rate
   reset_window(hold_, run_.cut_index, i + 1);

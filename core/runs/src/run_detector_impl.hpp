@@ -316,6 +316,8 @@ class RunDetector::Impl {
   // (lo when not given).
   void to_idle(std::size_t lo, bool need_quiet, std::size_t search_from = SIZE_MAX);
   void emit_diag(Diagnostic::Severity sev, std::string msg);
+  // An event of the open run (its cut, its stop), as the run stands now.
+  void emit_run_event(RunEvent::Kind kind);
   double median_of(std::size_t from, std::size_t to);
   // The smallest positive change between consecutive readings in [from, to): the converter's or
   // the printing's step on quantized readings; 0 when none changes.

@@ -349,10 +349,7 @@ void RunDetector::Impl::stop_at(std::size_t i, std::size_t stop, double z, doubl
   depart_band_ = std::max(6.0 * sd_z, 0.05 * std::abs(amp));
   departing_ = 0;
   state_ = State::tail;
-  RunEvent e;
-  e.kind = RunEvent::Kind::stop;
-  e.run = run_;
-  events_.push_back(std::move(e));
+  emit_run_event(RunEvent::Kind::stop);
   tail_ends_by_time(i);
 }
 
