@@ -310,12 +310,17 @@ void RunDetector::Impl::recut_after_rise(Run& r, std::size_t coast_end) {
   // Far beyond the coast's sample-to-sample noise (the median over the whole coast: a rough stretch
   // before the rise, an open pin's hum, does not set it).
   const double thr = std::max({8.0 * rough_sd(c, coast_end), 0.05 * std::abs(amp), 3.0 * coast_step_});
-  // Medians of five: a dropout or two (a loose wire's zeros) are no rise.
-  const auto med5 = [&](std::size_t k) {
-    double a[5] = {v(k - 2), v(k - 1), v(k), v(k + 1), v(k + 2)};
-    std::nth_element(a, a + 2, a + 5);
-    return a[2];
-  };
+  // Medians of five: a dropout or two (a loose wire's zeros) are no rise. Each sample's is taken
+  // once (both searches below read them, three times a sample), by min and max: this search was a
+  // third of `spindown fit`'s time with a sort of five per look.
+  const auto median3 = [](double a, double b, double c) { return std::max(std::min(a, b), std::min(std::max(a, b), c)); };
+  std::vector<double>& medians = median5_;
+  medians.resize(coast_end - c);
+  for (std::size_t k = c + 2; k + 2 < coast_end; ++k) {
+    const double a = v(k - 2), b = v(k - 1), d = v(k + 1), e = v(k + 2);
+    medians[k - c] = median3(v(k), std::max(std::min(a, b), std::min(d, e)), std::min(std::max(a, b), std::max(d, e)));
+  }
+  const auto med5 = [&](std::size_t k) { return medians[k - c]; };
   double low = std::numeric_limits<double>::infinity();
   std::size_t rise = 0;
   double rose = 0, rose_from = 0;

@@ -413,6 +413,7 @@ class RunDetector::Impl {
   double* scratch(std::size_t size);
   std::unique_ptr<double[]> scratch_;
   std::size_t scratch_size_ = 0;
+  std::vector<double> median5_;  // recut_after_rise: each coast sample's median of five
 };
 
 }  // namespace spindown
