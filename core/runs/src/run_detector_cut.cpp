@@ -307,9 +307,6 @@ void RunDetector::Impl::recut_after_rise(Run& r, std::size_t coast_end) {
   if (coast_end < c + 16) return;
   const double zero = r.stopped ? r.zero_level : motor_zero();
   const double amp = v0_ - zero;
-  // Far beyond the coast's sample-to-sample noise (the median over the whole coast: a rough stretch
-  // before the rise, an open pin's hum, does not set it).
-  const double thr = std::max({8.0 * rough_sd(c, coast_end), 0.05 * std::abs(amp), 3.0 * coast_step_});
   // Medians of five: a dropout or two (a loose wire's zeros) are no rise. Each sample's is taken
   // once (both searches below read them, three times a sample), by min and max: this search was a
   // third of `spindown fit`'s time with a sort of five per look.
@@ -321,30 +318,42 @@ void RunDetector::Impl::recut_after_rise(Run& r, std::size_t coast_end) {
     medians[k - c] = median3(v(k), std::max(std::min(a, b), std::min(d, e)), std::min(std::max(a, b), std::max(d, e)));
   }
   const auto med5 = [&](std::size_t k) { return medians[k - c]; };
-  double low = std::numeric_limits<double>::infinity();
-  std::size_t rise = 0;
-  double rose = 0, rose_from = 0;
-  for (std::size_t k = c + 2; k + 2 < coast_end; ++k) {
-    const double m = med5(k);
-    if (m - low > thr) {
-      if (rise == 0 || k > rise + 1) rose_from = low;
-      rise = k, rose = m - rose_from, low = m;
-    } else {
-      low = std::min(low, m);
+  // The last rise of more than thr above the lowest reading before it, or a later step down.
+  const auto last_jump = [&](double thr, double& rose) {
+    double low = std::numeric_limits<double>::infinity(), rose_from = 0;
+    std::size_t rise = 0;
+    for (std::size_t k = c + 2; k + 2 < coast_end; ++k) {
+      const double m = med5(k);
+      if (m - low > thr) {
+        if (rise == 0 || k > rise + 1) rose_from = low;
+        rise = k, rose = m - rose_from, low = m;
+      } else {
+        low = std::min(low, m);
+      }
     }
-  }
-  // … nor steps down: a fall within three samples far steeper than the coast's own pace on either
-  // side of it (an open pin above the back-EMF, then connected to the motor).
-  if (coast_end >= c + 24) {
-    for (std::size_t k = c + 10; k + 10 < coast_end; ++k) {
-      const double drop = med5(k - 2) - med5(k + 1);
-      if (!(drop > thr)) continue;
-      const double before = (med5(k - 8) - med5(k - 2)) / (t(k - 2) - t(k - 8));
-      const double after = (med5(k + 1) - med5(k + 7)) / (t(k + 7) - t(k + 1));
-      const double pace = std::max({before, after, 0.0}) * (t(k + 1) - t(k - 2));
-      if (drop > 4.0 * pace + thr && k > rise) rise = k - 1, rose = -drop;
+    // … nor steps down: a fall within three samples far steeper than the coast's own pace on either
+    // side of it (an open pin above the back-EMF, then connected to the motor).
+    if (coast_end >= c + 24) {
+      for (std::size_t k = c + 10; k + 10 < coast_end; ++k) {
+        const double drop = med5(k - 2) - med5(k + 1);
+        if (!(drop > thr)) continue;
+        const double before = (med5(k - 8) - med5(k - 2)) / (t(k - 2) - t(k - 8));
+        const double after = (med5(k + 1) - med5(k + 7)) / (t(k + 7) - t(k + 1));
+        const double pace = std::max({before, after, 0.0}) * (t(k + 1) - t(k - 2));
+        if (drop > 4.0 * pace + thr && k > rise) rise = k - 1, rose = -drop;
+      }
     }
-  }
+    return rise;
+  };
+  // A jump is far beyond the coast's sample-to-sample noise (the median over the whole coast: a
+  // rough stretch before the rise, an open pin's hum, does not set it), a twentieth of the coast's
+  // height and three steps of the print. Most coasts have no jump even of the last two: then the
+  // noise (a median over the whole coast, most of this search's time) is not needed, as a higher
+  // threshold finds no jump where a lower one found none.
+  const double least = std::max(0.05 * std::abs(amp), 3.0 * coast_step_);
+  double rose = 0;
+  if (last_jump(least, rose) == 0) return;
+  const std::size_t rise = last_jump(std::max(8.0 * rough_sd(c, coast_end), least), rose);
   if (rise == 0) return;
   // The coast after the rise: its cut found as any cut is, with the samples before the rise as lead-in.
   std::size_t a = rise, b = rise;
