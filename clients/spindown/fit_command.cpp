@@ -205,8 +205,7 @@ int run_fit(const FitCommandOptions& options) {
         if (csv_table)
           d.text = run_table_csv_rows(d.file, csv_style);
         else if (!json_table)
-          d.text = options.json ? file_fit_json_text(d.file, plan.report) : format_file_fit(d.file, plan.report);
-        if (json_compact) compact_json(d.text);
+          d.text = options.json ? file_fit_json_text(d.file, plan.report, json_compact) : format_file_fit(d.file, plan.report);
         return d;
       },
       [&](std::size_t, Done d) {

@@ -283,15 +283,11 @@ std::string document(std::span<const FileFit> files, const ReportOptions& opt) {
   return fit_report_json(files, opt).dump(2, ' ', false, Json::error_handler_t::replace);
 }
 
-// As `spindown fit --json` writes into a pipe or a file: each entry compacted.
+// As `spindown fit --json` writes into a pipe or a file: compact entries.
 std::string streamed_compact(std::span<const FileFit> files, const ReportOptions& opt) {
   std::string out;
   FitReportJsonText doc(true);
-  for (const auto& f : files) {
-    std::string text = file_fit_json_text(f, opt);
-    compact_json(text);
-    doc.add(text, out);
-  }
+  for (const auto& f : files) doc.add(file_fit_json_text(f, opt, true), out);
   doc.finish(out);
   return out;
 }

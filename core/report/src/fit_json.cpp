@@ -1,4 +1,4 @@
-// The `fit --json` contract (docs/cli.md), written once: PrettyJsonWriter streams it for fit,
+// The `fit --json` contract (docs/cli.md), written once: JsonWriter streams it for fit,
 // refit and the FIT messages; the Json documents are that text read back.
 #include <algorithm>
 #include <cmath>
@@ -11,7 +11,7 @@
 #include "spindown/quantity.hpp"
 
 #include "fit_report_support.hpp"
-#include "pretty_json_writer.hpp"
+#include "json_writer.hpp"
 
 namespace spindown {
 
@@ -35,7 +35,7 @@ bool has_repeated_param_names(const FileFit& file) {
 
 // The `fit --json` contract of one run (with the tags when given); leaves the run's object open
 // (a file's entry adds "health" last).
-void write_run_fit(PrettyJsonWriter& w, const RunFit& fit, const ReportOptions& opt, const RunTags* tags = nullptr) {
+void write_run_fit(JsonWriter& w, const RunFit& fit, const ReportOptions& opt, const RunTags* tags = nullptr) {
   const std::string_view residual_unit = quantity_unit(fit.quantity);
   const Run& run = fit.run;
   w.begin_object();
@@ -160,7 +160,7 @@ void write_run_fit(PrettyJsonWriter& w, const RunFit& fit, const ReportOptions& 
 }
 
 // A run's "health" object.
-void write_health(PrettyJsonWriter& w, const HealthVerdict& v) {
+void write_health(JsonWriter& w, const HealthVerdict& v) {
   w.begin_object();
   w.member("level", health_level_name(v.level));
   w.member("reason", v.reason);
@@ -188,8 +188,9 @@ void write_health(PrettyJsonWriter& w, const HealthVerdict& v) {
 }
 
 // One file's entry of the contract; the writer is done (out cut to its text) on return.
-void write_file_fit(std::string& out, std::size_t indent, const FileFit& file, const ReportOptions& opt) {
-  PrettyJsonWriter w(out, indent);
+void write_file_fit(std::string& out, std::size_t indent, const FileFit& file, const ReportOptions& opt,
+                    bool compact = false) {
+  JsonWriter w(out, indent, compact);
   w.begin_object();
   w.member("file", file.file);
   if (!file.bench.empty()) w.member("bench_id", file.bench);
@@ -237,11 +238,11 @@ void write_file_fit(std::string& out, std::size_t indent, const FileFit& file, c
 
 }  // namespace
 
-std::string file_fit_json_text(const FileFit& file, const ReportOptions& opt) {
-  constexpr std::size_t indent = 4;  // inside {"files": [ … ]}
+std::string file_fit_json_text(const FileFit& file, const ReportOptions& opt, bool compact) {
+  const std::size_t indent = compact ? 0 : 4;  // inside {"files": [ … ]}
   std::string out(indent, ' ');
   if (has_repeated_param_names(file)) {
-    const std::string text = file_fit_json(file, opt).dump(2, ' ', false, Json::error_handler_t::replace);
+    const std::string text = file_fit_json(file, opt).dump(compact ? -1 : 2, ' ', false, Json::error_handler_t::replace);
     for (char c : text) {
       out += c;
       if (c == '\n') out.append(indent, ' ');  // a raw newline in a dump is always layout
@@ -249,7 +250,7 @@ std::string file_fit_json_text(const FileFit& file, const ReportOptions& opt) {
     return out;
   }
   out.reserve(2048 + 3072 * file.runs.size() + 128 * file.diagnostics.size());
-  write_file_fit(out, indent, file, opt);
+  write_file_fit(out, indent, file, opt, compact);
   return out;
 }
 
@@ -259,7 +260,7 @@ namespace {
 std::string run_fit_text(const RunFit& fit, const ReportOptions& opt, const RunTags* tags) {
   std::string out;
   {
-    PrettyJsonWriter w(out, 0);
+    JsonWriter w(out, 0);
     write_run_fit(w, fit, opt, tags);
     w.end_object();
   }
@@ -279,7 +280,7 @@ Json tagged_run_fit_json(const RunFit& fit, const RunTags& tags, const ReportOpt
 Json health_json(const HealthVerdict& v) {
   std::string out;
   {
-    PrettyJsonWriter w(out, 0);
+    JsonWriter w(out, 0);
     write_health(w, v);
   }
   return Json::parse(out);
@@ -318,7 +319,7 @@ void append_run_fit_json_text(std::string& out, const RunFit& fit, const ReportO
     }
     return;
   }
-  PrettyJsonWriter w(out, indent);
+  JsonWriter w(out, indent);
   write_run_fit(w, fit, opt, tags);
   if (health) {  // last, as a file's entry has it
     w.key("health");
@@ -337,24 +338,6 @@ void FitReportJsonText::add(std::string_view file_json, std::string& out) {
 void FitReportJsonText::finish(std::string& out) const {
   if (compact_) out += any_ ? "]}" : "{\"files\":[]}";
   else out += any_ ? "\n  ]\n}" : "{\n  \"files\": []\n}";
-}
-
-void compact_json(std::string& text) {
-  std::size_t w = 0;
-  bool in_string = false, escaped = false;
-  for (const char c : text) {
-    if (in_string) {
-      if (escaped) escaped = false;
-      else if (c == '\\') escaped = true;
-      else if (c == '"') in_string = false;
-    } else if (c == ' ' || c == '\n' || c == '\t' || c == '\r') {
-      continue;
-    } else if (c == '"') {
-      in_string = true;
-    }
-    text[w++] = c;
-  }
-  text.resize(w);
 }
 
 }  // namespace spindown

@@ -9,7 +9,7 @@
 #include "spindown/csv_cells.hpp"
 #include "spindown/quantity.hpp"
 #include "fit_report_support.hpp"
-#include "pretty_json_writer.hpp"
+#include "json_writer.hpp"
 
 namespace spindown {
 
@@ -119,7 +119,7 @@ void append_run_table_json_rows(const FileFit& file, std::string& out, bool& fir
   for (std::size_t i = 0; i < file.runs.size(); ++i) {
     out += first_row ? "\n  " : ",\n  ";
     first_row = false;
-    PrettyJsonWriter w(out, 2);
+    JsonWriter w(out, 2);
     w.begin_object();
     for (const auto& c : row(file, i)) {
       w.runtime_key(c.name);

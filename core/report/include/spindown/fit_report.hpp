@@ -82,13 +82,14 @@ void append_run_fit_json_text(std::string& out, const RunFit& fit, const ReportO
 
 // `spindown fit --json` without a document: one entry of fit_report_json(files)'s "files"
 // array exactly as dump(2, ' ', false, Json::error_handler_t::replace) lays it out there
-// (indented four spaces, without the separator), written straight to text. Building and
-// freeing the Json document cost as much as reading the files.
-std::string file_fit_json_text(const FileFit& file, const ReportOptions& opt = {});
+// (indented four spaces, without the separator), written straight to text; compact: as
+// dump(-1, …) writes it, no layout whitespace (a third of the bytes), as a pipe or a file gets
+// it. Building and freeing the Json document cost as much as reading the files.
+std::string file_fit_json_text(const FileFit& file, const ReportOptions& opt = {}, bool compact = false);
 
 // Appends file_fit_json_text() entries, in order, into the bytes of
 // fit_report_json(files).dump(2, ' ', false, Json::error_handler_t::replace).
-// compact: the same document without layout whitespace (compact_json), as a pipe or a file gets it.
+// compact: dump(-1, …)'s bytes instead, of compact entries.
 class FitReportJsonText {
  public:
   explicit FitReportJsonText(bool compact = false) : compact_(compact) {}
@@ -99,10 +100,6 @@ class FitReportJsonText {
   bool any_ = false;
   bool compact_ = false;
 };
-
-// JSON text without its layout: every space, tab and line break outside strings dropped (the
-// same document, a third of the bytes of an indented one). In place; text is whole JSON values.
-void compact_json(std::string& text);
 
 // Text for people.
 std::string format_run_fit(const RunFit& fit, const ReportOptions& opt = {});

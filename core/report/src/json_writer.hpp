@@ -1,7 +1,7 @@
 #pragma once
-// A JSON writer laid out exactly as nlohmann's dump(2, ' ', false, error_handler_t::replace),
-// straight into a string: the one writer of the `fit --json` contract (fit_json.cpp). Private to
-// the report module.
+// A JSON writer laid out exactly as nlohmann's dump(2, ' ', false, error_handler_t::replace), or
+// compact as dump(-1, …), straight into a string: the one writer of the `fit --json` contract
+// (fit_json.cpp). Private to the report module.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -54,19 +54,21 @@ class PlainKey {
 
 // Writes JSON laid out as nlohmann's dump(2, ' ', false, error_handler_t::replace): "{" then each
 // member on its own line indented two more, "key": value, ",\n" between members, the closing
-// bracket on its own line at the container's indent; "{}" and "[]" when empty.
+// bracket on its own line at the container's indent; "{}" and "[]" when empty. Compact, as
+// dump(-1, …): no line breaks or indent, "key":value, "," between members.
 //
 // The text goes straight into out's bytes through a cursor (room made ahead, doubling; out is cut
 // to what was written when the writer goes): a member is a few small copies, where
 // std::string's appends cost more than the bytes (a file's JSON is ~60 members).
-class PrettyJsonWriter {
+class JsonWriter {
  public:
-  PrettyJsonWriter(std::string& out, std::size_t indent) : out_(out), size_(out.size()), indent_(indent) {
+  JsonWriter(std::string& out, std::size_t indent, bool compact = false)
+      : out_(out), size_(out.size()), indent_(indent), compact_(compact) {
     out_.resize(std::max(out_.capacity(), size_ + 256));
   }
-  ~PrettyJsonWriter() { out_.resize(size_); }
-  PrettyJsonWriter(const PrettyJsonWriter&) = delete;
-  PrettyJsonWriter& operator=(const PrettyJsonWriter&) = delete;
+  ~JsonWriter() { out_.resize(size_); }
+  JsonWriter(const JsonWriter&) = delete;
+  JsonWriter& operator=(const JsonWriter&) = delete;
 
   void begin_object() { open('{'); }
   void end_object() { close('}'); }
@@ -83,7 +85,7 @@ class PrettyJsonWriter {
     next_element();
     if (!is_plain(k)) {
       string(k);
-      put(": ");
+      put(compact_ ? ":" : ": ");
       return;
     }
     quoted_key(k);
@@ -159,10 +161,14 @@ class PrettyJsonWriter {
     *p++ = '"';
     std::memcpy(p, k.data(), k.size());
     std::memcpy(p + k.size(), "\": ", 3);
-    size_ += k.size() + 4;
+    size_ += k.size() + (compact_ ? 3 : 4);
   }
-  // A line break, then the indent.
+  // A line break, then the indent (compact: only the comma).
   void new_line(bool comma) {
+    if (compact_) {
+      if (comma) put(",");
+      return;
+    }
     if (indent_ > layout_spaces) {  // deeper than any document here: not worth a faster way
       put(comma ? ",\n" : "\n");
       put(std::string(indent_, ' '));
@@ -192,6 +198,7 @@ class PrettyJsonWriter {
   std::string& out_;
   std::size_t size_;  // bytes of out_ written; the rest is room
   std::size_t indent_;
+  bool compact_;
   std::vector<bool> empty_;  // per open container: nothing written in it yet
 };
 
