@@ -184,10 +184,16 @@ for cols, rows in [(80, 32), (120, 40)]:
             for b in benches:
                 if l.startswith(b + " "):
                     rows_of[b] = l
-        if len(rows_of) != 3 or not all(("%d " % last_fit[b]["run"]) in rows_of[b] for b in benches):
+        head = frame[header]
+        # The FIT column's run number (its header's place in the row): "3 " anywhere in a row also
+        # matches "3 coast" or an age of "0.3 s", before any fit.
+        fit_at = head.find("FIT")
+        def fit_run(row):
+            words = row[fit_at:].split() if fit_at >= 0 else []
+            return words[0] if words else ""
+        if len(rows_of) != 3 or not all(fit_run(rows_of[b]) == str(last_fit[b]["run"]) for b in benches):
             continue
         ok = True
-        head = frame[header]
         for col in ("c3", "c4", "HEALTH"):
             if col not in head:
                 problems.append("%dx%d: header has no %s: %r" % (cols, rows, col, head))
