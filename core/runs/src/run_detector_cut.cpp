@@ -307,17 +307,13 @@ void RunDetector::Impl::recut_after_rise(Run& r, std::size_t coast_end) {
   if (coast_end < c + 16) return;
   const double zero = r.stopped ? r.zero_level : motor_zero();
   const double amp = v0_ - zero;
-  // Medians of five: a dropout or two (a loose wire's zeros) are no rise. Each sample's is taken
-  // once (both searches below read them, three times a sample), by min and max: this search was a
-  // third of `spindown fit`'s time with a sort of five per look.
-  const auto median3 = [](double a, double b, double c) { return std::max(std::min(a, b), std::min(std::max(a, b), c)); };
-  std::vector<double>& medians = median5_;
-  medians.resize(coast_end - c);
-  for (std::size_t k = c + 2; k + 2 < coast_end; ++k) {
-    const double a = v(k - 2), b = v(k - 1), d = v(k + 1), e = v(k + 2);
-    medians[k - c] = median3(v(k), std::max(std::min(a, b), std::min(d, e)), std::min(std::max(a, b), std::max(d, e)));
-  }
-  const auto med5 = [&](std::size_t k) { return medians[k - c]; };
+  // Medians of five: a dropout or two (a loose wire's zeros) are neither a rise nor a step down.
+  // Each sample's is taken once: both searches below read it, three times a sample (a sort of
+  // five per look was a third of `spindown fit`'s time).
+  median5_.resize(coast_end - c);
+  for (std::size_t k = c + 2; k + 2 < coast_end; ++k)
+    median5_[k - c] = median_of_five(v(k - 2), v(k - 1), v(k), v(k + 1), v(k + 2));
+  const auto med5 = [&](std::size_t k) { return median5_[k - c]; };
   // The last rise of more than thr above the lowest reading before it, or a later step down.
   const auto last_jump = [&](double thr, double& rose) {
     double low = std::numeric_limits<double>::infinity(), rose_from = 0;
@@ -331,7 +327,7 @@ void RunDetector::Impl::recut_after_rise(Run& r, std::size_t coast_end) {
         low = std::min(low, m);
       }
     }
-    // … nor steps down: a fall within three samples far steeper than the coast's own pace on either
+    // A step down: a fall within three samples far steeper than the coast's own pace on either
     // side of it (an open pin above the back-EMF, then connected to the motor).
     if (coast_end >= c + 24) {
       for (std::size_t k = c + 10; k + 10 < coast_end; ++k) {
@@ -347,9 +343,9 @@ void RunDetector::Impl::recut_after_rise(Run& r, std::size_t coast_end) {
   };
   // A jump is far beyond the coast's sample-to-sample noise (the median over the whole coast: a
   // rough stretch before the rise, an open pin's hum, does not set it), a twentieth of the coast's
-  // height and three steps of the print. Most coasts have no jump even of the last two: then the
-  // noise (a median over the whole coast, most of this search's time) is not needed, as a higher
-  // threshold finds no jump where a lower one found none.
+  // height and three steps of the print. Most coasts have no jump even of that least size: then
+  // the noise (a median over the whole coast, most of this search's time) is not needed, as a
+  // higher threshold finds no jump where a lower one found none.
   const double least = std::max(0.05 * std::abs(amp), 3.0 * coast_step_);
   double rose = 0;
   if (last_jump(least, rose) == 0) return;

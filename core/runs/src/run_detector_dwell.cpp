@@ -74,8 +74,7 @@ bool RunDetector::Impl::frozen(std::size_t from, std::size_t to) const {
 
 double RunDetector::Impl::median3(std::size_t k, std::size_t c, std::size_t e) const {
   if (k <= c || k + 1 >= e) return v(k);  // the span's ends have one neighbour inside it
-  const double a = v(k - 1), b = v(k), d = v(k + 1);
-  return std::max(std::min(a, b), std::min(std::max(a, b), d));
+  return median_of_three(v(k - 1), v(k), v(k + 1));
 }
 
 bool RunDetector::Impl::falls_faster_later(std::size_t c, std::size_t e, double margin) const {

@@ -15,6 +15,15 @@
 
 namespace spindown {
 
+// Medians by min and max (readings are finite: the detector takes no other), the same value a
+// sort gives.
+inline double median_of_three(double a, double b, double c) {
+  return std::max(std::min(a, b), std::min(std::max(a, b), c));
+}
+inline double median_of_five(double a, double b, double c, double d, double e) {
+  return median_of_three(c, std::max(std::min(a, b), std::min(d, e)), std::min(std::max(a, b), std::max(d, e)));
+}
+
 class RunDetector::Impl {
  public:
   using State = RunDetector::State;
