@@ -141,27 +141,30 @@ inline Case pause_before_the_coast_case(const SyntheticRunSpec& base, int k) {
   return single("pause before the coast", s);
 }
 
-// A heavy flywheel coasting for 10-14 minutes
-inline Case long_coast_case(const SyntheticRunSpec& base, int k) {
+// A flywheel 20-28 times the lab's on the lab's friction: it coasts for 10-14 minutes
+inline SyntheticRunSpec heavy_flywheel(const SyntheticRunSpec& base, int k) {
   SyntheticRunSpec s = base;
   s.bench.inertia_kg_m2 = base.bench.inertia_kg_m2 * (20.0 + 2.0 * (k % 5));
   s.friction = {1.822e-7, 1.1389e-4};
+  s.max_coast_s = 1200;
+  return s;
+}
+
+// The heavy flywheel logged at 10 Hz
+inline Case long_coast_case(const SyntheticRunSpec& base, int k) {
+  SyntheticRunSpec s = heavy_flywheel(base, k);
   s.period_s = 0.1;
   s.jitter_s = 0.002;
-  s.max_coast_s = 1200;
   return single("long coast", s);
 }
 
 // The heavy flywheel logged once a second: the windows must hold enough of its readings
 inline Case slow_logger_case(const SyntheticRunSpec& base, int k) {
-  SyntheticRunSpec s = base;
-  s.bench.inertia_kg_m2 = base.bench.inertia_kg_m2 * (20.0 + 2.0 * (k % 5));
-  s.friction = {1.822e-7, 1.1389e-4};
+  SyntheticRunSpec s = heavy_flywheel(base, k);
   s.period_s = 1.0;
   s.jitter_s = 0.01;
   s.lead_in_s = 20.0;
   s.tail_s = 60.0;
-  s.max_coast_s = 1200;
   return single("slow logger", s);
 }
 
