@@ -351,6 +351,37 @@ void RunDetector::Impl::recut_after_rise(Run& r, std::size_t coast_end) {
   if (last_jump(least, rose) == 0) return;
   const std::size_t rise = last_jump(std::max(8.0 * rough_sd(c, coast_end), least), rose);
   if (rise == 0) return;
+  // A ripple (a wheel's once per revolution, a commutator's) moves neighbouring samples together:
+  // its crests stand above its troughs by far more than the sample-to-sample noise says. Where the
+  // coast shows one all along (the smaller of its two halves': an open pin's hum before a
+  // connection is in one of them only), a rise or a step is evidence only when the level over a
+  // whole ripple after it stands apart from the level over a whole ripple before it, by more than
+  // those means' own noise allows.
+  const std::size_t mid = c + (coast_end - c) / 2;
+  const LagNoise early = noise_over(c, mid), late = noise_over(mid, coast_end);
+  const LagNoise& noise = early.wander < late.wander ? early : late;
+  // (After a floating lead-in the hum may go on past the cut found: a rise there is the connection.)
+  if (noise.wander > 2.0 * noise.white && r.lead_in != "floating") {
+    const std::size_t len = std::max<std::size_t>(5, 2 * noise.wander_lag);
+    if (rise < c + len || rise + len > coast_end) return;
+    double before = 0, after = 0;
+    for (std::size_t k = rise - len; k < rise; ++k) before += v(k);
+    for (std::size_t k = rise; k < rise + len; ++k) after += v(k);
+    const double shift = (after - before) / double(len);
+    const double se = noise.wander * std::sqrt(2.0 / double(len));
+    // … and only on a coast: the means over whole ripples before the rise fall, each within those
+    // means' noise of the one before (an open pin's swing rises and falls by far more).
+    bool falls = true;
+    double prev = std::numeric_limits<double>::infinity();
+    for (std::size_t k0 = c; k0 + len <= rise && falls; k0 += len) {
+      double m = 0;
+      for (std::size_t k = k0; k < k0 + len; ++k) m += v(k);
+      m /= double(len);
+      falls = m <= prev + 4.0 * se;
+      prev = m;
+    }
+    if (falls && (rose > 0 ? !(shift > std::max(4.0 * se, least)) : !(-shift > std::max(4.0 * se, least)))) return;
+  }
   // The coast after the rise: its cut found as any cut is, with the samples before the rise as lead-in.
   std::size_t a = rise, b = rise;
   while (a > c && t(rise) - t(a - 1) <= back_search_s) --a;
@@ -399,6 +430,18 @@ double RunDetector::Impl::rough_sd(std::size_t from, std::size_t to) const {
   for (std::size_t j = 0; j < d.size(); ++j) d[j] = std::abs(v(from + j + 2) - 2.0 * v(from + j + 1) + v(from + j));
   std::nth_element(d.begin(), d.begin() + std::ptrdiff_t(d.size() / 2), d.end());
   return 1.4826 * d[d.size() / 2] / std::sqrt(6.0);
+}
+
+LagNoise RunDetector::Impl::noise_over(std::size_t from, std::size_t to) const {
+  std::vector<double> x;
+  x.reserve(to > from ? to - from : 0);
+  for (std::size_t k = from; k < to; ++k) x.push_back(v(k));
+  std::size_t max_lag = 1;
+  if (to > from + 2) {
+    const double period = (t(to - 1) - t(from)) / double(to - 1 - from);
+    if (period > 0) max_lag = std::size_t(std::clamp(0.5 / period, 1.0, 128.0));
+  }
+  return measure_lag_noise(x, max_lag);
 }
 
 double RunDetector::Impl::smoothed(std::size_t k, std::size_t lo, std::size_t hi) const {
