@@ -399,6 +399,9 @@ void RunDetector::Impl::close_asymptotic(std::size_t i, bool at_end, double z, d
   run_.end = Run::End::asymptotic;
   complete_run(held_long ? held_from + 1 : i + 1);
   to_idle(i + 1, true);
+  // The coast goes on below its floor, a step of the print at a time: no new run until the reading
+  // rises well above where it was closed (a new spin-up), as after any coast closed before its stop.
+  block_until_rise(z);
 }
 
 bool RunDetector::Impl::quiet_dwell_above_rest(double z, double sd_z, double amp) const {
