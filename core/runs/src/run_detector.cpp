@@ -592,9 +592,10 @@ bool RunDetector::Impl::smooth_curve(const WindowFit& w, double mu, double drop)
   // An open pin's hum is rough from sample to sample.
   // Only a window of a second or more (a shorter one of a coarse counter is a few readings, whose
   // bend - the cut's kink - the cut search needs more of the coast to place) that holds few
-  // readings (a slow logger: 8-16 over the second): with more, a line follows a coast's bend
-  // within the window closely enough.
-  return w.n >= 8 && w.n <= 16 && w.span_s >= 1.0 &&
+  // readings (a slow logger, a coarse 20 Hz propeller log: 8-32 over the second): with more, a
+  // line follows a coast's bend within the window closely enough, and a powered nudge's fall
+  // would pass for a coast (the truth corpus's 'nudge before a run': 2 more invented at 64).
+  return w.n >= 8 && w.n <= 32 && w.span_s >= 1.0 &&
          rough_sd(w.first, w.end) <= confirm_max_roughness * std::max(mu, drop);
 }
 
