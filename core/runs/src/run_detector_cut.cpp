@@ -349,8 +349,13 @@ void RunDetector::Impl::recut_after_rise(Run& r, std::size_t coast_end) {
   const double least = std::max(0.05 * std::abs(amp), 3.0 * coast_step_);
   double rose = 0;
   if (last_jump(least, rose) == 0) return;
-  const std::size_t rise = last_jump(std::max(8.0 * rough_sd(c, coast_end), least), rose);
+  const double white = rough_sd(c, coast_end);
+  const std::size_t rise = last_jump(std::max(8.0 * white, least), rose);
   if (rise == 0) return;
+  // What made it evidence, said with it: the jump in units of the reading's noise.
+  std::string evidence = white > 0 ? fmt::format(" ({:.0f} times the reading's sample-to-sample noise {:.2g})",
+                                                 std::abs(rose) / white, white)
+                                   : std::string(" (the reading shows no noise)");
   // A ripple (a wheel's once per revolution, a commutator's) moves neighbouring samples together:
   // its crests stand above its troughs by far more than the sample-to-sample noise says. Where the
   // coast shows one all along (the smaller of its two halves': an open pin's hum before a
@@ -381,6 +386,9 @@ void RunDetector::Impl::recut_after_rise(Run& r, std::size_t coast_end) {
       prev = m;
     }
     if (falls && (rose > 0 ? !(shift > std::max(4.0 * se, least)) : !(-shift > std::max(4.0 * se, least)))) return;
+    if (falls)
+      evidence = fmt::format(" (its level over whole ripples of {} samples moved {:.3g}, {:.0f} times those means' noise)",
+                             len, shift, std::abs(shift) / se);
   }
   // The coast after the rise: its cut found as any cut is, with the samples before the rise as lead-in.
   std::size_t a = rise, b = rise;
@@ -401,9 +409,9 @@ void RunDetector::Impl::recut_after_rise(Run& r, std::size_t coast_end) {
   r.lead_in = classify_lead_in(sp);
   v0_ = sp.v0;
   const std::string said = fmt::format(
-      "the reading {} by {:.3g} at {}, inside the coast taken from {}: a coast never {}, so the coast is taken "
+      "the reading {} by {:.3g}{} at {}, inside the coast taken from {}: a coast never {}, so the coast is taken "
       "from {} (the pin connected to the motor then? the power back on?), lead-in {}",
-      rose > 0 ? "rose" : "stepped down", std::abs(rose), fmt_s(t(rise)), fmt_s(t_old),
+      rose > 0 ? "rose" : "stepped down", std::abs(rose), evidence, fmt_s(t(rise)), fmt_s(t_old),
       rose > 0 ? "rises" : "jumps", fmt_s(r.t_cut_s), r.lead_in);
   run_note_ = run_note_.empty() ? said : said + "; " + run_note_;
   run_note_severity_ = Diagnostic::Severity::warning;
