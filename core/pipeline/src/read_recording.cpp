@@ -1,5 +1,7 @@
 #include "spindown/read_recording.hpp"
 
+#include "spindown/held_readings.hpp"
+
 #include <algorithm>
 #include <cerrno>
 #include <cstdint>
@@ -237,7 +239,9 @@ std::vector<Recording> read_recordings(const std::string& path, const ReadOption
   }
   const FileFormat format = detect_format(bytes, options);
   if (format == FileFormat::delimited_text) {
-    add(read_delimited_text(bytes, path, options.delimited), {FileFormat::delimited_text, {}, {}, 0});
+    Recording rec = read_delimited_text(bytes, path, options.delimited);
+    take_held_readings_once(rec);  // a slower channel logged in every row: each reading once
+    add(std::move(rec), {FileFormat::delimited_text, {}, {}, 0});
   } else if (format == FileFormat::spindown_v1) {
     std::int64_t lost = 0;
     Recording rec = read_spindown_text(bytes, path, options.spindown, &lost);
