@@ -385,10 +385,12 @@ void RunDetector::Impl::recut_after_rise(Run& r, std::size_t coast_end) {
       falls = m <= prev + 4.0 * se;
       prev = m;
     }
-    if (falls && (rose > 0 ? !(shift > std::max(4.0 * se, least)) : !(-shift > std::max(4.0 * se, least)))) return;
-    if (falls)
+    if (falls) {
+      const double moved = rose > 0 ? shift : -shift;  // in the jump's own direction
+      if (!(moved > std::max(4.0 * se, least))) return;
       evidence = fmt::format(" (its level over whole ripples of {} samples moved {:.3g}, {:.0f} times those means' noise)",
                              len, shift, std::abs(shift) / se);
+    }
   }
   // The coast after the rise: its cut found as any cut is, with the samples before the rise as lead-in.
   std::size_t a = rise, b = rise;

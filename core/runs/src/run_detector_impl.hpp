@@ -256,8 +256,8 @@ class RunDetector::Impl {
   bool creeps_in(double t_cut, double t_quarter, double t_stop) const;
   // The sample-to-sample noise of [from, to) (second differences; 0 for fewer than 3 samples).
   double rough_sd(std::size_t from, std::size_t to) const;
-  // The noise of [from, to) at every lag up to half a second (reading_noise.hpp): what a rise or a
-  // peak must stand above to be evidence in this recording (a ripple included).
+  // The noise of [from, to) at every lag up to half a second (lag_noise.hpp): what a rise or a step
+  // inside a coast must stand above to be evidence in this recording (a ripple included).
   LagNoise noise_over(std::size_t from, std::size_t to) const;
   // The same for a coast found while after_silence_: the silenced coast's rest, from the first
   // sample after the silence; empty only when nothing of it is held.

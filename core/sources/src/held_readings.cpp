@@ -41,7 +41,8 @@ std::size_t take_held_readings_once(Recording& rec) {
     start = i;
   }
   if (rows.size() < 20) return 0;
-  if (quantile(rows, 0.02) < 3.0) return 0;
+  const double shortest = quantile(rows, 0.02);
+  if (shortest < 3.0) return 0;
   const double period = quantile(secs, 0.25);
   if (!(period >= 3.0 * row)) return 0;
   // Keep the first row of each value, and one row every period within a hold.
@@ -69,7 +70,7 @@ std::size_t take_held_readings_once(Recording& rec) {
   rec.warn(0, fmt::format("the value column holds each reading for {:.0f} rows or more (a reading about every {:.3g} s in "
                           "rows every {:.3g} s: a slower channel logged in every row): each reading taken once, "
                           "{} of {} rows kept",
-                          quantile(rows, 0.02), period, row, keep.size(), n));
+                          shortest, period, row, keep.size(), n));
   return dropped;
 }
 
