@@ -152,7 +152,8 @@ bench_id = "lab-000"
 [bench]
 inertia_kg_m2 = 2.5e-5
 EOF
-"$B/spindown" fit "$LOG" --bench-config "$T/lab-000.toml" --json >"$T/rule.json" 2>"$T/rule.err" || true
+"$B/spindown" fit "$LOG" --bench-config "$T/lab-000.toml" --json >"$T/rule.json" 2>"$T/rule.err" ||
+  fail "fit with a bench file exited $?: $(head -c 400 "$T/rule.err")"
 "$B/spindown" report "$LOG" --bench-config "$T/lab-000.toml" --no-explain -o "$T/rule.html" >/dev/null 2>&1 ||
   fail "report with a bench file exited $?"
 python3 - "$T/rule.json" "$T/rule.html" <<'EOF' || fail "fit and report take J and K_b by different rules"

@@ -53,10 +53,14 @@ PY
 # Each file alone: fragments, each difference explained.
 whole_alone=0
 for f in "${FILES[@]}"; do
-  "$B/spindown" refit "$f" --json 2>/dev/null >"$T/one.json" || true
+  # A file alone may hold only fragments (exit 1: nothing whole to fit); a crash or bad usage fails.
+  rc=0; "$B/spindown" refit "$f" --json 2>/dev/null >"$T/one.json" || rc=$?
+  ((rc <= 1)) || fail "refit $f --json exited $rc"
   n=$(python3 -c "import json,sys; d=json.load(open(sys.argv[1])); print(sum(r['lead_in'] != 'none' and r['end'] == 'stopped' for f in d['files'] for r in f['runs']))" "$T/one.json")
   whole_alone=$((whole_alone + n))
-  "$B/spindown" refit "$f" --compare >>"$T/alone.out" 2>/dev/null || true
+  # … and its comparison differs from the live FITs (exit 1), each difference explained (below).
+  rc=0; "$B/spindown" refit "$f" --compare >>"$T/alone.out" 2>/dev/null || rc=$?
+  ((rc <= 1)) || fail "refit $f --compare exited $rc"
 done
 echo "each file alone: $whole_alone runs whole and stopped"
 grep -E "differs|did not find|no live FIT" "$T/alone.out" | head -20
