@@ -321,3 +321,39 @@ TEST(OtherRigs, ATwentyHertzCoarsePropellerCoastIsFound) {
       [&](double w) { return w > 0 ? std::round(w / step + flicker(rng)) * step : 0.0; });
   expect_one_run(rec, t_cut, 0.11, t_cut + coast.stop_s, 0.3);
 }
+
+// A fan motor with two magnets on its hub, timed by an interrupt that stamps each pulse with
+// millis(): the sketch prints 30000/Δ rpm per pulse, Δ the whole milliseconds between the last two
+// pulses. An Uno's millis() counts 1.024-ms timer ticks and skips a count every 41 or 42 of them.
+// At 2800 rpm a pulse comes every 10.7 ms, so Δ is 10, 11 and now and then 12, and the reading
+// alternates between 3000, 2727 and 2500 for the 9 s the supply holds the speed: a noise of ±136
+// rpm whose highest few-sample means fall anywhere on the plateau. The coast (0.03 s⁻¹ ω + 6 rad/s² bearing and
+// brush drag) falls one reading step in about 1.9 s. One run, cut where the plateau ends: a level
+// and a line fitted through hundreds of readings place it within half that time of the power-off.
+TEST(OtherRigs, APerPulseTachometersAlternatingPeriodsAreAPlateauNotACoast) {
+  constexpr double rpm = 2 * M_PI / 60;
+  const Friction f{1.0, 0.03, 6.0};  // J = 1: the torques are decelerations
+  const double top = 2800 * rpm, t_on = 0.7, t_cut = 10.433;
+  const Coast coast(f, top);
+  const auto speed = [&](double t) {
+    if (t < t_on) return 0.0;
+    if (t < t_cut) return top * (1 - std::exp(-(t - t_on) / 0.35));
+    return coast.at(t - t_cut);
+  };
+  Recording rec;
+  rec.source = "physics";
+  double angle = 0, last_ms = -1;
+  const double dt = 1e-4;
+  for (double t = 0; t < t_cut + coast.stop_s; t += dt) {
+    angle += speed(t) * dt;
+    if (angle < M_PI) continue;
+    angle -= M_PI;
+    const double ms = std::floor(std::floor(t / 1.024e-3) * 1.024);  // millis() at the pulse
+    if (last_ms >= 0 && ms > last_ms) rec.push(ms / 1000, std::floor(30000 / (ms - last_ms)));
+    last_ms = ms;
+  }
+  const double step_s = (3000.0 - 2727.0) * rpm / (0.03 * top + 6.0);  // one reading step of the coast
+  const Segmentation seg = find_runs(rec);
+  ASSERT_EQ(seg.runs.size(), 1u);
+  EXPECT_NEAR(seg.runs[0].t_cut_s, t_cut, 0.5 * step_s);
+}

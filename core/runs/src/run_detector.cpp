@@ -706,6 +706,14 @@ inline double level_tiny(double v0, double m) {
   return no_slope && small_drop;
 }
 
+bool RunDetector::Impl::flickers(std::size_t from, std::size_t to) const {
+  if (to < from + 8) return false;  // a few samples of a rise can lie within three of their steps
+  double lo = v(from), hi = v(from);
+  for (std::size_t k = from; k < to; ++k) lo = std::min(lo, v(k)), hi = std::max(hi, v(k));
+  const double step = reading_step(from, to);
+  return step > 0 && hi - lo <= 3.0 * step;
+}
+
 double RunDetector::Impl::reading_step(std::size_t from, std::size_t to) const {
   double step = std::numeric_limits<double>::infinity();
   for (std::size_t k = from + 1; k < to; ++k) {
@@ -822,7 +830,9 @@ bool RunDetector::Impl::try_start_coast(std::size_t i, const WindowFit& w) {
   bool plausible = sp.v0 > 0;
   const double scale = std::abs(sp.v0);
   if (lead == "none") plausible = plausible && !unseen.empty();  // a stream that starts mid-coast, or a pause
-  if (lead == "powered" && sp.pre_sd > 0.05 * scale) plausible = false;  // a rough "plateau"
+  // A rough "plateau" is no motor's (a twentieth of the reading), unless the reading only flickers
+  // within three of its own printed steps: a per-pulse tachometer's whole-millisecond periods.
+  if (lead == "powered" && sp.pre_sd > 0.05 * scale && !flickers(sp.a, sp.pre_end)) plausible = false;
   // A coast from a motor at rest starts well above the zeros it leaves. A floating pin (the
   // handout's step 6: A0 is connected only after the cut) reads anywhere in 0.5–2.5 V, above or
   // below the back-EMF it is connected to: its coast needs no step, only the smooth decline the

@@ -461,6 +461,50 @@ double RunDetector::Impl::smoothed(std::size_t k, std::size_t lo, std::size_t hi
   return sum / double(to - from);
 }
 
+std::size_t RunDetector::Impl::level_end(std::size_t r, std::size_t p, std::size_t b) {
+  // [r, b] split into a level and the coast's line by least squares (the coast's start is close to
+  // a line), the level reaching from r past the peak p …
+  const SplitSums sums(*this, r, b);
+  const std::size_t c = r + sums.best_split(0);
+  if (c < p + 8) return p;
+  // … taken when the coast after the split is a second or more long (a kink with no step rests
+  // on the slope alone, and a ripple's swing down over a few tenths of a second fakes one) and
+  // falls by 4 standard errors of its slope, and the readings from the peak to the split are
+  // shown to be flat beside it (at a third of its slope, within two standard errors), as a
+  // powered lead-in is.
+  const WindowFit coast = window_over(ring_.get(), mask_, 1e300, c, b + 1);
+  const double slope = coast.slope();
+  const double se = coast.sxx() > 0 ? coast.resid_sd() / std::sqrt(coast.sxx()) : 0.0;
+  if (coast.n < 6 || t(b) - t(c) < 1.0 || !(-slope > 4.0 * se)) return p;
+  const WindowFit held = window_over(ring_.get(), mask_, 1e300, p, c);
+  const double held_se = held.sxx() > 0 ? held.resid_sd() / std::sqrt(held.sxx()) : 0.0;
+  return std::abs(held.slope()) + 2.0 * held_se <= 0.3 * -slope ? c : p;
+}
+
+void RunDetector::Impl::recut_at_level_end(Run& r, std::size_t coast_end) {
+  // A coast taken from a spin-up's peak whose reading held that level for a while: the coast starts
+  // where the level ends, judged now on the coast's first quarter (the cut judged on the samples
+  // up to the window that confirmed the coast may have had too little coast to tell).
+  const std::size_t p = r.cut_index;
+  if (r.lead_in != "spin-up" || coast_end < p + 24) return;
+  double low = v(p);
+  for (std::size_t k = p; k < coast_end; ++k) low = std::min(low, v(k));
+  const double quarter = v0_ - 0.25 * (v0_ - low);
+  std::size_t b = p + 16;
+  while (b + 1 < coast_end && smoothed(b, p, coast_end - 1) > quarter) ++b;
+  const std::size_t c = level_end(p, p, b);
+  if (c == p) return;
+  const double held = t(c) - t(p);
+  r.cut_index = c;
+  r.t_cut_s = t(c);
+  v0_ = smoothed(c, p, coast_end - 1);
+  const std::string said = fmt::format(
+      "the reading held the level it rose to for {:.3g} s after its peak: the coast is taken from where it "
+      "leaves that level, {}",
+      held, fmt_s(r.t_cut_s));
+  run_note_ = run_note_.empty() ? said : said + "; " + run_note_;
+}
+
 bool RunDetector::Impl::at_peak(CutSplit& sp, std::size_t b) {
   if (sp.clipped || b < sp.cut_index + 3) return false;
   const double thr = std::max(4.0 * sp.sd_post, 0.02 * std::abs(sp.v0));
@@ -474,7 +518,24 @@ bool RunDetector::Impl::at_peak(CutSplit& sp, std::size_t b) {
   }
   const double top = top3 / 3.0;
   if (top > smoothed(sp.cut_index, sp.cut_index, b) + thr && p < b) {
-    // A rise after the cut found: the coast starts at its peak, and what came before is the rise.
+    // A rise after the cut found: the coast starts where the level it rose to ends, and what came
+    // before is the rise. That level's highest 3-sample mean is only where its noise peaked (a
+    // per-pulse sensor's reading alternates between neighbouring periods for seconds): from where
+    // the rise reached the level (its median reading from the peak on; a coast straight from the
+    // peak puts that mid-coast, and no level is found), level_end splits it from the coast.
+    bool level = false;
+    if (b >= p + 16) {
+      std::vector<double> after;
+      after.reserve(b - p + 1);
+      for (std::size_t k = p; k <= b; ++k) after.push_back(v(k));
+      std::nth_element(after.begin(), after.begin() + std::ptrdiff_t(after.size() / 2), after.end());
+      const double mid = after[after.size() / 2];
+      std::size_t r = sp.cut_index;
+      while (r < p && smoothed(r, sp.cut_index, b) < mid) ++r;
+      const std::size_t e = level_end(r, p, b);
+      level = e > p;
+      p = e;
+    }
     sp.pre_end = p;
     sp.cut_index = p;
     sp.t_cut_s = t(p);
@@ -486,6 +547,7 @@ bool RunDetector::Impl::at_peak(CutSplit& sp, std::size_t b) {
     for (std::size_t k = p; k <= b; ++k) coast.add(t(k), v(k));
     sp.post_slope = coast.slope();
     sp.sd_post = coast.resid_sd();
+    if (level) sp.v0 = coast.mean() + sp.post_slope * (t(p) - coast.t0 - coast.st() / coast.n);
     return true;
   }
   // A lead-in that climbs into the cut: its last samples rise to the coast's start.

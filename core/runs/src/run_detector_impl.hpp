@@ -267,6 +267,11 @@ class RunDetector::Impl {
   // Whether the coast found in sp follows a rise straight into its peak (a spin-up): a rise after
   // the cut moves the cut to the peak.
   bool at_peak(CutSplit& sp, std::size_t b);
+  // Where a level that a rise reached at r ends, after its peak p (b: the newest sample looked at):
+  // p when no level is shown there.
+  std::size_t level_end(std::size_t r, std::size_t p, std::size_t b);
+  // At a run's close: a spin-up's coast re-cut where the level after its peak ends.
+  void recut_at_level_end(Run& r, std::size_t coast_end);
   bool try_start_coast(std::size_t i, const WindowFit& w);
   // The hold window ending at sample i is a standstill: where it began, when the coast met it, and
   // whether that is a stop (stop_at) or an exponential's floor (close_asymptotic), in these steps.
@@ -335,6 +340,8 @@ class RunDetector::Impl {
   // The smallest positive change between consecutive readings in [from, to): the converter's or
   // the printing's step on quantized readings; 0 when none changes.
   double reading_step(std::size_t from, std::size_t to) const;
+  // Whether samples [from, to) only flicker between printed values at most three steps apart.
+  bool flickers(std::size_t from, std::size_t to) const;
   // The median of the sample periods in [from, to) (at least two samples), as nth_element picks it.
   double median_period(std::size_t from, std::size_t to);
   // For the m periods ending at p[0..m) (the first one starting at prev, which becomes the time of
