@@ -357,3 +357,66 @@ TEST(OtherRigs, APerPulseTachometersAlternatingPeriodsAreAPlateauNotACoast) {
   ASSERT_EQ(seg.runs.size(), 1u);
   EXPECT_NEAR(seg.runs[0].t_cut_s, t_cut, 0.5 * step_s);
 }
+
+// A spin bike's coast-down exports pasted into one file, the time restarting at 0 in each: a
+// 60-tooth wheel read as 1/(interval of the last two teeth) rpm every 0.25 s, 0 after 2 s without
+// a tooth. Friction: belt and bearings 0.12 N·m, an eddy-current brake 0.02 N·m·s/rad, J = 0.36
+// kg·m², so the coast's end is a Coulomb stop that the brake's viscous part makes slow. The first
+// export pedals at 420 rpm and coasts to rest with 4 s of zeros; the second begins falling (its
+// cut before the export) and ends 1.5 s after the last tooth, its last reading held, no zero row;
+// the third pedals again. Each restart is a boundary: three runs, each stopped where the physics
+// stopped it (within two rows and the last tooth's interval), none cut short, the second taken
+// from its first row with its cut said to be unrecorded.
+TEST(OtherRigs, CoastsEachInItsOwnExportWithTheClockRestartingAreRunsThatStop) {
+  constexpr double rpm = 2 * M_PI / 60;
+  const Friction f{0.36, 0.02, 0.12};
+  Recording rec;
+  rec.source = "physics";
+  struct Truth {
+    double stop, tol;
+  };
+  std::vector<Truth> truth;
+  // One export: powered at w_top until t_cut (or falling from w_top at 0 when t_cut is 0), coasting
+  // after; rows every 0.25 s until `after` s past the stop (or past the last tooth).
+  const auto add_export = [&](double w_top, double t_cut, double after, bool past_last_tooth) {
+    const Coast coast(f, w_top);
+    const double tooth = 2 * M_PI / 60 / w_top;  // the teeth before the export's first row
+    double angle = 0, last = -tooth, prev = -2 * tooth, t = 0;
+    const double dt = 1e-3;
+    const double end = t_cut + coast.stop_s;
+    double next_row = 0, last_tooth_interval = 0;
+    std::vector<std::pair<double, double>> rows;
+    for (; t <= end + 10; t += dt) {
+      const double w = t < t_cut ? w_top : coast.at(t - t_cut);
+      angle += w * dt;
+      if (angle >= 2 * M_PI / 60) {
+        angle -= 2 * M_PI / 60;
+        prev = last, last = t + dt - angle / w;  // the edge, between the steps
+        if (prev >= 0) last_tooth_interval = last - prev;
+      }
+      if (t >= next_row - 1e-9) {
+        const bool gave_up = t - last > 2.0;
+        rows.emplace_back(next_row, gave_up ? 0.0 : std::round(10 / (60 * (last - prev)) * 60) / 10);
+        next_row += 0.25;
+      }
+      if (past_last_tooth ? (t > end && t - last >= after) : t >= end + after) break;
+    }
+    for (const auto& [time, value] : rows) rec.push(time, value);
+    truth.push_back({end, 0.5 + last_tooth_interval});
+  };
+  add_export(420 * rpm, 3.0, 4.0, false);
+  add_export(400 * rpm, 0.0, 1.5, true);
+  add_export(380 * rpm, 2.5, 3.0, false);
+  const Segmentation seg = find_runs(rec);
+  ASSERT_EQ(seg.runs.size(), 3u);
+  for (std::size_t k = 0; k < 3; ++k) {
+    SCOPED_TRACE(k);
+    EXPECT_TRUE(seg.runs[k].stopped);
+    EXPECT_NEAR(seg.runs[k].t_stop_s, truth[k].stop, truth[k].tol);
+  }
+  EXPECT_EQ(seg.runs[1].lead_in, "none");
+  EXPECT_NEAR(seg.runs[1].t_cut_s, 0.0, 1e-9);
+  bool said = false;
+  for (const Diagnostic& d : seg.diagnostics) said = said || d.message.find("clock's restart") != std::string::npos;
+  EXPECT_TRUE(said);
+}

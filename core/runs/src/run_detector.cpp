@@ -440,6 +440,16 @@ void RunDetector::Impl::new_source(const std::string& why) {
 }
 
 void RunDetector::Impl::restart_stream(const std::string& why, Run::End reason) {
+  // The stream so far ends here. A coast whose reading had come down to the motor's zero, or that
+  // a sensor held on its last value for longer than the coast's own fall allows (it gave up), may
+  // have stopped before the restart: the hold window decides, as at a recording's end. Any other
+  // is cut short.
+  if (state_ == State::coasting && next_index_ > run_.cut_index + 2) {
+    const std::size_t last = next_index_ - 1;
+    const double band = std::max({4.0 * coast_sd_, 3.0 * coast_step_, 1e-9 * std::abs(v0_)});
+    if (std::abs(v(last) - motor_zero()) <= band || held_into(run_.cut_index, next_index_) < next_index_)
+      coast_checks(last, ring_[last & mask_], true);
+  }
   restarted_mid_coast_ = state_ == State::coasting;
   after_silence_ = false;  // a new timeline: nothing on it continues the silenced coast
   if (state_ == State::coasting) {
@@ -452,6 +462,7 @@ void RunDetector::Impl::restart_stream(const std::string& why, Run::End reason) 
   have_plateau_ = false;
   need_rise_ = false;
   stream_start_ = next_index_;
+  stream_after_restart_ = reason == Run::End::clock_restart;
   resume_index_ = 0;
   last_t_ = -std::numeric_limits<double>::infinity();
   last_v_ = std::numeric_limits<double>::quiet_NaN();

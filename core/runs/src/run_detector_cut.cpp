@@ -593,6 +593,10 @@ std::string RunDetector::Impl::start_not_seen(CutSplit& sp) {
     return fmt::format("the recording paused for {:.3g} s (until {}) right before this coast: its cut was not "
                        "recorded, so the coast is taken from the first sample after the pause",
                        resume_pause_s_, fmt_s(t(a)));
+  if (stream_start_ > 0 && stream_after_restart_)
+    return fmt::format("the coast begins at the device clock's restart ({} on the new clock), falling: its cut was "
+                       "not recorded, so the coast is partial, taken from its first sample",
+                       fmt_s(t(a)));
   return fmt::format("the recording starts mid-coast at {}: the cut was not recorded, so the coast is partial",
                      fmt_s(t(a)));
 }

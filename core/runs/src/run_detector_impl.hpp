@@ -254,6 +254,12 @@ class RunDetector::Impl {
   // Whether a coast from t_cut that crossed its last quarter at t_quarter and reached its floor at
   // t_stop creeps in as an exponential does, rather than stopping.
   bool creeps_in(double t_cut, double t_quarter, double t_stop) const;
+  // The t-statistic of the rate the coast over [from, to) still falls at when it meets its floor z
+  // (friction a + b·height: a over its standard error).
+  double floor_rate_t(std::size_t from, std::size_t to, double z) const;
+  // The first sample of the value held up to sample to (after from) when it held longer than the
+  // coast's fall over the second before it allows (a sensor that holds its last reading); else to.
+  std::size_t held_into(std::size_t from, std::size_t to) const;
   // The sample-to-sample noise of [from, to) (second differences; 0 for fewer than 3 samples).
   double rough_sd(std::size_t from, std::size_t to) const;
   // The noise of [from, to) at every lag up to half a second (lag_noise.hpp): what a rise or a step
@@ -361,6 +367,7 @@ class RunDetector::Impl {
   std::size_t search_lo_ = 0;   // earliest index the current lead-in search may use (<= lo_): after a
                                 // rise that closed a coast, what came before the rise is lead-in too
   std::size_t stream_start_ = 0;  // first index after the stream start / last clock restart
+  bool stream_after_restart_ = false;  // that stream began at a clock restart (not a new source)
   std::size_t resume_index_ = 0;  // first sample after the last pause (over 2 s) while idle
   double resume_pause_s_ = 0;     // that pause's length
   bool need_quiet_ = false;     // after a closed coast: no new run until the decline pauses
@@ -399,6 +406,7 @@ class RunDetector::Impl {
   bool floor_doubt_ = false;  // the standstill may be a quiet reading's dwell on one step (found_standstill)
   double tail_until_s_ = 0;   // the tail ends then (t_stop + tail_s, longer on floor_doubt_)
   double stop_approach_t_ = 0;  // found_standstill's approach t-value of the run's standstill
+  double stop_floor_t_ = 0;     // … and the t-value of the rate it met its floor at (floor_rate_t)
   bool restarted_mid_coast_ = false;  // the clock restarted while a coast was open: its rest is a fragment
   // A coast closed by went_silent(): until the reading rises above silence_level_ +
   // silence_band_ or holds still low, a coast found is that one's rest (partial, no cut).

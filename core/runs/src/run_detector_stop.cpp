@@ -247,6 +247,7 @@ void RunDetector::Impl::found_standstill(std::size_t i, bool at_end) {
   run_.noise_level = sd_z;
   // … and right before it the reading still falls clearly (an exponential has flattened).
   stop_approach_t_ = approach_t_stat(stop);
+  stop_floor_t_ = floor_rate_t(k, first_in, z);
   if (!creeps_in(run_.t_cut_s, t_quarter, t_stop) || amp <= 0) {
     stop_at(i, stop, z, sd_z, amp);
   } else if (!creeping_ && !at_end) {
@@ -278,14 +279,18 @@ std::size_t RunDetector::Impl::standstill_start(std::size_t i, double z, double 
 
 double RunDetector::Impl::approach_meets_zero(std::size_t first_in, std::size_t k, double z, double t_quarter,
                                               std::size_t i) const {
-  // Stop time: the approach line (the last ≤2 s above the band) meets the zero level.
+  // Stop time: the approach line (the last ≤2 s above the band) meets the zero level. A value held
+  // into the standstill (a per-tooth sensor's last reading, held until it gives up) is one reading.
   double t_hit = t(first_in);
-  std::size_t from = first_in;
-  while (from > k && t(first_in) - t(from - 1) <= 2.0) --from;
-  if (first_in >= from + 3) {
+  const std::size_t held = held_into(k, first_in);
+  const std::size_t end = held < first_in ? held + 1 : first_in;  // the approach: [from, end)
+  const double t_ref = held < first_in ? t(held) : t(first_in);
+  std::size_t from = end;
+  while (from > k && t_ref - t(from - 1) <= 2.0) --from;
+  if (end >= from + 3) {
     WindowFit f;
     f.clear(from, t(from));
-    for (std::size_t j = from; j < first_in; ++j) f.add(t(j), v(j));
+    for (std::size_t j = from; j < end; ++j) f.add(t(j), v(j));
     const double sl = f.slope();
     if (sl < 0) {
       const double tb = f.st() / f.n, vb = f.mean();
@@ -432,7 +437,48 @@ bool RunDetector::Impl::creeps_in(double t_cut, double t_quarter, double t_stop)
   // longer falls clearly.
   const double last_quarter = t_stop - t_quarter;
   const double end_rate = last_quarter > 0 ? 0.25 * (t_stop - t_cut) / last_quarter : std::numeric_limits<double>::infinity();
-  return end_rate < stop_min_end_rate && stop_approach_t_ < stop_min_approach_t;
+  return end_rate < stop_min_end_rate && stop_approach_t_ < stop_min_approach_t && stop_floor_t_ < floor_rate_min_t;
+}
+
+std::size_t RunDetector::Impl::held_into(std::size_t from, std::size_t to) const {
+  // The value the coast shows last before sample to, and the first sample that shows it.
+  if (to < from + 3) return to;
+  const std::size_t last = to - 1;
+  std::size_t held = last;
+  while (held > from && v(held - 1) == v(last)) --held;
+  if (held == last) return to;
+  // The coast's own fall over the second before it (5 samples at least) …
+  std::size_t lo = held;
+  while (lo > from && (t(held) - t(lo - 1) <= 1.0 || held - lo < 5)) --lo;
+  const WindowFit f = window_over(ring_.get(), mask_, 1.0, lo, held);
+  if (f.n < 5) return to;
+  // … would have moved the reading by two of its steps there (or three of its noise) while it held.
+  const double moved = std::max(-f.slope(), 0.0) * (t(last) - t(held));
+  const double local_step = reading_step(lo, held + 1);
+  return moved > std::max(2.0 * (local_step > 0 ? local_step : coast_step_), 3.0 * f.resid_sd()) ? held : to;
+}
+
+double RunDetector::Impl::floor_rate_t(std::size_t from, std::size_t to, double z) const {
+  // The coast's fall over its last quarter as friction a + b·(height above the floor): each step
+  // between neighbouring samples, −Δv = (a + b·h)·Δt by least squares. An exponential's a is 0 (its
+  // rate dies with its height); a stop's is the rate it still falls at when it meets the floor.
+  // A value held into the floor longer than the coast allows (a per-tooth sensor's last reading,
+  // held until it gives up) is one reading: its repeats are left out.
+  if (const std::size_t held = held_into(from, to); held < to) to = held + 1;
+  if (to < from + 6) return 0.0;
+  double s11 = 0, s12 = 0, s22 = 0, s1y = 0, s2y = 0, syy = 0, n = 0;
+  for (std::size_t j = from; j + 1 < to; ++j) {
+    const double dt = t(j + 1) - t(j);
+    if (!(dt > 0)) continue;
+    const double x1 = dt, x2 = (0.5 * (v(j) + v(j + 1)) - z) * dt, y = v(j) - v(j + 1);
+    s11 += x1 * x1, s12 += x1 * x2, s22 += x2 * x2, s1y += x1 * y, s2y += x2 * y, syy += y * y, n += 1;
+  }
+  const double det = s11 * s22 - s12 * s12;
+  if (n < 5 || !(det > 0)) return 0.0;
+  const double a = (s1y * s22 - s2y * s12) / det, b = (s11 * s2y - s12 * s1y) / det;
+  const double sse = std::max(syy - a * s1y - b * s2y, 0.0);
+  const double se = std::sqrt(sse / (n - 2) * s22 / det);
+  return se > 0 ? a / se : (a > 0 ? std::numeric_limits<double>::infinity() : 0.0);
 }
 
 void RunDetector::Impl::block_until_rise(double level) {

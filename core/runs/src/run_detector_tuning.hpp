@@ -29,6 +29,9 @@ inline constexpr double stop_min_end_rate = 0.5;
 // … or the last stop_hold_s before the stop still falls with this t-statistic (an exponential
 // that has become "flat" shows ~3–6 there, a Coulomb stop tens).
 inline constexpr double stop_min_approach_t = 10.0;
+// … or the coast's fall over its last quarter, as a + b·(height above the floor), keeps a rate a at
+// the floor this many standard errors above 0 (Coulomb friction: an exponential's a is 0).
+inline constexpr double floor_rate_min_t = 4.0;
 // A 1 s hold window decides alone when its slope error is this fraction of the mean rate.
 inline constexpr double slope_resolution = 0.05;
 // In the tail, a hold-window mean this fraction of the amplitude below the zero level retracts
