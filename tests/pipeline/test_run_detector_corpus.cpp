@@ -102,7 +102,12 @@ namespace {
 // restart's own standstill check and the floor-rate stop test changed no run here; against truth,
 // test_detection_truth's long coast end p50 went 29.16 -> 29.15 periods, the rest unchanged.
 // Before: 0x509e2e99d2a77398.
-constexpr std::uint64_t recorded_hash = 0x1a566ebf87c06d4eull;
+// Then a coast that starts held at its highest value (the converter's top: the generator's 2.5 V
+// and 3.3 V references clip a 2.8 V coast) has every reading at that value left out of its fit,
+// with a warning: 7 of the 407 recordings gained it (six at 2.5, 3.3 or 2.499 V, one a stuck
+// 1.179 V after an open pin, truth's cut 5.495 s, found 5.498 s); every run's cut, stop and end
+// the same, test_detection_truth unchanged. Before: 0x1a566ebf87c06d4e.
+constexpr std::uint64_t recorded_hash = 0xa5c624e753639ca4ull;
 constexpr int generated_recordings = 400;
 
 TEST(RunDetectorCorpus, FindsTheRecordedRunsBitForBit) {

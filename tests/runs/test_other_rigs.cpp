@@ -6,6 +6,7 @@
 // Each test's truth is the physics' cut and stop.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <random>
@@ -418,5 +419,53 @@ TEST(OtherRigs, CoastsEachInItsOwnExportWithTheClockRestartingAreRunsThatStop) {
   EXPECT_NEAR(seg.runs[1].t_cut_s, 0.0, 1e-9);
   bool said = false;
   for (const Diagnostic& d : seg.diagnostics) said = said || d.message.find("clock's restart") != std::string::npos;
+  EXPECT_TRUE(said);
+}
+
+// The handout's procedure (A0 held to ground while the motor runs, put on the motor at the
+// power-off) on a 6 V supply: the back-EMF at the cut, 5.9 V, is above the 10-bit converter's top
+// (1023 counts = 4.995 V with a 5 V reference), so the coast's first seconds read the top, then
+// come down through it. The cut is the jump from 0; the pinned samples are said and are no part
+// of the fit (they are the converter's, not the motor's); the coast after them is.
+TEST(OtherRigs, ACoastThatStartsAboveTheConvertersTopIsCutAtTheJumpAndItsPinnedSamplesLeftOut) {
+  const Friction f{1.0, 0.05, 0.08};  // in volts of back-EMF: dV/dt = −0.05·V − 0.08
+  const double t_cut = 6.41, v_cut = 5.9;
+  const Coast coast(f, v_cut);
+  std::mt19937 rng(3250);
+  std::normal_distribution<double> noise(0, 0.004);
+  Recording rec;
+  rec.source = "physics";
+  double t_leave = 0, phase = 0;
+  for (double t = 0.013; t <= t_cut + coast.stop_s + 3; t += 0.0202) {
+    // The commutator's ripple (±1.2 %, 7 bars at the shaft's speed) makes the reading flicker
+    // between the top and the counts below it as it comes down.
+    const double w = t < t_cut ? 0.0 : coast.at(t - t_cut);
+    phase += 7 * 2 * M_PI * 8 * w / v_cut * 0.0202;
+    const double v = t < t_cut ? 0.0 : w * (1 + 0.012 * std::sin(phase)) + noise(rng);
+    const double counts = std::clamp(std::round(v / 5.0 * 1024), 0.0, 1023.0);
+    if (counts == 1023) t_leave = t;
+    rec.push(t, counts * 5.0 / 1024);
+  }
+  ASSERT_GT(t_leave, t_cut + 1.0);  // the coast sat at the top for over a second
+  const Segmentation seg = find_runs(rec);
+  ASSERT_EQ(seg.runs.size(), 1u);
+  const spindown::Run& r = seg.runs[0];
+  EXPECT_NEAR(r.t_cut_s, t_cut, 0.04);
+  EXPECT_TRUE(r.stopped);
+  // Every sample of the run read at the top is left out (or the run starts after them), and no
+  // sample after the reading came down.
+  std::size_t top = 0, out_after = 0;
+  for (std::size_t k = r.cut_index; k < r.stop_index; ++k) {
+    const bool out = std::binary_search(r.outliers.begin(), r.outliers.end(), k);
+    if (rec.value[k] == 1023 * 5.0 / 1024) {
+      ++top;
+      EXPECT_TRUE(out) << "pinned sample " << k << " in the fit";
+    } else if (rec.t_s[k] > t_leave && out) {
+      ++out_after;
+    }
+  }
+  EXPECT_LT(out_after, 3u);  // a dropout or two may be left out; the coast is not
+  bool said = false;
+  for (const Diagnostic& d : seg.diagnostics) said = said || d.message.find("converter's top") != std::string::npos;
   EXPECT_TRUE(said);
 }

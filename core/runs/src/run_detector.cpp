@@ -880,6 +880,7 @@ bool RunDetector::Impl::try_start_coast(std::size_t i, const WindowFit& w) {
                           run_.number, sp.pin_level, fmt_s(t(sp.pin_first)), fmt_s(t(sp.pin_last)),
                           sp.pin_last - sp.pin_first + 1));
   }
+  if (!sp.clipped) find_pinned_start(i);
   v0_ = sp.v0;
   standstill_ceiling_ = v0_ > 0 ? standstill_max_fraction * v0_ : std::numeric_limits<double>::infinity();
   coast_sd_ = sp.sd_post;

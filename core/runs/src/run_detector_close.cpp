@@ -291,6 +291,12 @@ void RunDetector::Impl::complete_run(std::size_t end) {
                 fmt::format("run {}: {} sample(s) of contact bounce at the coast's start left out of the fit (from {})",
                             e.run.number, bounce_.size(), fmt_s(t(bounce_.front()))));
     }
+    if (std::isfinite(pin_level_)) {
+      for (std::size_t k = r.cut_index; k < coast_end; ++k)
+        if (v(k) == pin_level_) e.run.outliers.push_back(k);
+      std::sort(e.run.outliers.begin(), e.run.outliers.end());
+      e.run.outliers.erase(std::unique(e.run.outliers.begin(), e.run.outliers.end()), e.run.outliers.end());
+    }
     scan_coast(e.run, coast_end);
     if (!run_note_.empty()) {
       e.has_diagnostic = true;
@@ -301,6 +307,7 @@ void RunDetector::Impl::complete_run(std::size_t end) {
   run_note_.clear();
   run_note_severity_ = Diagnostic::Severity::note;
   bounce_.clear();
+  pin_level_ = std::numeric_limits<double>::quiet_NaN();
 }
 
 }  // namespace spindown

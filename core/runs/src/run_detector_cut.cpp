@@ -68,6 +68,39 @@ bool RunDetector::Impl::split_at_top(CutSplit& sp, std::size_t a, std::size_t b,
   return true;
 }
 
+void RunDetector::Impl::find_pinned_start(std::size_t b) {
+  // A coast that starts above the converter's top reads its top until it comes down through it:
+  // mostly the same highest value (a ripple flickers it with values below as it comes down), held
+  // far longer than any value of the coast after it and than one step of the reading lasts there.
+  // Each reading at that top is a bound, not the motor's value: all are left out of the fit.
+  pin_level_ = std::numeric_limits<double>::quiet_NaN();
+  const std::size_t c = run_.cut_index;
+  if (b < c + 16) return;
+  double m = v(c);
+  for (std::size_t k = c; k <= b; ++k) m = std::max(m, v(k));
+  std::size_t end = c, at_top = 0;  // [c, end): from the cut to the last reading at the top
+  for (std::size_t k = c; k <= b; ++k)
+    if (v(k) == m) end = k + 1, ++at_top;
+  if (end > b || at_top < 5 || 2 * at_top < end - c || v(c) < m - 0.5 * (m - v(end))) return;
+  std::size_t longest = 1, cur = 1;
+  for (std::size_t k = end + 1; k <= b; ++k) {
+    cur = v(k) == v(k - 1) ? cur + 1 : 1;
+    longest = std::max(longest, cur);
+  }
+  const WindowFit after = window_over(ring_.get(), mask_, 1e300, end, b + 1);
+  const double slope = after.slope(), step = reading_step(c, b + 1);
+  const double period = b > end ? (t(b) - t(end)) / double(b - end) : 0.0;
+  const double step_lasts = slope < 0 && period > 0 && step > 0 ? step / -slope / period : 0.0;
+  if (!(slope < 0) || at_top < 3 * longest || double(at_top) < 3.0 * step_lasts) return;
+  pin_level_ = m;
+  emit_diag(Diagnostic::Severity::warning,
+            fmt::format("run {}: the reading sat at its highest value, {:g}, from {} to {} ({} readings at it), far "
+                        "longer than the coast after it holds any value: the converter's top (a back-EMF above its "
+                        "range) or a stuck reading, not the motor's value. Those readings are left out of the fit, "
+                        "which takes the coast from the values below it; the cut stays at {}",
+                        run_.number, m, fmt_s(t(c)), fmt_s(t(end - 1)), at_top, fmt_s(run_.t_cut_s)));
+}
+
 // The sums of a two-segment least-squares split of [a, b]: a constant lead-in [a, a+k) and a
 // linear coast [a+k, b], for every k at once (prefix sums of the lead-in, suffix sums of the line,
 // t relative to t(b)), in the detector's scratch space.

@@ -273,6 +273,9 @@ class RunDetector::Impl {
   // Whether the coast found in sp follows a rise straight into its peak (a spin-up): a rise after
   // the cut moves the cut to the peak.
   bool at_peak(CutSplit& sp, std::size_t b);
+  // Whether the open coast starts held at the converter's top (pin_level_, with a warning), seen up
+  // to sample b; every reading of the coast at that level is then left out of its fit.
+  void find_pinned_start(std::size_t b);
   // Where a level that a rise reached at r ends, after its peak p (b: the newest sample looked at):
   // p when no level is shown there.
   std::size_t level_end(std::size_t r, std::size_t p, std::size_t b);
@@ -366,6 +369,7 @@ class RunDetector::Impl {
   std::size_t lo_ = 0;          // earliest index a window that confirms a coast may start at
   std::size_t search_lo_ = 0;   // earliest index the current lead-in search may use (<= lo_): after a
                                 // rise that closed a coast, what came before the rise is lead-in too
+  double pin_level_ = std::numeric_limits<double>::quiet_NaN();  // the open coast's converter top
   std::size_t stream_start_ = 0;  // first index after the stream start / last clock restart
   bool stream_after_restart_ = false;  // that stream began at a clock restart (not a new source)
   std::size_t resume_index_ = 0;  // first sample after the last pause (over 2 s) while idle
