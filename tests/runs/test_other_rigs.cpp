@@ -469,3 +469,4 @@ TEST(OtherRigs, ACoastThatStartsAboveTheConvertersTopIsCutAtTheJumpAndItsPinnedS
   for (const Diagnostic& d : seg.diagnostics) said = said || d.message.find("converter's top") != std::string::npos;
   EXPECT_TRUE(said);
 }
+

@@ -857,7 +857,9 @@ bool RunDetector::Impl::try_start_coast(std::size_t i, const WindowFit& w) {
   if ((lead == "powered" || lead == "none") && w.span_s < 1.0) plausible = false;
   if (need_rise_ && sp.v0 < rise_level_) plausible = false;  // the last coast, still creeping down
   if (!plausible) return false;
-  if (lead == "powered" && sp.pre_flat && !sp.clipped && bounce_.empty()) refine_plateau_cut(sp, i);
+  pin_level_ = std::numeric_limits<double>::quiet_NaN();
+  const bool pinned_lead = lead == "powered" && !sp.clipped && pinned_lead_in(sp, i);
+  if (lead == "powered" && sp.pre_flat && !sp.clipped && !pinned_lead && bounce_.empty()) refine_plateau_cut(sp, i);
 
   run_ = Run{};
   run_.number = accepted_ + 1;
@@ -880,7 +882,16 @@ bool RunDetector::Impl::try_start_coast(std::size_t i, const WindowFit& w) {
                           run_.number, sp.pin_level, fmt_s(t(sp.pin_first)), fmt_s(t(sp.pin_last)),
                           sp.pin_last - sp.pin_first + 1));
   }
-  if (!sp.clipped) find_pinned_start(i);
+  if (pinned_lead) {
+    emit_diag(Diagnostic::Severity::warning,
+              fmt::format("run {}: the powered reading sat at its highest value, {:g}, until {}: the converter's top (a "
+                          "supply above its range), so the power-off may lie anywhere before that, hidden under it; "
+                          "the coast is taken from where the reading first comes down, and its readings at the top "
+                          "are left out of the fit",
+                          run_.number, pin_level_, fmt_s(run_.t_cut_s)));
+  } else if (!sp.clipped) {
+    find_pinned_start(i);
+  }
   v0_ = sp.v0;
   standstill_ceiling_ = v0_ > 0 ? standstill_max_fraction * v0_ : std::numeric_limits<double>::infinity();
   coast_sd_ = sp.sd_post;

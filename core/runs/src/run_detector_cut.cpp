@@ -68,6 +68,41 @@ bool RunDetector::Impl::split_at_top(CutSplit& sp, std::size_t a, std::size_t b,
   return true;
 }
 
+bool RunDetector::Impl::pinned_lead_in(CutSplit& sp, std::size_t b) {
+  // A powered lead-in held at the highest value of the search, exactly, for 9 in 10 of its readings
+  // and three times longer than any value of the coast after it: a supply above the converter's
+  // range (A0 on the motor's terminal). The power-off is hidden under it; the coast is taken from
+  // the first reading below the top after the last such hold (a ripple may bring it back to the top
+  // for a few readings as it comes down).
+  if (sp.npre < 8 || sp.pre_end > b) return false;
+  double m = v(sp.a);
+  for (std::size_t k = sp.a; k <= b; ++k) m = std::max(m, v(k));
+  std::size_t at_top = 0;
+  for (std::size_t k = sp.a; k < sp.pre_end; ++k) at_top += v(k) == m;
+  if (10 * at_top < 9 * sp.npre) return false;
+  std::size_t longest = 1, cur = 1;
+  for (std::size_t k = sp.pre_end + 1; k <= b; ++k) {
+    cur = v(k) == v(k - 1) ? cur + 1 : 1;
+    if (v(k) != m) longest = std::max(longest, cur);
+  }
+  const std::size_t hold = 3 * longest;
+  std::size_t first = sp.a, run = 0;  // first: the first reading below the top after a hold
+  for (std::size_t k = sp.a; k <= b; ++k) {
+    if (v(k) == m) {
+      ++run;
+    } else {
+      if (run >= hold) first = k;
+      run = 0;
+    }
+  }
+  if (first <= sp.a || first > b) return false;
+  sp.cut_index = sp.pre_end = first;
+  sp.npre = first - sp.a;
+  sp.t_cut_s = 0.5 * (t(first - 1) + t(first));
+  pin_level_ = m;
+  return true;
+}
+
 void RunDetector::Impl::find_pinned_start(std::size_t b) {
   // A coast that starts above the converter's top reads its top until it comes down through it:
   // mostly the same highest value (a ripple flickers it with values below as it comes down), held

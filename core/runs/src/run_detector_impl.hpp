@@ -276,6 +276,9 @@ class RunDetector::Impl {
   // Whether the open coast starts held at the converter's top (pin_level_, with a warning), seen up
   // to sample b; every reading of the coast at that level is then left out of its fit.
   void find_pinned_start(std::size_t b);
+  // Whether the powered lead-in in sp sits at the converter's top (seen up to sample b): the cut
+  // moved to where the reading first comes down, pin_level_ set.
+  bool pinned_lead_in(CutSplit& sp, std::size_t b);
   // Where a level that a rise reached at r ends, after its peak p (b: the newest sample looked at):
   // p when no level is shown there.
   std::size_t level_end(std::size_t r, std::size_t p, std::size_t b);
