@@ -470,3 +470,26 @@ TEST(OtherRigs, ACoastThatStartsAboveTheConvertersTopIsCutAtTheJumpAndItsPinnedS
   EXPECT_TRUE(said);
 }
 
+
+// A wheel hub spun up by hand on a stand, the logger started while it was still being pushed: the
+// recording begins on the rise (8300 rpm, climbing about 400 rpm/s), the hand lets go at 9600 rpm
+// 3 s in, and the hub coasts (windage and bearings) for minutes; 10 Hz, ±40 rpm noise. The
+// lead-in seen is only a rise: the cut is the release, not the recording's first readings.
+TEST(OtherRigs, ARecordingThatBeginsInTheSpinUpIsCutAtTheRelease) {
+  constexpr double rpm = 2 * M_PI / 60;
+  const Friction f{0.04, 2e-4, 0.05, 2e-6};
+  const double t0 = 77.3, t_cut = 80.3, top = 9600 * rpm;
+  const Coast coast(f, top);
+  const auto speed = [&](double t) {
+    if (t < t_cut) return top - 430 * rpm * (t_cut - t) + 6 * rpm * (t_cut - t) * (t_cut - t);
+    return coast.at(t - t_cut);
+  };
+  std::mt19937 rng(3262);
+  std::normal_distribution<double> noise(0, 40);
+  Recording rec;
+  rec.source = "physics";
+  for (double t = t0; t <= t_cut + 240; t += 0.1) rec.push(t, std::round((speed(t) / rpm + noise(rng)) * 100) / 100);
+  const Segmentation seg = find_runs(rec);
+  ASSERT_GE(seg.runs.size(), 1u);
+  EXPECT_NEAR(seg.runs[0].t_cut_s, t_cut, 0.4);
+}

@@ -149,7 +149,12 @@ TEST(WebService, TheStreamStartsWithASnapshotAndPushesTheFit) {
   std::thread reader([&] {
     body = read_events(s, "/events?bench=b1", [&](const std::string& b) {
       connected = b.find("event: snapshot") != std::string::npos;
-      return b.find("\"curves\":{") != std::string::npos && b.find("\n\n", b.find("\"curves\":{")) != std::string::npos;
+      // Enough once both the fit's detail (with its curves) and a samples event are in, in
+      // whichever order the service's pushes reach the page (a busy machine can order them
+      // either way).
+      const bool detail = b.find("\"curves\":{") != std::string::npos &&
+                          b.find("\n\n", b.find("\"curves\":{")) != std::string::npos;
+      return detail && b.find("event: samples") != std::string::npos;
     });
   });
   for (int i = 0; i < 500 && !connected; ++i) std::this_thread::sleep_for(10ms);

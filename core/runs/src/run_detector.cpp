@@ -717,6 +717,15 @@ inline double level_tiny(double v0, double m) {
   return no_slope && small_drop;
 }
 
+bool RunDetector::Impl::rises_steadily(std::size_t from, std::size_t to) const {
+  // A line through [from, to) rising by confirm_t_stat of its standard errors, the samples about it
+  // no rougher from sample to sample than about the line (a swing of an open pin's hum is not).
+  if (to < from + 8) return false;
+  const WindowFit f = window_over(ring_.get(), mask_, 1e300, from, to);
+  const double e = f.resid_sd();
+  return f.sxx() > 0 && e > 0 && f.slope() * std::sqrt(f.sxx()) > confirm_t_stat * e && rough_sd(from, to) <= e;
+}
+
 bool RunDetector::Impl::flickers(std::size_t from, std::size_t to) const {
   if (to < from + 8) return false;  // a few samples of a rise can lie within three of their steps
   double lo = v(from), hi = v(from);
@@ -803,12 +812,25 @@ bool RunDetector::Impl::try_start_coast(std::size_t i, const WindowFit& w) {
   double span = std::max(back_search_s, 2.0 * w.span_s);
   CutSplit sp;
   std::string lead;
+  bool rising_lead = false;
   for (int attempt = 0;; ++attempt) {
     std::size_t a = w0;
     while (a > lower && t(w0) - t(a - 1) <= span) --a;
     if (w0 - a < back_search_min_samples) a = w0 - std::min(w0 - lower, back_search_min_samples);
+    const CutSplit before = sp;
+    const std::string lead_before = lead;
     sp = split_at_cut(a, b, w);
     lead = classify_lead_in(sp);
+    // A further search, made because a powered lead-in was not shown flat (it may be a rise into
+    // the cut: a recording that begins in a spin-up), that reached the stream's start and found a
+    // lead-in too short to judge, is no better than the one before it.
+    if (attempt > 0 && a <= lower && sp.npre < 8 && before.npre >= 8 && !before.pre_declining &&
+        lead_before == "powered" && !sp.clipped && rises_steadily(before.a, before.pre_end)) {
+      sp = before;
+      lead = lead_before;
+      rising_lead = true;
+      break;
+    }
     // Search further back when the lead-in seen is too short to judge, is itself part of the
     // decline, or is a "plateau" not shown to be flatter than the coast.
     const bool unsure = sp.npre < 8 || sp.pre_declining || (lead == "powered" && !sp.pre_flat);
@@ -822,7 +844,7 @@ bool RunDetector::Impl::try_start_coast(std::size_t i, const WindowFit& w) {
   // The coast begins at the peak, never before a rise: a motor's ramp or a hand's push straight
   // into the peak (a speed sensor's reading) is the powered phase, not the coast.
   // (An open pin's hum rising into the connection is no spin-up: its lead-in is rough, the rise's smooth.)
-  const bool spin_up = lead != "floating" && at_peak(sp, b);
+  const bool spin_up = lead != "floating" && at_peak(sp, b, rising_lead);
   if (spin_up) lead = "spin-up";
   // A coast whose start was not recorded: the recording (or the stream after a clock restart)
   // begins on it, or resumes on it after a pause. Its cut is not known: the coast is partial and

@@ -573,9 +573,13 @@ void RunDetector::Impl::recut_at_level_end(Run& r, std::size_t coast_end) {
   run_note_ = run_note_.empty() ? said : said + "; " + run_note_;
 }
 
-bool RunDetector::Impl::at_peak(CutSplit& sp, std::size_t b) {
+bool RunDetector::Impl::at_peak(CutSplit& sp, std::size_t b, bool rising_lead) {
   if (sp.clipped || b < sp.cut_index + 3) return false;
-  const double thr = std::max(4.0 * sp.sd_post, 0.02 * std::abs(sp.v0));
+  // A rise is judged against the coast line's scatter; after a lead-in known to rise into the cut
+  // (a recording that begins in a spin-up), against the sample-to-sample noise when smaller: a
+  // line drawn through the rest of the rise and the fall after it scatters by the rise itself.
+  const double noise = rising_lead && sp.post_rough > 0 ? std::min(sp.sd_post, sp.post_rough) : sp.sd_post;
+  const double thr = std::max(4.0 * noise, 0.02 * std::abs(sp.v0));
   // The highest reading (a 3-sample mean, so one noisy sample does not make the peak) from the
   // cut found to the newest sample.
   std::size_t p = sp.cut_index;

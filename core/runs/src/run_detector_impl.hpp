@@ -272,7 +272,8 @@ class RunDetector::Impl {
   double smoothed(std::size_t k, std::size_t lo, std::size_t hi) const;
   // Whether the coast found in sp follows a rise straight into its peak (a spin-up): a rise after
   // the cut moves the cut to the peak.
-  bool at_peak(CutSplit& sp, std::size_t b);
+  // rising_lead: the lead-in is known to rise into the cut (judged against the finer noise).
+  bool at_peak(CutSplit& sp, std::size_t b, bool rising_lead = false);
   // Whether the open coast starts held at the converter's top (pin_level_, with a warning), seen up
   // to sample b; every reading of the coast at that level is then left out of its fit.
   void find_pinned_start(std::size_t b);
@@ -354,6 +355,8 @@ class RunDetector::Impl {
   double reading_step(std::size_t from, std::size_t to) const;
   // Whether samples [from, to) only flicker between printed values at most three steps apart.
   bool flickers(std::size_t from, std::size_t to) const;
+  // Whether samples [from, to) rise steadily: a line's slope far beyond its error, and no hum.
+  bool rises_steadily(std::size_t from, std::size_t to) const;
   // The median of the sample periods in [from, to) (at least two samples), as nth_element picks it.
   double median_period(std::size_t from, std::size_t to);
   // For the m periods ending at p[0..m) (the first one starting at prev, which becomes the time of
