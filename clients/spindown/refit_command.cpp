@@ -145,9 +145,21 @@ FitterOptions fitter_options(const RefitCommandOptions& o, const BenchFiles& fil
   return f;
 }
 
-// --compare's EXPLAIN: each refitted run's EXPLAIN against the recorded one of its bench and run
-// number, every field but the time; one line of counts. False when one differs.
-bool compare_explains(const std::string& path, const LogRefit& r, const std::regex& wanted) {
+// The recorded FIT messages of a session (recorded_fits), each with its bench and the fitter session
+// that published it: a run number counts from that session's start.
+struct LiveFit {
+  std::string bench;
+  Json json;
+  std::int64_t session = 0;
+};
+using LiveFits = std::vector<LiveFit>;
+
+// --compare's EXPLAIN: each refitted run's EXPLAIN against the recorded one of the same run, every
+// field but the time; one line of counts. False when one differs. The same run as the FITs are
+// paired (partners: the live FIT of each refitted run): the EXPLAIN of that FIT's bench, run number
+// and fitter session (run numbers restart with the fitter, so a number alone names several runs).
+bool compare_explains(const std::string& path, const LogRefit& r, const std::regex& wanted, const LiveFits& fits,
+                      const std::vector<std::size_t>& partners) {
   std::vector<const explain_t*> live;
   for (const explain_t& m : r.live_explains)
     if (std::regex_match(m.bench, wanted)) live.push_back(&m);
@@ -156,12 +168,20 @@ bool compare_explains(const std::string& path, const LogRefit& r, const std::reg
   const auto close = [](double a, double b) {
     return a == b || (std::isnan(a) && std::isnan(b)) || std::abs(a - b) <= 1e-9 * std::max(std::abs(a), std::abs(b));
   };
-  for (const RefitRun& run : r.runs) {
+  for (std::size_t i = 0; i < r.runs.size(); ++i) {
+    const RefitRun& run = r.runs[i];
     if (!run.explain) continue;
     ++refitted;
     const explain_t ours = to_explain_message(*run.explain, run.bench, 0);
-    std::size_t k = 0;
-    while (k < live.size() && (paired[k] || live[k]->bench != run.bench || live[k]->run != ours.run)) ++k;
+    std::size_t k = live.size();
+    if (i < partners.size() && partners[i] < fits.size()) {
+      const LiveFit& fit = fits[partners[i]];
+      const int number = fit.json.value("run", 0);
+      k = 0;
+      while (k < live.size() && (paired[k] || live[k]->bench != run.bench || live[k]->run != number ||
+                                 live[k]->source_session != fit.session))
+        ++k;
+    }
     if (k == live.size()) {
       ++only_refit;
       continue;
@@ -326,8 +346,6 @@ class SessionSpools {
 
 // The recorded FIT messages of the wanted benches as JSON without the timing fields, in log
 // order, each with its bench id; one the report cannot read is a warning on stderr.
-using LiveFits = std::vector<std::pair<std::string, Json>>;
-
 LiveFits recorded_fits(const std::string& path, const LogRefit& r, const std::string& bench_regex,
                        const ReportOptions& report) {
   LiveFits live;
@@ -336,7 +354,7 @@ LiveFits recorded_fits(const std::string& path, const LogRefit& r, const std::st
     if (!std::regex_match(m.bench, wanted)) continue;
     std::string why;
     if (auto jf = fit_message_json(m, report, &why))
-      live.emplace_back(m.bench, without_timing_fields(std::move(*jf)));
+      live.push_back({m.bench, without_timing_fields(std::move(*jf)), m.source_session});
     else
       std::cerr << path << ": warning: " << why << '\n';
   }
@@ -350,7 +368,11 @@ LiveFits recorded_fits(const std::string& path, const LogRefit& r, const std::st
 class FitComparison {
  public:
   FitComparison(const std::string& path, const LogRefit& r, const LiveFits& live, const ReportOptions& report)
-      : path_(path), r_(r), live_(live), report_(report), live_paired_(live.size(), false) {}
+      : path_(path), r_(r), live_(live), report_(report), live_paired_(live.size(), false),
+        partner_(r.runs.size(), live.size()) {}
+
+  // After run(): for each refitted run, the index of the live FIT paired with it (live.size(): none).
+  const std::vector<std::size_t>& partners() const { return partner_; }
 
   // False when a run differs or is on one side only, or nothing was recorded.
   bool run() {
@@ -365,7 +387,8 @@ class FitComparison {
         continue;
       }
       live_paired_[k] = true;
-      compare_pair(ours, without_timing_fields(refit["runs"][i]), live_[k].second, name);
+      partner_[i] = k;
+      compare_pair(ours, without_timing_fields(refit["runs"][i]), live_[k].json, name);
     }
     for (std::size_t k = 0; k < live_.size(); ++k)
       if (!live_paired_[k]) live_only(k);
@@ -379,8 +402,8 @@ class FitComparison {
     std::size_t best = live_.size();
     double best_overlap = 0;
     for (std::size_t k = 0; k < live_.size(); ++k) {
-      if (live_paired_[k] || live_[k].first != ours.bench) continue;
-      const double overlap = window_overlap_s(ours.fit.run, live_[k].second);
+      if (live_paired_[k] || live_[k].bench != ours.bench) continue;
+      const double overlap = window_overlap_s(ours.fit.run, live_[k].json);
       if (overlap > best_overlap) best = k, best_overlap = overlap;
     }
     return best;
@@ -389,7 +412,7 @@ class FitComparison {
   void refit_only(const RefitRun& ours, const std::string& name) {
     ++missing_live_;
     std::string why;
-    for (const auto& [bench, theirs] : live_)
+    for (const auto& [bench, theirs, session] : live_)
       if (bench == ours.bench && window_overlap_s(ours.fit.run, theirs) > 0) {
         why = fmt::format(" (split: it lies inside live run {} (cut at {:.3f} s), which the refit splits here)",
                           theirs.value("run", 0), number_in(theirs, "t_cut_s"));
@@ -446,7 +469,7 @@ class FitComparison {
   }
 
   void live_only(std::size_t k) {
-    const auto& [bench, theirs] = live_[k];
+    const auto& [bench, theirs, session] = live_[k];
     ++missing_refit_;
     // Part of a refitted run already paired: live split that run in two.
     std::string why;
@@ -484,6 +507,7 @@ class FitComparison {
   const LiveFits& live_;
   const ReportOptions& report_;
   std::vector<bool> live_paired_;
+  std::vector<std::size_t> partner_;
   std::size_t same_ = 0, differ_ = 0, missing_live_ = 0, missing_refit_ = 0;
   std::size_t verdict_live_only_ = 0, verdict_refit_only_ = 0, verdict_differ_ = 0;
 };
@@ -539,8 +563,9 @@ class RefitCommand {
     if (o_.compare) {
       // Recorded results in log order; the refit's likewise.
       const LiveFits live = recorded_fits(path, r, o_.bench_regex, report_);
-      if (!FitComparison(path, r, live, report_).run()) ok_ = false;
-      if (!compare_explains(path, r, std::regex(o_.bench_regex))) ok_ = false;
+      FitComparison fits(path, r, live, report_);
+      if (!fits.run()) ok_ = false;
+      if (!compare_explains(path, r, std::regex(o_.bench_regex), live, fits.partners())) ok_ = false;
       return;
     }
     ok_ = ok_ && r.file.usable();
@@ -574,7 +599,7 @@ class RefitCommand {
     }
     if (o_.json) {
       Json runs = Json::array();
-      for (const auto& [bench, jr] : live) runs.push_back(jr);
+      for (const LiveFit& l : live) runs.push_back(l.json);
       live_files_.push_back(Json{{"file", path}, {"runs", std::move(runs)}});
       return;
     }

@@ -5,6 +5,8 @@
 # (lead-in other than "none") must have it within 1.5 sample periods of a true cut, and a run
 # the fitter joined mid-coast must be published as partial.
 #   restart   the fitter killed (-9) mid-coast and started again 1 s later
+#   between   the fitter restarted between two runs (explain on): refit --compare pairs every FIT
+#             and EXPLAIN of the log with its refitted run although run numbers start again
 #   flood     5,000 new bench ids in a burst while a bench coasts (--max-benches 32)
 #   reset     an Arduino reset mid-coast of run 1, the USB cable pulled for 1 s mid-coast of run 2
 #   silent    the bench stops sending mid-coast for 4 s (--silent 2)
@@ -12,6 +14,7 @@
 source "$(dirname "${BASH_SOURCE[0]}")/netns_common.bash"
 
 SCEN=""
+EXPLAIN_OPT=(--no-explain)
 ensure_down() { for p in "$@"; do kill -9 "$p" 2>/dev/null || true; done; }
 
 # start_chain NAME [virtual bench options…]: bench, bridge, logger and fitter for one scenario.
@@ -34,7 +37,7 @@ start_chain() {
 }
 start_fitter() {  # start_fitter SCENARIO TAG [options…]
   local name=$1 tag=$2; shift 2
-  "$B/spindown-fitter" --lcm-url "$URL" --status-period 0.5 --no-explain -v "${FITTER_OPTS[@]}" "$@" \
+  "$B/spindown-fitter" --lcm-url "$URL" --status-period 0.5 "${EXPLAIN_OPT[@]}" -v "${FITTER_OPTS[@]}" "$@" \
     2>"$T/$name.$tag.err" &
   FITTER=$!; PIDS+=($FITTER)
 }
@@ -105,6 +108,29 @@ rc=0; "$B/spindown" refit "$LOG" --compare >"$T/restart.compare.out" 2>&1 || rc=
 grep -q "live joined this run mid-coast" "$T/restart.compare.out" || fail "restart: refit --compare does not explain the partial run"
 grep -q "1 identical, 1 different, 0 only refitted, 0 only live" "$T/restart.compare.out" ||
   fail "restart: refit --compare does not pair both runs: $(cat "$T/restart.compare.out")"
+
+# --- between: the fitter restarted between runs, explain on --------------------------------------
+# Three whole runs, two fitter sessions (runs 1 | 1, 2 by their numbers): every FIT and EXPLAIN in
+# the log is the refit's own, so --compare pairs them all and exits 0.
+EXPLAIN_OPT=()
+start_chain between --runs 3
+for _ in $(seq 300); do grep -q "run 1 fitted" "$T/between.fitter.err" && break; sleep 0.1; done
+grep -q "run 1 fitted" "$T/between.fitter.err" || fail "between: the fitter never fitted run 1"
+stop "$FITTER"
+start_fitter between fitter2
+finish_chain
+EXPLAIN_OPT=(--no-explain)
+judge between '
+assert not partial, f"a run was joined mid-coast: {partial}"
+assert len(whole) == 3, f"{len(whole)} whole FITs"
+print(f"PROMISE between: fitter restarted between runs: 3 of 3 runs whole, numbered 1 and then 1, 2 by the two sessions")
+'
+rc=0; "$B/spindown" refit "$LOG" --compare >"$T/between.compare.out" 2>&1 || rc=$?
+((rc == 0)) || fail "between: refit --compare exited $rc (want 0: all identical): $(cat "$T/between.compare.out")"
+grep -q "3 identical, 0 different, 0 only refitted, 0 only live" "$T/between.compare.out" ||
+  fail "between: refit --compare does not pair the 3 FITs: $(cat "$T/between.compare.out")"
+grep -q "EXPLAIN: 3 runs explained, 3 live EXPLAIN messages: 3 identical, 0 different, 0 only refitted, 0 only live" \
+  "$T/between.compare.out" || fail "between: refit --compare does not pair the 3 EXPLAINs: $(cat "$T/between.compare.out")"
 
 # --- flood: 5,000 new bench ids while a bench coasts ------------------------------------------
 FITTER_OPTS=(--max-benches 32)
