@@ -26,6 +26,14 @@ std::size_t MessageGate::PairHash::operator()(const PairKey& k) const {
   return std::hash<std::string>()(k.channel) ^ (std::hash<std::uint64_t>()(k.session) * 0x9e3779b97f4a7c15ull);
 }
 
+bool same_port(std::string_view a, std::string_view b) {
+  const auto port = [](std::string_view to) {
+    const std::size_t colon = to.rfind(':');
+    return colon == std::string_view::npos ? std::string_view() : to.substr(colon + 1);
+  };
+  return port(a) == port(b);
+}
+
 MessageGate::MessageGate(MessageGateOptions options) : o_(std::move(options)) {}
 
 GateResult MessageGate::check(std::string_view channel, const void* data, std::int64_t size, std::int64_t recv_utime) {
@@ -50,7 +58,10 @@ GateResult MessageGate::check(std::string_view channel, const void* data, std::i
                   fmt::format("a message of lab '{}', this program serves lab '{}' (two labs on one network: give "
                               "each its own multicast group and port, docs/lab-setup.md)",
                               shown_name(t.lab), o_.lab));
-  if (!o_.sent_to.empty() && !t.sent_to.empty() && t.sent_to != o_.sent_to)
+  // Sent to another group on this port: Linux hands every group joined on a port to each socket
+  // bound to it, so that is another lab's live traffic. Sent to another port, it did not reach this
+  // socket by that trap: a log replayed (or relayed) here on purpose, as README's replay recipe does.
+  if (!o_.sent_to.empty() && !t.sent_to.empty() && t.sent_to != o_.sent_to && same_port(t.sent_to, o_.sent_to))
     return refuse(GateVerdict::other_lab, counters_.other_lab,
                   fmt::format("sent to {}, not to {} where this program listens: another lab's traffic on this "
                               "port (Linux hands every group joined on a port to each socket bound to that port: "

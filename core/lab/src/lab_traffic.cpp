@@ -6,6 +6,7 @@
 #include "spindown/lcm_channels.hpp"
 #include "spindown/lcm_url.hpp"
 #include "spindown/message_auth.hpp"
+#include "spindown/message_gate.hpp"
 #include "spindown/session_id.hpp"
 
 namespace spindown {
@@ -98,7 +99,7 @@ std::vector<DoctorCheck> LabTraffic::checks(const std::string& our_lab, const st
   // Another group's traffic reaching this port (the trap of a PC that serves two labs).
   const std::string ours_to = lcm_destination(url);
   for (const auto& [to, d] : destinations_) {
-    if (to.empty() || ours_to.empty() || to == ours_to) continue;
+    if (to.empty() || ours_to.empty() || to == ours_to || !same_port(to, ours_to)) continue;  // replayed here
     std::string who;
     for (const auto& [host, senders] : d.senders) who += fmt::format("{}host {} ({})", who.empty() ? "" : "; ", host, join(senders));
     out.push_back({"other group " + shown_name(to), CheckLevel::warn,

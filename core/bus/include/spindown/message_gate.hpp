@@ -23,6 +23,11 @@
 
 namespace spindown {
 
+// Whether two udpm destinations ("GROUP:PORT") name the same port: a message sent to another group
+// on this port reached this socket through the kernel (another lab's traffic); one sent to another
+// port was replayed or relayed here.
+bool same_port(std::string_view a, std::string_view b);
+
 struct MessageGateOptions {
   std::string lab = "lab";               // this program's lab; "" takes every lab
   std::string sent_to;                   // the udpm GROUP:PORT it listens on; "" takes every group (logs)
