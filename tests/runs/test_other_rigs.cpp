@@ -493,3 +493,27 @@ TEST(OtherRigs, ARecordingThatBeginsInTheSpinUpIsCutAtTheRelease) {
   ASSERT_GE(seg.runs.size(), 1u);
   EXPECT_NEAR(seg.runs[0].t_cut_s, t_cut, 0.4);
 }
+
+// A supply read within the converter's range (3.40 V on a 5 V reference, two decimals) flickers with
+// 3.39 now and then; at the power-off the reading steps down to the back-EMF, 2.99 V, and coasts.
+// Here the stream begins half a second before the cut (a fitter started late), on a flicker: 22
+// readings of exactly 3.40, two of 3.39, two of 3.40, then the step, as a real log had it. A stretch
+// of exact 3.40s that ends in a flicker is no converter's top: the cut is the step.
+TEST(OtherRigs, ASupplyThatFlickersBelowItsLevelBeforeTheStepIsNoConvertersTop) {
+  const Friction f{1.0, 0.05, 0.08};
+  const double t0 = 5.963, period = 0.0202, t_cut = t0 + 26.5 * period, v_cut = 2.99;
+  const Coast coast(f, v_cut);
+  std::mt19937 rng(3270);
+  std::normal_distribution<double> noise(0, 0.002);
+  Recording rec;
+  rec.source = "physics";
+  for (int k = 0; t0 + k * period <= t_cut + coast.stop_s + 3; ++k) {
+    const double t = t0 + k * period;
+    const double v = t < t_cut ? (k == 0 || k == 23 || k == 24 ? 3.39 : 3.40) : coast.at(t - t_cut) + noise(rng);
+    rec.push(t, std::round(v * 100) / 100);
+  }
+  const Segmentation seg = find_runs(rec);
+  ASSERT_EQ(seg.runs.size(), 1u);
+  EXPECT_NEAR(seg.runs[0].t_cut_s, t_cut, 0.03);
+  for (const Diagnostic& d : seg.diagnostics) EXPECT_EQ(d.message.find("converter's top"), std::string::npos) << d.message;
+}

@@ -55,6 +55,12 @@ bool RunDetector::Impl::split_at_top(CutSplit& sp, std::size_t a, std::size_t b,
   if (!(q > lower && pinned >= 5 && pinned >= 3 * longest && pinned >= 3.0 * step_lasts && leave > 0 &&
         leave <= 0.02 * std::abs(m) + 3.0 * w.resid_sd()))
     return false;
+  // … and comes down from it as a coast does, never by a step within the next ten readings (a
+  // supply read within the converter's range, flickering with the value below it, then the step
+  // to the back-EMF at the cut: that step is the cut, as split_two_segments finds it).
+  double drop = 0;
+  for (std::size_t k = p + 1; k <= std::min(b, p + 10); ++k) drop = std::max(drop, v(k - 1) - v(k));
+  if (drop > 4.0 * std::max(leave, step) && drop > 6.0 * w.resid_sd()) return false;
   sp.clipped = true;
   sp.pin_first = q;
   sp.pin_last = p;
@@ -69,8 +75,9 @@ bool RunDetector::Impl::split_at_top(CutSplit& sp, std::size_t a, std::size_t b,
 }
 
 bool RunDetector::Impl::pinned_lead_in(CutSplit& sp, std::size_t b) {
-  // A powered lead-in held at the highest value of the search, exactly, for 9 in 10 of its readings
-  // and three times longer than any value of the coast after it: a supply above the converter's
+  // A powered lead-in held at the highest value of the search, exactly, for 9 in 10 of its readings,
+  // without a break from where it reached it, and three times longer than any value of the coast
+  // after it: a supply above the converter's
   // range (A0 on the motor's terminal). The power-off is hidden under it; the coast is taken from
   // the first reading below the top after the last such hold (a ripple may bring it back to the top
   // for a few readings as it comes down).
@@ -96,6 +103,14 @@ bool RunDetector::Impl::pinned_lead_in(CutSplit& sp, std::size_t b) {
     }
   }
   if (first <= sp.a || first > b) return false;
+  // A converter's top is a ceiling the reading never falls below while the signal is above it: from
+  // the first reading at the top to the one that leaves it, every reading is exactly the top. A
+  // supply read within the converter's range flickers with the value below it (its noise) all along.
+  std::size_t q = sp.a;
+  while (q < first && v(q) != m) ++q;
+  for (std::size_t k = q; k < first; ++k)
+    if (v(k) != m) return false;
+  if (first < q + std::max<std::size_t>(hold, 8)) return false;
   sp.cut_index = sp.pre_end = first;
   sp.npre = first - sp.a;
   sp.t_cut_s = 0.5 * (t(first - 1) + t(first));
