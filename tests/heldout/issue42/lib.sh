@@ -88,7 +88,7 @@ wait_file() { local n=$(( $2 * 10 )); for _ in $(seq 1 "$n"); do [ -e "$1" ] && 
 # faketime_env FILE: the environment (as env arguments) that steps a process's wall clock by the
 # offset written in FILE ("+0", "+3600"), re-read every second; the monotonic clock is not touched.
 faketime_env() {
-    [ -n "$FAKETIME_LIB" ] || harness_fail "libfaketime is not installed (apt-get install faketime)"
+    [ -n "$FAKETIME_LIB" ] || harness_fail "libfaketime is not installed (deploy/setup --tests installs it)"
     echo "LD_PRELOAD=$FAKETIME_LIB FAKETIME_TIMESTAMP_FILE=$1 FAKETIME_CACHE_DURATION=1 DONT_FAKE_MONOTONIC=1 FAKETIME_DONT_FAKE_MONOTONIC=1"
 }
 

@@ -2,8 +2,8 @@
 # run.sh BIN_DIR [SCRATCH_DIR]: the issue-42 held-out cases against the built programs in BIN_DIR.
 # One line per case, "PASS name" or "FAIL name: why", then "SUMMARY: N/M passed"; exit 1 if any failed.
 # Each case runs under timeout -k 5 120; the whole run stops starting cases past 14 minutes.
-# Needs root (network namespaces), iproute2, python3, lcm-logplayer, libfaketime (installed from
-# Debian's "faketime" package if missing). CASES="a b" runs only those cases.
+# Needs root (network namespaces), iproute2, python3, lcm-logplayer, libfaketime (Debian's
+# "faketime", from deploy/setup --tests). CASES="a b" runs only those cases.
 set -u
 export PYTHONDONTWRITEBYTECODE=1     # the judge imports build/python: write nothing there
 HERE=$(cd "$(dirname "$0")" && pwd)
@@ -22,10 +22,9 @@ for p in spindown spindown-fitter spindown-logger spindown-bridge spindown-virtu
     [ -x "$BIN/$p" ] || pre="${pre:+$pre; }missing $BIN/$p"
 done
 [ -d "$BIN/../python/spindown_log" ] || pre="${pre:+$pre; }missing the Python log reader $BIN/../python (docs/using-the-data.md)"
-if ! ls /usr/lib/*/faketime/libfaketime.so.1 > /dev/null 2>&1 && command -v apt-get > /dev/null && [ -z "$pre" ]; then
-    timeout -k 5 150 apt-get install -y -qq --no-install-recommends faketime > "$SCRATCH/apt.log" 2>&1 ||
-        echo "note: apt-get install faketime failed; the clock cases will fail (see $SCRATCH/apt.log)" >&2
-fi
+# libfaketime comes with deploy/setup --tests (Debian's faketime); never installed while testing.
+ls /usr/lib/*/faketime/libfaketime.so.1 > /dev/null 2>&1 ||
+    pre="${pre:+$pre; }missing libfaketime (deploy/setup --tests installs Debian's faketime)"
 
 # a safety net: namespaces (and their processes) a case left behind
 sweep() {
