@@ -40,11 +40,7 @@ bool RunDetector::Impl::split_at_top(CutSplit& sp, std::size_t a, std::size_t b,
   while (q > lower && v(q - 1) == m) --q;
   // Quantized data plateaus too; a clipped reading is pinned much longer than the longest
   // plateau of the coast after it.
-  std::size_t longest = 1, cur = 1;
-  for (std::size_t k = p + 2; k <= b; ++k) {
-    cur = v(k) == v(k - 1) ? cur + 1 : 1;
-    longest = std::max(longest, cur);
-  }
+  const std::size_t longest = longest_hold(p + 1, b);
   const std::size_t pinned = p - q + 1;
   const double leave = m - v(p + 1);
   // … and much longer than one step of the reading lasts at the coast's start: a heavy
@@ -77,22 +73,16 @@ bool RunDetector::Impl::split_at_top(CutSplit& sp, std::size_t a, std::size_t b,
 bool RunDetector::Impl::pinned_lead_in(CutSplit& sp, std::size_t b) {
   // A powered lead-in held at the highest value of the search, exactly, for 9 in 10 of its readings,
   // without a break from where it reached it, and three times longer than any value of the coast
-  // after it: a supply above the converter's
-  // range (A0 on the motor's terminal). The power-off is hidden under it; the coast is taken from
-  // the first reading below the top after the last such hold (a ripple may bring it back to the top
-  // for a few readings as it comes down).
+  // after it: a supply above the converter's range (A0 on the motor's terminal). The power-off is
+  // hidden under it; the coast is taken from the first reading below the top after the last such
+  // hold (a ripple may bring it back to the top for a few readings as it comes down).
   if (sp.npre < 8 || sp.pre_end > b) return false;
   double m = v(sp.a);
   for (std::size_t k = sp.a; k <= b; ++k) m = std::max(m, v(k));
   std::size_t at_top = 0;
   for (std::size_t k = sp.a; k < sp.pre_end; ++k) at_top += v(k) == m;
   if (10 * at_top < 9 * sp.npre) return false;
-  std::size_t longest = 1, cur = 1;
-  for (std::size_t k = sp.pre_end + 1; k <= b; ++k) {
-    cur = v(k) == v(k - 1) ? cur + 1 : 1;
-    if (v(k) != m) longest = std::max(longest, cur);
-  }
-  const std::size_t hold = 3 * longest;
+  const std::size_t hold = 3 * longest_hold(sp.pre_end, b, m);
   std::size_t first = sp.a, run = 0;  // first: the first reading below the top after a hold
   for (std::size_t k = sp.a; k <= b; ++k) {
     if (v(k) == m) {
@@ -132,11 +122,7 @@ void RunDetector::Impl::find_pinned_start(std::size_t b) {
   for (std::size_t k = c; k <= b; ++k)
     if (v(k) == m) end = k + 1, ++at_top;
   if (end > b || at_top < 5 || 2 * at_top < end - c || v(c) < m - 0.5 * (m - v(end))) return;
-  std::size_t longest = 1, cur = 1;
-  for (std::size_t k = end + 1; k <= b; ++k) {
-    cur = v(k) == v(k - 1) ? cur + 1 : 1;
-    longest = std::max(longest, cur);
-  }
+  const std::size_t longest = longest_hold(end, b);
   const WindowFit after = window_over(ring_.get(), mask_, 1e300, end, b + 1);
   const double slope = after.slope(), step = reading_step(c, b + 1);
   const double period = b > end ? (t(b) - t(end)) / double(b - end) : 0.0;
@@ -544,6 +530,15 @@ double RunDetector::Impl::smoothed(std::size_t k, std::size_t lo, std::size_t hi
   return sum / double(to - from);
 }
 
+std::size_t RunDetector::Impl::longest_hold(std::size_t from, std::size_t last, double except) const {
+  std::size_t longest = 1, cur = 1;
+  for (std::size_t k = from + 1; k <= last; ++k) {
+    cur = v(k) == v(k - 1) ? cur + 1 : 1;
+    if (!(v(k) == except)) longest = std::max(longest, cur);
+  }
+  return longest;
+}
+
 std::size_t RunDetector::Impl::level_end(std::size_t r, std::size_t p, std::size_t b) {
   // [r, b] split into a level and the coast's line by least squares (the coast's start is close to
   // a line), the level reaching from r past the peak p …
@@ -557,11 +552,9 @@ std::size_t RunDetector::Impl::level_end(std::size_t r, std::size_t p, std::size
   // powered lead-in is.
   const WindowFit coast = window_over(ring_.get(), mask_, 1e300, c, b + 1);
   const double slope = coast.slope();
-  const double se = coast.sxx() > 0 ? coast.resid_sd() / std::sqrt(coast.sxx()) : 0.0;
-  if (coast.n < 6 || t(b) - t(c) < 1.0 || !(-slope > 4.0 * se)) return p;
+  if (coast.n < 6 || t(b) - t(c) < 1.0 || !(-slope > 4.0 * coast.slope_se())) return p;
   const WindowFit held = window_over(ring_.get(), mask_, 1e300, p, c);
-  const double held_se = held.sxx() > 0 ? held.resid_sd() / std::sqrt(held.sxx()) : 0.0;
-  return std::abs(held.slope()) + 2.0 * held_se <= 0.3 * -slope ? c : p;
+  return std::abs(held.slope()) + 2.0 * held.slope_se() <= 0.3 * -slope ? c : p;
 }
 
 void RunDetector::Impl::recut_at_level_end(Run& r, std::size_t coast_end) {

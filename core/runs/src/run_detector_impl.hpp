@@ -87,6 +87,7 @@ class RunDetector::Impl {
       if (!(sxx_ > 0)) return 0.0;
       return (stv - st() * sv() / n) / sxx_;
     }
+    double slope_se() const { return sxx() > 0 ? resid_sd() / std::sqrt(sxx()) : 0.0; }
     double resid_sd() const {
       if (n < 3) return 0.0;
       const double syy = svv() - sv() * sv() / n;
@@ -353,6 +354,10 @@ class RunDetector::Impl {
   // The smallest positive change between consecutive readings in [from, to): the converter's or
   // the printing's step on quantized readings; 0 when none changes.
   double reading_step(std::size_t from, std::size_t to) const;
+  // The most readings in a row that hold one value in [from, last] (runs of `except` not counted):
+  // how long one printed value lasts there.
+  std::size_t longest_hold(std::size_t from, std::size_t last,
+                           double except = std::numeric_limits<double>::quiet_NaN()) const;
   // Whether samples [from, to) only flicker between printed values at most three steps apart.
   bool flickers(std::size_t from, std::size_t to) const;
   // Whether samples [from, to) rise steadily: a line's slope far beyond its error, and no hum.
