@@ -113,7 +113,6 @@ void RunDetector::Impl::find_pinned_start(std::size_t b) {
   // mostly the same highest value (a ripple flickers it with values below as it comes down), held
   // far longer than any value of the coast after it and than one step of the reading lasts there.
   // Each reading at that top is a bound, not the motor's value: all are left out of the fit.
-  pin_level_ = std::numeric_limits<double>::quiet_NaN();
   const std::size_t c = run_.cut_index;
   if (b < c + 16) return;
   double m = v(c);

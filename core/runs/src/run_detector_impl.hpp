@@ -256,7 +256,7 @@ class RunDetector::Impl {
   // t_stop creeps in as an exponential does, rather than stopping.
   bool creeps_in(double t_cut, double t_quarter, double t_stop) const;
   // The t-statistic of the rate the coast over [from, to) still falls at when it meets its floor z
-  // (friction a + b·height: a over its standard error).
+  // (friction a + b·height: a over its standard error); to: the approach's end (held_into).
   double floor_rate_t(std::size_t from, std::size_t to, double z) const;
   // The first sample of the value held up to sample to (after from) when it held longer than the
   // coast's fall over the second before it allows (a sensor that holds its last reading); else to.
@@ -292,9 +292,10 @@ class RunDetector::Impl {
   void found_standstill(std::size_t i, bool at_end);
   // The first sample of the standstill at level z (within band) that holds the window ending at i.
   std::size_t standstill_start(std::size_t i, double z, double band) const;
-  // When the approach line (the last ≤2 s before first_in, after sample k) meets the zero level z,
-  // within [t_quarter, t(i)]; t(first_in) when no falling line is there.
-  double approach_meets_zero(std::size_t first_in, std::size_t k, double z, double t_quarter, std::size_t i) const;
+  // When the approach line (the last ≤2 s of [k, end), end <= first_in the standstill's first
+  // sample) meets the zero level z, within [t_quarter, t(i)]; t(first_in) when no falling line is there.
+  double approach_meets_zero(std::size_t first_in, std::size_t end, std::size_t k, double z, double t_quarter,
+                             std::size_t i) const;
   // The open run's first sample at or after t_hit, at most i.
   std::size_t first_sample_from(double t_hit, std::size_t i) const;
   // A stop at sample stop that falls in a pause of the recording: the run's note says so.

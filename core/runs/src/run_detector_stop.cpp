@@ -238,7 +238,11 @@ void RunDetector::Impl::found_standstill(std::size_t i, bool at_end) {
   // Where the coast crossed the last quarter of its amplitude.
   const std::size_t k = last_quarter_index(run_.cut_index, first_in, z + 0.25 * amp);
   const double t_quarter = quarter_crossing_time(k, run_.cut_index, z + 0.25 * amp);
-  const std::size_t stop = first_sample_from(approach_meets_zero(first_in, k, z, t_quarter, i), i);
+  // A value held into the standstill longer than the coast allows (a per-tooth sensor's last
+  // reading, held until it gives up) is one reading: the approach ends at its first sample.
+  const std::size_t held = held_into(k, first_in);
+  const std::size_t approach_end = held < first_in ? held + 1 : first_in;
+  const std::size_t stop = first_sample_from(approach_meets_zero(first_in, approach_end, k, z, t_quarter, i), i);
   note_stop_in_pause(stop);
 
   // A real stop arrives with a finite slope; an exponential creeps in.
@@ -247,7 +251,7 @@ void RunDetector::Impl::found_standstill(std::size_t i, bool at_end) {
   run_.noise_level = sd_z;
   // … and right before it the reading still falls clearly (an exponential has flattened).
   stop_approach_t_ = approach_t_stat(stop);
-  stop_floor_t_ = floor_rate_t(k, first_in, z);
+  stop_floor_t_ = floor_rate_t(k, approach_end, z);
   if (!creeps_in(run_.t_cut_s, t_quarter, t_stop) || amp <= 0) {
     stop_at(i, stop, z, sd_z, amp);
   } else if (!creeping_ && !at_end) {
@@ -277,14 +281,11 @@ std::size_t RunDetector::Impl::standstill_start(std::size_t i, double z, double 
   return std::min(first_in, i);
 }
 
-double RunDetector::Impl::approach_meets_zero(std::size_t first_in, std::size_t k, double z, double t_quarter,
-                                              std::size_t i) const {
-  // Stop time: the approach line (the last ≤2 s above the band) meets the zero level. A value held
-  // into the standstill (a per-tooth sensor's last reading, held until it gives up) is one reading.
+double RunDetector::Impl::approach_meets_zero(std::size_t first_in, std::size_t end, std::size_t k, double z,
+                                              double t_quarter, std::size_t i) const {
+  // Stop time: the approach line (the last ≤2 s of [k, end) above the band) meets the zero level.
   double t_hit = t(first_in);
-  const std::size_t held = held_into(k, first_in);
-  const std::size_t end = held < first_in ? held + 1 : first_in;  // the approach: [from, end)
-  const double t_ref = held < first_in ? t(held) : t(first_in);
+  const double t_ref = end < first_in ? t(end - 1) : t(first_in);
   std::size_t from = end;
   while (from > k && t_ref - t(from - 1) <= 2.0) --from;
   if (end >= from + 3) {
@@ -462,9 +463,6 @@ double RunDetector::Impl::floor_rate_t(std::size_t from, std::size_t to, double 
   // The coast's fall over its last quarter as friction a + b·(height above the floor): each step
   // between neighbouring samples, −Δv = (a + b·h)·Δt by least squares. An exponential's a is 0 (its
   // rate dies with its height); a stop's is the rate it still falls at when it meets the floor.
-  // A value held into the floor longer than the coast allows (a per-tooth sensor's last reading,
-  // held until it gives up) is one reading: its repeats are left out.
-  if (const std::size_t held = held_into(from, to); held < to) to = held + 1;
   if (to < from + 6) return 0.0;
   double s11 = 0, s12 = 0, s22 = 0, s1y = 0, s2y = 0, syy = 0, n = 0;
   for (std::size_t j = from; j + 1 < to; ++j) {
