@@ -181,6 +181,7 @@ int run_watch(const WatchCommandOptions& o) {
                                      : std::string("signatures not checked")));
   // After every wait: the table's events, as lines or under the redrawn table.
   loop.every(0, [&](std::int64_t t) {
+    table.tick(t);
     for (auto& e : table.take_events()) {
       std::string line = clock_text(t) + "  " + e;
       if (redraw) {
@@ -210,6 +211,7 @@ int run_watch(const WatchCommandOptions& o) {
 
   // The last state stays on screen (a redraw) or closes the log (plain, --once).
   const std::int64_t t = wall_us();
+  table.tick(t);
   if (redraw) {
     redraw_screen(t);
   } else {

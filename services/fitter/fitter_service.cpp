@@ -60,7 +60,7 @@ void FitterService::fit_ready(const FitResult& r) {
   about.first_seq = r.first_seq;
   about.last_seq = r.last_seq;
   const std::int64_t now = wall_us();
-  about.latency_s = 1e-6 * double(now - r.detected_utime);
+  about.latency_s = 1e-6 * double(steady_wall_us() - r.detected_utime);  // the core's times never step
   about.health = r.health;
   about.bridge_host = r.bridge_host;
   about.bridge_session = r.bridge_session;
@@ -205,7 +205,7 @@ void FitterService::worker() {
                  "busy): no bench is judged silent until what arrived meanwhile has been handled\n",
                  stalled_s);
       draining_ = true;
-      drain_from_us = wall_us();
+      drain_from_us = steady_wall_us();
       drained_messages = 0;
     }
     last_round = round;
@@ -213,12 +213,14 @@ void FitterService::worker() {
       if (m.channel == status_channel_)
         own_channel_status(m);
       else
-        core_.on_message(m.channel, m.data.data(), static_cast<std::int64_t>(m.data.size()), m.recv_utime);
+        core_.on_message(m.channel, m.data.data(), static_cast<std::int64_t>(m.data.size()), m.recv_utime,
+                         m.host_utime);
     }
     // Benches gone silent mid-coast, by the time of the traffic just handled (as refit does with
-    // a log); by the clock only when none came and nothing received still waits.
+    // a log); by the clock only when none came and nothing received still waits. The core's times
+    // never step (clock.hpp steady_wall_us): a lab PC's wall clock stepped by NTP is not silence.
     const bool idle = batch.empty();
-    const std::int64_t now = idle ? wall_us() : batch.back().recv_utime;
+    const std::int64_t now = idle ? steady_wall_us() : batch.back().host_utime;
     drained_messages += static_cast<std::int64_t>(batch.size());
     batch.clear();
     if (draining_ && round >= next_drain_check) {
@@ -244,7 +246,7 @@ void FitterService::worker() {
 
 void FitterService::own_channel_status(const QueuedMessage& m) {
   const auto size = static_cast<std::int64_t>(m.data.size());
-  if (!core_.admit(m.channel, m.data.data(), size, m.recv_utime)) return;  // another lab's, unsigned, …
+  if (!core_.admit(m.channel, m.data.data(), size, m.recv_utime, m.host_utime)) return;  // another lab's, unsigned, …
   status_t s{};
   if (!decode_message(s, m.data.data(), size)) return;
   if (auto text = instances_.heard(s, m.recv_utime)) {
@@ -293,7 +295,7 @@ int FitterService::run(const StopSignals& stop) {
   worker_.join();
   // Runs still open are closed as abandoned (not fitted: a restarted fitter takes the rest of
   // the coast as partial), so no client shows them coasting for ever; then the last heartbeat.
-  core_.abandon_open_runs(wall_us(), "fitter stopping: the run was not finished; a fitter started again takes the "
+  core_.abandon_open_runs(steady_wall_us(), "fitter stopping: the run was not finished; a fitter started again takes the "
                                      "rest of its coast as a partial run");
   publish_status(wall_us(), "stopping");
   const FitterCounters& c = core_.counters();

@@ -103,20 +103,49 @@ TEST(MessageGate, WithTheKeyOnlySignedNewMessagesPass) {
   // Sent on another channel than the one it was signed for.
   const auto moved = signer.encode("SPINDOWN.b2.FIT", fit_at());
   EXPECT_EQ(check(moved).verdict, GateVerdict::bad_signature);
-  // A signed message sent long before it arrives: outside the window; within it, accepted.
+  // A source first heard with a message sent long before it arrives: outside the window (an old
+  // capture sent again after a restart); within it, accepted.
+  auto restarted = stamp_for("lab-a", test_key(), 77);
   fit_t late = fit_at();
   late.utime = t0 - 120'000'000;
-  EXPECT_EQ(check(signer.encode(ch, late)).verdict, GateVerdict::outside_window);
+  EXPECT_EQ(check(restarted.encode(ch, late)).verdict, GateVerdict::outside_window);
   late.utime = t0 - 30'000'000;
+  EXPECT_TRUE(check(restarted.encode(ch, late)).accepted());
+  // A known source whose wall clock stepped back 2 minutes (NTP, a laptop waking): its numbers
+  // still rise, so it is live, not a replay (issue 42).
+  late.utime = t0 - 150'000'000;
   EXPECT_TRUE(check(signer.encode(ch, late)).accepted());
   const GateCounters& c = gate.counters();
-  EXPECT_EQ(c.accepted, 3);
+  EXPECT_EQ(c.accepted, 4);
   EXPECT_EQ(c.replayed, 2);
   EXPECT_EQ(c.not_signed, 1);
   EXPECT_EQ(c.other_key, 1);
   EXPECT_EQ(c.bad_signature, 2);
   EXPECT_EQ(c.outside_window, 1);
   EXPECT_EQ(c.refused(), 7);
+}
+
+// A network reorders datagrams: a late signed message never seen is taken, a copy is a replay, and
+// one further back than the window can tell is refused as too old.
+TEST(MessageGate, ALateSignedDatagramIsNotAReplay) {
+  MessageGate gate(options("lab-a", test_key()));
+  auto signer = stamp_for("lab-a", test_key());
+  const std::string ch = "SPINDOWN.b1.SAMPLE";
+  std::vector<std::vector<unsigned char>> sent;
+  for (int i = 0; i < 1100; ++i) sent.push_back(signer.encode(ch, samples_at(t0)));
+  const auto check = [&](std::size_t i) { return gate.check(ch, sent[i].data(), std::int64_t(sent[i].size()), t0); };
+  EXPECT_TRUE(check(0).accepted());
+  EXPECT_TRUE(check(3).accepted());
+  EXPECT_TRUE(check(1).accepted()) << "late, never seen";
+  EXPECT_TRUE(check(2).accepted());
+  EXPECT_EQ(check(1).verdict, GateVerdict::replayed) << "a copy";
+  EXPECT_EQ(check(3).verdict, GateVerdict::replayed);
+  EXPECT_TRUE(check(1090).accepted());
+  const GateResult old = check(4);  // 1086 behind the newest
+  EXPECT_EQ(old.verdict, GateVerdict::replayed);
+  EXPECT_NE(old.text.find("too old to be told from a replay"), std::string::npos) << old.text;
+  EXPECT_TRUE(check(1000).accepted());
+  EXPECT_EQ(gate.counters().accepted, 6);
 }
 
 // Replays are judged per source and channel: another channel's or another source's counts do not

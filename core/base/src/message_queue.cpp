@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "spindown/clock.hpp"
+
 namespace spindown {
 
 MessageQueue::Offer MessageQueue::offer(std::int64_t recv_utime, std::string_view channel, const void* data,
@@ -13,7 +15,7 @@ MessageQueue::Offer MessageQueue::offer(std::int64_t recv_utime, std::string_vie
     counts_.last_oversize_channel = std::string(channel);
     return Offer::oversize;
   }
-  QueuedMessage m{recv_utime, std::string(channel), {}};
+  QueuedMessage m{recv_utime, steady_wall_us(), std::string(channel), {}};
   const auto* bytes = static_cast<const unsigned char*>(data);
   if (size > 0) m.data.assign(bytes, bytes + size);
   bool was_empty = false;

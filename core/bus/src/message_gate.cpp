@@ -88,27 +88,44 @@ GateResult MessageGate::check(std::string_view channel, const void* data, std::i
     case AuthStatus::malformed:
       return refuse(GateVerdict::bad_signature, counters_.bad_signature, a.why + ": its signature cannot be checked");
   }
-  const double skew_s = 1e-6 * double(recv_utime - t.utime);
-  if (!(std::abs(skew_s) <= o_.replay_window_s))
-    return refuse(GateVerdict::outside_window, counters_.outside_window,
-                  fmt::format("sent {:.1f} s {} it was received, beyond the {:g} s replay window: an old message "
-                              "sent again, or that host's clock is off (spindown doctor --listen measures it)",
-                              std::abs(skew_s), skew_s >= 0 ? "before" : "after", o_.replay_window_s));
   PairKey k{t.source_session, std::string(channel)};
   auto it = last_seq_.find(k);
-  if (it != last_seq_.end() && t.source_seq <= it->second)
-    return refuse(GateVerdict::replayed, counters_.replayed,
-                  fmt::format("message {} of that source again (already at {} on this channel): a replay",
-                              t.source_seq, it->second));
-  if (it != last_seq_.end()) {
-    it->second = t.source_seq;
-  } else {
+  if (it == last_seq_.end()) {  // a source first heard: its clock must agree with this one's
+    const double skew_s = 1e-6 * double(recv_utime - t.utime);
+    if (!(std::abs(skew_s) <= o_.replay_window_s))
+      return refuse(GateVerdict::outside_window, counters_.outside_window,
+                    fmt::format("sent {:.1f} s {} it was received, beyond the {:g} s replay window: an old message "
+                                "sent again, or that host's clock is off (spindown doctor --listen measures it)",
+                                std::abs(skew_s), skew_s >= 0 ? "before" : "after", o_.replay_window_s));
     if (o_.max_sources > 0 && last_seq_.size() >= o_.max_sources) {
       last_seq_.erase(order_.front());
       order_.pop_front();
     }
-    last_seq_.emplace(k, t.source_seq);
+    Seen seen;
+    seen.high = t.source_seq;
+    seen.below.set(0);
+    last_seq_.emplace(k, seen);
     order_.push_back(std::move(k));
+    ++counters_.accepted;
+    return r;
+  }
+  Seen& seen = it->second;
+  if (t.source_seq > seen.high) {
+    const std::int64_t ahead = t.source_seq - seen.high;
+    seen.below = ahead >= seq_window ? std::bitset<seq_window>{} : seen.below << static_cast<std::size_t>(ahead);
+    seen.below.set(0);
+    seen.high = t.source_seq;
+  } else {
+    const std::int64_t behind = seen.high - t.source_seq;
+    if (behind >= seq_window || seen.below.test(static_cast<std::size_t>(behind)))
+      return refuse(GateVerdict::replayed, counters_.replayed,
+                    behind >= seq_window
+                        ? fmt::format("message {} of that source, {} behind the newest ({}) on this channel: too old "
+                                      "to be told from a replay",
+                                      t.source_seq, behind, seen.high)
+                        : fmt::format("message {} of that source again (already seen on this channel): a replay",
+                                      t.source_seq));
+    seen.below.set(static_cast<std::size_t>(behind));  // a late datagram, not seen before
   }
   ++counters_.accepted;
   return r;

@@ -279,47 +279,60 @@ std::vector<std::string> LabTable::take_events() {
   return out;
 }
 
+// The fitter's rules (sample_stream.hpp): its words for a new source, two at once, a far jump.
+struct LabTable::StreamSink {
+  LabTable& table;
+  LabBenchRow& r;
+  std::int64_t now_us;
+  void problem(SampleProblem kind, std::int64_t count, std::string text) {
+    switch (kind) {
+      case SampleProblem::samples_lost:
+        ++r.seq_gaps;
+        r.samples_missing += count;
+        return;
+      case SampleProblem::new_source:
+        ++r.seq_restarts;
+        table.event(fmt::format("{}: {}", r.bench, text));
+        return;
+      case SampleProblem::two_sources:
+        r.two_sources = fmt::format("SPINDOWN.{}.SAMPLE {}", r.bench, text);
+        r.other_source_us = now_us;
+        table.event(r.two_sources);
+        return;
+      case SampleProblem::other_source:
+        r.other_source_samples += count;
+        r.other_source_us = now_us;
+        return;
+      case SampleProblem::jump:
+        ++r.seq_jumps;
+        table.event(fmt::format("{}: {}", r.bench, text));
+        return;
+      default: return;  // repeats, restarts, NaN…: the fitter's STATUS counts them
+    }
+  }
+  void sample(std::int64_t, std::int64_t, double) { ++r.samples; }
+};
+void LabTable::tick(std::int64_t now_us) {
+  for (auto& [id, r] : benches_)
+    if (r.stream.waiting()) {
+      r.stream.expire(now_us, StreamSink{*this, r, now_us});
+      gap_event(r, now_us);
+    }
+}
+
 void LabTable::on_samples(std::string_view bench, const samples_t& msg, std::int64_t now_us) {
   LabBenchRow& r = row(bench, now_us);
   if (msg.auth_key_id != 0) signed_traffic_ = true;
-  // The fitter's rules (sample_stream.hpp): its words for a new source, two at once, a far jump.
-  struct Sink {
-    LabTable& table;
-    LabBenchRow& r;
-    std::int64_t now_us;
-    void problem(SampleProblem kind, std::int64_t count, std::string text) {
-      switch (kind) {
-        case SampleProblem::samples_lost:
-          ++r.seq_gaps;
-          r.samples_missing += count;
-          return;
-        case SampleProblem::new_source:
-          ++r.seq_restarts;
-          table.event(fmt::format("{}: {}", r.bench, text));
-          return;
-        case SampleProblem::two_sources:
-          r.two_sources = fmt::format("SPINDOWN.{}.SAMPLE {}", r.bench, text);
-          r.other_source_us = now_us;
-          table.event(r.two_sources);
-          return;
-        case SampleProblem::other_source:
-          r.other_source_samples += count;
-          r.other_source_us = now_us;
-          return;
-        case SampleProblem::jump:
-          ++r.seq_jumps;
-          table.event(fmt::format("{}: {}", r.bench, text));
-          return;
-        default: return;  // repeats, restarts, NaN…: the fitter's STATUS counts them
-      }
-    }
-    void sample(std::int64_t, std::int64_t, double) { ++r.samples; }
-  };
   const auto n = static_cast<std::size_t>(std::max<std::int32_t>(0, std::min<std::int32_t>(
                                               msg.n, static_cast<std::int32_t>(std::min(msg.device_time_us.size(),
                                                                                           msg.value.size())))));
-  if (r.stream.take(msg, n, now_us, Sink{*this, r, now_us})) ++r.sample_messages;
+  if (r.stream.take(msg, n, now_us, StreamSink{*this, r, now_us})) ++r.sample_messages;
   r.has_samples = true;
+  gap_event(r, now_us);
+}
+
+// "sequence gaps: …", at most every gap_event_every_s.
+void LabTable::gap_event(LabBenchRow& r, std::int64_t now_us) {
   const double since = 1e-6 * double(now_us - r.last_gap_event_us);
   if (r.seq_gaps > r.gaps_at_last_event && (r.last_gap_event_us == 0 || since >= opt_.gap_event_every_s)) {
     event(fmt::format("{}: sequence gaps: {} so far, {} samples lost on the way to this listener", r.bench,

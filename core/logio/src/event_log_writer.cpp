@@ -7,6 +7,7 @@
 #include <fcntl.h>
 #include <fmt/format.h>
 #include <lcm/eventlog.h>
+#include <limits>
 #include <stdio_ext.h>
 #include <sys/statvfs.h>
 #include <unistd.h>
@@ -175,7 +176,7 @@ bool EventLogWriter::rotation_due(std::int64_t now_us, std::int64_t next_event_b
 
 bool EventLogWriter::write(std::int64_t recv_utime, std::string_view channel, const void* data,
                            std::int32_t size, std::int64_t now_us) {
-  track_samples(channel, data, size);
+  track_samples(channel, data, size, recv_utime);
   resume_if_due(now_us);
   if (disk_full_) {
     ++counters_.events_lost;
@@ -268,6 +269,8 @@ bool EventLogWriter::flush(std::int64_t now_us) {
 }
 
 void EventLogWriter::tick(std::int64_t now_us) {
+  for (auto& [key, t] : next_seq_)
+    if (!t.waiting.empty()) release_waiting(t, now_us);
   if (o_.retention.enabled() && now_us >= next_prune_us_) prune(now_us);
   resume_if_due(now_us);
   if (rotation_due(now_us, 0)) rotate(now_us, "rotating");
@@ -314,7 +317,11 @@ void EventLogWriter::close_file(std::int64_t now_us, std::string_view state) {
   }
 }
 
-void EventLogWriter::close(std::int64_t now_us, std::string_view why) { close_file(now_us, why); }
+void EventLogWriter::close(std::int64_t now_us, std::string_view why) {
+  for (auto& [key, t] : next_seq_)  // the last status counts every gap still open as missing
+    if (!t.waiting.empty()) release_waiting(t, std::numeric_limits<std::int64_t>::max());
+  close_file(now_us, why);
+}
 
 void EventLogWriter::write_status_event(std::int64_t now_us, std::string_view state) {
   if (!log_) return;
@@ -392,7 +399,8 @@ void EventLogWriter::fail_text(std::int64_t now_us, std::string text) {
   next_reopen_us_ = now_us + static_cast<std::int64_t>(o_.reopen_interval_s * 1e6);
 }
 
-void EventLogWriter::track_samples(std::string_view channel, const void* data, std::int32_t size) {
+void EventLogWriter::track_samples(std::string_view channel, const void* data, std::int32_t size,
+                                   std::int64_t recv_utime) {
   const auto parsed = parse_channel(channel);
   if (!parsed || parsed->kind != ChannelKind::sample) return;
   samples_t s{};
@@ -403,22 +411,54 @@ void EventLogWriter::track_samples(std::string_view channel, const void* data, s
   // Per bench and bridge session: a restarted bridge (a new session) numbers from 0 again without
   // being a repeat.
   const std::string key = parsed->bench + "/" + std::to_string(s.source_session);
+  const std::int64_t n = std::max<std::int32_t>(s.n, 0);
   auto it = next_seq_.find(key);
   if (it == next_seq_.end()) {
     if (next_seq_.size() >= o_.max_tracked_benches) {
       ++counters_.benches_untracked;
       return;
     }
-    next_seq_.emplace(key, s.seq + std::max<std::int32_t>(s.n, 0));
+    next_seq_[key].next_seq = s.seq + n;
     return;
   }
-  if (s.seq > it->second) {
-    ++counters_.seq_gaps;
-    counters_.samples_missing += s.seq - it->second;
-  } else if (s.seq < it->second) {
-    ++counters_.seq_repeats;  // a duplicate (or an unnamed bridge restarted): follow the new sequence
+  SeqTrack& t = it->second;
+  const ReorderOptions window;
+  if (s.seq < t.next_seq) {
+    if (t.waiting.take_lost(s.seq, n)) {  // it came after all: in the log, so not missing
+      counters_.samples_missing -= n;
+      counters_.samples_late += n;
+    } else {
+      counters_.seq_repeats += n;
+      // Far behind: an unnamed bridge (session 0) restarted its numbering: follow it.
+      if (t.next_seq - s.seq > window.max_samples) {
+        release_waiting(t, std::numeric_limits<std::int64_t>::max());
+        t.waiting.clear();
+        t.next_seq = s.seq + n;
+      }
+    }
+    return;
   }
-  it->second = s.seq + std::max<std::int32_t>(s.n, 0);
+  if (t.waiting.holds(s.seq, n)) {
+    counters_.seq_repeats += n;
+    return;
+  }
+  if (s.seq == t.next_seq)
+    t.next_seq += n;
+  else
+    t.waiting.insert(s.seq, n, recv_utime, char{});
+  release_waiting(t, recv_utime);
+}
+
+void EventLogWriter::release_waiting(SeqTrack& t, std::int64_t now_us) {
+  while (t.waiting.ready(t.next_seq, now_us, ReorderOptions{})) {
+    const auto e = t.waiting.pop();
+    if (e.seq > t.next_seq) {
+      ++counters_.seq_gaps;
+      counters_.samples_missing += e.seq - t.next_seq;
+      t.waiting.lost(t.next_seq, e.seq, now_us == std::numeric_limits<std::int64_t>::max() ? e.recv_us : now_us);
+    }
+    t.next_seq = std::max(t.next_seq, e.seq + e.n);
+  }
 }
 
 status_t EventLogWriter::make_status(std::int64_t now_us) const {
@@ -437,6 +477,7 @@ status_t EventLogWriter::make_status(std::int64_t now_us) const {
       {"decode_errors", counters_.decode_errors},
       {"seq_gaps", counters_.seq_gaps},
       {"samples_missing", counters_.samples_missing},
+      {"samples_late", counters_.samples_late},
       {"seq_repeats", counters_.seq_repeats},
       {"benches_untracked", counters_.benches_untracked},
       {"disk_full_episodes", counters_.disk_full_episodes},

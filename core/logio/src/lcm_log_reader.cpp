@@ -425,15 +425,17 @@ void take_samples(BenchState& st, const LcmLogEvent& ev) {
           st.reporter.warn(event, fmt::format("SPINDOWN.{}.SAMPLE {}", st.log.bench, text));
           return;
         case SampleProblem::other_source:
-        case SampleProblem::jump: break;
+        case SampleProblem::jump:
+        case SampleProblem::late: break;
         case SampleProblem::bad_value:
         case SampleProblem::time_backwards: break;
       }
       st.reporter.warn(event, text);
     }
     void sample(std::int64_t, std::int64_t t_us, double v) { rec.push(static_cast<double>(t_us) / 1e6, v); }
+    void origin(std::int64_t e) { event = e; }  // a message that waited past a gap: its own event
   };
-  st.stream.take(m, static_cast<std::size_t>(std::max(m.n, 0)), ev.log_utime, Sink{st, rec, ev.number});
+  st.stream.take(m, static_cast<std::size_t>(std::max(m.n, 0)), ev.log_utime, Sink{st, rec, ev.number}, ev.number);
   if (st.stream.quantity_known) rec.quantity = st.stream.quantity;
 }
 
@@ -443,16 +445,18 @@ void flush_samples(BenchState& st) {
   struct Sink {
     BenchState& st;
     Recording& rec;
+    std::int64_t event;
     void problem(SampleProblem kind, std::int64_t count, std::string text) {
       if (kind == SampleProblem::samples_lost) st.log.samples_lost += count;
       if (kind == SampleProblem::clock_restart && !rec.empty() &&
           (rec.clock_restarts.empty() || rec.clock_restarts.back() != rec.size()))
         rec.clock_restarts.push_back(rec.size());
-      st.reporter.warn(st.last_event, text);
+      st.reporter.warn(event, text);
     }
     void sample(std::int64_t, std::int64_t t_us, double v) { rec.push(static_cast<double>(t_us) / 1e6, v); }
+    void origin(std::int64_t e) { event = e; }
   };
-  st.stream.flush(Sink{st, rec});
+  st.stream.flush(Sink{st, rec, st.last_event});
 }
 
 void take_config(BenchState& st, const LcmLogEvent& ev) {

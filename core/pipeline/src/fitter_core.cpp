@@ -118,6 +118,11 @@ bool FitterCore::admit(std::string_view id, std::int64_t recv_utime, std::string
 }
 
 void FitterCore::on_message(std::string_view channel, const void* data, std::int64_t size, std::int64_t recv_utime) {
+  on_message(channel, data, size, recv_utime, recv_utime);
+}
+
+void FitterCore::on_message(std::string_view channel, const void* data, std::int64_t size, std::int64_t wall_utime,
+                            std::int64_t recv_utime) {
   ++counters_.messages;
   const auto parts = split_channel(channel);
   const auto kind = parts ? channel_kind(parts->suffix) : std::nullopt;
@@ -144,10 +149,10 @@ void FitterCore::on_message(std::string_view channel, const void* data, std::int
       error(fmt::format("{}: {}; message skipped", channel, why), recv_utime);
       return;
     }
-    if (!admit_samples(channel, msg, data, size, recv_utime)) return;
+    if (!admit_samples(channel, msg, data, size, wall_utime, recv_utime)) return;
     on_samples(bench, msg, recv_utime);
   } else {
-    if (!admit(channel, data, size, recv_utime)) return;
+    if (!admit(channel, data, size, wall_utime, recv_utime)) return;
     config_t msg{};
     if (!decode_message(msg, data, size, &why)) {
       ++counters_.decode_errors;
@@ -158,8 +163,9 @@ void FitterCore::on_message(std::string_view channel, const void* data, std::int
   }
 }
 
-bool FitterCore::admit(std::string_view channel, const void* data, std::int64_t size, std::int64_t recv_utime) {
-  const GateResult g = gate_.check(channel, data, size, recv_utime);
+bool FitterCore::admit(std::string_view channel, const void* data, std::int64_t size, std::int64_t wall_utime,
+                       std::int64_t recv_utime) {
+  const GateResult g = gate_.check(channel, data, size, wall_utime);
   switch (g.verdict) {
     case GateVerdict::accepted:
     case GateVerdict::undecodable: return true;  // the decoder names what is wrong
@@ -172,6 +178,12 @@ bool FitterCore::admit(std::string_view channel, const void* data, std::int64_t 
   }
   sink_.notice(gate_verdict_name(g.verdict), channel, g.text);
   error(g.text, recv_utime);
+  // Samples that arrive and are refused are not silence: the bench's run waits (poll()).
+  if (const auto parts = split_channel(channel); parts && channel_kind(parts->suffix) == ChannelKind::sample)
+    if (auto it = benches_.find(parts->bench); it != benches_.end()) {
+      it->second->last_refused_utime = recv_utime;
+      it->second->last_refused = g.text;
+    }
   return false;
 }
 
@@ -276,7 +288,8 @@ struct FitterCore::StreamSink {
       case SampleProblem::unknown_quantity:
       case SampleProblem::quantity_change: ++c.quantity_errors; break;
       case SampleProblem::samples_lost: ++c.seq_gaps, c.samples_lost += count; break;
-      case SampleProblem::repeated: ++c.duplicates; break;
+      case SampleProblem::repeated: c.duplicates += count; break;
+      case SampleProblem::late: c.late_samples += count; break;
       case SampleProblem::sequence_restart: ++c.seq_restarts; return;  // the clock's restart says it
       case SampleProblem::clock_restart:  // the detector says it when it closes the run
         ++c.clock_restarts;
@@ -311,6 +324,7 @@ struct FitterCore::StreamSink {
 };
 
 void FitterCore::flush_stream(Bench& b, std::int64_t utime) { b.stream.flush(StreamSink{*this, b, utime}); }
+void FitterCore::expire_stream(Bench& b, std::int64_t utime) { b.stream.expire(utime, StreamSink{*this, b, utime}); }
 
 // Inlined into each on_samples(): at one sample per message a call's register saves and
 // argument moves cost as much as the checks.

@@ -249,7 +249,25 @@ bool FitterCore::silence_due(std::int64_t now_utime) const {
 void FitterCore::poll(std::int64_t now_utime) {
   const auto silent_us = static_cast<std::int64_t>(opt_.silent_s * 1e6);
   for (auto& [id, b] : benches_) {
+    if (b->stream.waiting()) {  // gaps that waited long enough for late messages are lost
+      try {
+        expire_stream(*b, now_utime);
+      } catch (const std::exception& e) {
+        ++counters_.internal_errors;
+        error(fmt::format("{}: internal error taking what waited past a gap: {}", b->channel, e.what()), now_utime);
+      }
+    }
     if (b->open_state == 0 || now_utime - b->last_sample_utime < silent_us) continue;
+    if (now_utime - b->last_refused_utime < silent_us) {  // its samples arrive and are refused: not silent
+      if (!b->refused_said) {
+        b->refused_said = true;
+        error(fmt::format("{}: run {} is kept open: the bench still sends, but its samples are refused ({})",
+                          b->channel, b->open_run.number, b->last_refused),
+              now_utime);
+      }
+      continue;
+    }
+    b->refused_said = false;
     try {
       b->detector.went_silent(opt_.silent_s);  // not the silence measured: live and refit say the same
       handle_events(*b, now_utime);

@@ -110,7 +110,8 @@ void WebLab::on_samples(std::string_view id, const samples_t& msg, std::int64_t 
   Bench& b = bench(id);
   std::vector<TracePoint> kept;
   const auto n = static_cast<std::size_t>(std::max<std::int32_t>(0, msg.n));
-  if (!b.stream.take(msg, n, now_us, TakeSink{kept}) || kept.empty()) return;
+  b.stream.take(msg, n, now_us, TakeSink{kept});  // also what waited past a gap this message filled
+  if (kept.empty()) return;
   b.activity.last_sample_us = now_us;
   b.activity.last_value = kept.back().value;
   b.activity.quantity = msg.quantity;

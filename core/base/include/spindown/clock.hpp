@@ -19,6 +19,17 @@ inline std::int64_t monotonic_ns() {
       .count();
 }
 
+// Wall time that never steps: the wall clock as it read the first time this is called, advanced by
+// the monotonic clock since. For the host times whose differences are durations (a bench's
+// silence, a rate cap, how long a message waited past a gap) in a program that may see its wall
+// clock stepped (an NTP correction, a laptop waking, an RTC kept in local time): a +1 h step is
+// not an hour of silence. Never for times compared with another machine's (signatures' freshness
+// and every utime sent keep wall_us()).
+inline std::int64_t steady_wall_us() {
+  static const std::int64_t anchor = wall_us() - monotonic_ns() / 1000;
+  return monotonic_ns() / 1000 + anchor;
+}
+
 // A steady_clock deadline seconds from now (seconds may be fractional).
 inline std::chrono::steady_clock::time_point steady_after(double seconds) {
   return std::chrono::steady_clock::now() +

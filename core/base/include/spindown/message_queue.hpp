@@ -22,7 +22,8 @@
 namespace spindown {
 
 struct QueuedMessage {
-  std::int64_t recv_utime = 0;
+  std::int64_t recv_utime = 0;  // wall time LCM read it (a signature's freshness is judged on it)
+  std::int64_t host_utime = 0;  // steady_wall_us() when queued: for durations (clock.hpp)
   std::string channel;
   std::vector<unsigned char> data;
 };

@@ -1,14 +1,18 @@
 #pragma once
 // What a reader lets through (issue 31): a received message's bytes, before anything uses them.
 // The lab first — a message of another lab is counted and named, never used, with or without
-// signatures — then, with the lab key, its signature (verify_message) and the replay window: a
-// signed message must be newer than the last one seen from its source on its channel
-// (source_seq) and sent within replay_window_s of its receive time (its utime), so an old
-// message sent again is refused. The fitter (FitterCore, live and refit), the logger (it records
+// signatures — then, with the lab key, its signature (verify_message) and replays: a signed
+// message's source_seq must not have been seen from its source on its channel (a sliding window of
+// the last seq_window numbers, as IPsec's anti-replay window: a network that reorders datagrams
+// does not make a late one a replay), and the first message of a source must have been sent
+// within replay_window_s of its receive time (its utime), so an old message sent again after a
+// restart is refused. Once a source is known its source_seq alone tells a replay: a wall clock
+// stepped on either PC (NTP, a laptop waking) does not refuse a live bench (issue 42). The fitter (FitterCore, live and refit), the logger (it records
 // everything and counts), `spindown watch` and the log reader all take messages through one.
 //
 // Bounded: the replay state keeps max_sources (source, channel) pairs, the oldest forgotten
 // first; only messages whose signature is valid enter it.
+#include <bitset>
 #include <cstdint>
 #include <deque>
 #include <optional>
@@ -103,7 +107,12 @@ class MessageGate {
   };
   MessageGateOptions o_;
   GateCounters counters_;
-  std::unordered_map<PairKey, std::int64_t, PairHash> last_seq_;  // highest source_seq accepted
+  static constexpr std::int64_t seq_window = 1024;
+  struct Seen {
+    std::int64_t high = 0;               // highest source_seq accepted
+    std::bitset<seq_window> below;       // bit i: high - i accepted
+  };
+  std::unordered_map<PairKey, Seen, PairHash> last_seq_;
   std::deque<PairKey> order_;                                     // insertion order, for the bound
 };
 

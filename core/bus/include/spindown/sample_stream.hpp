@@ -6,10 +6,13 @@
 //
 // A stream has one source: the bridge process (its host and session, samples_t.source_*) whose
 // samples it takes (issue 31). Per message of that source: the quantity code must be known and
-// must not change; the sequence number tells lost samples (a jump forward) and a repeated
-// message (backward, times already seen: skipped); a new clock epoch, or times that start again
-// below the last, is a restarted device clock (a new timeline). Per sample: a value must be
-// finite and a device time must advance.
+// must not change; the sequence number orders the stream: a message past a gap waits in a
+// reorder window (reorder_window.hpp) until the gap fills (a late datagram, taken in its place)
+// or has waited reorder.window_us (then the gap's samples are lost); a message with samples
+// already taken is a repeat (skipped), one whose gap was already called lost is late (skipped,
+// named as late). A new clock epoch, or times that start again below the last, is a restarted
+// device clock (a new timeline). Per sample: a value must be finite and a device time must
+// advance.
 //
 // What a forged or damaged message cannot do any more:
 // - A message far from where the stream is (more than max_gap_samples ahead, device time more
@@ -41,6 +44,7 @@
 
 #include "spindown/message_decode.hpp"
 #include "spindown/recording.hpp"
+#include "spindown/reorder_window.hpp"
 #include "spindown/session_id.hpp"
 
 namespace spindown {
@@ -61,6 +65,7 @@ enum class SampleProblem {
   two_sources,       // a second source sends at the same time as the stream's (named once per source)
   other_source,      // count: samples of a source that is not the stream's, refused
   jump,              // count: held samples that did not continue the stream, dropped (forged or damaged)
+  late,              // count: samples that arrived after their gap was called lost (counted there); skipped
 };
 
 struct SampleStreamOptions {
@@ -70,6 +75,7 @@ struct SampleStreamOptions {
   std::int64_t max_gap_us = 10'000'000;  // and a forward device-time step up to this
   std::size_t max_held_samples = 8192;   // held per stream at most (more are refused and counted)
   std::size_t max_sources = 4;           // other sources remembered per channel
+  ReorderOptions reorder;                // how long a message past a gap waits for the gap to fill
 };
 
 // A sample's device time and value from either form of samples_t, and the message's source.
@@ -91,6 +97,7 @@ struct HeldSamples {
   std::string source_host;
   std::vector<std::int64_t> t_us;
   std::vector<double> v;
+  std::int64_t origin = 0;  // the caller's name for the message (a log's event number), see take()
 };
 inline std::int64_t sample_time_us(const HeldSamples& m, std::size_t i) { return m.t_us[i]; }
 inline double sample_value(const HeldSamples& m, std::size_t i) { return m.v[i]; }
@@ -115,11 +122,16 @@ struct SampleStream {
 
   // Takes a message of n samples (n already checked against its arrays), received at recv_us.
   // For each thing wrong, sink.problem(SampleProblem, count, text) with the words to report; for
-  // each sample kept, sink.sample(seq, device_time_us, value). Returns false when the message is
-  // not taken now (skipped, refused or held). Inlined: at one sample per message a call costs as
-  // much as the checks; everything rare is a call.
+  // each sample kept, sink.sample(seq, device_time_us, value). Returns true when the message is
+  // the stream's: taken now, or waiting past a gap to be taken in order; false when it is skipped,
+  // refused or held (a far jump, another source). origin names the message for the caller (a log's
+  // event number): when a message that waited is taken later, sink.origin(its origin) is called
+  // first, if the sink has it, so what is said of it names the right message. Inlined: at one
+  // sample per message a call costs as much as the checks; everything rare is a call.
   template <class Message, class Sink>
-  [[gnu::always_inline]] inline bool take(const Message& m, std::size_t n, std::int64_t recv_us, Sink&& sink) {
+  [[gnu::always_inline]] inline bool take(const Message& m, std::size_t n, std::int64_t recv_us, Sink&& sink,
+                                          std::int64_t origin = 0) {
+    origin_ = origin;
     if (!have_source) [[unlikely]] {
       adopt_source(sample_session(m), m.source_host, recv_us);
     } else if (sample_session(m) != session || m.source_host != host) [[unlikely]] {
@@ -135,6 +147,7 @@ struct SampleStream {
   // taken; a new source's held messages that never took over are counted as refused.
   template <class Sink>
   void flush(Sink&& sink) {
+    release_waiting(std::numeric_limits<std::int64_t>::max(), sink);
     if (jump_.active) adopt_jump(jump_.first_recv_us, sink);
     for (Other& o : others_) {
       if (o.held_samples > 0)
@@ -145,6 +158,14 @@ struct SampleStream {
       o.held_samples = 0;
     }
   }
+
+  // Time passes with no message (the fitter's poll): gaps waited for long enough are lost, and
+  // what waited behind them is taken.
+  template <class Sink>
+  void expire(std::int64_t now_us, Sink&& sink) {
+    if (!waiting_.empty()) release_waiting(now_us, sink);
+  }
+  bool waiting() const { return !waiting_.empty(); }
 
   // "host bench-pc (session 3f9a0c1d5e7b2a48)" of the stream's source.
   std::string source_text() const { return source_words(session, host); }
@@ -182,9 +203,10 @@ struct SampleStream {
   }
 
   template <class Message>
-  static HeldSamples hold(const Message& m, std::size_t n) {
+  HeldSamples hold(const Message& m, std::size_t n) {
     HeldSamples h;
     h.seq = m.seq;
+    h.origin = origin_;
     h.clock_epoch = m.clock_epoch;
     h.quantity = m.quantity;
     h.source_session = sample_session(m);
@@ -221,18 +243,63 @@ struct SampleStream {
       return true;  // nothing to take, and an empty message does not move the stream
     if (have_seq) [[likely]] {
       const Relation r = relation(m, n, next_seq, epoch, last_t_us);
-      if (r == Relation::repeated) [[unlikely]] {
-        const auto count = static_cast<std::int64_t>(n);
-        sink.problem(SampleProblem::repeated, count,
-                     fmt::format("samples {} to {} were already received (repeated message); skipped", m.seq,
-                                 m.seq + count - 1));
-        return false;
-      }
-      if (r == Relation::jump || jump_.active) [[unlikely]]
-        return take_far(m, n, recv_us, r, sink);
+      if (r != Relation::continues || m.seq != next_seq || !waiting_.empty() || jump_.active) [[unlikely]]
+        return take_out_of_order(m, n, recv_us, r, sink);
     }
     accept(m, n, sink, false);
     return true;
+  }
+
+  // Anything but the next message in order: a repeat, a late one, one past a gap, a far jump.
+  template <class Message, class Sink>
+  bool take_out_of_order(const Message& m, std::size_t n, std::int64_t recv_us, Relation r, Sink& sink) {
+    const auto count = static_cast<std::int64_t>(n);
+    if (r == Relation::repeated) {
+      if (const auto called = waiting_.take_lost(m.seq, count)) {
+        sink.problem(SampleProblem::late, count,
+                     fmt::format("samples {} to {} arrived {:.1f} s after they were counted lost (a gap waits {:g} s "
+                                 "for late messages); not used",
+                                 m.seq, m.seq + count - 1, 1e-6 * double(recv_us - *called),
+                                 1e-6 * double(options.reorder.window_us)));
+        return false;
+      }
+      say_repeated(m.seq, count, sink);
+      return false;
+    }
+    if (r == Relation::jump && !waiting_.empty() &&
+        relation(m, n, waiting_.end_seq(), epoch, waiting_.back().item.t_us.back()) == Relation::continues)
+      r = Relation::continues;  // it continues what waits past a gap
+    if (r == Relation::jump) return take_far(m, n, recv_us, sink);
+    if (jump_.active) drop_jump(m, sink);  // the old position went on: what was held was not the stream
+    if (waiting_.holds(m.seq, count)) {
+      say_repeated(m.seq, count, sink);
+      return false;
+    }
+    if (m.seq == next_seq)  // the gap's first message: taken, then what waited behind it
+      accept(m, n, sink, false);
+    else
+      waiting_.insert(m.seq, count, recv_us, hold(m, n));
+    release_waiting(recv_us, sink);
+    return true;
+  }
+
+  template <class Sink>
+  void say_repeated(std::int64_t seq, std::int64_t count, Sink& sink) {
+    sink.problem(SampleProblem::repeated, count,
+                 fmt::format("samples {} to {} were already received (repeated message); skipped", seq,
+                             seq + count - 1));
+  }
+
+  // What waits past a gap, in order, while it continues the stream or its gap has waited long
+  // enough (now_us = max: everything, at the end or when the stream moves elsewhere).
+  template <class Sink>
+  void release_waiting(std::int64_t now_us, Sink& sink) {
+    while (waiting_.ready(next_seq, now_us, options.reorder)) {
+      const auto e = waiting_.pop();
+      if (e.seq > next_seq) waiting_.lost(next_seq, e.seq, now_us == std::numeric_limits<std::int64_t>::max() ? e.recv_us : now_us);
+      if constexpr (requires { sink.origin(std::int64_t{}); }) sink.origin(e.item.origin);
+      accept(e.item, e.item.t_us.size(), sink, false);
+    }
   }
 
   template <class Message, class Sink>
@@ -311,14 +378,9 @@ struct SampleStream {
     }
   }
 
-  // A message far from the stream, or any message while one is held.
+  // A message far from the stream.
   template <class Message, class Sink>
-  bool take_far(const Message& m, std::size_t n, std::int64_t recv_us, Relation r, Sink& sink) {
-    if (r == Relation::continues) {  // the old position went on: what was held was not the stream
-      drop_jump(m, sink);
-      accept(m, n, sink, false);
-      return true;
-    }
+  bool take_far(const Message& m, std::size_t n, std::int64_t recv_us, Sink& sink) {
     const Relation to_held = jump_.active ? relation(m, n, jump_.next_seq, jump_.epoch, jump_.last_t_us) : Relation::jump;
     if (to_held == Relation::repeated) {  // a copy of a held message
       sink.problem(SampleProblem::repeated, static_cast<std::int64_t>(n),
@@ -378,6 +440,7 @@ struct SampleStream {
   // The held position is the stream's from now: its messages are taken in order.
   template <class Sink>
   void adopt_jump(std::int64_t, Sink& sink) {
+    release_waiting(std::numeric_limits<std::int64_t>::max(), sink);  // the old position's, first
     std::vector<HeldSamples> held = std::move(jump_.held);
     jump_ = Jump{};
     bool first = true;
@@ -461,6 +524,8 @@ struct SampleStream {
   template <class Message, class Sink>
   bool take_over(Other& o, const Message& m, std::size_t n, std::int64_t recv_us, Sink& sink) {
     if (jump_.active) adopt_jump(recv_us, sink);
+    release_waiting(std::numeric_limits<std::int64_t>::max(), sink);  // the old stream's, to its end
+    waiting_.clear();  // and its losses: the new source numbers its own
     sink.problem(SampleProblem::new_source, 0,
                  fmt::format("a new source: {} after {} went quiet {:.1f} s ago (the bridge restarted or the board was "
                              "replugged); a new stream starts here and no run spans it",
@@ -486,6 +551,8 @@ struct SampleStream {
 
   std::vector<Other> others_;
   Jump jump_;
+  ReorderWindow<HeldSamples> waiting_;  // the stream's messages past a gap
+  std::int64_t origin_ = 0;             // of the message being taken
 };
 
 }  // namespace spindown

@@ -122,6 +122,8 @@ class LabTable {
   // Decoded messages; bench is the bench id of the channel they came on, now_us the host
   // time they arrived (µs since the epoch).
   void on_samples(std::string_view bench, const samples_t& msg, std::int64_t now_us);
+  // Time passes: sequence gaps that waited long enough for late datagrams are counted lost.
+  void tick(std::int64_t now_us);
   void on_config(std::string_view bench, const config_t& msg, std::int64_t now_us);
   void on_run(std::string_view bench, const run_t& msg, std::int64_t now_us);
   void on_fit(std::string_view bench, const fit_t& msg, std::int64_t now_us);
@@ -166,6 +168,8 @@ class LabTable {
 
   LabTableOptions opt_;
   std::map<std::string, LabBenchRow, std::less<>> benches_;
+  struct StreamSink;  // a bench's SampleStream words -> its row and the events
+  void gap_event(LabBenchRow& r, std::int64_t now_us);
   std::map<std::string, LabServiceRow, std::less<>> services_;  // "service/instance"
   std::int64_t last_fitter_us_ = 0;  // the newest heartbeat of any fitter
   bool fitter_stopping_ = false;     // that heartbeat said "stopping"

@@ -36,6 +36,7 @@
 
 #include "spindown/lcm_status.hpp"
 #include "spindown/log_retention.hpp"
+#include "spindown/reorder_window.hpp"
 
 struct _lcm_eventlog_t;
 
@@ -75,9 +76,12 @@ struct EventLogCounters {
   std::int64_t queue_drops = 0;      // events dropped before the writer (queue full), reported to it
   std::int64_t status_events = 0;    // the logger's own status events written into the logs
   std::int64_t decode_errors = 0;    // SAMPLE events that did not decode as samples_t (still logged)
-  std::int64_t seq_gaps = 0;         // SAMPLE messages that came after missing sequence numbers
-  std::int64_t samples_missing = 0;  // samples missing by sequence number
-  std::int64_t seq_repeats = 0;      // SAMPLE messages with a sequence number already seen (restart, duplicate)
+  // By sequence number, with the fitter's reorder window (reorder_window.hpp): a message past a
+  // gap waits for the gap to fill; only what never came within the window is missing.
+  std::int64_t seq_gaps = 0;         // gaps in the sequence numbers not filled within the window
+  std::int64_t samples_missing = 0;  // samples missing by sequence number (less those that came late)
+  std::int64_t samples_late = 0;     // samples that came after their gap was counted (in the log all the same)
+  std::int64_t seq_repeats = 0;      // samples whose sequence number was already seen (a duplicate, a restart)
   std::int64_t benches_untracked = 0;// SAMPLE messages of benches beyond max_tracked_benches
   std::int64_t disk_full_episodes = 0;  // times the disk filled up (each one write error)
   std::int64_t oversize_drops = 0;   // events larger than the recorder's max_event_bytes, not recorded
@@ -156,7 +160,12 @@ class EventLogWriter {
   // deleted until `bytes` and a margin fit. False when they still do not.
   bool make_room(std::int64_t bytes, std::int64_t now_us);
   void count_deletions(LogPruneResult& r, std::int64_t now_us);
-  void track_samples(std::string_view channel, const void* data, std::int32_t size);
+  void track_samples(std::string_view channel, const void* data, std::int32_t size, std::int64_t recv_utime);
+  struct SeqTrack {
+    std::int64_t next_seq = 0;    // every sample before it came (or was counted missing)
+    ReorderWindow<char> waiting;  // messages past a gap, by sequence number
+  };
+  void release_waiting(SeqTrack& t, std::int64_t now_us);
   bool rotation_due(std::int64_t now_us, std::int64_t next_event_bytes) const;
 
   EventLogWriterOptions o_;
@@ -183,7 +192,7 @@ class EventLogWriter {
   bool disk_full_ = false;
   double queue_depth_ = 0;
   EventLogCounters counters_;
-  std::unordered_map<std::string, std::int64_t> next_seq_;  // "bench/session" -> expected samples_t.seq
+  std::unordered_map<std::string, SeqTrack> next_seq_;  // "bench/session" -> where its samples_t.seq stands
   std::string last_error_;
   std::int64_t last_error_utime_ = 0;
   mutable StatusHeartbeat status_;

@@ -103,7 +103,8 @@ struct FitterCounters {
   std::int64_t other_channels = 0;     // not SPINDOWN.<bench>.SAMPLE|CONFIG
   std::int64_t seq_gaps = 0;           // gaps in samples_t.seq
   std::int64_t samples_lost = 0;       // samples missing in those gaps
-  std::int64_t duplicates = 0;         // repeated messages skipped
+  std::int64_t duplicates = 0;         // samples of repeated messages (sequence numbers seen), skipped
+  std::int64_t late_samples = 0;       // samples that came after their gap was counted lost (skipped)
   std::int64_t seq_restarts = 0;       // sequence number went back (bridge restarted)
   std::int64_t clock_restarts = 0;     // device clock epochs
   std::int64_t nan_values = 0;         // non-finite values skipped
@@ -192,13 +193,26 @@ class FitterCore {
   // decoded and used, other channels counted. recv_utime is the host receive time (µs since the
   // epoch; from the log when refitting) used by the rate cap, the replay window and for latency.
   void on_message(std::string_view channel, const void* data, std::int64_t size, std::int64_t recv_utime);
+  // Live, two clocks: wall_utime is the wall time LCM read the message (a signed source first
+  // heard must agree with it: the replay window), recv_utime the host time that never steps
+  // (clock.hpp steady_wall_us) for everything else (silence, rate cap, reorder window).
+  void on_message(std::string_view channel, const void* data, std::int64_t size, std::int64_t wall_utime,
+                  std::int64_t recv_utime);
   // The gate alone, for a reader that decodes itself (refit): false when the message must not be
   // used (counted and named). A message that does not decode passes (its decoder names it).
-  bool admit(std::string_view channel, const void* data, std::int64_t size, std::int64_t recv_utime);
+  bool admit(std::string_view channel, const void* data, std::int64_t size, std::int64_t recv_utime) {
+    return admit(channel, data, size, recv_utime, recv_utime);
+  }
+  bool admit(std::string_view channel, const void* data, std::int64_t size, std::int64_t wall_utime,
+             std::int64_t recv_utime);
   // admit() for a SAMPLE already viewed (its lab read): nearly always one comparison.
   bool admit_samples(std::string_view channel, const SamplesView& view, const void* data, std::int64_t size,
+                     std::int64_t wall_utime, std::int64_t recv_utime) {
+    return gate_.accepts_at_once(view.lab, view.sent_to) || admit(channel, data, size, wall_utime, recv_utime);
+  }
+  bool admit_samples(std::string_view channel, const SamplesView& view, const void* data, std::int64_t size,
                      std::int64_t recv_utime) {
-    return gate_.accepts_at_once(view.lab, view.sent_to) || admit(channel, data, size, recv_utime);
+    return admit_samples(channel, view, data, size, recv_utime, recv_utime);
   }
   // Already decoded messages (tests, tools; a log reader's view); bench is the channel's bench id.
   void on_samples(std::string_view bench, const samples_t& msg, std::int64_t recv_utime);
@@ -240,6 +254,7 @@ class FitterCore {
   struct Bench;
   struct StreamSink;  // SampleStream's problems and samples -> counters, errors, the detector
   void flush_stream(Bench& b, std::int64_t utime);
+  void expire_stream(Bench& b, std::int64_t utime);  // gaps waited out (sample_stream.hpp expire)
   inline Bench* bench_for(std::string_view id, std::int64_t recv_utime, std::string_view kind);
   Bench* find_bench(std::string_view id, std::int64_t recv_utime, std::string_view kind);  // past the cache
   bool admit(std::string_view id, std::int64_t recv_utime, std::string_view kind);  // room for a new bench?
