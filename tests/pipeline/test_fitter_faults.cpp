@@ -7,12 +7,15 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 #include <vector>
 
 #include "fitter_test_support.hpp"
 #include "spindown/fitter_core.hpp"
+#include "spindown/lab_key.hpp"
+#include "spindown/message_stamp.hpp"
 #include "spindown/runs.hpp"
 
 namespace spindown {
@@ -157,6 +160,48 @@ TEST(FitterFaults, ASilentBenchHasItsRunClosedAfterTheTimeout) {
   // Once is enough: later polls do not close it again.
   core.poll(utime + 30'000'000);
   EXPECT_EQ(sink.fits.size(), 1u);
+}
+
+// The bench still sends, but what it sends is refused (signed with a key the fitter does not have:
+// the lab key was changed on one PC only): that is not silence. The run stays open and the
+// refusal is said; once nothing at all arrives for silent_s, the run is closed as silent (issue 42).
+TEST(FitterFaults, ARunIsNotSilentWhileItsSamplesArriveRefused) {
+  const TwoRuns tr = two_runs(41);
+  const auto key = [](unsigned char fill) {
+    std::array<unsigned char, lab_key_bytes> b{};
+    b.fill(fill);
+    return lab_key_from_bytes(b);
+  };
+  CollectingSink sink;
+  FitterOptions o;
+  o.silent_s = 10;
+  o.gate.key = key(5);
+  FitterCore core(o, sink);
+  MessageStamp bench_pc(SourceIdentity{"", "", "bench-pc", 42, 0}, key(5));
+  std::int64_t seq = 0, utime = 0;
+  const auto send = [&](MessageStamp& stamp, std::size_t i) {
+    samples_t m = batch("a", tr.s, i, 1, seq++);
+    utime += 20000;
+    m.utime = utime;
+    const auto bytes = stamp.encode("SPINDOWN.a.SAMPLE", m);
+    core.on_message("SPINDOWN.a.SAMPLE", bytes.data(), static_cast<std::int64_t>(bytes.size()), utime);
+    core.poll(utime);
+  };
+  const std::size_t mid = (tr.first.cut_index + tr.first.stop_index) / 2;
+  for (std::size_t i = 0; i < mid; ++i) send(bench_pc, i);
+  EXPECT_EQ(core.counters().runs_started, 1);
+  MessageStamp rekeyed(SourceIdentity{"", "", "bench-pc", 43, 0}, key(6));
+  for (std::size_t i = mid; i < mid + 750; ++i) send(rekeyed, i);  // 15 s of refused samples
+  EXPECT_TRUE(sink.fits.empty()) << "closed as silent while samples arrived";
+  EXPECT_EQ(core.counters().bad_signatures, 750);
+  const auto said = std::find_if(sink.problems.begin(), sink.problems.end(),
+                                 [](const std::string& p) { return p.find("kept open") != std::string::npos; });
+  ASSERT_NE(said, sink.problems.end());
+  EXPECT_NE(said->find("not this lab's key"), std::string::npos) << *said;
+  core.poll(utime + 10'500'000);  // then nothing at all
+  ASSERT_EQ(sink.fits.size(), 1u);
+  EXPECT_EQ(sink.fits[0].fit.run.end, Run::End::silent);
+  EXPECT_EQ(sink.fits[0].fit.run.end_index, mid);
 }
 
 // A network outage mid-coast (issue 31): the bench goes on sampling, but nothing reaches the

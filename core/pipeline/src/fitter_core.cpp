@@ -178,8 +178,10 @@ bool FitterCore::admit(std::string_view channel, const void* data, std::int64_t 
   }
   sink_.notice(gate_verdict_name(g.verdict), channel, g.text);
   error(g.text, recv_utime);
-  // Samples that arrive and are refused are not silence: the bench's run waits (poll()).
-  if (const auto parts = split_channel(channel); parts && channel_kind(parts->suffix) == ChannelKind::sample)
+  // Samples of this lab that arrive and are refused (unsigned, another key, a replay) are not
+  // silence: the bench's run waits (poll()). Another lab's bench of the same name is not this one.
+  if (const auto parts = split_channel(channel);
+      g.verdict != GateVerdict::other_lab && parts && channel_kind(parts->suffix) == ChannelKind::sample)
     if (auto it = benches_.find(parts->bench); it != benches_.end()) {
       it->second->last_refused_utime = recv_utime;
       it->second->last_refused = g.text;

@@ -261,9 +261,10 @@ void FitterCore::poll(std::int64_t now_utime) {
     if (now_utime - b->last_refused_utime < silent_us) {  // its samples arrive and are refused: not silent
       if (!b->refused_said) {
         b->refused_said = true;
-        error(fmt::format("{}: run {} is kept open: the bench still sends, but its samples are refused ({})",
-                          b->channel, b->open_run.number, b->last_refused),
-              now_utime);
+        std::string text = fmt::format("{}: run {} is kept open: the bench still sends, but its samples are refused ({})",
+                                       b->channel, b->open_run.number, b->last_refused);
+        sink_.notice("kept open", b->channel, text);
+        error(std::move(text), now_utime);
       }
       continue;
     }
