@@ -21,12 +21,8 @@ LabSettings lab_settings_from(const LabOptions& o) {
   return *s;
 }
 
-MessageGateOptions gate_options_from(const LabOptions& o) {
-  const LabSettings s = lab_settings_from(o);
-  MessageGateOptions g;
-  g.lab = s.lab;
-  g.key = s.key;
-  return g;
+MessageGateOptions gate_options_from(const LabOptions& o, const std::string& lcm_url) {
+  return lab_gate(lab_settings_from(o), lcm_url);
 }
 
 }  // namespace spindown::cli

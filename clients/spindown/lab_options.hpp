@@ -22,6 +22,6 @@ void add_lab_options(CLI::App* sub, LabOptions& o, const std::string& group = "L
 // The lab and key they name; a bad name or an unreadable key is bad usage (CLI::ValidationError).
 LabSettings lab_settings_from(const LabOptions& o);
 // The gate of a reader of the lab's messages (message_gate.hpp).
-MessageGateOptions gate_options_from(const LabOptions& o);
+MessageGateOptions gate_options_from(const LabOptions& o, const std::string& lcm_url = "");
 
 }  // namespace spindown::cli

@@ -149,9 +149,7 @@ int run_watch(const WatchCommandOptions& o) {
   }
   LabTableOptions topt;
   topt.lab_units = o.lab_units;
-  MessageGateOptions gate_options = gate_options_from(o.lab);
-  gate_options.sent_to = lcm_destination(o.lcm_url);
-  MessageGate gate(gate_options);
+  MessageGate gate(gate_options_from(o.lab, o.lcm_url));
   topt.signatures_checked = gate.signing();
   LabTable table(topt);
   const std::regex wanted(o.bench_regex);

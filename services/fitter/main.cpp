@@ -129,15 +129,15 @@ std::optional<int> parse_options(int argc, char** argv, spindown::FitterServiceO
     return 2;
   }
   o.lab = *lab;
-  o.core.gate.lab = lab->lab;
-  o.core.gate.key = lab->key;
+  o.lcm_url = spindown::with_receive_buffer(o.lcm_url, recv_buf);
+  const double replay_window_s = o.core.gate.replay_window_s;  // --replay-window
+  o.core.gate = spindown::lab_gate(*lab, o.lcm_url);
+  o.core.gate.replay_window_s = replay_window_s;
   if (!o.core.is_valid(&why)) {
     fmt::print(stderr, "spindown-fitter: {}\n", why);
     return 2;
   }
 
-  o.lcm_url = spindown::with_receive_buffer(o.lcm_url, recv_buf);
-  o.core.gate.sent_to = spindown::lcm_destination(o.lcm_url);  // another group's traffic on this port: another lab
   return std::nullopt;
 }
 

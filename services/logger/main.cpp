@@ -216,11 +216,7 @@ int main(int argc, char** argv) {
   recorder.start();
   spindown::MessageStamp stamp(spindown::this_process_identity(o.lab.lab, url), o.lab.key);
   loop.set_stamp(&stamp);
-  spindown::MessageGateOptions gate_options;
-  gate_options.lab = o.lab.lab;
-  gate_options.sent_to = spindown::lcm_destination(url);
-  gate_options.key = o.lab.key;
-  spindown::MessageGate gate(gate_options);
+  spindown::MessageGate gate(spindown::lab_gate(o.lab, url));
   Heartbeat heartbeat(loop, recorder, w.status_channel, gate);
 
   // LCM 1.3.1 drops silently past a subscription's queue capacity (30 unless set): no limit

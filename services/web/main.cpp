@@ -85,11 +85,7 @@ std::optional<int> parse_options(int argc, char** argv, spindown::WebServiceOpti
     fmt::print(stderr, "spindown-web: {}\n", why);
     return 2;
   }
-  spindown::MessageGateOptions gate;
-  gate.lab = lab->lab;
-  gate.key = lab->key;
-  gate.sent_to = spindown::lcm_destination(o.lcm_url);
-  o.check = [g = std::make_shared<spindown::MessageGate>(std::move(gate))](
+  o.check = [g = std::make_shared<spindown::MessageGate>(spindown::lab_gate(*lab, o.lcm_url))](
                 std::string_view channel, const void* data, std::int64_t size,
                 std::int64_t recv_utime) -> std::optional<std::string> {
     const spindown::GateResult r = g->check(channel, data, size, recv_utime);

@@ -191,5 +191,20 @@ TEST(MessageStamp, FillsTheSourceFieldsAndCountsMessages) {
   EXPECT_FALSE(me.host.empty());
 }
 
+// Every program builds its gate one way: the lab's name and key, and the group and port it listens
+// on (another group's traffic on that port is another lab's); a log reader checks no destination.
+TEST(MessageGate, TheLabGateOfAListenerAndOfALogReader) {
+  LabSettings lab;
+  lab.lab = "lab-a";
+  lab.key = test_key();
+  const MessageGateOptions live = lab_gate(lab, "udpm://239.255.76.67:7667?ttl=0");
+  EXPECT_EQ(live.lab, "lab-a");
+  ASSERT_TRUE(live.key.has_value());
+  EXPECT_EQ(live.key->id, test_key().id);
+  EXPECT_EQ(live.sent_to, "239.255.76.67:7667");
+  EXPECT_EQ(live.replay_window_s, MessageGateOptions{}.replay_window_s);
+  EXPECT_TRUE(lab_gate(lab).sent_to.empty());
+}
+
 }  // namespace
 }  // namespace spindown

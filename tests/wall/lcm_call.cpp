@@ -1,4 +1,4 @@
-// Must not link below `bus`: LCM's header is a system header any file can name, but the
+// Must not link in the physics: LCM's header is a system header any file can name, but the
 // library itself is linked only from bus up, so a call into it is an undefined reference.
 #include <lcm/lcm.h>
 int main() {

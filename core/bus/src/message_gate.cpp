@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <functional>
 
+#include "spindown/lcm_url.hpp"
 #include "spindown/session_id.hpp"
 
 namespace spindown {
@@ -129,6 +130,15 @@ GateResult MessageGate::check(std::string_view channel, const void* data, std::i
   }
   ++counters_.accepted;
   return r;
+}
+
+MessageGateOptions lab_gate(const LabSettings& lab, const std::string& lcm_url) {
+  MessageGateOptions g;
+  g.lab = lab.lab;
+  g.key = lab.key;
+  // Another group's traffic on this port is another lab's (message_gate.cpp check()).
+  if (!lcm_url.empty()) g.sent_to = lcm_destination(lcm_url);
+  return g;
 }
 
 }  // namespace spindown

@@ -21,6 +21,7 @@
 #include <unordered_map>
 
 #include "spindown/lab_key.hpp"
+#include "spindown/lab_settings.hpp"
 #include "spindown/message_auth.hpp"
 #include "spindown/message_decode.hpp"
 #include "spindown/session_id.hpp"
@@ -115,5 +116,10 @@ class MessageGate {
   std::unordered_map<PairKey, Seen, PairHash> last_seq_;
   std::deque<PairKey> order_;                                     // insertion order, for the bound
 };
+
+// The gate of a program of lab `lab` (its name and key) listening on lcm_url: the one way every
+// program builds it (fitter, logger, watch, web; refit and the log readers with lcm_url "", where
+// no destination is checked). The replay window stays the default unless the caller sets it.
+MessageGateOptions lab_gate(const LabSettings& lab, const std::string& lcm_url = "");
 
 }  // namespace spindown
