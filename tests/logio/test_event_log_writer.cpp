@@ -414,6 +414,28 @@ TEST(EventLogWriter, CountsSampleSequenceGapsPerBench) {
   EXPECT_EQ(w.counters().events, 7);  // undecodable events are still logged
 }
 
+// The lab's gate refused them (forged, replayed, another key): written, never counted as the
+// lab's loss, repeats or late samples (issue 42: a forger made 5 million "missing" samples).
+TEST(EventLogWriter, RefusedMessagesAreWrittenButNotCountedInTheSequence) {
+  TempDir dir;
+  EventLogWriter w(options_in(dir), kT0);
+  w.open(kT0);
+  auto put = [&](std::int64_t seq, bool accepted) {
+    const auto m = encode_samples("a", seq, 1);
+    w.write(kT0, "SPINDOWN.a.SAMPLE", m.data(), static_cast<std::int32_t>(m.size()), kT0, accepted);
+  };
+  for (int i = 0; i < 10; ++i) {
+    put(i, true);
+    put(1'000'000 + 7 * i, false);  // a forged stream under the bridge's session
+    put(i, false);                  // a replay of the real one
+  }
+  w.tick(kT0 + 10 * ReorderOptions{}.window_us);
+  EXPECT_EQ(w.counters().seq_gaps, 0);
+  EXPECT_EQ(w.counters().samples_missing, 0);
+  EXPECT_EQ(w.counters().seq_repeats, 0);
+  EXPECT_EQ(w.counters().events, 30);
+}
+
 TEST(LogRecorder, DrainsEverythingQueuedOnStop) {
   TempDir dir;
   EventLogWriter w(options_in(dir), kT0);

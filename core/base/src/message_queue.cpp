@@ -7,7 +7,7 @@
 namespace spindown {
 
 MessageQueue::Offer MessageQueue::offer(std::int64_t recv_utime, std::string_view channel, const void* data,
-                                        std::size_t size) {
+                                        std::size_t size, bool accepted) {
   if (size > limits_.max_message_bytes) {
     std::lock_guard lock(mutex_);
     ++counts_.oversize_drops;
@@ -15,7 +15,7 @@ MessageQueue::Offer MessageQueue::offer(std::int64_t recv_utime, std::string_vie
     counts_.last_oversize_channel = std::string(channel);
     return Offer::oversize;
   }
-  QueuedMessage m{recv_utime, steady_wall_us(), std::string(channel), {}};
+  QueuedMessage m{recv_utime, steady_wall_us(), accepted, std::string(channel), {}};
   const auto* bytes = static_cast<const unsigned char*>(data);
   if (size > 0) m.data.assign(bytes, bytes + size);
   bool was_empty = false;

@@ -175,8 +175,8 @@ bool EventLogWriter::rotation_due(std::int64_t now_us, std::int64_t next_event_b
 }
 
 bool EventLogWriter::write(std::int64_t recv_utime, std::string_view channel, const void* data,
-                           std::int32_t size, std::int64_t now_us) {
-  track_samples(channel, data, size, recv_utime);
+                           std::int32_t size, std::int64_t now_us, bool accepted) {
+  if (accepted) track_samples(channel, data, size, recv_utime);
   resume_if_due(now_us);
   if (disk_full_) {
     ++counters_.events_lost;

@@ -50,9 +50,9 @@ void LogRecorder::start() {
 }
 
 bool LogRecorder::offer(std::int64_t recv_utime, std::string_view channel, const void* data,
-                        std::int32_t size) {
+                        std::int32_t size, bool accepted) {
   const std::size_t n = size > 0 ? static_cast<std::size_t>(size) : 0;
-  return queue_.offer(recv_utime, channel, data, n) == MessageQueue::Offer::queued;
+  return queue_.offer(recv_utime, channel, data, n, accepted) == MessageQueue::Offer::queued;
 }
 
 void LogRecorder::stop(std::string_view why) {
@@ -101,7 +101,8 @@ void LogRecorder::run() {
     // After stop() the queue is closed: this batch holds everything offered, and is the last.
     const bool open = queue_.take_all(batch, next_flush);
     for (const QueuedMessage& ev : batch)
-      writer_.write(ev.recv_utime, ev.channel, ev.data.data(), static_cast<std::int32_t>(ev.data.size()), wall_us());
+      writer_.write(ev.recv_utime, ev.channel, ev.data.data(), static_cast<std::int32_t>(ev.data.size()), wall_us(),
+                    ev.accepted);
     batch.clear();
 
     const std::int64_t now = wall_us();

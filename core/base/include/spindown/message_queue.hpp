@@ -24,6 +24,7 @@ namespace spindown {
 struct QueuedMessage {
   std::int64_t recv_utime = 0;  // wall time LCM read it (a signature's freshness is judged on it)
   std::int64_t host_utime = 0;  // steady_wall_us() when queued: for durations (clock.hpp)
+  bool accepted = true;         // the receiver's gate let it through (the logger records every message)
   std::string channel;
   std::vector<unsigned char> data;
 };
@@ -52,7 +53,8 @@ class MessageQueue {
   MessageQueue& operator=(const MessageQueue&) = delete;
 
   // From the receiving thread.
-  Offer offer(std::int64_t recv_utime, std::string_view channel, const void* data, std::size_t size);
+  Offer offer(std::int64_t recv_utime, std::string_view channel, const void* data, std::size_t size,
+              bool accepted = true);
 
   // From the worker: waits until a message is queued, close() or until, then moves everything
   // queued into batch (emptied first). False once the queue is closed: this batch is the last.

@@ -108,8 +108,10 @@ class EventLogWriter {
 
   // Writes one event (rotating first when due). False when it could not be written; the reason
   // is counted and in last_error().
+  // accepted = false: a message the lab's gate refused, written but not counted in the samples'
+  // sequence (samples_missing, seq_repeats are the lab's own streams).
   bool write(std::int64_t recv_utime, std::string_view channel, const void* data, std::int32_t size,
-             std::int64_t now_us);
+             std::int64_t now_us, bool accepted = true);
 
   // Hands buffered events to the kernel (and fdatasync with sync_on_flush). False on error.
   bool flush(std::int64_t now_us);

@@ -44,7 +44,10 @@ class LogRecorder {
   void start();
 
   // From the receiving thread: queue one event. False when the queue was full (counted).
-  bool offer(std::int64_t recv_utime, std::string_view channel, const void* data, std::int32_t size);
+  // accepted: the lab's gate let it through; a refused one is recorded all the same (the log is
+  // the evidence) but never counted in the samples' sequence (a forger's gaps are not loss).
+  bool offer(std::int64_t recv_utime, std::string_view channel, const void* data, std::int32_t size,
+             bool accepted = true);
 
   // Writes everything queued, closes the writer with state why and joins the thread.
   void stop(std::string_view why = "stopped");
