@@ -5,6 +5,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -24,6 +25,7 @@
 #include "spindown/explain_report.hpp"
 #include "spindown/fit_message.hpp"
 #include "spindown/health_report.hpp"
+#include "spindown/log_lab.hpp"
 #include "spindown/progress.hpp"
 
 namespace spindown::cli {
@@ -577,12 +579,29 @@ class RefitCommand {
     std::cout.flush();
   }
 
+  // The lab whose messages are refitted: --lab (or $SPINDOWN_LAB) when given, else the lab the
+  // log's own logger served (log_lab.hpp), with the group and port it listened on: a PC serving
+  // two labs records both, and the default lab name would refit the other lab's benches.
+  FitterOptions session_options(const std::string& first_file, const std::string& path) const {
+    FitterOptions f = fopt_;
+    if (!o_.input.lab.lab.empty() || std::getenv("SPINDOWN_LAB")) return f;
+    const std::optional<LogLab> lab = log_lab(first_file);
+    if (!lab || (lab->lab == f.gate.lab && lab->sent_to == f.gate.sent_to)) return f;
+    f.gate.lab = lab->lab;
+    f.gate.sent_to = lab->sent_to;
+    std::cerr << fmt::format("{}: recorded by the logger of lab '{}'{}: that lab's messages are refitted, others "
+                             "counted and named (--lab to choose)\n",
+                             path, lab->lab, lab->sent_to.empty() ? std::string() : " on " + lab->sent_to);
+    return f;
+  }
+
   // The session through the live fitter's core, its runs spooled as they are fitted (when streaming).
   LogRefit read_session(const std::vector<std::string>& session, const std::string& path, SessionSpools& spools) {
     // On a terminal only (never in pipes or files), throttled, erased before anything is printed.
     ProgressReporter progress(STDERR_FILENO, show_progress_);
+    const FitterOptions options = session_options(session.front(), path);
     LogRefit r = refit_log_session(
-        session, fopt_, o_.live || o_.compare, {},
+        session, options, o_.live || o_.compare, {},
         [&](std::int64_t done, std::int64_t total, std::size_t runs) {
           progress.update(done, total, "refit", fmt::format("{} run{} fitted  {}", runs, runs == 1 ? "" : "s", path));
         },

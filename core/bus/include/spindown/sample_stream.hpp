@@ -473,8 +473,9 @@ struct SampleStream {
     if (o.named) return;
     o.named = true;
     sink.problem(SampleProblem::two_sources, 0,
-                 fmt::format("has two sources: {} and {}, sending at the same time (two bridges with one bench id, "
-                             "or a forger); the samples of {} are not used",
+                 fmt::format("has two sources: {} and {}, sending at the same time (two bridges with one bench id: two "
+                             "labs on one group and port? give each lab its own --lab, group and port, "
+                             "docs/lab-setup.md; or a forger); the samples of {} are not used",
                              source_words(session, host), source_words(o.session, o.host),
                              source_words(o.session, o.host)));
   }
