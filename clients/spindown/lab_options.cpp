@@ -10,7 +10,8 @@ void add_lab_options(CLI::App* sub, LabOptions& o, const std::string& group) {
   sub->add_option("--lab", o.lab, lab_option_help)->group(group);
   sub->add_option("--key", o.key,
                   "Lab key file (32 bytes; spindown keygen): use only messages signed with it, and name the unsigned, "
-                  "wrongly signed and replayed ones (default: none, every message is used)")
+                  "wrongly signed and replayed ones (default: none, every message is used); NEW,OLD while keys change: "
+                  "either key's messages are used")
       ->group(group);
 }
 

@@ -32,7 +32,7 @@ struct FitterServiceOptions {
   std::size_t max_queue_messages = 200000;  // received but not yet processed
   std::size_t max_queue_bytes = 64u << 20;
   bool verbose = false;                 // one line per run event and fit on stderr
-  LabSettings lab{"lab", std::nullopt, ""};  // the lab's name and key (also in core.gate)
+  LabSettings lab{"lab", std::nullopt, {}, ""};  // the lab's name and key (also in core.gate)
 };
 
 class FitterService final : public FitterSink {

@@ -48,7 +48,8 @@ std::optional<int> parse_options(int argc, char** argv, LoggerOptions& o) {
                  "named; the heartbeat names it (default: $SPINDOWN_LAB, else 'lab')");
   app.add_option("--key", o.key_option,
                  "lab key file: every message is recorded, and unsigned, wrongly signed and replayed ones are counted "
-                 "and named; the heartbeat is signed (default: the systemd credential lab-key when loaded)");
+                 "and named; the heartbeat is signed (default: the systemd credential lab-key when loaded); NEW,OLD "
+                 "while keys change: signs with NEW, accepts both");
   app.add_option("--channels", o.channels,
                  "channel regex (default SPINDOWN\\..*, or SPINDOWN\\.<bench>\\..* with --bench)");
   app.add_option("--dir", w.dir, "directory for the logs (must exist)")->capture_default_str();
@@ -226,9 +227,10 @@ int main(int argc, char** argv) {
   const bool subscribed = loop.subscribe_raw(
       o.channels,
       [&](const spindown::LcmMessage& m) {
-        recorder.offer(m.recv_utime, m.channel, m.data, static_cast<std::int32_t>(m.size));
-        // Recorded whatever it is (the log is the evidence); counted when it is not the lab's own.
+        // Recorded whatever it is (the log is the evidence); counted when it is not the lab's own,
+        // and then kept out of the samples' sequence counters (a forged stream's gaps are no loss).
         const spindown::GateResult g = gate.check(m.channel, m.data, m.size, m.recv_utime);
+        recorder.offer(m.recv_utime, m.channel, m.data, static_cast<std::int32_t>(m.size), !g.refused());
         if (g.refused()) heartbeat.refused(g);
       },
       {.queue_capacity = 0});

@@ -111,5 +111,31 @@ TEST(LabKey, TheOptionElseTheSystemdCredentialElseNone) {
   EXPECT_NE(lab_settings_text(*s).find("lab 'lab-2'; messages signed with key 0x"), std::string::npos);
 }
 
+// Changing the key (docs/security.md): --key NEW,OLD signs with the first and accepts both; under
+// systemd the credential lab-key-previous is accepted too. One unreadable file refuses them all.
+TEST(LabKey, SeveralKeysWhileTheKeyChanges) {
+  TempDir d;
+  const std::string next = d.write("new.key", std::string(32, 'n'));
+  const std::string old = d.write("old.key", std::string(32, 'o'));
+  const LabKeyChoice both = choose_lab_key(next + "," + old, std::nullopt);
+  ASSERT_TRUE(both.key) << both.error;
+  ASSERT_EQ(both.also_accepted.size(), 1u);
+  EXPECT_EQ(both.key->id, choose_lab_key(next, std::nullopt).key->id);
+  EXPECT_EQ(both.also_accepted[0].id, choose_lab_key(old, std::nullopt).key->id);
+  const LabKeyChoice missing = choose_lab_key(next + "," + (d.path / "gone.key").string(), std::nullopt);
+  EXPECT_FALSE(missing.key);
+  EXPECT_NE(missing.error.find("gone.key"), std::string::npos) << missing.error;
+  d.write(lab_key_credential, std::string(32, 'n'));
+  d.write(lab_key_previous_credential, std::string(32, 'o'));
+  const LabKeyChoice cred = choose_lab_key("", d.path.string());
+  ASSERT_TRUE(cred.key);
+  ASSERT_EQ(cred.also_accepted.size(), 1u);
+  EXPECT_EQ(cred.also_accepted[0].id, both.also_accepted[0].id);
+  std::string why;
+  const auto s = resolve_lab_settings("lab", next + "," + old, &why);
+  ASSERT_TRUE(s) << why;
+  EXPECT_NE(lab_settings_text(*s).find("also accepted while keys change"), std::string::npos) << lab_settings_text(*s);
+}
+
 }  // namespace
 }  // namespace spindown

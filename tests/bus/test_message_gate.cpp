@@ -206,5 +206,27 @@ TEST(MessageGate, TheLabGateOfAListenerAndOfALogReader) {
   EXPECT_TRUE(lab_gate(lab).sent_to.empty());
 }
 
+// While keys change, a gate given the old key as well accepts both signers; one without it names
+// the old key and the way to give both.
+TEST(MessageGate, BothKeysWhileTheKeyChanges) {
+  auto old_signer = stamp_for("lab-a", test_key(5), 1);
+  auto new_signer = stamp_for("lab-a", test_key(6), 2);
+  MessageGateOptions o = options("lab-a", test_key(6));
+  o.also_accepted.push_back(test_key(5));
+  MessageGate both(o);
+  MessageGate new_only(options("lab-a", test_key(6)));
+  const std::string ch = "SPINDOWN.b1.SAMPLE";
+  const auto a = old_signer.encode(ch, samples_at(t0));
+  const auto b = new_signer.encode(ch, samples_at(t0));
+  EXPECT_TRUE(both.check(ch, a.data(), std::int64_t(a.size()), t0).accepted());
+  EXPECT_TRUE(both.check(ch, b.data(), std::int64_t(b.size()), t0).accepted());
+  const GateResult r = new_only.check(ch, a.data(), std::int64_t(a.size()), t0);
+  EXPECT_EQ(r.verdict, GateVerdict::other_key);
+  EXPECT_NE(r.text.find("--key NEW,OLD"), std::string::npos) << r.text;
+  auto forged = old_signer.encode(ch, samples_at(t0));
+  forged[30] ^= 0x10;
+  EXPECT_EQ(both.check(ch, forged.data(), std::int64_t(forged.size()), t0).verdict, GateVerdict::bad_signature);
+}
+
 }  // namespace
 }  // namespace spindown

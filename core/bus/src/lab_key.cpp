@@ -1,5 +1,7 @@
 #include "spindown/lab_key.hpp"
 
+#include <algorithm>
+
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
@@ -107,22 +109,41 @@ std::optional<LabKey> load_lab_key(const std::string& path, std::string* why) {
 
 LabKeyChoice choose_lab_key(const std::string& option_path, const std::optional<std::string>& credentials_dir) {
   LabKeyChoice c;
-  std::string path;
+  std::vector<std::string> paths;
   if (!option_path.empty()) {
-    path = option_path;
+    for (std::size_t at = 0; at <= option_path.size();) {  // NEW.key,OLD.key: the first signs
+      const std::size_t comma = std::min(option_path.find(',', at), option_path.size());
+      if (comma > at) paths.push_back(option_path.substr(at, comma - at));
+      at = comma + 1;
+    }
     c.source = "--key " + option_path;
   } else if (credentials_dir && !credentials_dir->empty()) {
     const std::string candidate = *credentials_dir + "/" + lab_key_credential;
     struct stat st {};
     if (::stat(candidate.c_str(), &st) != 0) return c;  // no key loaded: signing off
-    path = candidate;
+    paths.push_back(candidate);
     c.source = fmt::format("systemd credential {}", lab_key_credential);
-  } else {
-    return c;
+    const std::string previous = *credentials_dir + "/" + lab_key_previous_credential;
+    if (::stat(previous.c_str(), &st) == 0) {
+      paths.push_back(previous);
+      c.source += fmt::format(" (and {})", lab_key_previous_credential);
+    }
   }
-  std::string why;
-  c.key = load_lab_key(path, &why);
-  if (!c.key) c.error = why;
+  if (paths.empty()) return c;
+  for (const std::string& path : paths) {
+    std::string why;
+    std::optional<LabKey> key = load_lab_key(path, &why);
+    if (!key) {
+      c.key.reset();
+      c.also_accepted.clear();
+      c.error = why;
+      return c;
+    }
+    if (!c.key)
+      c.key = std::move(key);
+    else
+      c.also_accepted.push_back(std::move(*key));
+  }
   return c;
 }
 

@@ -22,13 +22,17 @@ std::optional<LabSettings> resolve_lab_settings(const std::string& lab_option, c
     return std::nullopt;
   }
   s.key = std::move(k.key);
+  s.also_accepted = std::move(k.also_accepted);
   s.key_source = std::move(k.source);
   return s;
 }
 
 std::string lab_settings_text(const LabSettings& s) {
   if (!s.key) return fmt::format("lab '{}'; messages not signed (no lab key)", s.lab);
-  return fmt::format("lab '{}'; messages signed with key {} ({})", s.lab, key_id_text(s.key->id), s.key_source);
+  std::string also;
+  for (const LabKey& k : s.also_accepted) also += fmt::format(", {}", key_id_text(k.id));
+  return fmt::format("lab '{}'; messages signed with key {} ({}){}", s.lab, key_id_text(s.key->id), s.key_source,
+                     also.empty() ? std::string() : fmt::format("; also accepted while keys change: key{}", also.substr(1)));
 }
 
 }  // namespace spindown

@@ -72,7 +72,10 @@ GateResult MessageGate::check(std::string_view channel, const void* data, std::i
     ++counters_.accepted;
     return r;
   }
-  const LabKey& key = *o_.key;
+  const LabKey* chosen = &*o_.key;  // the key the message names, when it is one accepted
+  for (const LabKey& k : o_.also_accepted)
+    if (t.auth_key_id == k.id && t.auth_key_id != o_.key->id) chosen = &k;
+  const LabKey& key = *chosen;
   const AuthCheck a = verify_message(channel, data, size, key);
   switch (a.status) {
     case AuthStatus::valid: break;
@@ -81,7 +84,8 @@ GateResult MessageGate::check(std::string_view channel, const void* data, std::i
                     fmt::format("not signed, and this lab signs its messages (key {})", key_id_text(key.id)));
     case AuthStatus::other_key:
       return refuse(GateVerdict::other_key, counters_.other_key,
-                    fmt::format("signed with key {}, not this lab's key {} (another lab's key, or an old one)",
+                    fmt::format("signed with key {}, not this lab's key {} (another lab's key, or an old one: "
+                                "while keys change, give both, --key NEW,OLD, docs/security.md)",
                                 key_id_text(t.auth_key_id), key_id_text(key.id)));
     case AuthStatus::bad_signature:
       return refuse(GateVerdict::bad_signature, counters_.bad_signature,
@@ -136,6 +140,7 @@ MessageGateOptions lab_gate(const LabSettings& lab, const std::string& lcm_url) 
   MessageGateOptions g;
   g.lab = lab.lab;
   g.key = lab.key;
+  g.also_accepted = lab.also_accepted;
   // Another group's traffic on this port is another lab's (message_gate.cpp check()).
   if (!lcm_url.empty()) g.sent_to = lcm_destination(lcm_url);
   return g;

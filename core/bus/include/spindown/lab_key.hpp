@@ -11,12 +11,14 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace spindown {
 
 inline constexpr std::size_t lab_key_bytes = 32;
 // The name of the credential the units load (LoadCredential=lab-key:…).
 inline constexpr const char* lab_key_credential = "lab-key";
+inline constexpr const char* lab_key_previous_credential = "lab-key-previous";
 
 struct LabKey {
   std::array<unsigned char, lab_key_bytes> bytes{};
@@ -35,8 +37,12 @@ LabKey lab_key_from_bytes(const std::array<unsigned char, lab_key_bytes>& bytes)
 // The key a program uses: option_path when not empty, else the credential lab-key in
 // credentials_dir ($CREDENTIALS_DIRECTORY under systemd) when that file exists, else none
 // (signing off). error is set when a key was asked for (or present) but cannot be used.
+// While keys are changed (docs/security.md, "Changing the key"), option_path may name several
+// files, comma-separated: the first signs, every one is accepted; under systemd the credential
+// lab-key-previous, when present, is accepted too.
 struct LabKeyChoice {
   std::optional<LabKey> key;
+  std::vector<LabKey> also_accepted;  // keys accepted besides key (a rotation)
   std::string source;  // "--key FILE", "systemd credential lab-key", "" (none)
   std::string error;
 };

@@ -5,6 +5,7 @@
 // not signed and signatures not required).
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "spindown/lab_key.hpp"
 
@@ -13,6 +14,7 @@ namespace spindown {
 struct LabSettings {
   std::string lab;
   std::optional<LabKey> key;
+  std::vector<LabKey> also_accepted;  // accepted besides key while keys are changed
   std::string key_source;  // where the key came from ("" without one)
 };
 
@@ -31,6 +33,7 @@ inline constexpr const char* lab_option_help =
     "'lab')";
 inline constexpr const char* key_option_help =
     "lab key file (32 bytes; spindown keygen): sign what is sent and use only messages signed with it (default: "
-    "the systemd credential lab-key when the unit loads one; none: signing off)";
+    "the systemd credential lab-key when the unit loads one; none: signing off); NEW,OLD while keys change: signs "
+    "with NEW, accepts both (docs/security.md)";
 
 }  // namespace spindown

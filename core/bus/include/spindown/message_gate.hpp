@@ -19,6 +19,7 @@
 #include <string>
 #include <string_view>
 #include <unordered_map>
+#include <vector>
 
 #include "spindown/lab_key.hpp"
 #include "spindown/lab_settings.hpp"
@@ -37,6 +38,7 @@ struct MessageGateOptions {
   std::string lab = "lab";               // this program's lab; "" takes every lab
   std::string sent_to;                   // the udpm GROUP:PORT it listens on; "" takes every group (logs)
   std::optional<LabKey> key;             // signatures required when set
+  std::vector<LabKey> also_accepted;     // and these keys' signatures accepted too (a rotation)
   double replay_window_s = 60;           // signed: |receive time − utime| at most this
   std::size_t max_sources = 4096;        // (source, channel) pairs remembered for replays
   // Every lab's messages, no key (a library reader's default: the caller narrows it).
