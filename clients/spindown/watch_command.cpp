@@ -63,7 +63,8 @@ bool listen(LcmLoop& loop, ChannelKind kind, const std::regex& wanted, bool ever
       [table_call, &gate, &table](const Msg& m, const LcmMessage& r) {
         const std::int64_t now = r.recv_utime > 0 ? r.recv_utime : wall_us();
         if (const GateResult g = gate.check(r.channel, r.data, r.size, now); g.refused()) {
-          table.on_refused(g, now);
+          const auto parsed = parse_channel(r.channel);
+          table.on_refused(g, now, parsed && parsed->kind == ChannelKind::sample ? parsed->bench : std::string());
           return;
         }
         table_call(parse_channel(r.channel)->bench, m, now);

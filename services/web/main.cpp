@@ -87,9 +87,9 @@ std::optional<int> parse_options(int argc, char** argv, spindown::WebServiceOpti
   }
   o.check = [g = std::make_shared<spindown::MessageGate>(spindown::lab_gate(*lab, o.lcm_url))](
                 std::string_view channel, const void* data, std::int64_t size,
-                std::int64_t recv_utime) -> std::optional<std::string> {
-    const spindown::GateResult r = g->check(channel, data, size, recv_utime);
-    if (r.refused()) return r.text;
+                std::int64_t recv_utime) -> std::optional<spindown::GateResult> {
+    spindown::GateResult r = g->check(channel, data, size, recv_utime);
+    if (r.refused()) return r;
     return std::nullopt;
   };
   fmt::print(stderr, "spindown-web: {}\n", spindown::lab_settings_text(*lab));

@@ -290,6 +290,29 @@ TEST(LabTable, CollidingFittersUnknownFitsAndRefusedMessages) {
       << table.render(t0 + sec);
 }
 
+// A bench whose samples are all refused (its PC has another key) has a row that says so, and why;
+// another lab's bench of a name never gets one; a bench whose samples are let through again is
+// back to its run (issue 42).
+TEST(LabTable, ABenchWhoseSamplesAreRefusedIsShownRefused) {
+  LabTable table;
+  GateResult rekeyed;
+  rekeyed.verdict = GateVerdict::other_key;
+  rekeyed.text = "SPINDOWN.b9.SAMPLE: samples_t from host pc9 (session 0000000000000009): signed with key 0x1, not "
+                 "this lab's key 0x2; not used";
+  table.on_refused(rekeyed, t0, "b9");
+  GateResult other_lab;
+  other_lab.verdict = GateVerdict::other_lab;
+  other_lab.text = "SPINDOWN.b8.SAMPLE: samples_t …: a message of lab 'B'; not used";
+  table.on_refused(other_lab, t0, "b8");
+  EXPECT_EQ(table.bench("b8"), nullptr);
+  const std::string text = table.render(t0 + sec);
+  EXPECT_TRUE(contains(text, "REFUSED: other key")) << text;
+  EXPECT_TRUE(contains(text, "b9: its samples are refused: SPINDOWN.b9.SAMPLE")) << text;
+  table.on_samples("b9", samples_msg("b9", 0, 5), t0 + 2 * sec);
+  EXPECT_FALSE(contains(table.render(t0 + 2 * sec), "REFUSED")) << table.render(t0 + 2 * sec);
+  EXPECT_FALSE(contains(table.render(t0 + 20 * sec), "REFUSED"));
+}
+
 TEST(LabTable, BridgeStatusGoesToItsBenchServicesToTheirOwnRows) {
   LabTable table;
   table.on_status("bench-a",

@@ -215,6 +215,24 @@ TEST(WebLab, StatesFollowTheRunAndTheBenchGoesSilent) {
   EXPECT_EQ(bench_of(expected.state_json(t0_us), "b9")["bridge"]["health"], "silent");
 }
 
+// A bench whose every sample the gate refuses (its PC has another key) gets a tile that says it is
+// refused, and why; another lab's bench of a name gets none (issue 42).
+TEST(WebLab, ABenchWhoseSamplesAreRefusedHasATileThatSaysSo) {
+  WebLab lab;
+  GateResult rekeyed;
+  rekeyed.verdict = GateVerdict::other_key;
+  rekeyed.text = "SPINDOWN.b7.SAMPLE: samples_t from host pc7 (session 07): signed with key 0x1, not this lab's key 0x2";
+  lab.on_refused(rekeyed, t0_us, "b7");
+  GateResult other_lab;
+  other_lab.verdict = GateVerdict::other_lab;
+  other_lab.text = "SPINDOWN.b6.SAMPLE: a message of lab 'B'";
+  lab.on_refused(other_lab, t0_us, "b6");
+  const Json st = lab.state_json(t0_us + sec_us);
+  EXPECT_EQ(bench_of(st, "b7")["state"], "refused");
+  EXPECT_NE(bench_of(st, "b7")["refused"].get<std::string>().find("signed with key 0x1"), std::string::npos);
+  for (const Json& b : st["benches"]) EXPECT_NE(b["id"], "b6");
+}
+
 TEST(WebLab, TheBridgesHealthSaysUnpluggedRepluggedAndSilent) {
   WebLab lab;
   const auto health = [&](std::int64_t now) {

@@ -200,9 +200,12 @@ TEST(WebService, APagePastTheCapIsRefused) {
 
 TEST(WebService, ARefusedOrBrokenMessageIsNeverShown) {
   WebServiceOptions o;
-  o.check = [](std::string_view channel, const void*, std::int64_t, std::int64_t) -> std::optional<std::string> {
-    if (channel == "SPINDOWN.b1.FIT") return std::string(channel) + ": not signed";
-    return std::nullopt;
+  o.check = [](std::string_view channel, const void*, std::int64_t, std::int64_t) -> std::optional<GateResult> {
+    if (channel != "SPINDOWN.b1.FIT") return std::nullopt;
+    GateResult r;
+    r.verdict = GateVerdict::not_signed;
+    r.text = std::string(channel) + ": not signed";
+    return r;
   };
   WebService s(o);
   const SimulatedRun r = simulated_run(4);

@@ -328,6 +328,7 @@ void LabTable::on_samples(std::string_view bench, const samples_t& msg, std::int
                                                                                           msg.value.size())))));
   if (r.stream.take(msg, n, now_us, StreamSink{*this, r, now_us})) ++r.sample_messages;
   r.has_samples = true;
+  r.last_sample_us = now_us;
   gap_event(r, now_us);
 }
 
@@ -499,7 +500,13 @@ void LabTable::on_status(std::string_view channel_id, const status_t& msg, std::
   changed_ = true;
 }
 
-void LabTable::on_refused(const GateResult& g, std::int64_t) {
+void LabTable::on_refused(const GateResult& g, std::int64_t now_us, std::string_view bench) {
+  if (!bench.empty() && g.verdict != GateVerdict::other_lab) {
+    LabBenchRow& r = row(bench, now_us);
+    r.refused = g.text;
+    r.refused_kind = gate_verdict_name(g.verdict);
+    r.refused_us = now_us;
+  }
   ++refused_;
   const std::string kind(gate_verdict_name(g.verdict));
   ++refused_by_kind_[kind];
@@ -526,6 +533,12 @@ bool LabTable::run_unfollowed(const LabBenchRow& r, std::int64_t now_us) const {
   return fitter_stopping_ || now_us - last_fitter_us_ >= lost_us;
 }
 
+bool LabTable::refused_now(const LabBenchRow& r, std::int64_t now_us) const {
+  const auto stale_us = static_cast<std::int64_t>(opt_.stale_s * 1e6);
+  return r.refused_us > 0 && now_us - r.refused_us <= stale_us &&
+         (r.last_sample_us == 0 || now_us - r.last_sample_us > stale_us);
+}
+
 bool LabTable::two_sources_now(const LabBenchRow& r, std::int64_t now_us) const {
   return !r.two_sources.empty() && now_us - r.other_source_us <= static_cast<std::int64_t>(opt_.stale_s * 1e6);
 }
@@ -547,6 +560,7 @@ std::string LabTable::bench_table(std::int64_t now_us, std::size_t width) const 
       {"BENCH", "BENCH", 0, [](const LabBenchRow& r, bool) { return r.bench; }},
       {"RUN", "RUN", 0,
        [&](const LabBenchRow& r, bool brief) {
+         if (refused_now(r, now_us)) return brief ? std::string("REFUSED") : "REFUSED: " + r.refused_kind;
          const bool unfollowed = run_unfollowed(r, now_us);
          return brief ? run_short(r, unfollowed) : run_state_text(r, unfollowed, now_us);
        }},
@@ -624,6 +638,7 @@ std::string LabTable::render(std::int64_t now_us, std::size_t width) const {
   // marked in the row and said under the table.
   for (const auto& [id, r] : benches_) {
     if (two_sources_now(r, now_us)) out += cut_to_width("  " + r.two_sources, width) + '\n';
+    if (refused_now(r, now_us)) out += cut_to_width("  " + r.bench + ": its samples are refused: " + r.refused, width) + '\n';
     if (!r.fit_doubt.empty())
       out += cut_to_width(fmt::format("  {}: run {} fit NOT VERIFIED: {}", id, r.fit_run, r.fit_doubt), width) + '\n';
   }

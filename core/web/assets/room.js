@@ -60,7 +60,7 @@
     setHealth(t.health, fit);
     setDoubts(t.doubts, fit);
     setBridge(t.bridge, s.bridge);
-    setText(t.bridgeInfo, bridgeDetail(s.bridge));
+    setText(t.bridgeInfo, s.refused ? `its samples are refused: ${s.refused}` : bridgeDetail(s.bridge));
     t.dirty = true;
   }
 

@@ -224,9 +224,12 @@ void WebLab::on_explain(std::string_view id, const explain_t& msg, std::int64_t)
 
 void WebLab::on_bad_message(std::string text, std::int64_t now_us) { table_.on_bad_message(std::move(text), now_us); }
 
-void WebLab::on_refused(std::string text, std::int64_t) {
+void WebLab::on_refused(const GateResult& refused, std::int64_t now_us, std::string_view id) {
   ++refused_;
-  last_refused_ = std::move(text);
+  last_refused_ = refused.text;
+  if (id.empty() || refused.verdict == GateVerdict::other_lab) return;
+  bench(id);  // a tile for a bench whose every sample is refused (the summary says so)
+  table_.on_refused(refused, now_us, id);
 }
 
 // ---- JSON ------------------------------------------------------------------------------------------
@@ -254,7 +257,10 @@ Json WebLab::summary_json(const Bench& b, std::int64_t now_us, bool counters) co
   const LabBenchRow* row = table_.bench(b.id);
   Json j;
   j["id"] = b.id;
-  j["state"] = std::string(bench_state_name(bench_state(row, b.activity, now_us, opt_.silent_after_s)));
+  const bool refused = row && table_.refused_now(*row, now_us);
+  j["state"] = refused ? std::string("refused")
+                       : std::string(bench_state_name(bench_state(row, b.activity, now_us, opt_.silent_after_s)));
+  j["refused"] = refused ? row->refused : std::string();
   j["expected"] = b.expected;
   j["unit"] = std::string(unit_of(b.activity.quantity));
   Json bridge;

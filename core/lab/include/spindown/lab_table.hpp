@@ -95,6 +95,11 @@ struct LabBenchRow {
   std::int64_t other_source_samples = 0;  // samples of a second source, not the stream's
   std::int64_t seq_jumps = 0;        // messages that jumped far from the stream and were dropped
   std::string two_sources;           // the latest "has two sources: …" ("" never)
+  std::int64_t last_sample_us = 0;   // host time of its last SAMPLE the gate let through
+  // Its SAMPLEs the gate refused (unsigned, another key, a replay; never another lab's): the
+  // latest reason, its kind and when. Shown as the row's state while no sample is let through.
+  std::string refused, refused_kind;
+  std::int64_t refused_us = 0;
   std::int64_t other_source_us = 0;  // when a second source was last heard
   std::int64_t last_gap_event_us = 0;
   std::int64_t gaps_at_last_event = 0;
@@ -133,10 +138,14 @@ class LabTable {
   void on_bad_message(std::string text, std::int64_t now_us);
   // A message the gate refused (another lab's; with the key, unsigned, wrongly signed, replayed):
   // never shown as data; counted, the first of each kind an event, the latest in the footer.
-  void on_refused(const GateResult& refused, std::int64_t now_us);
+  // bench: the bench of a refused SAMPLE ("" for other channels): unless it is another lab's, the
+  // bench gets a row that says its samples are refused and why (a key changed on one PC).
+  void on_refused(const GateResult& refused, std::int64_t now_us, std::string_view bench = {});
 
   // Whether row's open run is no longer followed by a fitter at now_us (fitter_lost_s).
   bool run_unfollowed(const LabBenchRow& row, std::int64_t now_us) const;
+  // Whether row's samples are being refused now: refused within stale_s, none let through since.
+  bool refused_now(const LabBenchRow& row, std::int64_t now_us) const;
   // The table at now_us. width > 0 fits it to that many columns (a terminal's width): one row per
   // bench with its run, the last fit's model, the combined model's c3 and c4 with their errors and
   // the health verdict always; headers and cells shortened first, then the columns worth least

@@ -96,7 +96,8 @@ class WebLab {
   // A message that did not decode, or that the bench's handler refused (its words).
   void on_bad_message(std::string text, std::int64_t now_us);
   // A message refused before decoding (signature, lab): never shown as data; counted and named.
-  void on_refused(std::string text, std::int64_t now_us);
+  // bench: a refused SAMPLE's bench: unless another lab's, its tile says it is refused, and why.
+  void on_refused(const GateResult& refused, std::int64_t now_us, std::string_view bench = {});
 
   // GET /api/state: {"benches":[summary…],"lab":{…}}; summaries with their counters.
   Json state_json(std::int64_t now_us) const;

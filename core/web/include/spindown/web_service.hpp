@@ -14,6 +14,7 @@
 #include <string>
 #include <string_view>
 
+#include "spindown/message_gate.hpp"
 #include "spindown/event_fanout.hpp"
 #include "spindown/lcm_loop.hpp"
 #include "spindown/web_lab.hpp"
@@ -23,10 +24,10 @@ namespace spindown {
 
 class StopSignals;
 
-// A received message's bytes → nullopt to accept it, or why it is refused ("SPINDOWN.b1.FIT: not
-// signed"). With the lab's signing on, MessageGate::check (bus) is this hook.
-using MessageCheck = std::function<std::optional<std::string>(std::string_view channel, const void* data,
-                                                              std::int64_t size, std::int64_t recv_utime)>;
+// A received message's bytes → nullopt to accept it, or the gate's verdict and words when it is
+// refused ("SPINDOWN.b1.FIT: … not signed …"). MessageGate::check (bus) is this hook.
+using MessageCheck = std::function<std::optional<GateResult>(std::string_view channel, const void* data,
+                                                             std::int64_t size, std::int64_t recv_utime)>;
 
 struct WebServiceOptions {
   std::string lcm_url;           // "" = LCM_DEFAULT_URL or LCM's default
