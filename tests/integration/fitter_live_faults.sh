@@ -5,6 +5,7 @@
 # (lead-in other than "none") must have it within 1.5 sample periods of a true cut, and a run
 # the fitter joined mid-coast must be published as partial.
 #   restart   the fitter killed (-9) mid-coast and started again 1 s later
+#   late      the fitter restarted late in a coast while four bounded busy loops load the PC
 #   between   the fitter restarted between two runs (explain on): refit --compare pairs every FIT
 #             and EXPLAIN of the log with its refitted run although run numbers start again
 #   flood     5,000 new bench ids in a burst while a bench coasts (--max-benches 32)
@@ -108,6 +109,27 @@ rc=0; "$B/spindown" refit "$LOG" --compare >"$T/restart.compare.out" 2>&1 || rc=
 grep -q "live joined this run mid-coast" "$T/restart.compare.out" || fail "restart: refit --compare does not explain the partial run"
 grep -q "1 identical, 1 different, 0 only refitted, 0 only live" "$T/restart.compare.out" ||
   fail "restart: refit --compare does not pair both runs: $(cat "$T/restart.compare.out")"
+
+# --- late: restarted late in a coast on a busy PC ---------------------------------------------
+# Issue 42 item 7: under load a restarted fitter once claimed a "supply" cut 6.7 s into a coast.
+# The fitter is killed 1 s into run 1's coast and started again 2.5 s later while four busy loops
+# (bounded: 12 s each) share the 2 cores: it joins the stream late in the coast, its first samples
+# late and in bursts. Whatever it sees, it claims no cut it did not see.
+start_chain late --runs 2
+wait_coasting "$T/late.fitter.err" 1
+sleep 1
+kill -9 "$FITTER"; wait "$FITTER" 2>/dev/null || true
+HOGS=()
+for _ in 1 2 3 4; do timeout 12 sh -c 'while :; do :; done' & HOGS+=($!); PIDS+=($!); done
+sleep 2.5
+start_fitter late fitter2
+for h in "${HOGS[@]}"; do wait "$h" 2>/dev/null || true; done
+finish_chain
+judge late '
+assert len(partial) <= 1, f"{len(partial)} partial FITs"
+print(f"PROMISE late: fitter restarted 3.5 s into a coast beside 4 busy loops: 0 invented cuts; "
+      f"{len(partial)} partial, {len(whole)} whole")
+'
 
 # --- between: the fitter restarted between runs, explain on --------------------------------------
 # Three whole runs, two fitter sessions (runs 1 | 1, 2 by their numbers): every FIT and EXPLAIN in

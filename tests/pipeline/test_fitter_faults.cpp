@@ -70,6 +70,37 @@ bool has_warning(const CollectingSink& sink, const std::string& text) {
   });
 }
 
+// Wherever in a coast the fitter joins (a restart, a busy PC whose first samples come late), from
+// just after the cut to just before the stop, it never claims the cut it did not see (issue 42
+// item 7: under load a restarted fitter published a "supply" cut 6.7 s into a coast).
+TEST(FitterFaults, JoinedAnywhereInACoastNeverClaimsACut) {
+  int claimed = 0, tried = 0;
+  std::string where;
+  for (std::uint64_t seed : {31u, 41u, 51u, 61u}) {
+    const TwoRuns tr = two_runs(seed);
+    const std::size_t span = tr.first.stop_index - tr.first.cut_index;
+    for (int k = 1; k < 20; ++k) {
+      const std::size_t join = tr.first.cut_index + span * std::size_t(k) / 20;
+      CollectingSink sink;
+      FitterCore core({}, sink);
+      std::int64_t seq = std::int64_t(join), utime = 0;
+      feed_range(core, "a", tr.s, join, tr.s.t_us.size(), seq, utime);
+      core.finish(utime);
+      ++tried;
+      for (const FitResult& f : sink.fits) {
+        const spindown::Run& r = f.fit.run;
+        if (r.partial() || std::abs(r.t_cut_s - tr.second.t_cut_s) <= 2 * tr.second.period_s) continue;
+        ++claimed;
+        where += fmt::format(" seed {} join {}/20 at {:.3f} s: cut {:.3f} s lead-in {}, stop {:.3f} (true cuts {:.3f}, "
+                             "{:.3f}, stop {:.3f});",
+                             seed, k, 1e-6 * double(tr.s.t_us[join]), r.t_cut_s, r.lead_in, r.t_stop_s,
+                             tr.first.t_cut_s, tr.second.t_cut_s, tr.first.t_stop_s);
+      }
+    }
+  }
+  EXPECT_EQ(claimed, 0) << tried << " joins:" << where;
+}
+
 // The fitter restarted (or the bench was re-admitted) a third into run 1's coast: run 1 is
 // partial everywhere, never a cut at the moment the samples started; run 2 is whole.
 TEST(FitterFaults, JoinedMidCoastIsPartialNeverACut) {

@@ -824,7 +824,7 @@ bool RunDetector::Impl::try_start_coast(std::size_t i, const WindowFit& w) {
     // A further search, made because a powered lead-in was not shown flat (it may be a rise into
     // the cut: a recording that begins in a spin-up), that reached the stream's start and found a
     // lead-in too short to judge, is no better than the one before it.
-    if (attempt > 0 && a <= lower && sp.npre < 8 && before.npre >= 8 && !before.pre_declining &&
+    if (attempt > 0 && a <= lower && sp.npre < min_lead_samples && before.npre >= min_lead_samples && !before.pre_declining &&
         lead_before == "powered" && !sp.clipped && rises_steadily(before.a, before.pre_end)) {
       sp = before;
       lead = lead_before;
@@ -833,7 +833,7 @@ bool RunDetector::Impl::try_start_coast(std::size_t i, const WindowFit& w) {
     }
     // Search further back when the lead-in seen is too short to judge, is itself part of the
     // decline, or is a "plateau" not shown to be flatter than the coast.
-    const bool unsure = sp.npre < 8 || sp.pre_declining || (lead == "powered" && !sp.pre_flat);
+    const bool unsure = sp.npre < min_lead_samples || sp.pre_declining || (lead == "powered" && !sp.pre_flat);
     if (unsure && a > lower && attempt < 5) {
       span *= 2;
       continue;
@@ -949,6 +949,7 @@ void RunDetector::clock_restart() { impl_->clock_restart(); }
 void RunDetector::new_source(const std::string& why) { impl_->new_source(why); }
 void RunDetector::finish() { impl_->finish(); }
 void RunDetector::went_silent(double silent_s) { impl_->went_silent(silent_s); }
+void RunDetector::joined_stream() { impl_->joined_stream(); }
 std::vector<RunEvent> RunDetector::take_events() { return impl_->take_events(); }
 bool RunDetector::has_events() const { return impl_->has_events(); }
 RunDetector::State RunDetector::state() const { return impl_->state(); }

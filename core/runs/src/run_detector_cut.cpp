@@ -76,7 +76,7 @@ bool RunDetector::Impl::pinned_lead_in(CutSplit& sp, std::size_t b) {
   // after it: a supply above the converter's range (A0 on the motor's terminal). The power-off is
   // hidden under it; the coast is taken from the first reading below the top after the last such
   // hold (a ripple may bring it back to the top for a few readings as it comes down).
-  if (sp.npre < 8 || sp.pre_end > b) return false;
+  if (sp.npre < min_lead_samples || sp.pre_end > b) return false;
   double m = v(sp.a);
   for (std::size_t k = sp.a; k <= b; ++k) m = std::max(m, v(k));
   std::size_t at_top = 0;
@@ -641,10 +641,19 @@ std::string RunDetector::Impl::start_not_seen(CutSplit& sp) {
   // The first sample after the stream's start or the last pause, whichever came last.
   const bool after_pause = resume_index_ > stream_start_;
   const std::size_t seen_from = after_pause ? resume_index_ : stream_start_;
-  if (c < seen_from || std::max(sp.a, base_) > seen_from) return {};
+  if (c < seen_from) return {};
+  // Joined part-way into a stream (joined_stream()): a "cut" found within the first samples, with
+  // less than twice the lead-in it takes to judge one (try_start_coast's "too short"), has no
+  // powered phase before it to show: the coast's start was not seen. A fitter that joined a coast late in it took its
+  // first samples for a supply (issue 42 item 7). (A recording that starts so close to its cut
+  // keeps its cut: it began with the bridge's stream.)
+  const std::size_t seen = c - seen_from;  // samples before the cut since the stream's start
+  const bool too_short =
+      joined_stream_ && !after_pause && stream_start_ == 0 && seen < 2 * min_lead_samples;
+  if (!too_short && std::max(sp.a, base_) > seen_from) return {};
   // From there to the cut found, a "lead-in" that lies on the coast's line is more coast.
   const std::size_t a = seen_from;
-  if (c > a) {
+  if (c > a && !too_short) {
     const double tol = std::max(4.0 * sp.sd_post, 0.01 * std::abs(sp.v0));
     double sse = 0;
     for (std::size_t k = a; k < c; ++k) {

@@ -14,6 +14,8 @@ inline constexpr double back_search_s = 2.0;
 inline constexpr double idle_keep_s = 40.0;
 // Samples searched at least, for slow loops.
 inline constexpr std::size_t back_search_min_samples = 16;
+// A lead-in of fewer samples is too short to judge (flat, rising or part of the decline).
+inline constexpr std::size_t min_lead_samples = 8;
 // A coast is confirmed by a decline this many standard errors strong …
 inline constexpr double confirm_t_stat = 6.0;
 // … whose residual roughness is at most this fraction of its level (rejects a floating pin).

@@ -78,6 +78,11 @@ class RunDetector {
   // that run's rest: partial, never given a cut, until the reading shows the coast is over (it
   // rises above where the silence began, or holds still at a standstill). Nothing happens when idle.
   void went_silent(double silent_s);
+  // Live, before the first sample: the samples begin in a stream already under way (a listener
+  // that joined a bridge's stream part-way: its first sequence number is not the stream's first).
+  // A cut found within the first samples with a lead-in too short to judge is then no cut: the
+  // coast's start was not seen (a fitter restarted, or slow to start, late in a coast).
+  void joined_stream();
 
   // Events since the last call, oldest first.
   std::vector<RunEvent> take_events();
