@@ -8,7 +8,8 @@
 # name runs on lab B's PC. Checks, against each virtual bench's truth:
 #   - each lab's fitter fitted exactly its own bench-1's runs (cuts within 0.2 s of its truth),
 #     never the other lab's: the other lab's messages reached it and were counted (other_lab);
-#   - lab A's log, refitted for lab A, has lab A's runs only;
+#   - lab A's log, refitted for lab A, has lab A's runs only; each lab's log refitted without
+#     --lab has that lab's runs only (the lab its logger served);
 #   - `spindown doctor` on the shared PC names lab B's traffic on lab A's group and port;
 #   - the two lab-A fitters named each other, and watch showed it.
 source "$(dirname "$0")/lab_common.bash"
@@ -100,6 +101,19 @@ PY
   { cat "$LAB_WORK/compare-a.out"; fail "lab A: refit --compare found differences"; }
 grep -q "$A_RUNS runs refitted, $A_RUNS live FIT messages: $A_RUNS identical, 0 different" "$LAB_WORK/compare-a.out" ||
   { cat "$LAB_WORK/compare-a.out"; fail "lab A's log refitted for lab A has another lab's runs"; }
+
+# 1b. Refit as a user would, without --lab (issue 42 item 4): a log refits the lab its logger
+# served (its heartbeat in the log says which), so lab A's log, which holds lab B's traffic too,
+# gives lab A's runs only; lab B's log lab B's. Before, both took the default lab name.
+for l in a b; do
+  log_var="LOG_${l^^}"
+  "$LAB_BIN/spindown" refit "${!log_var}" --json >"$LAB_WORK/refit-$l.json" 2>"$LAB_WORK/refit-$l.err" ||
+    { cat "$LAB_WORK/refit-$l.err"; fail "refit of lab ${l^^}'s log without --lab failed"; }
+  grep -q "recorded by the logger of lab 'lab-$l'" "$LAB_WORK/refit-$l.err" ||
+    { cat "$LAB_WORK/refit-$l.err"; fail "refit of lab ${l^^}'s log did not say whose log it is"; }
+  python3 "$src/deploy/lab/lab_fits.py" check-runs "$LAB_WORK/refit-$l.json" "bench-1=$LAB_WORK/$l-bench-1.truth.json" ||
+    fail "lab ${l^^}'s log refitted without --lab: its runs are not exactly lab ${l^^}'s"
+done
 
 # 2. Each fitter heard the other lab (one PC, one port) and used none of it.
 for f in fitter fitter-b; do
