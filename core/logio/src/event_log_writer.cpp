@@ -450,15 +450,13 @@ void EventLogWriter::track_samples(std::string_view channel, const void* data, s
 }
 
 void EventLogWriter::release_waiting(SeqTrack& t, std::int64_t now_us) {
-  while (t.waiting.ready(t.next_seq, now_us, ReorderOptions{})) {
-    const auto e = t.waiting.pop();
+  t.waiting.release(t.next_seq, now_us, ReorderOptions{}, [&](const ReorderWindow<char>::Entry& e) {
     if (e.seq > t.next_seq) {
       ++counters_.seq_gaps;
       counters_.samples_missing += e.seq - t.next_seq;
-      t.waiting.lost(t.next_seq, e.seq, now_us == std::numeric_limits<std::int64_t>::max() ? e.recv_us : now_us);
     }
     t.next_seq = std::max(t.next_seq, e.seq + e.n);
-  }
+  });
 }
 
 status_t EventLogWriter::make_status(std::int64_t now_us) const {

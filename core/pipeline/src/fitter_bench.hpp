@@ -61,6 +61,7 @@ struct FitterCore::Bench {
   double lowest_reading = std::numeric_limits<double>::infinity();
   std::uint64_t last_active = 0, arrival = 0;
   std::int64_t last_sample_utime = 0;  // host time of its last samples (poll(): silent benches)
+  bool sampled = false;                 // a sample was taken (the first one's seq: joined_stream())
   std::int64_t last_refused_utime = 0;  // host time its SAMPLE channel last brought a refused message
   std::string last_refused;             // and why (the gate's words)
   bool refused_said = false;            // "kept open: … refused" said for this silence

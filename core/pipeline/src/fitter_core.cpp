@@ -397,8 +397,10 @@ void FitterCore::restart_clock(Bench& b, std::int64_t recv_utime) {
 [[gnu::always_inline]] inline void FitterCore::push_sample(Bench& b, std::int64_t seq, double t_s, double value,
                                                            std::int64_t recv_utime) {
   if (b.pending_restart) restart_clock(b, recv_utime);
-  if (b.detector.samples_seen() == 0 && seq > 0) [[unlikely]]
-    b.detector.joined_stream();  // the bridge's stream began before this fitter heard it
+  if (!b.sampled) [[unlikely]] {  // its first sample: one flag on the hot path, not a call
+    b.sampled = true;
+    if (seq > 0) b.detector.joined_stream();  // the bridge's stream began before this fitter heard it
+  }
   ++counters_.samples;
   b.mirror.push_back({t_s, value, seq});
   b.lowest_reading = std::min(b.lowest_reading, value);  // a NaN reading leaves it as it was

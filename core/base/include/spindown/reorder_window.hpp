@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <deque>
+#include <limits>
 #include <optional>
 #include <utility>
 
@@ -47,6 +48,12 @@ class ReorderWindow {
   void insert(std::int64_t seq, std::int64_t n, std::int64_t recv_us, Item item) {
     auto it = std::upper_bound(waiting_.begin(), waiting_.end(), seq,
                                [](std::int64_t s, const Entry& e) { return s < e.seq; });
+    if (waiting_.empty()) {
+      oldest_ = recv_us;
+      oldest_known_ = true;
+    } else {
+      oldest_ = std::min(oldest_, recv_us);  // (when not known, looked for again anyway)
+    }
     waiting_.insert(it, Entry{seq, n, recv_us, std::move(item)});
     samples_ += n;
   }
@@ -56,15 +63,28 @@ class ReorderWindow {
   bool ready(std::int64_t next_seq, std::int64_t now_us, const ReorderOptions& o) const {
     if (waiting_.empty()) return false;
     if (waiting_.front().seq <= next_seq || samples_ > o.max_samples) return true;
-    std::int64_t oldest = waiting_.front().recv_us;
-    for (const Entry& e : waiting_) oldest = std::min(oldest, e.recv_us);
-    return now_us - oldest >= o.window_us;
+    return now_us - oldest() >= o.window_us;
+  }
+
+  // Each message that goes now, in order (ready() with the stream at next_seq, which take moves
+  // on): a gap before it is remembered as lost (at now_us; at the end, now_us = max, when the
+  // message came), then take(entry) takes it. One loop for every follower of a stream: the sample
+  // stream accepts the message, the logger only counts.
+  template <class Take>
+  void release(const std::int64_t& next_seq, std::int64_t now_us, const ReorderOptions& o, Take&& take) {
+    while (ready(next_seq, now_us, o)) {
+      Entry e = pop();
+      if (e.seq > next_seq)
+        lost(next_seq, e.seq, now_us == std::numeric_limits<std::int64_t>::max() ? e.recv_us : now_us);
+      take(e);
+    }
   }
 
   Entry pop() {
     Entry e = std::move(waiting_.front());
     waiting_.pop_front();
     samples_ -= e.n;
+    if (e.recv_us == oldest_) oldest_known_ = false;  // found again when next asked
     return e;
   }
 
@@ -95,12 +115,26 @@ class ReorderWindow {
   }
 
  private:
+  // The earliest receive time of what waits: how long the oldest gap has been open. Kept on
+  // insert, looked for again only after the oldest message left (a gap's wait is checked on every
+  // message while one is open).
+  std::int64_t oldest() const {
+    if (!oldest_known_) {
+      oldest_ = waiting_.front().recv_us;
+      for (const Entry& e : waiting_) oldest_ = std::min(oldest_, e.recv_us);
+      oldest_known_ = true;
+    }
+    return oldest_;
+  }
+
   static constexpr std::size_t remembered_losses = 64;
   struct Loss {
     std::int64_t from, to, called_us;
   };
   std::deque<Entry> waiting_;
   std::int64_t samples_ = 0;
+  mutable std::int64_t oldest_ = 0;
+  mutable bool oldest_known_ = true;  // (nothing waits: insert sets it)
   std::deque<Loss> losses_;
 };
 

@@ -294,12 +294,10 @@ struct SampleStream {
   // enough (now_us = max: everything, at the end or when the stream moves elsewhere).
   template <class Sink>
   void release_waiting(std::int64_t now_us, Sink& sink) {
-    while (waiting_.ready(next_seq, now_us, options.reorder)) {
-      const auto e = waiting_.pop();
-      if (e.seq > next_seq) waiting_.lost(next_seq, e.seq, now_us == std::numeric_limits<std::int64_t>::max() ? e.recv_us : now_us);
+    waiting_.release(next_seq, now_us, options.reorder, [&](const auto& e) {
       if constexpr (requires { sink.origin(std::int64_t{}); }) sink.origin(e.item.origin);
-      accept(e.item, e.item.t_us.size(), sink, false);
-    }
+      accept(e.item, e.item.t_us.size(), sink, false);  // says the samples lost before it, moves next_seq
+    });
   }
 
   template <class Message, class Sink>
