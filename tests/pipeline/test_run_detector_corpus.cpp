@@ -114,7 +114,19 @@ namespace {
 // time (hidden under the top, so neither is right) 4 came closer and 6 went further;
 // test_detection_truth unchanged. (A first rule took 9 in 10 readings at the top and moved 21: a
 // supply within range that flickers with the value below it is no ceiling.) Before: 0xa5c624e753639ca4.
-constexpr std::uint64_t recorded_hash = 0xb09ff437f07ef48cull;
+// Then a stream's first samples are judged "more coast" on the coast's own noise (they were
+// judged on their own spread: eight repeats of one printed value showed none), unless they are
+// quieter than the coast beyond chance (χ² at 1 in 1,000: a reading pinned at the top), or span
+// less than two of the reading's steps of the coast's fall: 6 of 407 changed, against the
+// generator's truth 5 came closer and 1 is as far. Recordings that begin at the cut (36, 261)
+// have it at their first sample (was 0.19 and 0.22 s late, "powered"); after a clock set back
+// mid-coast (250, 313) the rest of the coast is no new run ("powered" cuts invented there); a
+// supply pinned at 3.3 V (80) keeps its 0.3-s lead-in, cut 5.582 s against truth's 5.534 (was the
+// first sample, 5.234, "starts mid-coast"); 170 (5 % ripple, a 0.3-s supply lead-in, cut 0.300)
+// went from 0.556 to 0.000. test_detection_truth and the real recordings unchanged; the flaky
+// heldout.issue31 replug-uno cut (a reset board's stream restarting at 0.57 V) is gone.
+// Before: 0xb09ff437f07ef48c.
+constexpr std::uint64_t recorded_hash = 0x683d728afca32aa7ull;
 constexpr int generated_recordings = 400;
 
 TEST(RunDetectorCorpus, FindsTheRecordedRunsBitForBit) {

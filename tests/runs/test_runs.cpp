@@ -599,3 +599,28 @@ TEST(FindRuns, APoweredLevelThatRunsIntoTheCoastIsCutWhereTheyMeet) {
   }
   EXPECT_LT(worst, 1.5) << "worst cut error in periods";
 }
+
+TEST(FindRuns, ALateCoastThatRepeatsOneReadingAtItsStartIsNoPoweredPlateau) {
+  // A recording (or a bridge restarted on a reset board) that begins 19–21 s into the lab motor's
+  // 27-s coast: at 0.6 V it falls 0.01 V (one printed step) in about six samples, so its first
+  // samples may repeat one value eight times. That is the coast, not a powered plateau: the cut
+  // was not recorded, and no start phase may make one up (a flaky heldout.issue31 replug-uno case:
+  // "run 3 cut 2.220 lead_in powered" on a stream whose first readings were 0.57 ×8, 0.56, 0.57 …).
+  int cuts = 0, tried = 0;
+  std::string first_bad;
+  for (int k = 0; k < 100; ++k) {
+    SyntheticRunSpec spec;
+    spec.start_s = 19.0 + 0.02 * k;
+    spec.seed = 4100 + std::uint64_t(k);
+    const SyntheticRun s = make_synthetic_run(spec);
+    const auto seg = find_runs(to_recording(s));
+    ++tried;
+    for (const auto& r : seg.runs) {
+      if (r.lead_in == "none") continue;
+      if (first_bad.empty()) first_bad = fmt::format("start {:.2f} s after the cut: cut at {:.3f} s, lead-in {}",
+                                                     spec.start_s, r.t_cut_s, r.lead_in);
+      ++cuts;
+    }
+  }
+  EXPECT_EQ(cuts, 0) << cuts << " of " << tried << " late starts got a cut; first: " << first_bad;
+}

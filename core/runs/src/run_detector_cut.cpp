@@ -15,6 +15,21 @@ namespace spindown {
 
 using namespace detector_tuning;
 
+namespace {
+
+constexpr double z_one_in_1000 = -3.090232306167813;  // the standard normal's 0.1 % quantile
+
+// The χ² distribution's lower quantile at the normal quantile z, for dof degrees of freedom
+// (Wilson–Hilferty: within a few percent from 3 degrees of freedom).
+double chi2_lower_tail(double dof, double z) {
+  if (dof < 1) return 0.0;
+  const double c = 2.0 / (9.0 * dof);
+  const double q = 1.0 - c + z * std::sqrt(c);
+  return q > 0 ? dof * q * q * q : 0.0;
+}
+
+}  // namespace
+
 RunDetector::Impl::CutSplit RunDetector::Impl::split_at_cut(std::size_t a, std::size_t b, const WindowFit& w) {
   CutSplit sp;
   sp.a = a;
@@ -665,11 +680,24 @@ std::string RunDetector::Impl::start_not_seen(CutSplit& sp) {
     // lead-in, its step hidden in the noise).
     if (c - a >= 5) {
       const WindowFit pre = window_over(ring_.get(), mask_, 1e300, a, c);
-      // A quantized reading can repeat one value over a few samples of a coast: its spread is at
-      // least the step's.
-      const double e = std::max(pre.resid_sd(), reading_step(a, c + 1) * step_sd);
+      // The question is whether these samples are more coast: if they are, their noise is the
+      // coast's, measured over its many samples. Far quieter than that, beyond chance (χ² at 1 in
+      // 1,000), they are no coast: a level held (a reading pinned at the converter's top).
+      // A quantized reading's spread is at least the step's, however often it repeats a value.
+      const double post_noise = sp.post_rough > 0 ? std::min(sp.sd_post, sp.post_rough) : sp.sd_post;
+      const double e_pre = std::max(pre.resid_sd(), reading_step(a, c + 1) * step_sd);
+      const double dof = double(c - a) - 2.0;
+      if (post_noise > 0 && dof * (e_pre * e_pre) / (post_noise * post_noise) < chi2_lower_tail(dof, z_one_in_1000))
+        return {};
+      // Otherwise its slope is judged on the coast's noise: a few readings that repeat one value
+      // (a quantized coast near its end, 0.57 V eight times on a 10-mV print) show a spread below it.
+      const double e = std::max(e_pre, post_noise);
       const double s = pre.slope(), se = pre.sxx() > 0 ? e / std::sqrt(pre.sxx()) : 0.0;
-      if (s - sp.post_slope > 3.0 * se && s > 0.5 * sp.post_slope) return {};
+      // Nor can a span over which the coast's line falls less than two of the reading's steps show
+      // a level: the print cannot tell a plateau there from the coast.
+      const double fall = -sp.post_slope * (t(c - 1) - t(a));
+      const bool resolvable = fall >= 2.0 * reading_step(a, next_index_);
+      if (resolvable && s - sp.post_slope > 3.0 * se && s > 0.5 * sp.post_slope) return {};
     }
   }
   sp.cut_index = a;
