@@ -362,5 +362,42 @@ TEST(SampleStream, ExpireTakesWhatWaitedBehindAGap) {
   EXPECT_FALSE(s.waiting());
 }
 
+// The stream's first datagrams overtaken (200 ± 200 ms of jitter between the PCs): sequence 1
+// arrives first, then 5, then 0. What came first waits for what it overtook: every sample is taken
+// in order from 0, none "repeated" (before, seq 0 and its neighbours were skipped as repeats).
+TEST(SampleStream, AStreamWhoseFirstDatagramsWereOvertakenStartsAtZero) {
+  SampleStream s;
+  Counting sink;
+  Bridge a{7, "bench-pc"};
+  std::vector<samples_t> sent;
+  for (int i = 0; i < 12; ++i) sent.push_back(a.next());
+  std::int64_t recv = t0;
+  for (int i : {1, 5, 0, 4, 2, 3, 6, 7, 9, 8, 10, 11}) take(s, sent[static_cast<std::size_t>(i)], recv += 20 * ms, sink);
+  s.flush(sink);
+  EXPECT_EQ(sink.count(SampleProblem::repeated), 0);
+  EXPECT_EQ(sink.total(SampleProblem::samples_lost), 0);
+  ASSERT_EQ(sink.seqs.size(), 12u);
+  for (std::size_t i = 0; i < 12; ++i) EXPECT_EQ(sink.seqs[i], std::int64_t(i));
+}
+
+// A follower that joins a running stream (a fitter started mid-session) waits the window once for
+// anything older, then begins at the first sample it heard: nothing before it is "lost".
+TEST(SampleStream, AJoinedStreamBeginsAfterTheWindowWithNothingLost) {
+  SampleStream s;
+  Counting sink;
+  Bridge a{7, "bench-pc"};
+  a.seq = 5000;
+  std::int64_t recv = t0;
+  for (int i = 0; i < 10; ++i) take(s, a.next(), recv += 20 * ms, sink);
+  EXPECT_TRUE(sink.seqs.empty());  // waiting for what it may have overtaken
+  s.expire(t0 + 20 * ms + s.options.reorder.window_us, sink);
+  ASSERT_EQ(sink.seqs.size(), 10u);
+  EXPECT_EQ(sink.seqs.front(), 5000);
+  EXPECT_EQ(sink.total(SampleProblem::samples_lost), 0);
+  EXPECT_FALSE(s.waiting());
+  take(s, a.next(), recv += 20 * ms, sink);  // and then in step, at once
+  EXPECT_EQ(sink.seqs.size(), 11u);
+}
+
 }  // namespace
 }  // namespace spindown

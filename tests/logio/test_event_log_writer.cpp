@@ -414,6 +414,28 @@ TEST(EventLogWriter, CountsSampleSequenceGapsPerBench) {
   EXPECT_EQ(w.counters().events, 7);  // undecodable events are still logged
 }
 
+// The stream's first datagrams overtaken (jitter between the PCs): 1, then 5, then 0 … The first
+// heard waits for what it overtook; nothing is a repeat or missing (before: seq 0 was "repeated").
+// A bench first heard far past 0 (a logger started mid-session) starts there after the window.
+TEST(EventLogWriter, AStreamWhoseFirstDatagramsWereOvertakenCountsNothing) {
+  TempDir dir;
+  EventLogWriter w(options_in(dir), kT0);
+  w.open(kT0);
+  auto put = [&](const std::string& bench, std::int64_t seq, std::int64_t at) {
+    const auto m = encode_samples(bench, seq, 1);
+    w.write(at, "SPINDOWN." + bench + ".SAMPLE", m.data(), static_cast<std::int32_t>(m.size()), at);
+  };
+  std::int64_t at = kT0;
+  for (int seq : {1, 5, 0, 4, 2, 3, 6, 8, 7, 9}) put("a", seq, at += 20'000);
+  for (int seq = 7000; seq < 7010; ++seq) put("b", seq, at += 20'000);
+  w.tick(at + ReorderOptions{}.window_us);
+  put("b", 7010, at += 20'000);
+  w.tick(at + ReorderOptions{}.window_us);
+  EXPECT_EQ(w.counters().seq_repeats, 0);
+  EXPECT_EQ(w.counters().samples_missing, 0);
+  EXPECT_EQ(w.counters().seq_gaps, 0);
+}
+
 // The lab's gate refused them (forged, replayed, another key): written, never counted as the
 // lab's loss, repeats or late samples (issue 42: a forger made 5 million "missing" samples).
 TEST(EventLogWriter, RefusedMessagesAreWrittenButNotCountedInTheSequence) {

@@ -269,8 +269,12 @@ bool EventLogWriter::flush(std::int64_t now_us) {
 }
 
 void EventLogWriter::tick(std::int64_t now_us) {
-  for (auto& [key, t] : next_seq_)
-    if (!t.waiting.empty()) release_waiting(t, now_us);
+  for (auto& [key, t] : next_seq_) {
+    if (t.starting)
+      begin_stream(t, now_us);
+    else if (!t.waiting.empty())
+      release_waiting(t, now_us);
+  }
   if (o_.retention.enabled() && now_us >= next_prune_us_) prune(now_us);
   resume_if_due(now_us);
   if (rotation_due(now_us, 0)) rotate(now_us, "rotating");
@@ -318,8 +322,10 @@ void EventLogWriter::close_file(std::int64_t now_us, std::string_view state) {
 }
 
 void EventLogWriter::close(std::int64_t now_us, std::string_view why) {
-  for (auto& [key, t] : next_seq_)  // the last status counts every gap still open as missing
+  for (auto& [key, t] : next_seq_) {  // the last status counts every gap still open as missing
+    if (t.starting) begin_stream(t, std::numeric_limits<std::int64_t>::max());
     if (!t.waiting.empty()) release_waiting(t, std::numeric_limits<std::int64_t>::max());
+  }
   close_file(now_us, why);
 }
 
@@ -418,11 +424,24 @@ void EventLogWriter::track_samples(std::string_view channel, const void* data, s
       ++counters_.benches_untracked;
       return;
     }
-    next_seq_[key].next_seq = s.seq + n;
+    SeqTrack& t = next_seq_[key];
+    t.next_seq = s.seq + n;
+    if (s.seq == 0) return;
+    // First heard past its start: it may have overtaken what was sent before it (ReorderWindow::start).
+    t.starting = true;
+    t.waiting.insert(s.seq, n, recv_utime, char{});
     return;
   }
   SeqTrack& t = it->second;
   const ReorderOptions window;
+  if (t.starting) [[unlikely]] {
+    if (t.waiting.holds(s.seq, n))
+      counters_.seq_repeats += n;
+    else
+      t.waiting.insert(s.seq, n, recv_utime, char{});
+    begin_stream(t, recv_utime);
+    return;
+  }
   if (s.seq < t.next_seq) {
     if (t.waiting.take_lost(s.seq, n)) {  // it came after all: in the log, so not missing
       counters_.samples_missing -= n;
@@ -447,6 +466,12 @@ void EventLogWriter::track_samples(std::string_view channel, const void* data, s
   else
     t.waiting.insert(s.seq, n, recv_utime, char{});
   release_waiting(t, recv_utime);
+}
+
+void EventLogWriter::begin_stream(SeqTrack& t, std::int64_t now_us) {
+  if (!t.waiting.start(t.next_seq, now_us, ReorderOptions{})) return;
+  t.starting = false;
+  release_waiting(t, now_us);
 }
 
 void EventLogWriter::release_waiting(SeqTrack& t, std::int64_t now_us) {

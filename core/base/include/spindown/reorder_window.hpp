@@ -6,6 +6,8 @@
 // receive time (or more than `max_samples` wait). A message that arrives after its gap was called
 // lost is *late*, never "repeated": the last `remembered_losses` lost ranges are kept to tell.
 //
+// A stream first heard past sequence number 0 waits the same way for what it overtook (start()).
+//
 // Used by everyone who follows samples_t.seq: the fitter, refit, watch and the web page through
 // SampleStream (which waits with the samples), the logger's loss counters (which wait with none).
 #include <algorithm>
@@ -78,6 +80,16 @@ class ReorderWindow {
         lost(next_seq, e.seq, now_us == std::numeric_limits<std::int64_t>::max() ? e.recv_us : now_us);
       take(e);
     }
+  }
+
+  // A stream first heard past its start (a bridge numbers from 0): what came first may have
+  // overtaken what was sent before it, so it waits like a message past a gap. The stream starts
+  // (true, next_seq set to the first waiting) once 0 has come, or once that wait is over (a
+  // follower that joined a running stream), with nothing before it called lost.
+  bool start(std::int64_t& next_seq, std::int64_t now_us, const ReorderOptions& o) const {
+    if (!ready(0, now_us, o)) return false;
+    next_seq = waiting_.front().seq;
+    return true;
   }
 
   Entry pop() {

@@ -147,6 +147,7 @@ struct SampleStream {
   // taken; a new source's held messages that never took over are counted as refused.
   template <class Sink>
   void flush(Sink&& sink) {
+    if (starting_) begin_stream(std::numeric_limits<std::int64_t>::max(), sink);
     release_waiting(std::numeric_limits<std::int64_t>::max(), sink);
     if (jump_.active) adopt_jump(jump_.first_recv_us, sink);
     for (Other& o : others_) {
@@ -163,7 +164,10 @@ struct SampleStream {
   // what waited behind them is taken.
   template <class Sink>
   void expire(std::int64_t now_us, Sink&& sink) {
-    if (!waiting_.empty()) release_waiting(now_us, sink);
+    if (starting_) [[unlikely]]
+      begin_stream(now_us, sink);
+    else if (!waiting_.empty())
+      release_waiting(now_us, sink);
   }
   bool waiting() const { return !waiting_.empty(); }
 
@@ -192,6 +196,7 @@ struct SampleStream {
     std::int64_t held_samples = 0;
   };
   enum class Relation { continues, repeated, jump };
+  bool starting_ = false;  // first heard past sequence number 0: waiting for what it overtook
 
   static std::string source_words(std::uint64_t s, std::string_view h) { return spindown::source_text(h, s); }
 
@@ -245,9 +250,33 @@ struct SampleStream {
       const Relation r = relation(m, n, next_seq, epoch, last_t_us);
       if (r != Relation::continues || m.seq != next_seq || !waiting_.empty() || jump_.active) [[unlikely]]
         return take_out_of_order(m, n, recv_us, r, sink);
+    } else if (m.seq > 0 || starting_) [[unlikely]] {
+      return take_before_start(m, n, recv_us, sink);
     }
     accept(m, n, sink, false);
     return true;
+  }
+
+  // The stream first heard past its sequence number 0: what comes waits, in order, for what the
+  // network delayed behind it (ReorderWindow::start), then the stream begins at the first waiting.
+  template <class Message, class Sink>
+  bool take_before_start(const Message& m, std::size_t n, std::int64_t recv_us, Sink& sink) {
+    const auto count = static_cast<std::int64_t>(n);
+    if (waiting_.holds(m.seq, count)) {
+      say_repeated(m.seq, count, sink);
+      return false;
+    }
+    starting_ = true;
+    waiting_.insert(m.seq, count, recv_us, hold(m, n));
+    begin_stream(recv_us, sink);
+    return true;
+  }
+  template <class Sink>
+  void begin_stream(std::int64_t now_us, Sink& sink) {
+    if (!waiting_.start(next_seq, now_us, options.reorder)) return;
+    starting_ = false;
+    have_seq = true;
+    release_waiting(now_us, sink);
   }
 
   // Anything but the next message in order: a repeat, a late one, one past a gap, a far jump.

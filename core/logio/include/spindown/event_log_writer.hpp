@@ -166,7 +166,9 @@ class EventLogWriter {
   struct SeqTrack {
     std::int64_t next_seq = 0;    // every sample before it came (or was counted missing)
     ReorderWindow<char> waiting;  // messages past a gap, by sequence number
+    bool starting = false;        // first heard past sequence number 0: waiting for what it overtook
   };
+  void begin_stream(SeqTrack& t, std::int64_t now_us);
   void release_waiting(SeqTrack& t, std::int64_t now_us);
   bool rotation_due(std::int64_t now_us, std::int64_t next_event_bytes) const;
 
