@@ -7,11 +7,18 @@
 #include <string>
 #include <vector>
 
+#include "spindown/read_recording.hpp"
 #include "spindown/serial_bridge.hpp"
 
 using namespace spindown;
 
 namespace {
+
+std::string fmt_sample(int millis, double value, char delimiter) {
+  char line[64];
+  std::snprintf(line, sizeof line, "%d%c%.4g\r\n", millis, delimiter, value);
+  return line;
+}
 
 struct CaptureSink : BridgeSink {
   std::vector<samples_t> samples;
@@ -378,4 +385,70 @@ TEST(BridgeSettings, BadFileNamesFileKeyAndProblem) {
     EXPECT_EQ(std::string(e.what()).rfind(path + ":1:", 0), 0u) << e.what();
   }
   std::remove(path.c_str());
+}
+
+// What `spindown fit` reads of a capture is what the bridge publishes of the same bytes (issue
+// 43): sketches that print "millis,value" with a comma, or a header and three columns, were 100 %
+// bad lines at the bridge while fit read the file. The bridge learns the layout from the first
+// lines with the file reader and reads every line by it: the same samples, time and value.
+namespace {
+std::vector<std::pair<double, double>> fit_reads(const std::string& bytes) {
+  const std::string path = ::testing::TempDir() + "/bridge_same_bytes.txt";
+  std::ofstream(path, std::ios::binary) << bytes;
+  const auto recs = read_recordings(path);
+  std::vector<std::pair<double, double>> out;
+  if (recs.size() == 1)
+    for (std::size_t i = 0; i < recs[0].size(); ++i) out.emplace_back(recs[0].t_s[i], recs[0].value[i]);
+  std::remove(path.c_str());
+  return out;
+}
+void expect_bridge_reads_as_fit(const std::string& bytes, std::size_t rows) {
+  CaptureSink sink;
+  SerialBridge b(settings(), sink);
+  b.start(T0);
+  b.connected(T0);
+  std::int64_t t = T0;
+  for (std::size_t at = 0; at < bytes.size(); at += 7) b.feed(bytes.substr(at, 7), t += 1000);  // as a port delivers
+  b.stop(t);
+  const auto fit = fit_reads(bytes);
+  const auto live = sink.flat();
+  ASSERT_EQ(fit.size(), rows);
+  ASSERT_EQ(live.size(), fit.size()) << b.last_error();
+  for (std::size_t i = 0; i < fit.size(); ++i) {
+    EXPECT_EQ(live[i].seq, std::int64_t(i));
+    EXPECT_NEAR(1e-6 * double(live[i].t_us), fit[i].first, 1e-9) << "sample " << i;
+    EXPECT_DOUBLE_EQ(live[i].value, fit[i].second) << "sample " << i;
+  }
+  EXPECT_EQ(b.counters().lines_bad, 0) << b.last_error();
+}
+}  // namespace
+
+TEST(BridgeLogic, CommaSeparatedSketchLinesAreReadAsFitReadsThem) {
+  std::string bytes;
+  for (int i = 0; i < 60; ++i) bytes += fmt_sample(2281 + 20 * i, i < 20 ? -0.0005 : 2.8 - 0.01 * (i - 20), ',');
+  expect_bridge_reads_as_fit(bytes, 60);
+}
+
+TEST(BridgeLogic, AHeaderAndThreeColumnsAreReadAsFitReadsThem) {
+  std::string bytes = "ms\traw\tvolts\r\n";
+  for (int i = 0; i < 60; ++i) {
+    const double v = i < 20 ? 0.0 : 2.8 - 0.01 * (i - 20);
+    char line[64];
+    std::snprintf(line, sizeof line, "%d\t%d\t%.2f\r\n", 20 * i, int(std::lround(v / 5.0 * 1023)), v);
+    bytes += line;
+  }
+  expect_bridge_reads_as_fit(bytes, 60);
+}
+
+TEST(BridgeLogic, ABootMessageBeforeTheLabLinesIsNoTable) {
+  CaptureSink sink;
+  SerialBridge b(settings(), sink);
+  b.start(T0);
+  b.connected(T0);
+  std::string bytes = "ets Jun  8 2016 00:22:57\r\nrst:0x1 (POWERON_RESET),boot:0x13 (SPI_FAST_FLASH_BOOT)\r\n";
+  for (int i = 0; i < 10; ++i) bytes += fmt_sample(100 + 20 * i, 1.0, '\t');
+  b.feed(bytes, T0);
+  EXPECT_EQ(b.counters().lines_bad, 2);
+  EXPECT_EQ(sink.flat().size(), 10u);
+  EXPECT_EQ(b.protocol(), WireProtocol::lab);
 }

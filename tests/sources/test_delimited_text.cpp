@@ -98,6 +98,25 @@ TEST(DelimitedText, SemicolonCsvWithDecimalComma) {
   EXPECT_EQ(r.quantity, Quantity::back_emf_volts);
 }
 
+// Google Sheets or LibreOffice in a German locale, saved as comma CSV: numbers quoted with a
+// decimal comma ("6,010","2,65"). The quotes keep the fields apart; the comma in them is decimal.
+// Before, every line was skipped ("time '0,0' is not a number") and no option helped.
+TEST(DelimitedText, CommaCsvWithQuotedDecimalCommas) {
+  std::string text = "\"Zeit\",\"Spannung\"\n";
+  for (int i = 0; i < 20; ++i) text += fmt::format("\"{},{:03d}\",\"2,{:02d}\"\n", 6 + i / 50, (i % 50) * 20, 99 - i);
+  const Recording r = read_delimited_text(text, "sheets.csv");
+  SCOPED_TRACE(all_diagnostics(r));
+  ASSERT_EQ(r.size(), 20u);
+  EXPECT_DOUBLE_EQ(r.t_s[3], 6.06);
+  EXPECT_DOUBLE_EQ(r.value[3], 2.96);
+  // An English sheet's quoted points stay points.
+  std::string en = "\"time\",\"volts\"\n";
+  for (int i = 0; i < 20; ++i) en += fmt::format("\"{:.2f}\",\"2.{:02d}\"\n", 6 + 0.02 * i, 99 - i);
+  const Recording e = read_delimited_text(en, "sheets-en.csv");
+  ASSERT_EQ(e.size(), 20u);
+  EXPECT_DOUBLE_EQ(e.value[3], 2.96);
+}
+
 TEST(DelimitedText, NoHeaderTwoColumnsInfersUnits) {
   const Recording ms = read_delimited_text(rows(40, ",", 1000, 0), "ms.csv");
   SCOPED_TRACE(all_diagnostics(ms));
@@ -393,4 +412,22 @@ TEST(DelimitedText, NoSpeedColumnFoundStillProposesTheClock) {
   const Recording r = read_delimited_text(text, "flat.csv");
   ASSERT_TRUE(r.has_errors());
   EXPECT_TRUE(mentions(r, "try --time-column 1 --time-unit ms and name the speed")) << all_diagnostics(r);
+}
+
+// A sketch that prints the volts alone at a known rate (the handout's delay(20)): with the period
+// given, row k is at k periods; without it, the refusal names the option.
+TEST(DelimitedText, ValuesAloneWithAGivenPeriod) {
+  std::string text;
+  for (int i = 0; i < 30; ++i) text += fmt::format("{:.2f}\r\n", 2.8 - 0.01 * i);
+  const Recording refused = read_delimited_text(text, "volts.txt");
+  EXPECT_TRUE(refused.empty());
+  EXPECT_NE(all_diagnostics(refused).find("--period-ms 20"), std::string::npos) << all_diagnostics(refused);
+  DelimitedTextOptions o;
+  o.period_ms = 20;
+  const Recording r = read_delimited_text(text, "volts.txt", o);
+  SCOPED_TRACE(all_diagnostics(r));
+  ASSERT_EQ(r.size(), 30u);
+  EXPECT_DOUBLE_EQ(r.t_s[0], 0.0);
+  EXPECT_DOUBLE_EQ(r.t_s[10], 0.2);
+  EXPECT_DOUBLE_EQ(r.value[10], 2.7);
 }

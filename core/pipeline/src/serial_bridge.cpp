@@ -1,6 +1,7 @@
 #include "spindown/serial_bridge.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -159,9 +160,10 @@ void SerialBridge::on_line(const LineSplitter::Line& line, std::int64_t now_us) 
     on_lab_line(line.text, now_us);
 }
 
-void SerialBridge::bad_line(std::string_view text, std::string_view why, std::int64_t now_us) {
+void SerialBridge::bad_line(std::string_view text, std::string_view why, std::int64_t now_us, std::int64_t line_no) {
   ++counters_.lines_bad;
-  error(fmt::format("{} line {}: {}: \"{}\"", s_.device, lines_seen_, why, printable(text)), now_us);
+  error(fmt::format("{} line {}: {}: \"{}\"", s_.device, line_no < 0 ? lines_seen_ : line_no, why, printable(text)),
+        now_us);
 }
 
 void SerialBridge::set_protocol(WireProtocol p, std::int64_t now_us) {
@@ -178,16 +180,97 @@ void SerialBridge::set_protocol(WireProtocol p, std::int64_t now_us) {
 }
 
 void SerialBridge::on_lab_line(std::string_view text, std::int64_t now_us) {
+  if (table_) [[unlikely]] {
+    on_table_line(text, now_us, lines_seen_);
+    return;
+  }
   const LabLine l = parse_lab_line(text);
   switch (l.kind) {
     case LabLine::Kind::blank: ++counters_.lines_blank; return;
-    case LabLine::Kind::garbled: bad_line(text, l.why, now_us); return;
+    case LabLine::Kind::garbled: hold_for_layout(text, now_us); return;
     case LabLine::Kind::sample: break;
   }
+  if (!held_.empty()) [[unlikely]]
+    held_.clear();  // a few lines of something else (a boot message) before the lab's lines
   good_line(now_us);
   set_protocol(WireProtocol::lab, now_us);
   const auto r = clock_.update(static_cast<std::uint64_t>(l.millis));
   add_sample(r, now_us, l.value, -1);
+}
+
+namespace {
+// Lines that are not millis<TAB>volts held before a layout is looked for: the file reader finds a
+// header, its delimiter and its columns from as many (it looks at the first 20 at most).
+constexpr std::size_t layout_lines = 8;
+}  // namespace
+
+void SerialBridge::hold_for_layout(std::string_view text, std::int64_t now_us) {
+  bad_line(text, parse_lab_line(text).why, now_us);  // said at once; taken back if a layout reads it
+  held_.push_back({std::string(text), now_us, lines_seen_});
+  if (held_.size() >= layout_lines) learn_layout(now_us);
+}
+
+void SerialBridge::learn_layout(std::int64_t now_us) {
+  std::string text;
+  for (const HeldLine& h : held_) (text += h.text) += '\n';
+  DelimitedLayout layout;
+  const Recording rec = read_delimited_text(text, s_.device, {}, &layout);
+  // A table when nearly every held line is one of its rows (a header and a units row aside):
+  // boot messages and noise are reported as before.
+  if (rec.has_errors() || rec.size() + 2 < held_.size()) {
+    held_.clear();
+    return;
+  }
+  counters_.lines_bad -= static_cast<std::int64_t>(held_.size());  // read again below, by the layout
+  table_.emplace(layout);
+  const double per_s = time_units_per_second(layout.time_unit);
+  const bool millis = layout.time_unit == TimeUnit::ms, micros = layout.time_unit == TimeUnit::us;
+  table_tick_us_ = millis ? 1000 : 1;
+  table_ticks_per_unit_ = millis || micros ? 1.0 : 1e6 / per_s;
+  set_protocol(WireProtocol::lab, now_us);
+  // millis() and micros() wrap at 2^32 ticks; seconds from a PC's logger do not.
+  clock_.set_tick_us(table_tick_us_, millis || micros ? 1ull << 32 : 1ull << 62);
+  if (layout.quantity_from_header && layout.quantity != s_.quantity) {
+    s_.quantity = layout.quantity;
+    next_config_us_ = now_us;
+  }
+  std::string columns;
+  for (const Diagnostic& d : rec.diagnostics)
+    if (const auto at = d.message.find("time = column"); at != std::string::npos) columns = d.message.substr(at);
+  error(fmt::format("{}: the lines are not millis<TAB>volts; read as spindown fit reads them: {}", s_.device, columns),
+        now_us);
+  // The held lines, by the layout now: its header (the lines before the first row) named the columns.
+  std::vector<HeldLine> held = std::move(held_);
+  held_.clear();
+  bool rows = false;
+  for (const HeldLine& h : held) {
+    if (!rows && !table_->read(h.text).ok) {
+      good_line(h.recv_us);  // the header: used, it named the columns
+      continue;
+    }
+    rows = true;
+    on_table_line(h.text, h.recv_us, h.line_no);
+  }
+}
+
+void SerialBridge::on_table_line(std::string_view text, std::int64_t now_us, std::int64_t line_no) {
+  if (text.find_first_not_of(" \t\r") == std::string_view::npos) {
+    ++counters_.lines_blank;
+    return;
+  }
+  const DelimitedRowReader::Row row = table_->read(text);
+  if (!row.ok) {
+    bad_line(text, row.why, now_us, line_no);
+    return;
+  }
+  const double ticks = std::round(row.time * table_ticks_per_unit_);
+  if (!(ticks >= 0) || ticks > 9.0e15) {
+    bad_line(text, "time is negative or out of range", now_us, line_no);
+    return;
+  }
+  good_line(now_us);
+  const auto r = clock_.update(static_cast<std::uint64_t>(ticks));
+  add_sample(r, now_us, row.value, -1);
 }
 
 void SerialBridge::on_spindown_line(std::string_view text, std::int64_t now_us) {

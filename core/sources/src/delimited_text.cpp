@@ -102,7 +102,7 @@ int resolve_named(const std::string& spec, const std::vector<ColumnName>& cols, 
 
 bool DelimitedTextOptions::names_columns() const {
   return !time_column.empty() || !value_column.empty() || time_unit.has_value() || quantity.has_value() ||
-         delimiter != 0 || header.has_value();
+         delimiter != 0 || header.has_value() || period_ms.has_value();
 }
 
 bool DelimitedTextOptions::is_valid(std::string* why) const {
@@ -119,6 +119,10 @@ bool DelimitedTextOptions::is_valid(std::string* why) const {
   if (delimiter != 0 && delimiter != ',' && delimiter != ';' && delimiter != '\t' && delimiter != ' ')
     return fail(fmt::format("delimiter '{}' is not one of ',', ';', tab or blank", delimiter));
   if (max_line_reports == 0) return fail("max_line_reports must be at least 1");
+  if (period_ms && !(std::isfinite(*period_ms) && *period_ms > 0))
+    return fail(fmt::format("period {} ms is not a positive number", *period_ms));
+  if (period_ms && (!time_column.empty() || time_unit))
+    return fail("a period (--period-ms) stands for the time column: give it, or the time column and its unit");
   if (!std::isfinite(value_scale) || value_scale <= 0)
     return fail(fmt::format("value scale {} is not a positive number", value_scale));
   return true;
@@ -151,6 +155,36 @@ bool header_needs_delimited_reader(std::string_view line) {
   return false;
 }
 
+const std::vector<std::string_view>& DelimitedRowReader::split(std::string_view line, char delimiter) {
+  splitter_.split(line, delimiter, fields_);
+  for (auto& f : fields_) f = unquote_single(f);
+  return fields_;
+}
+
+DelimitedRowReader::Row DelimitedRowReader::read(std::string_view line) {
+  Row row;
+  split(line, layout_.delimiter);
+  const std::size_t need = static_cast<std::size_t>(std::max(layout_.time_column, layout_.value_column)) + 1;
+  if (fields_.size() < need) {
+    row.why = fmt::format("{} fields, column {} is missing", fields_.size(), need);
+    return row;
+  }
+  std::string_view w;
+  const std::string_view tf = fields_[static_cast<std::size_t>(layout_.time_column)];
+  if (!parse_number(tf, layout_.decimal_comma, row.time, w)) {
+    row.why = fmt::format("time '{}' is {}", text::escape_invalid_utf8(tf.substr(0, 40)), w);
+    return row;
+  }
+  const std::string_view vf = fields_[static_cast<std::size_t>(layout_.value_column)];
+  if (!parse_number(vf, layout_.decimal_comma, row.value, w)) {
+    row.why = fmt::format("value '{}' is {}", text::escape_invalid_utf8(vf.substr(0, 40)), w);
+    return row;
+  }
+  row.value *= layout_.value_scale;
+  row.ok = true;
+  return row;
+}
+
 namespace {
 
 // One delimited-text file read step by step (read_delimited_text): its content lines, the
@@ -173,16 +207,14 @@ class DelimitedReader {
   std::optional<std::string> choose_value_unit();
   void read_rows();
   void choose_time_unit_and_finish();
+  const DelimitedLayout& layout() const { return rows_.layout(); }
 
  private:
   struct Line {
     std::int64_t number;
     std::string_view text;
   };
-  void split(std::string_view line) {
-    splitter_.split(line, delim_, fields_);
-    for (auto& f : fields_) f = unquote_single(f);
-  }
+  void split(std::string_view line) { fields_ = rows_.split(line, delim_); }
   bool is_number(std::string_view f) const {
     double x;
     std::string_view w;
@@ -203,7 +235,7 @@ class DelimitedReader {
   char delim_ = ' ';
   bool decimal_comma_ = false;
   std::string_view delim_name_;
-  CsvFieldSplitter splitter_;
+  DelimitedRowReader rows_{DelimitedLayout{}};  // splits every line; reads the rows once the layout is chosen
   std::vector<std::string_view> fields_;
   std::vector<ColumnName> cols_;
   bool have_header_ = false;
@@ -251,6 +283,20 @@ void DelimitedReader::choose_delimiter() {
     }
   }
   decimal_comma_ = delim_ != ',';
+  // A comma CSV whose numbers are quoted with decimal commas ("6,010","2,65": Google Sheets or
+  // LibreOffice in a German locale): the quotes keep the fields apart, the comma in them is decimal.
+  if (delim_ == ',') {
+    std::size_t comma_numbers = 0, point_numbers = 0;
+    for (std::size_t i = 0; i < probe; ++i) {
+      for (const std::string_view f : rows_.split(content_[i].text, ',')) {
+        double x;
+        std::string_view w;
+        if (f.find(',') != std::string_view::npos && parse_number(f, true, x, w)) ++comma_numbers;
+        else if (f.find('.') != std::string_view::npos && parse_number(f, false, x, w)) ++point_numbers;
+      }
+    }
+    decimal_comma_ = comma_numbers > 0 && point_numbers == 0;
+  }
   delim_name_ = delim_ == '\t' ? "tab" : delim_ == ' ' ? "blanks" : std::string_view(&delim_, 1);
 }
 
@@ -332,8 +378,9 @@ const ColumnGuess& DelimitedReader::guess() {
 // The time and value columns: as named, else by their header names, else the two of a two-column
 // file; else the reason, with what the numbers propose.
 std::optional<std::string> DelimitedReader::choose_columns() {
-  if (cols_.size() < 2)
-    return fmt::format("no samples: line {} has {} field (delimiter {}); need a time and a value column",
+  if (cols_.size() < 2 && !o_.period_ms)
+    return fmt::format("no samples: line {} has {} field (delimiter {}); need a time and a value column, or the "
+                       "readings' period if the sketch printed them at a known rate (--period-ms 20 for delay(20))",
                        content_.front().number, cols_.size(), delim_name_);
   std::string why;
   if (!o_.time_column.empty() && (tcol_ = resolve_named(o_.time_column, cols_, have_header_, &why)) < 0)
@@ -341,6 +388,20 @@ std::optional<std::string> DelimitedReader::choose_columns() {
   if (!o_.value_column.empty() && (vcol_ = resolve_named(o_.value_column, cols_, have_header_, &why)) < 0)
     return "value column: " + why;
   if (tcol_ >= 0 && tcol_ == vcol_) return fmt::format("time and value are both column {}", tcol_ + 1);
+  if (o_.period_ms) {  // no time column: the value is the named one, the only one, or the one named a value
+    if (vcol_ < 0 && cols_.size() == 1) vcol_ = 0;
+    if (vcol_ < 0) {
+      std::vector<int> named;
+      for (std::size_t i = 0; i < cols_.size(); ++i)
+        if (is_value_name(cols_[i])) named.push_back(static_cast<int>(i));
+      if (named.size() != 1)
+        return fmt::format("which of the {} columns ({}) is the value? name it (value column)", cols_.size(),
+                           list_columns(cols_));
+      vcol_ = named[0];
+    }
+    tcol_ = vcol_;  // read_rows gives each row its time from the period
+    return std::nullopt;
+  }
   auto candidates = [&](auto pred, int exclude) {
     std::vector<int> out;
     for (std::size_t i = 0; i < cols_.size(); ++i)
@@ -357,8 +418,16 @@ std::optional<std::string> DelimitedReader::choose_columns() {
     auto c = candidates([](const ColumnName& col) { return is_time_name(col); }, vcol_);
     if (c.size() == 1) tcol_ = c[0];
     else if (c.size() > 1) return fmt::format("columns {} could each be the time; name one (time column)", names_of(c));
-    else if (cols_.size() == 2) tcol_ = vcol_ == 0 ? 1 : 0;
-    else if (const auto p = column_proposal(guess()))
+    else if (cols_.size() == 2) {
+      tcol_ = vcol_ == 0 ? 1 : 0;
+      // Two unnamed columns the other way round (volts<TAB>millis): the numbers say the time is the
+      // other one. Refused with the options that read it, never fitted from the wrong column.
+      if (!have_header_ && vcol_ < 0 && guess().time == 1)
+        if (const auto p = column_proposal(guess()))
+          return fmt::format("column 1 is no time (it does not rise steadily) but column 2 does: the columns are not "
+                             "time, value in that order{}: {}",
+                             unnamed, *p);
+    } else if (const auto p = column_proposal(guess()))
       return fmt::format("cannot tell which of the {} columns is the time{}: {}", cols_.size(), unnamed, *p);
     else
       return fmt::format("cannot tell which of the {} columns is the time{} ({}); name it (time column)", cols_.size(),
@@ -405,42 +474,37 @@ std::optional<std::string> DelimitedReader::choose_value_unit() {
     return fmt::format("cannot tell the unit of value column '{}' (V, rpm or rad/s); name it: {}", value_col.name,
                        option);
   }
-  if (!o_.time_unit && !cols_[tcol_].unit.empty() && !parse_time_unit(cols_[tcol_].unit))
+  if (!o_.period_ms && !o_.time_unit && !cols_[tcol_].unit.empty() && !parse_time_unit(cols_[tcol_].unit))
     return fmt::format("time column '{}': its unit '{}' is not one spindown reads (s, ms, us); convert the times or "
                        "name their unit: --time-unit s, ms or us",
                        cols_[tcol_].name, cols_[tcol_].unit);
   return std::nullopt;
 }
 
-// Each row's time and value; a row without them is said (the first few one by one) and skipped.
+// Each row's time and value (DelimitedRowReader, by the layout chosen); a row without them is said
+// (the first few one by one) and skipped.
 void DelimitedReader::read_rows() {
   reporter_.emplace(rec_, o_.max_line_reports);
   raw_.reserve(content_.size());
-  const std::size_t need = static_cast<std::size_t>(std::max(tcol_, vcol_)) + 1;
+  DelimitedLayout layout;
+  layout.delimiter = delim_;
+  layout.decimal_comma = decimal_comma_;
+  layout.time_column = tcol_;
+  layout.value_column = vcol_;
+  layout.quantity = rec_.quantity;
+  layout.quantity_from_header = quantity_from_ == "from the header";
+  layout.value_scale = value_scale_;
+  rows_ = DelimitedRowReader(layout);
   for (std::size_t i = first_data_; i < content_.size(); ++i) {
     const Line& line = content_[i];
-    split(line.text);
-    if (fields_.size() < need) {
+    const DelimitedRowReader::Row row = rows_.read(line.text);
+    if (!row.ok) {
       ++bad_;
-      reporter_->warn(line.number, fmt::format("{}: {} fields, column {} is missing; skipped",
-                                               text::quote_line(line.text), fields_.size(), need));
+      reporter_->warn(line.number, fmt::format("{}: {}; skipped", text::quote_line(line.text), row.why));
       continue;
     }
-    double t = 0, v = 0;
-    std::string_view w;
-    if (!parse_number(fields_[tcol_], decimal_comma_, t, w)) {
-      ++bad_;
-      reporter_->warn(line.number, fmt::format("{}: time '{}' is {}; skipped", text::quote_line(line.text),
-                                               text::escape_invalid_utf8(fields_[tcol_].substr(0, 40)), w));
-      continue;
-    }
-    if (!parse_number(fields_[vcol_], decimal_comma_, v, w)) {
-      ++bad_;
-      reporter_->warn(line.number, fmt::format("{}: value '{}' is {}; skipped", text::quote_line(line.text),
-                                               text::escape_invalid_utf8(fields_[vcol_].substr(0, 40)), w));
-      continue;
-    }
-    raw_.add(line.number, line.text.data(), t, v * value_scale_, false);
+    const double t = o_.period_ms ? *o_.period_ms * double(raw_.size()) : row.time;
+    raw_.add(line.number, line.text.data(), t, row.value, false);
   }
 }
 
@@ -449,7 +513,10 @@ void DelimitedReader::read_rows() {
 void DelimitedReader::choose_time_unit_and_finish() {
   TimeUnit unit = TimeUnit::s;
   std::string unit_from = "given";
-  if (o_.time_unit) {
+  if (o_.period_ms) {
+    unit = TimeUnit::ms;
+    unit_from = fmt::format("a reading every {:g} ms", *o_.period_ms);
+  } else if (o_.time_unit) {
     unit = *o_.time_unit;
   } else if (auto u = implied_time_unit(cols_[tcol_])) {
     unit = *u;
@@ -465,6 +532,7 @@ void DelimitedReader::choose_time_unit_and_finish() {
                              integral ? "are whole numbers" : "have fractions", step, time_unit_name(unit)));
   }
 
+  rows_.set_time_unit(unit);
   text::TimelineRules rules;
   rules.units_per_s = time_units_per_second(unit);
   rules.unit = time_unit_name(unit);
@@ -481,10 +549,11 @@ void DelimitedReader::choose_time_unit_and_finish() {
           ? fmt::format("{} read as {}", value_unit_name_, quantity_unit(rec_.quantity))
           : value_scale_ != 1 ? fmt::format("{} x {:g}", quantity_unit(rec_.quantity), value_scale_)
                               : std::string(quantity_unit(rec_.quantity));
-  const std::string columns = fmt::format(
-      "time = column {} '{}' in {} ({}), value = column {} '{}' in {} ({}), delimiter {}", tcol_ + 1,
-      cols_[tcol_].name, time_unit_name(unit), unit_from, vcol_ + 1, cols_[vcol_].name, value_unit, quantity_from_,
-      delim_name_);
+  const std::string time = o_.period_ms ? fmt::format("time = {} (--period-ms)", unit_from)
+                                        : fmt::format("time = column {} '{}' in {} ({})", tcol_ + 1, cols_[tcol_].name,
+                                                      time_unit_name(unit), unit_from);
+  const std::string columns = fmt::format("{}, value = column {} '{}' in {} ({}), delimiter {}", time, vcol_ + 1,
+                                          cols_[vcol_].name, value_unit, quantity_from_, delim_name_);
   if (rec_.empty()) {
     rec_.error(0, fmt::format("no samples: {} lines, none with a usable time and value ({})", lines_, columns));
     return;
@@ -501,7 +570,8 @@ void DelimitedReader::choose_time_unit_and_finish() {
 
 }  // namespace
 
-Recording read_delimited_text(std::string_view text, std::string source, const DelimitedTextOptions& options) {
+Recording read_delimited_text(std::string_view text, std::string source, const DelimitedTextOptions& options,
+                              DelimitedLayout* layout) {
   Recording rec;
   rec.source = std::move(source);
   if (!text::readable_text(text, options, "delimited text", rec)) return rec;
@@ -520,6 +590,7 @@ Recording read_delimited_text(std::string_view text, std::string source, const D
   if (auto why = reader.choose_value_unit()) return give_up(std::move(*why));
   reader.read_rows();
   reader.choose_time_unit_and_finish();
+  if (layout) *layout = reader.layout();
   return rec;
 }
 

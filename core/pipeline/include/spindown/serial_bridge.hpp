@@ -5,8 +5,12 @@
 //
 // Per line: "S,…" and "#…" lines are spindown-v1 (spindown_protocol.hpp), everything else is
 // the lab sketch's "millis<TAB>volts" (lab_line.hpp). The protocol is detected from the lines
-// themselves and may change (a reflashed board). Only lines that parse become samples; every
-// other line is counted and the last one reported with the reason.
+// themselves and may change (a reflashed board). A sketch that prints another table ("millis,volts"
+// with commas, a header and three columns) is read as `spindown fit` reads its capture: the
+// first lines that are not millis<TAB>volts wait until the file reader has learned their
+// layout from them (read_delimited_text), then each line is read by it (DelimitedRowReader).
+// Only lines that parse become samples; every other line is counted and the last one reported
+// with the reason.
 //
 // A wrong baud rate garbles every byte: no line is ever valid and most bytes are not text. Once
 // wrong_baud_bytes arrived since the last valid line and at least a quarter of them are not
@@ -14,6 +18,7 @@
 // and last_error, until a valid line arrives. (A long line of text is not a baud problem.)
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -23,6 +28,7 @@
 #include <spindown/status_t.hpp>
 
 #include "spindown/bridge_settings.hpp"
+#include "spindown/delimited_text.hpp"
 #include "spindown/device_clock.hpp"
 #include "spindown/line_splitter.hpp"
 #include "spindown/spindown_protocol.hpp"
@@ -91,11 +97,17 @@ class SerialBridge {
  private:
   void on_line(const LineSplitter::Line& line, std::int64_t now_us);
   void on_lab_line(std::string_view text, std::int64_t now_us);
+  // Lines that are not the lab's millis<TAB>volts: the first few wait while the file reader
+  // (read_delimited_text, as `spindown fit` reads a capture) learns their table from them; then
+  // every line is read by that layout (on_table_line), or they are reported bad as before.
+  void hold_for_layout(std::string_view text, std::int64_t now_us);
+  void learn_layout(std::int64_t now_us);
+  void on_table_line(std::string_view text, std::int64_t now_us, std::int64_t line_no);
   void on_spindown_line(std::string_view text, std::int64_t now_us);
   void set_protocol(WireProtocol p, std::int64_t now_us);
   void add_sample(const DeviceClock::Reading& r, std::int64_t host_us, double value, std::int32_t raw);
   void flush();
-  void bad_line(std::string_view text, std::string_view why, std::int64_t now_us);
+  void bad_line(std::string_view text, std::string_view why, std::int64_t now_us, std::int64_t line_no = -1);
   void good_line(std::int64_t now_us);
   void check_wrong_baud(std::int64_t now_us);
   void forget_wrong_baud();
@@ -110,6 +122,15 @@ class SerialBridge {
   bool banner_seen_ = false;
   bool have_device_seq_ = false;
   std::uint32_t last_device_seq_ = 0;
+
+  struct HeldLine {
+    std::string text;
+    std::int64_t recv_us, line_no;
+  };
+  std::vector<HeldLine> held_;                 // lines waiting for a layout (at most layout_lines)
+  std::optional<DelimitedRowReader> table_;    // the layout learned: every line is read by it
+  std::int64_t table_tick_us_ = 1000;          // µs per device tick of the table's time column
+  double table_ticks_per_unit_ = 1;
 
   samples_t batch_{};
   std::int64_t next_seq_ = 0;

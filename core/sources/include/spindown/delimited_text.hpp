@@ -12,7 +12,9 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
+#include "spindown/csv_fields.hpp"
 #include "spindown/column_names.hpp"
 #include "spindown/quantity.hpp"
 #include "spindown/recording.hpp"
@@ -29,6 +31,9 @@ struct DelimitedTextOptions {
   double value_scale = 1;             // with quantity: a reading times this is in it (mV: 0.001)
   char delimiter = 0;                 // ',', ';', '\t' or ' ' (any run of blanks); 0: detect
   std::optional<bool> header;         // empty: a first row with a non-number is a header
+  // The readings' period (ms) when the file has no time column (a sketch that prints the volts
+  // alone at a known rate, delay(20)): row k's time is k periods; a time column is not read.
+  std::optional<double> period_ms;
   std::size_t max_line_reports = 20;  // bad lines reported one by one before only a count
 
   // True when the user named anything about the columns (then a text file is read as
@@ -43,7 +48,48 @@ struct DelimitedTextOptions {
 // read, or names a speed without a unit. The lab's own "millis<TAB>volts" does not.
 bool header_needs_delimited_reader(std::string_view line);
 
-Recording read_delimited_text(std::string_view text, std::string source, const DelimitedTextOptions& options = {});
+// The layout a delimited text was read by: what read_delimited_text chose or was told, enough to
+// read one more row of it alone. The serial bridge reads a sketch's lines with it (learned by
+// read_delimited_text from the first lines), so what `spindown fit` reads of a capture is what the
+// bridge publishes of the same bytes.
+struct DelimitedLayout {
+  char delimiter = '\t';       // ',', ';', '\t' or ' ' (any run of blanks)
+  bool decimal_comma = false;  // "2,81" is 2.81
+  int time_column = 0;         // 0-based
+  int value_column = 1;
+  TimeUnit time_unit = TimeUnit::ms;
+  Quantity quantity = Quantity::back_emf_volts;
+  bool quantity_from_header = false;  // false: assumed (volts) or given
+  double value_scale = 1;             // a reading times this is in quantity
+};
+
+// One row by a layout: its time (in the layout's time unit) and value (in its quantity), or why
+// not ("3 fields, column 4 is missing", "time 'x' is not a number"). read_delimited_text reads
+// every row of a file with it.
+class DelimitedRowReader {
+ public:
+  explicit DelimitedRowReader(const DelimitedLayout& layout) : layout_(layout) {}
+  struct Row {
+    bool ok = false;
+    double time = 0, value = 0;
+    std::string why;
+  };
+  Row read(std::string_view line);
+  // The fields of line (single quotes taken off), valid until the next call.
+  const std::vector<std::string_view>& split(std::string_view line, char delimiter);
+  const DelimitedLayout& layout() const { return layout_; }
+  void set_time_unit(TimeUnit unit) { layout_.time_unit = unit; }
+
+ private:
+  DelimitedLayout layout_;
+  CsvFieldSplitter splitter_;
+  std::vector<std::string_view> fields_;
+};
+
+// Reads text; when layout is given, it is set to the layout the rows were read by (when there
+// were rows to read).
+Recording read_delimited_text(std::string_view text, std::string source, const DelimitedTextOptions& options = {},
+                              DelimitedLayout* layout = nullptr);
 Recording read_delimited_text_file(const std::string& path, const DelimitedTextOptions& options = {});
 
 }  // namespace spindown
