@@ -100,6 +100,13 @@ std::function<void()> add_input_options(CLI::App* sub, InputOptions& opt, InputP
     sub->add_option("--time-unit", opt.time_unit, "Time unit: ms, s or us")->group(text);
     sub->add_option("--value-unit", opt.value_unit, "Value unit: V, rpm or rad/s")->group(text);
     sub->add_option("--delimiter", opt.delimiter, "Column delimiter: , ; tab space")->group(text);
+    sub->add_option("--period-ms", opt.period_ms,
+                    "The readings' period when the file has no time column (a sketch printing the volts alone: "
+                    "--period-ms 20 for delay(20)); row k is at k periods")
+        ->check(CLI::PositiveNumber)
+        ->excludes("--time-column")
+        ->excludes("--time-unit")
+        ->group(text);
 
     const char* klass = "A class's files";
     sub->add_option("--roster", opt.roster,
@@ -209,6 +216,7 @@ ReadOptions read_options_from(const InputOptions& o) {
     d.value_scale = unit->scale;
   }
   if (!o.delimiter.empty()) d.delimiter = parse_delimiter(o.delimiter);
+  if (o.period_ms > 0) d.period_ms = o.period_ms;
   read.lcm.gate = gate_options_from(o.lab);
   std::string why;
   if (!read.is_valid(&why)) bad_usage(why);

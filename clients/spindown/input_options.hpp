@@ -33,6 +33,7 @@ struct InputOptions {
 
   // Delimited text: columns and units when they are not obvious from the header.
   std::string time_column, value_column, time_unit, value_unit, delimiter;
+  double period_ms = 0;  // 0: not given
 
   // A class's text files: which bench (and student) each is from.
   std::string roster, bench_pattern;

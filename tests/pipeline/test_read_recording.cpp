@@ -1,4 +1,7 @@
 #include <gtest/gtest.h>
+#include <fmt/format.h>
+
+#include <cmath>
 
 #include <algorithm>
 #include <filesystem>
@@ -193,6 +196,43 @@ TEST(ReadRecording, SyntheticPuttyLogFromDisk) {
   ASSERT_EQ(recs.size(), 1u);
   EXPECT_EQ(recs[0].size(), run.t_ms.size()) << all_diagnostics(recs[0]);
   EXPECT_TRUE(mentions(recs[0], "cut short"));
+}
+
+// Columns the other way round (volts<TAB>millis): refused with the options that read it, never
+// fitted from the wrong column; following the proposal reads every sample. All readings negative
+// (a differential probe's leads swapped): read as their magnitude, said.
+TEST(ReadRecording, SwappedColumnsAreProposedAndNegativeReadingsSaid) {
+  std::string swapped, negative;
+  for (int i = 0; i < 300; ++i) {
+    const double v = i < 50 ? 0.0 : 2.8 * std::exp(-(i - 50) * 0.01);
+    swapped += fmt::format("{:.2f}\t{}\r\n", v, 1000 + 20 * i);
+    negative += fmt::format("{}\t{:.2f}\r\n", 1000 + 20 * i, -v);
+  }
+  const TempFile s("swapped.txt", swapped);
+  const auto rs = read_recordings(s.path);
+  ASSERT_EQ(rs.size(), 1u);
+  EXPECT_TRUE(rs[0].empty());
+  std::string err;
+  for (const auto& d : rs[0].diagnostics)
+    if (d.severity == Diagnostic::Severity::error) err = d.message;
+  EXPECT_NE(err.find("--time-column 2"), std::string::npos) << err;
+  EXPECT_NE(err.find("--value-column 1"), std::string::npos) << err;
+  ReadOptions o;
+  o.delimited.time_column = "2";
+  o.delimited.value_column = "1";
+  o.delimited.time_unit = TimeUnit::ms;
+  const auto followed = read_recordings(s.path, o);
+  ASSERT_EQ(followed.size(), 1u);
+  EXPECT_EQ(followed[0].size(), 300u);
+
+  const TempFile n("negative.txt", negative);
+  const auto rn = read_recordings(n.path);
+  ASSERT_EQ(rn.size(), 1u);
+  ASSERT_EQ(rn[0].size(), 300u);
+  EXPECT_DOUBLE_EQ(rn[0].value[50], 2.8);
+  bool said = false;
+  for (const auto& d : rn[0].diagnostics) said = said || d.message.find("leads are the wrong way round") != std::string::npos;
+  EXPECT_TRUE(said);
 }
 
 TEST(ReadRecording, DetectFormat) {

@@ -474,3 +474,21 @@ TEST(ArduinoText, BinaryVerdictIsTheFirst8KibsWhateverPathReadsThem) {
     }
   }
 }
+
+// A sketch that prints micros() instead of millis() (its delay(20) steps the clock by ~20,000):
+// read as µs, with a warning naming the unit and the option for the other reading; a 1-Hz
+// millis() log (steps of 1000) stays milliseconds.
+TEST(ArduinoText, MicrosInsteadOfMillisIsReadAsMicroseconds) {
+  std::string text;
+  for (int i = 0; i < 100; ++i) text += std::to_string(13456788 + 20391 * i) + "\t2.50\r\n";
+  const Recording r = read_arduino_text(text, "week.log");
+  ASSERT_EQ(r.size(), 100u);
+  EXPECT_NEAR(r.t_s[1] - r.t_s[0], 0.020391, 1e-9);
+  bool said = false;
+  for (const auto& d : r.diagnostics) said = said || (d.message.find("micros()") != std::string::npos &&
+                                                      d.message.find("--time-unit ms") != std::string::npos);
+  EXPECT_TRUE(said);
+  const Recording slow = read_arduino_text(cadence(5000, 100, 1000), "slow.log");
+  ASSERT_EQ(slow.size(), 100u);
+  EXPECT_NEAR(slow.t_s[1] - slow.t_s[0], 1.0, 1e-9);
+}

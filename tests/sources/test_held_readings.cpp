@@ -73,5 +73,21 @@ TEST(HeldReadings, ACoarseSlowTailThatChangesEveryRowAtItsStartIsLeft) {
   EXPECT_EQ(take_held_readings_once(rec), 0u);
 }
 
+TEST(HeldReadings, AQuantizedCoastWithoutNoiseThatHoldsEveryValueForRowsIsLeft) {
+  // The lab's motor (Coulomb and viscous friction) through its 10-bit converter, printed to 2
+  // decimals, no noise: every value is held 3 rows or more (0.19 V/s at the cut is 0.004 V a row)
+  // and changes whenever the coast crosses the next one — at any time, not on a slower clock.
+  // Before, 2 of 3 rows were dropped as "a slower channel logged in every row".
+  Recording rec;
+  rec.source = "sheet.csv";
+  double w = 2.8 / 0.0080926;
+  for (double t = 0; t < 30.0 && w > 0; t += 0.02) {
+    rec.push(t, std::round(std::round(0.0080926 * w * 1023 / 5) * 5 / 1023 * 100) / 100);
+    for (int k = 0; k < 20; ++k) w -= (1.8e-7 * w + 1.14e-4) / 1.127e-5 * 0.001;
+  }
+  ASSERT_GT(rec.size(), 1000u);
+  EXPECT_EQ(take_held_readings_once(rec), 0u);
+}
+
 }  // namespace
 }  // namespace spindown

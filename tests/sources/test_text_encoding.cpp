@@ -124,3 +124,17 @@ TEST(TextEncoding, OfficeDocumentsAreNamedWithWhatToDo) {
   EXPECT_FALSE(office_document("0\t0.00\r\n"));
   EXPECT_FALSE(office_document("PK"));
 }
+
+// Excel for Mac's "CSV (Comma delimited)": Mac OS Roman, lines ended by a CR alone. The names
+// come out right (ë is 0x91 there, a quotation mark in Windows-1252), and the note says so.
+TEST(TextEncoding, ExcelForMacCsvIsMacRoman) {
+  const std::string bytes = "file,bench,student\rZo\x91/putty.log,bench1,Zo\x91 Bront\x91\rJ\x9Fgen,bench2,J\x9Frgen Gro\xA7\r";
+  const EncodingGuess g = guess_text_encoding(bytes);
+  EXPECT_EQ(g.encoding, TextEncoding::mac_roman);
+  const std::string text = decode_text(bytes, g);
+  EXPECT_NE(text.find("Zo\xC3\xAB Bront\xC3\xAB"), std::string::npos) << text;
+  EXPECT_NE(text.find("J\xC3\xBCrgen Gro\xC3\x9F"), std::string::npos) << text;
+  EXPECT_NE(decoding_note(g).find("Mac OS Roman"), std::string::npos);
+  // The same bytes with Windows line ends are Windows-1252.
+  EXPECT_EQ(guess_text_encoding("a,b\r\nZo\x91,1\r\n").encoding, TextEncoding::cp1252);
+}

@@ -88,3 +88,32 @@ TEST(TextRepairs, TimestampsAndCommasTogether) {
   EXPECT_EQ(repair_text(text).size(), 2u);
   EXPECT_EQ(text.substr(0, 14), "0\t2.40\n20\t2.41");
 }
+
+// A pyserial script's print(ser.readline()) writes each line as a Python bytes literal: unwrapped
+// and unescaped line for line (the tab, the \xNN escapes), said in a note; the lab's reader then
+// reads the samples.
+TEST(TextRepairs, PythonBytesLiteralsAreUnwrapped) {
+  std::string text = "b'11\\t0.00\\r\\n'\nb'48231\\t0.00\\r\\n'\nb'48251\\t2.80\\r\\n'\r\nb\"48272\\t2.79\\r\\n\"\n"
+                     "b'48292\\t2.78\\r\\n'\nb'\\xb0C\\t\\\\ok'\n";
+  ASSERT_TRUE(needs_text_repair(text));
+  const auto notes = repair_text(text);
+  EXPECT_EQ(text, "11\t0.00\n48231\t0.00\n48251\t2.80\n48272\t2.79\n48292\t2.78\n\xb0" "C\t\\ok\n");
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("Python bytes literals"), std::string::npos);
+  EXPECT_NE(notes[0].find("6 lines"), std::string::npos);
+  std::string lab_text = lab;
+  EXPECT_FALSE(needs_text_repair(lab_text));
+}
+
+// Arduino IDE 2's Serial Monitor with "Show timestamp" on a sketch that prints the volts alone:
+// the timestamp is the only time there is, so it becomes the time column (ms of the day), on
+// across midnight. Before: "line 1 has 1 field".
+TEST(TextRepairs, SerialMonitorTimestampsOfValuesAloneBecomeTheirTime) {
+  std::string text = "23:59:59.950 -> 2.64\r\n23:59:59.970 -> 2.63\r\n23:59:59.990 -> 2.61\r\n"
+                     "00:00:00.010 -> 2.60\r\n00:00:00.030 -> 2.58\r\n";
+  ASSERT_TRUE(needs_text_repair(text));
+  const auto notes = repair_text(text);
+  EXPECT_EQ(text, "86399950\t2.64\r\n86399970\t2.63\r\n86399990\t2.61\r\n86400010\t2.60\r\n86400030\t2.58\r\n");
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("is its time"), std::string::npos) << notes[0];
+}

@@ -4,6 +4,9 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <limits>
 #include <cstdint>
 #include <cstring>
 #include <fcntl.h>
@@ -12,6 +15,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "spindown/column_guess.hpp"
 #include "spindown/file_bytes.hpp"
 #include "spindown/lab_line.hpp"
 #include "spindown/spindown_protocol.hpp"
@@ -124,6 +128,71 @@ FileFormat detect_format(std::string_view head, const ReadOptions& options) {
 }
 
 namespace {
+
+// Two columns the other way round ("volts<TAB>millis"): the lab's reader took the volts for times
+// and dropped most lines as "time repeats". When the numbers say the time is another column
+// (column_guess.hpp, as for a table without names), the recording is refused with the options
+// that read it; nothing is fitted from the wrong column.
+void refuse_swapped_columns(std::string_view bytes, Recording& rec) {
+  if (rec.lines_read < 20 || rec.size() * 2 >= rec.lines_read) return;
+  std::vector<std::vector<double>> cols;
+  std::size_t rows = 0;
+  text::LineCursor lines(bytes.substr(0, 64 * 1024));
+  while (!lines.at_end() && rows < 400) {
+    const std::string_view line = trim(lines.next_line());
+    std::vector<double> row;
+    std::size_t at = 0;
+    while (at < line.size()) {
+      const std::size_t end = line.find_first_of(" \t,;", at);
+      const std::string_view f = line.substr(at, end == std::string_view::npos ? std::string_view::npos : end - at);
+      double x = 0;
+      const auto [p, ec] = std::from_chars(f.data(), f.data() + f.size(), x);
+      row.push_back(ec == std::errc() && p == f.data() + f.size() ? x : std::numeric_limits<double>::quiet_NaN());
+      if (end == std::string_view::npos) break;
+      at = line.find_first_not_of(" \t,;", end);
+    }
+    if (row.size() < 2 || std::isnan(row[0]) || std::isnan(row[1])) continue;
+    if (cols.empty()) cols.resize(row.size());
+    if (row.size() != cols.size()) continue;
+    for (std::size_t c = 0; c < row.size(); ++c) cols[c].push_back(row[c]);
+    ++rows;
+  }
+  if (rows < 20) return;
+  const ColumnGuess guess = guess_columns(cols);
+  if (guess.time <= 0) return;
+  const auto proposal = column_proposal(guess);
+  if (!proposal) return;
+  rec.t_s.clear();
+  rec.value.clear();
+  rec.clock_restarts.clear();
+  // The lines' own complaints ("time 0 s repeats") were about the wrong column: the error says it.
+  std::erase_if(rec.diagnostics, [](const Diagnostic& d) { return d.line > 0 && d.severity == Diagnostic::Severity::warning; });
+  rec.error(0, fmt::format("column 1 is no time ({} of {} lines not used as samples): the columns are not "
+                           "millis<TAB>volts in that order; {}",
+                           rec.lines_read - rec.size(), rec.lines_read, *proposal));
+}
+
+// Every reading negative (a differential probe's leads swapped, a motor turned the other way):
+// no coast rises from rest in it. Read as their magnitude, and said.
+void read_negative_as_magnitude(Recording& rec) {
+  std::size_t negative = 0, positive = 0;
+  double lowest = 0;
+  for (const double v : rec.value) {
+    negative += v < 0;
+    positive += v > 0;
+    lowest = std::min(lowest, v);
+  }
+  if (negative < 20 || positive * 20 > negative) return;
+  // A coast, not a rest's noise a step below zero: it passes through many values.
+  std::vector<double> levels;
+  for (const double v : rec.value)
+    if (v < 0 && levels.size() < 20 && std::find(levels.begin(), levels.end(), v) == levels.end()) levels.push_back(v);
+  if (levels.size() < 20) return;
+  for (double& v : rec.value) v = -v;
+  rec.warn(0, fmt::format("{} of {} readings are negative (down to {:g}) and {} positive: the probe's leads are the "
+                          "wrong way round (or the motor turned the other way); read as their magnitude",
+                          negative, rec.size(), lowest, positive));
+}
 
 Recording failed(const std::string& path, std::string message) {
   Recording rec;
@@ -241,13 +310,17 @@ std::vector<Recording> read_recordings(const std::string& path, const ReadOption
   if (format == FileFormat::delimited_text) {
     Recording rec = read_delimited_text(bytes, path, options.delimited);
     take_held_readings_once(rec);  // a slower channel logged in every row: each reading once
+    read_negative_as_magnitude(rec);
     add(std::move(rec), {FileFormat::delimited_text, {}, {}, 0});
   } else if (format == FileFormat::spindown_v1) {
     std::int64_t lost = 0;
     Recording rec = read_spindown_text(bytes, path, options.spindown, &lost);
     add(std::move(rec), {FileFormat::spindown_v1, {}, {}, lost});
   } else {
-    add(read_arduino_text(bytes, path, options.arduino), {FileFormat::arduino_text, {}, {}, 0});
+    Recording rec = read_arduino_text(bytes, path, options.arduino);
+    refuse_swapped_columns(bytes, rec);
+    read_negative_as_magnitude(rec);
+    add(std::move(rec), {FileFormat::arduino_text, {}, {}, 0});
   }
   for (auto it = repairs.rbegin(); it != repairs.rend(); ++it)
     out.back().diagnostics.insert(out.back().diagnostics.begin(),

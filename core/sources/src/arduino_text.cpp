@@ -34,6 +34,21 @@ bool is_column_header(std::string_view line) {
   return letters;
 }
 
+// The median step between the first few hundred consecutive times (0: too few).
+double median_step(const std::vector<double>& t) {
+  std::vector<double> steps;
+  for (std::size_t i = 1; i < t.size() && steps.size() < 400; ++i)
+    if (t[i] > t[i - 1]) steps.push_back(t[i] - t[i - 1]);
+  if (steps.size() < 5) return 0;
+  std::nth_element(steps.begin(), steps.begin() + std::ptrdiff_t(steps.size() / 2), steps.end());
+  return steps[steps.size() / 2];
+}
+
+bool micros_clock(const std::vector<double>& t) {
+  const double step = median_step(t);
+  return step >= 4000 && step <= 200000;
+}
+
 }  // namespace
 
 Recording read_arduino_text(std::string_view text, std::string source, const ArduinoTextOptions& options) {
@@ -122,11 +137,15 @@ Recording read_arduino_text(std::string_view text, std::string source, const Ard
   if (!binary_decided && binary.binary()) return refuse_binary();  // all of it read: decided
   const std::int64_t lines = cursor.line_number();
 
+  // A sketch that prints micros() instead of millis(): its loop of delay(20) steps the clock by
+  // ~20,000. Steps of 4 to 200 "seconds" read as millis would leave no coast a second sample;
+  // as µs they are the lab's 4–200 ms. (Both are unsigned 32-bit counters.)
+  const double ticks_per_s = micros_clock(raw.t) ? 1e6 : 1000;
   text::TimelineRules rules;
-  rules.units_per_s = 1000;
-  rules.unit = "ms";
-  rules.wrap = 4294967296.0;  // millis() is an unsigned 32-bit counter
-  rules.reset_min_back = options.reset_min_back_s * 1000;
+  rules.units_per_s = ticks_per_s;
+  rules.unit = ticks_per_s == 1000 ? "ms" : "us";
+  rules.wrap = 4294967296.0;
+  rules.reset_min_back = options.reset_min_back_s * ticks_per_s;
   rules.drop_cut_first = options.drop_cut_first_line;
   const text::TimelineCounts timeline = text::build_timeline(raw, rules, rec, reporter);
   reporter.finish();
@@ -143,6 +162,11 @@ Recording read_arduino_text(std::string_view text, std::string source, const Ard
                                blank, headers + column_headers, raw.size()));
     return rec;
   }
+  if (ticks_per_s != 1000)
+    rec.warn(0, fmt::format("the times step by ~{:.0f} from sample to sample: micros() (µs), not millis() — as "
+                            "milliseconds no coast would hold two samples; read as µs (if they are milliseconds "
+                            "after all: --time-unit ms)",
+                            median_step(raw.t)));
   rec.note(0, text::summary_with_counts(fmt::format("{} samples from {} lines", rec.size(), lines),
                                         {{headers, "PuTTY header"},
                                          {column_headers, "column header"},

@@ -45,6 +45,16 @@ std::size_t take_held_readings_once(Recording& rec) {
   if (shortest < 3.0) return 0;
   const double period = quantile(secs, 0.25);
   if (!(period >= 3.0 * row)) return 0;
+  // A slower channel changes only on its own clock: from one change to the next is a whole number
+  // of its periods (one, or more when a reading repeated). A slow coast read through a coarse print
+  // (2 decimals) also holds each value for rows, but steps to the next value whenever the coast
+  // crosses it: the spans between its changes are any length, most not a whole number of periods.
+  std::size_t whole = 0;
+  for (const double d : secs) {
+    const double k = d / period;
+    whole += std::fabs(k - std::round(k)) <= 0.15;
+  }
+  if (double(whole) < 0.7 * double(secs.size())) return 0;
   // Keep the first row of each value, and one row every period within a hold.
   std::vector<std::size_t> keep;
   keep.reserve(std::size_t(double(n) * row / period) + 16);

@@ -94,7 +94,20 @@ constexpr std::uint16_t cp1252_high[32] = {
     0x2039, 0x0152, 0x008D, 0x017D, 0x008F, 0x0090, 0x2018, 0x2019, 0x201C, 0x201D, 0x2022,
     0x2013, 0x2014, 0x02DC, 0x2122, 0x0161, 0x203A, 0x0153, 0x009D, 0x017E, 0x0178};
 
-std::string cp1252_to_utf8(std::string_view text) {
+// Mac OS Roman's 0x80–0xFF (Apple's table; 0xF0 is the Apple logo, a private-use character).
+constexpr std::uint16_t mac_roman_high[128] = {
+    0x00C4, 0x00C5, 0x00C7, 0x00C9, 0x00D1, 0x00D6, 0x00DC, 0x00E1, 0x00E0, 0x00E2, 0x00E4, 0x00E3, 0x00E5,
+    0x00E7, 0x00E9, 0x00E8, 0x00EA, 0x00EB, 0x00ED, 0x00EC, 0x00EE, 0x00EF, 0x00F1, 0x00F3, 0x00F2, 0x00F4,
+    0x00F6, 0x00F5, 0x00FA, 0x00F9, 0x00FB, 0x00FC, 0x2020, 0x00B0, 0x00A2, 0x00A3, 0x00A7, 0x2022, 0x00B6,
+    0x00DF, 0x00AE, 0x00A9, 0x2122, 0x00B4, 0x00A8, 0x2260, 0x00C6, 0x00D8, 0x221E, 0x00B1, 0x2264, 0x2265,
+    0x00A5, 0x00B5, 0x2202, 0x2211, 0x220F, 0x03C0, 0x222B, 0x00AA, 0x00BA, 0x03A9, 0x00E6, 0x00F8, 0x00BF,
+    0x00A1, 0x00AC, 0x221A, 0x0192, 0x2248, 0x2206, 0x00AB, 0x00BB, 0x2026, 0x00A0, 0x00C0, 0x00C3, 0x00D5,
+    0x0152, 0x0153, 0x2013, 0x2014, 0x201C, 0x201D, 0x2018, 0x2019, 0x00F7, 0x25CA, 0x00FF, 0x0178, 0x2044,
+    0x20AC, 0x2039, 0x203A, 0xFB01, 0xFB02, 0x2021, 0x00B7, 0x201A, 0x201E, 0x2030, 0x00C2, 0x00CA, 0x00C1,
+    0x00CB, 0x00C8, 0x00CD, 0x00CE, 0x00CF, 0x00CC, 0x00D3, 0x00D4, 0xF8FF, 0x00D2, 0x00DA, 0x00DB, 0x00D9,
+    0x0131, 0x02C6, 0x02DC, 0x00AF, 0x02D8, 0x02D9, 0x02DA, 0x00B8, 0x02DD, 0x02DB, 0x02C7};
+
+std::string single_byte_to_utf8(std::string_view text, bool mac) {
   std::string out;
   out.reserve(text.size() + text.size() / 8);
   for (std::size_t i = 0; i < text.size();) {
@@ -102,11 +115,14 @@ std::string cp1252_to_utf8(std::string_view text) {
     out.append(text.substr(i, high - i));
     if (high == text.size()) break;
     const auto c = static_cast<unsigned char>(text[high]);
-    append_utf8(out, c < 0xA0 ? cp1252_high[c - 0x80] : c);
+    append_utf8(out, mac ? mac_roman_high[c - 0x80] : c < 0xA0 ? cp1252_high[c - 0x80] : c);
     i = high + 1;
   }
   return out;
 }
+
+// Lines ended by a CR alone (a classic Mac's, as Excel for Mac writes CSV), none by LF.
+bool cr_line_ends(std::string_view s) { return s.find('\r') != std::string_view::npos && s.find('\n') == std::string_view::npos; }
 
 // Trailing Ctrl-Z: from the first 0x1A of a run at the end (line ends between them allowed).
 std::size_t dos_eof_bytes(std::string_view s) {
@@ -152,13 +168,17 @@ EncodingGuess guess_text_encoding(std::string_view bytes) {
       i += len;
     }
   }
-  if (g.not_utf8 > 0) g.encoding = multibyte > 0 || g.bom ? TextEncoding::mixed : TextEncoding::cp1252;
+  if (g.not_utf8 > 0)
+    g.encoding = multibyte > 0 || g.bom ? TextEncoding::mixed
+                 : cr_line_ends(bytes)  ? TextEncoding::mac_roman
+                                        : TextEncoding::cp1252;
   else if (multibyte > 0 && !g.bom) g.encoding = TextEncoding::utf8;
   return g;
 }
 
 bool needs_decoding(const EncodingGuess& g) {
-  return g.dos_eof > 0 || g.bom || g.encoding == TextEncoding::cp1252 || g.encoding == TextEncoding::utf16le ||
+  return g.dos_eof > 0 || g.bom || g.encoding == TextEncoding::cp1252 || g.encoding == TextEncoding::mac_roman ||
+         g.encoding == TextEncoding::utf16le ||
          g.encoding == TextEncoding::utf16be;
 }
 
@@ -170,7 +190,8 @@ std::string decode_text(std::string_view bytes, const EncodingGuess& g) {
   }
   bytes.remove_suffix(g.dos_eof);
   if (g.bom && bytes.starts_with("\xEF\xBB\xBF")) bytes.remove_prefix(3);
-  if (g.encoding == TextEncoding::cp1252) return cp1252_to_utf8(bytes);
+  if (g.encoding == TextEncoding::cp1252 || g.encoding == TextEncoding::mac_roman)
+    return single_byte_to_utf8(bytes, g.encoding == TextEncoding::mac_roman);
   return std::string(bytes);
 }
 
@@ -184,6 +205,10 @@ std::string decoding_note(const EncodingGuess& g) {
     case TextEncoding::cp1252:
       return fmt::format("read as Windows-1252 (cp1252, Latin-1), as Excel saves \"CSV\" on a Western European PC: "
                          "{} byte{} {} not UTF-8; save as \"CSV UTF-8\" to be sure of every character",
+                         g.not_utf8, g.not_utf8 == 1 ? "" : "s", g.not_utf8 == 1 ? "is" : "are");
+    case TextEncoding::mac_roman:
+      return fmt::format("read as Mac OS Roman, as Excel for Mac saves \"CSV\" (lines end in CR alone): {} byte{} "
+                         "{} not UTF-8; save as \"CSV UTF-8\" to be sure of every character",
                          g.not_utf8, g.not_utf8 == 1 ? "" : "s", g.not_utf8 == 1 ? "is" : "are");
     case TextEncoding::utf8_bom: return "UTF-8 byte-order mark skipped";
     case TextEncoding::ascii:

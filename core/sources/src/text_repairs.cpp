@@ -24,6 +24,28 @@ std::size_t timestamp_prefix(std::string_view line) {
   return shape.size();
 }
 
+// The timestamp's time of day in ms ("10:21:38.234" → 37,298,234); line starts with one.
+std::int64_t timestamp_ms(std::string_view line) {
+  auto num = [&](std::size_t at, std::size_t n) {
+    std::int64_t v = 0;
+    for (std::size_t i = at; i < at + n; ++i) v = v * 10 + (line[i] - '0');
+    return v;
+  };
+  return ((num(0, 2) * 60 + num(3, 2)) * 60 + num(6, 2)) * 1000 + num(9, 3);
+}
+
+// What follows a timestamp is one number alone ("2.64": a sketch that prints only the volts).
+bool one_number(std::string_view rest) {
+  while (!rest.empty() && (rest.back() == '\r' || rest.back() == ' ')) rest.remove_suffix(1);
+  if (rest.empty()) return false;
+  std::size_t i = rest[0] == '-' ? 1 : 0, digits = 0;
+  for (; i < rest.size(); ++i) {
+    if (is_digit(rest[i])) ++digits;
+    else if (rest[i] != '.') return false;
+  }
+  return digits > 0;
+}
+
 // A line of the lab's two columns whose value has a decimal comma: "<digits><TAB|spaces>[-]
 // <digits>,<digits>" and trailing space or CR. Sets *comma to the comma's offset.
 bool comma_sample(std::string_view line, std::size_t* comma) {
@@ -69,7 +91,7 @@ void each_line(std::string_view text, std::size_t limit, F&& f) {
 }
 
 struct HeadCounts {
-  std::size_t lines = 0, timestamped = 0, comma = 0, point = 0;
+  std::size_t lines = 0, timestamped = 0, value_only = 0, comma = 0, point = 0;
 };
 
 HeadCounts count_head(std::string_view text) {
@@ -80,11 +102,69 @@ HeadCounts count_head(std::string_view text) {
     const std::size_t skip = timestamp_prefix(line);
     c.timestamped += skip > 0;
     line.remove_prefix(skip);
+    c.value_only += skip > 0 && one_number(line);
     std::size_t comma = 0;
     c.comma += comma_sample(line, &comma);
     c.point += point_sample(line);
   });
   return c;
+}
+
+// A Python bytes literal as print(ser.readline()) writes it: b'5234\t2.80\r\n' (or in double
+// quotes). Its content, unescaped, into out; false when line is not one.
+bool bytes_literal(std::string_view line, std::string* out) {
+  while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) line.remove_suffix(1);
+  if (line.size() < 3 || line[0] != 'b' || (line[1] != '\'' && line[1] != '"') || line.back() != line[1]) return false;
+  const std::string_view body = line.substr(2, line.size() - 3);
+  std::string text;
+  for (std::size_t i = 0; i < body.size(); ++i) {
+    if (body[i] != '\\') {
+      text += body[i];
+      continue;
+    }
+    if (++i == body.size()) return false;
+    switch (body[i]) {
+      case 't': text += '\t'; break;
+      case 'r':
+      case 'n': break;  // the line's own end: the line ends here anyway
+      case '\\': text += '\\'; break;
+      case '\'': text += '\''; break;
+      case '"': text += '"'; break;
+      case 'x': {
+        if (i + 2 >= body.size()) return false;
+        int v = 0;
+        for (const char h : body.substr(i + 1, 2)) {
+          const char l = static_cast<char>(h | 0x20);
+          const int d = is_digit(h) ? h - '0' : l >= 'a' && l <= 'f' ? l - 'a' + 10 : -1;
+          if (d < 0) return false;
+          v = v * 16 + d;
+        }
+        text += static_cast<char>(v);
+        i += 2;
+        break;
+      }
+      default: return false;
+    }
+  }
+  if (out) *out = std::move(text);
+  return true;
+}
+
+std::size_t count_bytes_literals(std::string_view text, std::size_t* lines) {
+  std::size_t n = 0;
+  *lines = 0;
+  each_line(text, head_bytes, [&](std::string_view line, std::size_t) {
+    if (line.empty() || line == "\r") return;
+    ++*lines;
+    n += bytes_literal(line, nullptr);
+  });
+  return n;
+}
+
+bool bytes_literals_to_unwrap(std::string_view text) {
+  std::size_t lines = 0;
+  const std::size_t n = count_bytes_literals(text, &lines);
+  return n >= 3 && n * 2 >= lines;
 }
 
 bool timestamps_to_strip(const HeadCounts& c) { return c.timestamped >= 3 && c.timestamped * 2 >= c.lines; }
@@ -107,6 +187,7 @@ EncodingGuess encoding_to_undo(std::string_view text) {
 
 bool needs_text_repair(std::string_view text) {
   if (needs_decoding(encoding_to_undo(text))) return true;
+  if (bytes_literals_to_unwrap(text)) return true;
   const HeadCounts c = count_head(text);
   return timestamps_to_strip(c) || commas_to_read(c);
 }
@@ -117,9 +198,31 @@ std::vector<std::string> repair_text(std::string& text) {
     text = decode_text(text, g);
     if (std::string note = decoding_note(g); !note.empty()) notes.push_back(std::move(note));
   }
+  if (bytes_literals_to_unwrap(text)) {
+    std::string out, content;
+    out.reserve(text.size());
+    std::size_t unwrapped = 0;
+    each_line(text, text.size(), [&](std::string_view line, std::size_t pos) {
+      if (bytes_literal(line, &content)) {
+        out += content;
+        ++unwrapped;
+      } else {
+        out.append(line);
+      }
+      if (pos + line.size() < text.size()) out += '\n';
+    });
+    text.swap(out);
+    notes.push_back(fmt::format("Python bytes literals (b'5234\\t2.80\\r\\n', as print(ser.readline()) of a pyserial "
+                                "script writes them) unwrapped in {} lines",
+                                unwrapped));
+  }
   const HeadCounts c = count_head(text);
   const bool strip = timestamps_to_strip(c), commas = commas_to_read(c);
   if (!strip && !commas) return notes;
+  // A sketch that prints the volts alone: the timestamp (the PC's time of arrival) is the only
+  // time there is, so it becomes the time column, in ms of the day (across midnight: on).
+  const bool as_time = strip && c.value_only * 5 >= c.timestamped * 4;
+  std::int64_t last_ms = -1, days = 0;
   std::string out;
   out.reserve(text.size());
   std::size_t stripped = 0, converted = 0;
@@ -128,6 +231,12 @@ std::vector<std::string> repair_text(std::string& text) {
     if (strip) {
       const std::size_t skip = timestamp_prefix(line);
       stripped += skip > 0;
+      if (skip > 0 && as_time) {
+        const std::int64_t ms = timestamp_ms(line);
+        if (last_ms >= 0 && ms + 12 * 3600 * 1000 < last_ms) ++days;  // past midnight
+        last_ms = ms;
+        out += std::to_string(ms + days * 86'400'000) + '\t';
+      }
       line.remove_prefix(skip);
     }
     std::size_t comma = 0;
@@ -142,7 +251,12 @@ std::vector<std::string> repair_text(std::string& text) {
     if (newline) out += '\n';
   });
   text.swap(out);
-  if (strip)
+  if (strip && as_time)
+    notes.push_back(fmt::format("Arduino IDE serial monitor timestamps (\"10:21:38.234 -> \") on {} lines of one value "
+                                "each: the timestamp, when the PC received the line, is its time (ms of the day; "
+                                "USB delivers lines in bursts, so times are only as good as a few ms)",
+                                stripped));
+  else if (strip)
     notes.push_back(fmt::format("Arduino IDE serial monitor timestamps (\"10:21:38.234 -> \") removed from {} lines; "
                                 "each sample's own millis is its time",
                                 stripped));

@@ -7,6 +7,8 @@
 //    and "CSV (Trennzeichen-getrennt)" and older Windows editors write on a Western European PC.
 //    Taken when bytes above 0x7F occur and none of them forms UTF-8; text that mixes UTF-8 with
 //    bytes that are not is left alone (its bad bytes are shown as \xNN where a message quotes them);
+//  - Mac OS Roman: what Excel for Mac's "CSV (Comma delimited)" writes, its lines ended by a CR
+//    alone (classic Mac). Taken instead of Windows-1252 when the lines end in CR only;
 //  - a trailing Ctrl-Z (0x1A, DOS's end-of-file mark): the end of the text, without a word.
 // An office document (an Excel workbook, .xlsx or .xls; an OpenDocument spreadsheet) is named as
 // such, with what to do: save it as CSV (UTF-8).
@@ -17,7 +19,7 @@
 
 namespace spindown {
 
-enum class TextEncoding { ascii, utf8, utf8_bom, utf16le, utf16be, cp1252, mixed };
+enum class TextEncoding { ascii, utf8, utf8_bom, utf16le, utf16be, cp1252, mac_roman, mixed };
 
 struct EncodingGuess {
   TextEncoding encoding = TextEncoding::ascii;

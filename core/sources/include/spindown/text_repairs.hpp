@@ -6,6 +6,8 @@
 //    decoded to UTF-8 (binary data and office documents are left to the readers, which refuse them);
 //  - the Arduino IDE serial monitor's timestamps ("10:21:38.234 -> 5234<TAB>0.00"): removed, the
 //    sample's own millis stays its time;
+//  - a pyserial script's print(ser.readline()): Python bytes literals (b'5234\t2.80\r\n'),
+//    unwrapped and unescaped;
 //  - a decimal comma in the lab's two columns ("5234<TAB>2,45", a spreadsheet with a European
 //    locale): read as a point, only when no sample line uses a point.
 #include <string>
