@@ -46,6 +46,33 @@ TEST_F(BenchNamingTest, RosterNamesBenchAndStudentByPathOrFileName) {
   EXPECT_EQ(b.student, "Smith, Bob");
 }
 
+// Moodle's submissions unzipped on a Mac: folders named in NFD ("u" + combining diaeresis); the
+// roster typed on Windows (NFC), or the other way round (names pasted from Finder). Both students
+// of one file name are found by their folders, with their names in NFC; "give its folder too" is
+// not said when the folder is given.
+TEST_F(BenchNamingTest, NamesAreComparedAfterUnicodeNormalisation) {
+  const std::string nfc_name = "J\xc3\xbcrgen", nfd_name = "Ju\xcc\x88rgen";
+  fs::create_directories(dir / "class" / nfd_name);
+  fs::create_directories(dir / "class" / "Zoe");
+  const std::string roster = write("roster.csv", "file,bench,student\n"
+                                                 "class/" + nfc_name + "/putty.log,bench3," + nfc_name + "\n"
+                                                 "class/Zoe/putty.log,bench1,Zoe\n");
+  const BenchNaming naming(roster, "");
+  const BenchName j = naming.name((dir / "class" / nfd_name / "putty.log").string());
+  EXPECT_EQ(j.bench, "bench3") << j.problem;
+  EXPECT_EQ(j.student, nfc_name);
+  EXPECT_TRUE(j.problem.empty()) << j.problem;
+  const BenchName z = naming.name((dir / "class" / "Zoe" / "putty.log").string());
+  EXPECT_EQ(z.bench, "bench1");
+  // The roster in NFD, the folders in NFC: the same.
+  const std::string roster2 = write("roster2.csv", "file,bench,student\nclass/" + nfd_name + "/putty.log,bench3," +
+                                                       nfd_name + "\n");
+  const BenchNaming naming2(roster2, "");
+  const BenchName j2 = naming2.name((dir / "class" / nfc_name / "putty.log").string());
+  EXPECT_EQ(j2.bench, "bench3") << j2.problem;
+  EXPECT_EQ(j2.student, nfc_name);
+}
+
 TEST_F(BenchNamingTest, SpreadsheetExportsAreRead) {
   // Semicolons (a European spreadsheet), a byte-order mark, CR LF, other columns, another order.
   const std::string roster =
@@ -101,8 +128,8 @@ TEST_F(BenchNamingTest, AWorkbookOrUndecodableBytesAreRefusedWithWhatToDo) {
     return std::string("no error");
   };
   // The first bytes of an .xlsx as Excel writes it: a zip whose first entry is [Content_Types].xml.
-  const std::string xlsx = std::string("PK\x03\x04\x14\x00\x06\x00\x08\x00\x00\x00\x21\x00", 14) +
-                           std::string(12, '\x01') + std::string("\x13\x00\x00\x00", 4) + "[Content_Types].xml";
+  std::string xlsx("PK\x03\x04\x14\x00\x06\x00\x08\x00\x00\x00\x21\x00", 14);
+  xlsx.append(12, '\x01').append("\x13\x00\x00\x00", 4).append("[Content_Types].xml");
   const std::string w = message("roster.xlsx", xlsx);
   EXPECT_NE(w.find("an Excel workbook (.xlsx)"), std::string::npos) << w;
   EXPECT_NE(w.find("save it as CSV (UTF-8)"), std::string::npos) << w;

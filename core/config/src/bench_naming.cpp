@@ -1,4 +1,5 @@
 #include "spindown/bench_naming.hpp"
+#include "spindown/unicode_nfc.hpp"
 
 #include <algorithm>
 #include <filesystem>
@@ -94,7 +95,7 @@ ClassRoster load_class_roster(const std::string& path) {
     if (std::all_of(f.begin(), f.end(), [](const std::string& x) { return x.empty(); })) return;
     if (f.size() <= std::max(*col_file, *col_bench))
       throw at(fmt::format("{} field{} where the header has {}: '{}'", f.size(), f.size() == 1 ? "" : "s", columns, line));
-    RosterEntry e{f[*col_file], f[*col_bench], col_student && *col_student < f.size() ? f[*col_student] : "",
+    RosterEntry e{nfc(f[*col_file]), f[*col_bench], nfc(col_student && *col_student < f.size() ? f[*col_student] : ""),
                   static_cast<std::size_t>(number)};
     if (e.file.empty()) throw at("no file named");
     std::string bad;
@@ -133,18 +134,20 @@ BenchName BenchNaming::name(const std::string& path, const std::string& fallback
   namespace fs = std::filesystem;
   std::vector<std::string> problems;
   if (roster_) {
-    const fs::path given = fs::path(path).lexically_normal();
+    // Paths and names compared in NFC: a roster typed on Windows and folders unzipped on a Mac
+    // (NFD) spell "Jürgen" with different bytes (unicode_nfc.hpp).
+    const fs::path given = fs::path(nfc(fs::path(path).lexically_normal().string()));
     const std::string base = given.filename().string();
     const fs::path roster_dir = fs::path(roster_->path).parent_path();
     std::error_code ec;
-    const fs::path real = fs::weakly_canonical(given, ec);
+    const fs::path real = fs::path(nfc(fs::weakly_canonical(fs::path(path), ec).string()));
     const RosterEntry* by_path = nullptr;
     std::vector<const RosterEntry*> by_name;
     for (const auto& e : roster_->entries) {
-      const fs::path listed = fs::path(e.file).lexically_normal();
+      const fs::path listed = fs::path(nfc(fs::path(e.file).lexically_normal().string()));
       if (listed == given) by_path = &e;
       if (!by_path && !real.empty()) {
-        const fs::path there = fs::weakly_canonical(roster_dir / listed, ec);
+        const fs::path there = fs::path(nfc(fs::weakly_canonical(roster_dir / listed, ec).string()));
         if (!ec && there == real) by_path = &e;
       }
       if (listed.filename().string() == base) by_name.push_back(&e);
