@@ -538,3 +538,26 @@ TEST(HealthBaseline, RunsThatNeverStoppedOrWerePartialAreNotUsed) {
 }
 
 }  // namespace spindown
+
+namespace spindown {
+namespace {
+
+// A load across the motor's leads (left on a switched-off driver; a meter's shunt): viscous
+// friction far up and dry friction *down* (the terminal voltage divided). Electrical braking is
+// named first, before grease; with dry friction as it was, viscous up stays "lubrication".
+TEST(MotorHealth, ViscousUpWithDryDownIsElectricalBrakingNotGrease) {
+  MotorHealthConfig cfg;
+  cfg.baseline = lab_baseline();
+  const HealthVerdict v = assess_health(combined_fit(7.4 * cv0, 2e-8, 0.83 * cc0, 5e-7), cfg);
+  EXPECT_EQ(v.level, HealthLevel::service) << v.reason;
+  const auto leads = v.reason.find("leads are disconnected"), grease = v.reason.find("lubrication");
+  ASSERT_NE(leads, std::string::npos) << v.reason;
+  EXPECT_NE(v.reason.find("electrical braking"), std::string::npos) << v.reason;
+  EXPECT_TRUE(grease == std::string::npos || leads < grease) << v.reason;
+  const HealthVerdict g = assess_health(combined_fit(3.0 * cv0, 2e-8, 1.0 * cc0, 5e-7), cfg);
+  EXPECT_EQ(g.reason.find("electrical braking"), std::string::npos) << g.reason;
+  EXPECT_NE(g.reason.find("lubrication"), std::string::npos) << g.reason;
+}
+
+}  // namespace
+}  // namespace spindown

@@ -150,6 +150,26 @@ HealthFinding note_finding(std::string what, HealthLevel level, std::string reas
   return f;
 }
 
+// What the two ratios say together (issue 43): viscous friction up while dry friction reads
+// *down* is electrical braking, not grease. A resistance across the motor's terminals (its leads
+// left on a switched-off driver, a meter on them) draws current and brakes in proportion to
+// speed, and divides the terminal voltage that is read, so dry friction reads lower; grease and
+// wear never lower dry friction. So the first advice is the leads. (Viscous up with dry friction
+// as it was stays "lubrication": too thick a grease does that too.)
+void name_the_cause(HealthFinding& dry, HealthFinding& viscous) {
+  const bool dry_down = dry.ratio < 1.0 - std::max(2.0 * dry.ratio_std_error, 0.05);
+  if (viscous.level == HealthLevel::ok || viscous.ratio <= 1 || !dry_down) return;
+  viscous.reason = fmt::format(
+      "viscous friction {} the baseline (±{:.2g}) while dry friction reads lower ({}): electrical braking, not "
+      "grease — a resistance across the motor's terminals (its leads left on a switched-off driver, a meter on "
+      "them) brakes in proportion to speed and divides the voltage read; check that the motor's leads are "
+      "disconnected, then lubrication",
+      times(viscous.ratio), viscous.ratio_std_error, times(dry.ratio));
+  if (dry.level != HealthLevel::ok)
+    dry.reason = fmt::format("dry friction {} the baseline: the voltage read divided by that load, not less friction",
+                             times(dry.ratio));
+}
+
 void compare_with_baseline(const FittedFriction& fr, double J, const HealthBaseline& b, const HealthThresholds& th,
                            std::vector<HealthFinding>& out) {
   // A single run scatters around the baseline by the run-to-run spread as well as by the
@@ -172,6 +192,8 @@ void compare_with_baseline(const FittedFriction& fr, double J, const HealthBasel
   else
     out.push_back(
         note_finding("viscous friction", HealthLevel::ok, "baseline viscous friction is not positive: not compared"));
+
+  if (ref_c.value > 0 && ref_v.value > 0) name_the_cause(out[out.size() - 2], out.back());
 
   // What the known-good motor would have done from this run's speed at the cut.
   const double t_run = coast_time(fr.viscous.value, fr.coulomb.value, J, fr.omega0, 0);
