@@ -78,6 +78,14 @@ bool take(SampleStream& s, const samples_t& m, std::int64_t recv, Counting& sink
   return s.take(m, static_cast<std::size_t>(m.n), recv, sink);
 }
 
+// Samples 0..n-1 taken once each, in order; none called lost or repeated.
+void expect_every_sample_once_in_order(const Counting& sink, std::size_t n) {
+  EXPECT_EQ(sink.total(SampleProblem::samples_lost), 0);
+  EXPECT_EQ(sink.count(SampleProblem::repeated), 0);
+  ASSERT_EQ(sink.seqs.size(), n);
+  for (std::size_t i = 0; i < n; ++i) ASSERT_EQ(sink.seqs[i], std::int64_t(i));
+}
+
 // The board replugged / the bridge restarted: a new session starting at sequence 0 and device
 // time 0. Before, every message was "repeated" until the new clock passed the old one.
 TEST(SampleStream, ARestartedBridgeIsANewStreamNeverRepeated) {
@@ -307,10 +315,7 @@ TEST(SampleStream, ABlockDeliveredLateInsideTheWindowIsWhole) {
   for (int i = 100; i < 175; ++i) take(s, sent[std::size_t(i)], recv, sink);  // 1.5 s late, all at once
   EXPECT_EQ(sink.seqs.size(), 250u);
   for (int i = 250; i < 300; ++i) take(s, sent[std::size_t(i)], recv += 20 * ms, sink);
-  EXPECT_EQ(sink.total(SampleProblem::samples_lost), 0);
-  EXPECT_EQ(sink.count(SampleProblem::repeated), 0);
-  ASSERT_EQ(sink.seqs.size(), 300u);
-  for (std::size_t i = 0; i < 300; ++i) ASSERT_EQ(sink.seqs[i], std::int64_t(i));
+  expect_every_sample_once_in_order(sink, 300);
 }
 
 // A real loss is called once its gap has waited the window, exactly; a straggler after that is
@@ -374,10 +379,7 @@ TEST(SampleStream, AStreamWhoseFirstDatagramsWereOvertakenStartsAtZero) {
   std::int64_t recv = t0;
   for (int i : {1, 5, 0, 4, 2, 3, 6, 7, 9, 8, 10, 11}) take(s, sent[static_cast<std::size_t>(i)], recv += 20 * ms, sink);
   s.flush(sink);
-  EXPECT_EQ(sink.count(SampleProblem::repeated), 0);
-  EXPECT_EQ(sink.total(SampleProblem::samples_lost), 0);
-  ASSERT_EQ(sink.seqs.size(), 12u);
-  for (std::size_t i = 0; i < 12; ++i) EXPECT_EQ(sink.seqs[i], std::int64_t(i));
+  expect_every_sample_once_in_order(sink, 12);
 }
 
 // A follower that joins a running stream (a fitter started mid-session) waits the window once for
