@@ -561,3 +561,22 @@ TEST(MotorHealth, ViscousUpWithDryDownIsElectricalBrakingNotGrease) {
 
 }  // namespace
 }  // namespace spindown
+
+namespace spindown {
+namespace {
+
+// A scope's sample index followed as milliseconds of a 20-ms period: c3 and c4 both exactly 20x
+// the baseline. Not judged (no SERVICE on a healthy motor), and the time unit is named; J wrong
+// (0.37x both) is no round factor and stays judged.
+TEST(MotorHealth, BothFrictionsTheSameRoundMultipleIsATimeUnitNotWear) {
+  MotorHealthConfig cfg;
+  cfg.baseline = lab_baseline();
+  const HealthVerdict v = assess_health(combined_fit(20 * cv0, 2e-8, 20 * cc0, 5e-6), cfg);
+  EXPECT_EQ(v.level, HealthLevel::not_judged) << v.reason;
+  EXPECT_NE(v.reason.find("time unit"), std::string::npos) << v.reason;
+  const HealthVerdict j = assess_health(combined_fit(0.37 * cv0, 2e-9, 0.37 * cc0, 4e-7), cfg);
+  EXPECT_NE(j.level, HealthLevel::not_judged) << j.reason;
+}
+
+}  // namespace
+}  // namespace spindown

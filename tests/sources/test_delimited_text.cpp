@@ -431,3 +431,32 @@ TEST(DelimitedText, ValuesAloneWithAGivenPeriod) {
   EXPECT_DOUBLE_EQ(r.t_s[10], 0.2);
   EXPECT_DOUBLE_EQ(r.value[10], 2.7);
 }
+
+// An oscilloscope's "Save CSV": "X,CH1,Start,Increment," over "Sequence,Volt,-4.000000e+00,
+// 2.000000e-02", rows "k,value,". Sample k is at Start + k·Increment s, read so. A column that
+// only counts samples is never proposed as a clock (following "--time-column 1 --time-unit ms"
+// made every rate 20x): the refusal asks for the period.
+TEST(DelimitedText, AScopesStartAndIncrementTimeItsSamples) {
+  std::string text = "X,CH1,Start,Increment,\nSequence,Volt,-4.000000e+00,2.000000e-02\n";
+  for (int i = 0; i < 40; ++i) text += fmt::format("{},{:.2e},\n", i, i < 10 ? 0.0 : 2.8 - 0.01 * i);
+  const Recording r = read_delimited_text(text, "scope.csv");
+  SCOPED_TRACE(all_diagnostics(r));
+  ASSERT_EQ(r.size(), 40u);
+  EXPECT_NEAR(r.t_s[0], -4.0, 1e-12);
+  EXPECT_NEAR(r.t_s[10], -3.8, 1e-12);
+  EXPECT_EQ(r.quantity, Quantity::back_emf_volts);
+
+  std::string index;
+  for (int i = 0; i < 200; ++i) index += fmt::format("{},{:.2f}\n", i, i < 20 ? 0.0 : 2.8 * std::exp(-(i - 20) / 60.0));
+  const Recording refused = read_delimited_text(index, "index.csv");
+  EXPECT_TRUE(refused.empty());
+  const std::string why = all_diagnostics(refused);
+  EXPECT_NE(why.find("--period-ms"), std::string::npos) << why;
+  EXPECT_EQ(why.find("--time-column 1"), std::string::npos) << why;
+  DelimitedTextOptions o;
+  o.period_ms = 20;
+  o.value_column = "2";
+  const Recording followed = read_delimited_text(index, "index.csv", o);
+  ASSERT_EQ(followed.size(), 200u);
+  EXPECT_NEAR(followed.t_s[50], 1.0, 1e-12);
+}

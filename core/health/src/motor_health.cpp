@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <optional>
 #include <fmt/format.h>
 #include <limits>
 #include <numbers>
@@ -168,6 +169,32 @@ void name_the_cause(HealthFinding& dry, HealthFinding& viscous) {
   if (dry.level != HealthLevel::ok)
     dry.reason = fmt::format("dry friction {} the baseline: the voltage read divided by that load, not less friction",
                              times(dry.ratio));
+}
+
+// Dry and viscous friction both the same round multiple of the baseline (×20, ×50, ×60, ×1000,
+// or a tenth…): time read in the wrong unit scales both rates alike (a sample number taken for
+// milliseconds of a 20-ms loop gives ×20, seconds for minutes ×60, µs for ms ×1000), and a scale
+// of the reading alike; wear does not land on a round number for both. Not judged, and said.
+std::optional<std::string> round_multiple(const std::vector<HealthFinding>& findings) {
+  const HealthFinding* dry = nullptr;
+  const HealthFinding* viscous = nullptr;
+  for (const auto& f : findings) {
+    if (f.what == "dry friction" && f.ratio > 0) dry = &f;
+    if (f.what == "viscous friction" && f.ratio > 0) viscous = &f;
+  }
+  if (!dry || !viscous || std::fabs(dry->ratio / viscous->ratio - 1.0) > 0.05) return std::nullopt;
+  const double r = std::sqrt(dry->ratio * viscous->ratio);
+  for (const double k : {10.0, 20.0, 50.0, 60.0, 100.0, 1000.0}) {
+    for (const double m : {k, 1.0 / k}) {
+      if (std::fabs(r / m - 1.0) > 0.05) continue;
+      return fmt::format("not judged: dry and viscous friction are both {} the baseline ({} and {}): one round "
+                         "factor on both is the signature of a time unit or a scale, not of wear (a sample number "
+                         "read as milliseconds of a {:g}-ms loop, seconds as minutes, µs as ms) — check the time "
+                         "column and its unit (--time-unit, --period-ms) before the motor",
+                         times(m), times(dry->ratio), times(viscous->ratio), m >= 1 ? m : 1.0 / m);
+    }
+  }
+  return std::nullopt;
 }
 
 void compare_with_baseline(const FittedFriction& fr, double J, const HealthBaseline& b, const HealthThresholds& th,
@@ -406,6 +433,11 @@ HealthVerdict assess_health(const RunFit& fit, const MotorHealthConfig& cfg) {
       v.findings.push_back(note_finding("baseline", HealthLevel::check,
                                         "the combined model did not converge, so the friction cannot be compared "
                                         "with the baseline — repeat the run"));
+  }
+  if (const auto why = round_multiple(v.findings)) {
+    v.level = HealthLevel::not_judged;
+    v.reason = *why;
+    return v;
   }
   if (datasheet_torque) {
     // The datasheet gives one torque, so the best model alone can be compared when the combined one failed.

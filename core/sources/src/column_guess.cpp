@@ -166,6 +166,7 @@ ColumnGuess guess_columns(const std::vector<std::vector<double>>& columns) {
     const TimeCandidate& t = times.front();
     g.time = t.column;
     g.time_unit = t.unit;
+    g.time_counter = t.counter;
     g.time_why = fmt::format("rises steadily from {:g} to {:g} in steps of {:g} ({})", t.first, t.last, t.step,
                              unit_words(t.unit));
   }
@@ -188,6 +189,13 @@ ColumnGuess guess_columns(const std::vector<std::vector<double>>& columns) {
 
 std::optional<std::string> column_proposal(const ColumnGuess& g) {
   if (g.time < 0) return std::nullopt;
+  if (g.time_counter) {  // 0, 1, 2…: the samples' numbers; taken for ms they would make every rate wrong
+    if (g.value < 0) return std::nullopt;
+    return fmt::format("column {} counts the samples 0, 1, 2 … (a sample number, not a clock) and column {} {}: give "
+                       "the time between samples, e.g. --period-ms 20 for the lab sketch's delay(20) or a scope's "
+                       "Increment in ms, with --value-column {}",
+                       g.time + 1, g.value + 1, g.value_why, g.value + 1);
+  }
   if (g.value < 0)
     return fmt::format("column {} {}: try --time-column {} --time-unit {} and name the speed (or back-EMF) column "
                        "with --value-column (no column falls as a coast does)",

@@ -207,6 +207,7 @@ class DelimitedReader {
   std::optional<std::string> choose_value_unit();
   void read_rows();
   void choose_time_unit_and_finish();
+  bool read_scope_header();
   const DelimitedLayout& layout() const { return rows_.layout(); }
 
  private:
@@ -242,6 +243,10 @@ class DelimitedReader {
   std::size_t first_data_ = 0, unit_rows_ = 0;
   std::optional<ColumnGuess> guessed_;
   int tcol_ = -1, vcol_ = -1;
+  struct ScopeTiming {
+    double start_s, increment_s;
+  };
+  std::optional<ScopeTiming> scope_;  // an oscilloscope's CSV: sample k is at Start + k·Increment
   std::string quantity_from_ = "given", value_unit_name_;
   double value_scale_ = 1;
   text::RawSamples raw_;
@@ -331,7 +336,8 @@ void DelimitedReader::read_header() {
   for (std::size_t i = 0; i < fields_.size(); ++i)
     cols_.push_back(have_header_ ? describe_column(fields_[i]) : ColumnName{fmt::format("{}", i + 1), "", ""});
   first_data_ = have_header_ ? 1 : 0;
-  if (have_header_ && content_.size() > 1) {
+  const bool scope = have_header_ && content_.size() > 1 && read_scope_header();
+  if (!scope && have_header_ && content_.size() > 1) {
     split(content_[1].text);
     std::vector<std::string> units;
     for (const auto f : fields_) units.push_back(unit_cell(f));
@@ -353,6 +359,34 @@ void DelimitedReader::read_header() {
     c.name = text::escape_invalid_utf8(c.name);
     c.unit = text::escape_invalid_utf8(c.unit);
   }
+}
+
+// An oscilloscope's "Save CSV" (Rigol's and others'): "X,CH1,Start,Increment," over
+// "Sequence,Volt,-4.000000e+00,2.000000e-02": the first column numbers the samples, and sample k
+// is at Start + k·Increment seconds. The second row names the units; the rows follow it.
+bool DelimitedReader::read_scope_header() {
+  int start = -1, increment = -1;
+  for (std::size_t i = 0; i < cols_.size(); ++i) {
+    const std::string n = ascii_lower(cols_[i].name);
+    if (n == "start") start = static_cast<int>(i);
+    if (n == "increment") increment = static_cast<int>(i);
+  }
+  if (start < 0 || increment < 0 || o_.period_ms || !o_.time_column.empty()) return false;
+  split(content_[1].text);
+  double t0 = 0, dt = 0;
+  std::string_view w;
+  if (fields_.size() <= static_cast<std::size_t>(std::max(start, increment)) ||
+      !parse_number(fields_[static_cast<std::size_t>(start)], decimal_comma_, t0, w) ||
+      !parse_number(fields_[static_cast<std::size_t>(increment)], decimal_comma_, dt, w) || !(dt > 0))
+    return false;
+  if (fields_.size() > 1 && cols_.size() > 1 && cols_[1].unit.empty()) cols_[1].unit = std::string(trim(fields_[1]));
+  scope_ = ScopeTiming{t0, dt};
+  first_data_ = 2;
+  unit_rows_ = 1;
+  rec_.note(content_[1].number, fmt::format("an oscilloscope's CSV: sample k of column 1 is at {:g} s + k x {:g} s "
+                                            "(its Start and Increment)",
+                                            t0, dt));
+  return true;
 }
 
 // What the numbers say when the names do not: the table's first rows, column by column.
@@ -390,6 +424,7 @@ std::optional<std::string> DelimitedReader::choose_columns() {
   if (tcol_ >= 0 && tcol_ == vcol_) return fmt::format("time and value are both column {}", tcol_ + 1);
   if (o_.period_ms) {  // no time column: the value is the named one, the only one, or the one named a value
     if (vcol_ < 0 && cols_.size() == 1) vcol_ = 0;
+    if (vcol_ < 0 && guess().time_counter && guess().value >= 0) vcol_ = guess().value;  // beside a sample number
     if (vcol_ < 0) {
       std::vector<int> named;
       for (std::size_t i = 0; i < cols_.size(); ++i)
@@ -418,8 +453,12 @@ std::optional<std::string> DelimitedReader::choose_columns() {
     auto c = candidates([](const ColumnName& col) { return is_time_name(col); }, vcol_);
     if (c.size() == 1) tcol_ = c[0];
     else if (c.size() > 1) return fmt::format("columns {} could each be the time; name one (time column)", names_of(c));
-    else if (cols_.size() == 2) {
+    else if (scope_) {
+      tcol_ = 0;  // the scope's sample number, timed by its Start and Increment
+    } else if (cols_.size() == 2) {
       tcol_ = vcol_ == 0 ? 1 : 0;
+      if (guess().time_counter && guess().time == tcol_)
+        if (const auto p = column_proposal(guess())) return fmt::format("no clock in the file{}: {}", unnamed, *p);
       // Two unnamed columns the other way round (volts<TAB>millis): the numbers say the time is the
       // other one. Refused with the options that read it, never fitted from the wrong column.
       if (!have_header_ && vcol_ < 0 && guess().time == 1)
@@ -433,6 +472,7 @@ std::optional<std::string> DelimitedReader::choose_columns() {
       return fmt::format("cannot tell which of the {} columns is the time{} ({}); name it (time column)", cols_.size(),
                          unnamed, list_columns(cols_));
   }
+  if (vcol_ < 0 && scope_ && cols_.size() >= 2) vcol_ = 1;  // CH1
   if (vcol_ < 0) {
     auto c = candidates([](const ColumnName& col) { return is_value_name(col); }, tcol_);
     if (c.size() == 1) vcol_ = c[0];
@@ -503,7 +543,9 @@ void DelimitedReader::read_rows() {
       reporter_->warn(line.number, fmt::format("{}: {}; skipped", text::quote_line(line.text), row.why));
       continue;
     }
-    const double t = o_.period_ms ? *o_.period_ms * double(raw_.size()) : row.time;
+    const double t = o_.period_ms ? *o_.period_ms * double(raw_.size())
+                     : scope_     ? scope_->start_s + row.time * scope_->increment_s
+                                  : row.time;
     raw_.add(line.number, line.text.data(), t, row.value, false);
   }
 }
@@ -516,6 +558,9 @@ void DelimitedReader::choose_time_unit_and_finish() {
   if (o_.period_ms) {
     unit = TimeUnit::ms;
     unit_from = fmt::format("a reading every {:g} ms", *o_.period_ms);
+  } else if (scope_) {
+    unit = TimeUnit::s;
+    unit_from = fmt::format("the scope's Start {:g} s and Increment {:g} s", scope_->start_s, scope_->increment_s);
   } else if (o_.time_unit) {
     unit = *o_.time_unit;
   } else if (auto u = implied_time_unit(cols_[tcol_])) {

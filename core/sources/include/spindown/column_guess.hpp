@@ -25,6 +25,7 @@ struct ColumnGuess {
   int time = -1;   // 0-based; -1 when no column rises steadily
   TimeUnit time_unit = TimeUnit::s;
   std::string time_why;   // "rises steadily from 0 to 61.98 in steps of 0.02 (seconds)"
+  bool time_counter = false;  // the time column counts 0, 1, 2… by exactly 1: a sample number, no clock
   int value = -1;  // 0-based; -1 when no column rises and falls or falls to a rest
   std::string value_why;  // "rises to 4.21 and falls to 0 over 1450 samples"
   double value_peak = 0;  // the value column's largest reading
@@ -35,7 +36,8 @@ ColumnGuess guess_columns(const std::vector<std::vector<double>>& columns);
 
 // "--time-column 1 --time-unit s --value-column 3" (1-based) and why, when the guess found both;
 // nullopt otherwise. A peak reading above 30 (no back-EMF of the lab's motors) adds that the unit
-// must be named too.
+// must be named too. A sample number is never proposed as a clock: the period is asked for
+// (--period-ms) with the value column.
 std::optional<std::string> column_proposal(const ColumnGuess& guess);
 
 }  // namespace spindown
