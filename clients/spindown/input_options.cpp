@@ -98,7 +98,10 @@ std::function<void()> add_input_options(CLI::App* sub, InputOptions& opt, InputP
     sub->add_option("--time-column", opt.time_column, "Time column: header name or 1-based index")->group(text);
     sub->add_option("--value-column", opt.value_column, "Value column: header name or 1-based index")->group(text);
     sub->add_option("--time-unit", opt.time_unit, "Time unit: ms, s or us")->group(text);
-    sub->add_option("--value-unit", opt.value_unit, "Value unit: V, rpm or rad/s")->group(text);
+    sub->add_option("--value-unit", opt.value_unit,
+                    "Value unit: V, rpm or rad/s (or mV, rev/s, deg/s); counts: a sketch's raw analogRead() of a 5 V "
+                    "10-bit converter, x 5/1023 V")
+        ->group(text);
     sub->add_option("--delimiter", opt.delimiter, "Column delimiter: , ; tab space")->group(text);
     sub->add_option("--period-ms", opt.period_ms,
                     "The readings' period when the file has no time column (a sketch printing the volts alone: "
@@ -209,9 +212,12 @@ ReadOptions read_options_from(const InputOptions& o) {
     d.time_unit = parse_time_unit(o.time_unit);
     if (!d.time_unit) bad_usage(fmt::format("--time-unit '{}' is not one of: s, ms, us", o.time_unit));
   }
-  if (!o.value_unit.empty()) {
+  if (o.value_unit == "counts") {  // analogRead()'s counts of the lab's Uno: 10 bits on a 5 V reference
+    d.quantity = Quantity::back_emf_volts;
+    d.value_scale = 5.0 / 1023.0;
+  } else if (!o.value_unit.empty()) {
     const auto unit = parse_value_unit(o.value_unit);
-    if (!unit) bad_usage(fmt::format("--value-unit '{}' is not one of: {}", o.value_unit, value_units_read()));
+    if (!unit) bad_usage(fmt::format("--value-unit '{}' is not one of: {}, counts", o.value_unit, value_units_read()));
     d.quantity = unit->quantity;
     d.value_scale = unit->scale;
   }

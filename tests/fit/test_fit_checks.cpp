@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "spindown/fit.hpp"
@@ -45,6 +46,21 @@ TEST(FitChecks, ATachometerInRpmReadAsVoltsIsDoubtedWithTheFix) {
   EXPECT_TRUE(mentions(f.doubts, "try --value-unit rpm")) << f.doubts.front();
   // Read as what it is, the same run is believed.
   EXPECT_TRUE(fit_of(c, rpm, Quantity::rpm).doubts.empty());
+}
+
+// The handout's sketch with its "* 5.0 / 1023" left out prints analogRead()'s counts ("574.00"):
+// whole numbers up to 1023 are doubted as counts and the fix proposed is --value-unit counts (the
+// rpm reading, followed, gave c4 5.8x too small); read as counts x 5/1023 V, the run is believed.
+TEST(FitChecks, RawAnalogReadCountsAreDoubtedAsCounts) {
+  const Case c = make_case(SyntheticRunSpec{});
+  std::vector<double> counts, volts;
+  for (double v : c.run.volts) counts.push_back(std::round(v / 5.0 * 1023));
+  for (double n : counts) volts.push_back(n * 5.0 / 1023);
+  const RunFit f = fit_of(c, counts);
+  ASSERT_FALSE(f.doubts.empty());
+  EXPECT_TRUE(mentions(f.doubts, "try --value-unit counts")) << f.doubts.front();
+  EXPECT_FALSE(mentions(f.doubts, "--value-unit rpm")) << f.doubts.front();
+  EXPECT_TRUE(fit_of(c, volts).doubts.empty());
 }
 
 // Issue 32 (a vehicle's km/h in a headerless file): readings of a few tens, read as volts by

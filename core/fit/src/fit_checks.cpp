@@ -42,7 +42,7 @@ double reading_step(std::span<const double> values) {
   return whole * 10 >= seen * 9 ? step : 0.0;
 }
 
-std::vector<std::string> unit_doubts(const RunFit& fit, double peak) {
+std::vector<std::string> unit_doubts(const RunFit& fit, double peak, bool whole_numbers) {
   std::vector<std::string> out;
   const ModelFit* best = best_model(fit);
   const double omega0 = best ? best->omega0 : std::numeric_limits<double>::quiet_NaN();
@@ -51,13 +51,20 @@ std::vector<std::string> unit_doubts(const RunFit& fit, double peak) {
     case Quantity::back_emf_volts:
       if (peak > plausible_max_volts) {
         const bool looks_rpm = std::fabs(peak / rpm_per_volt) <= 12.0;
+        // Whole numbers within a 10-bit converter's range: the sketch printed analogRead()'s counts
+        // (its "* 5.0 / 1023" line left out), the likelier reading on a lab bench than a slow motor in rpm.
+        const bool counts = whole_numbers && peak <= 1023;
+        const std::string rpm = fmt::format("a speed in rpm ({:.3g} V at {:.0f} rpm/V): try --value-unit rpm",
+                                            peak / rpm_per_volt, rpm_per_volt);
         out.push_back(fmt::format(
             "readings up to {:.6g} V: far beyond any back-EMF a lab bench makes or an Arduino pin reads (0–5 V){} — "
             "the numbers below are not the motor's friction",
             peak,
-            looks_rpm ? fmt::format("; they look like a speed in rpm ({:.3g} V at {:.0f} rpm/V): try --value-unit rpm",
-                                    peak / rpm_per_volt, rpm_per_volt)
-                      : std::string("; check the value's unit (--value-unit V, rpm or rad/s)")));
+            counts      ? fmt::format("; whole numbers up to {:g}: raw analogRead() counts of a 10-bit converter "
+                                      "(the sketch's * 5.0 / 1023 left out): try --value-unit counts (x 5/1023 V)",
+                                      peak)
+            : looks_rpm ? "; they look like " + rpm
+                        : std::string("; check the value's unit (--value-unit V, rpm or rad/s)")));
         return out;
       }
       break;
@@ -171,8 +178,12 @@ void check_fit(RunFit& fit, std::span<const double> tau, std::span<const double>
                std::span<const double> raw, double k) {
   fit.reading_step = reading_step(raw);
   double peak = 0;
-  for (double v : raw) peak = std::max(peak, v);
-  fit.doubts = unit_doubts(fit, peak);
+  bool whole_numbers = !raw.empty();
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    peak = std::max(peak, raw[i]);
+    if (i % 8 == 0) whole_numbers = whole_numbers && raw[i] == std::round(raw[i]);
+  }
+  fit.doubts = unit_doubts(fit, peak, whole_numbers);
 
   // What the print can resolve: a model with more friction terms whose curve stays within half a
   // step of a simpler one's is not told apart from it by the readings, whatever ΔBIC says.

@@ -29,8 +29,8 @@ inline constexpr double plausible_max_omega = 3000.0;
 double reading_step(std::span<const double> values);
 
 // Doubts about the units of a fit's readings (empty when plausible). peak: the largest reading
-// of the run.
-std::vector<std::string> unit_doubts(const RunFit& fit, double peak);
+// of the run; whole_numbers: every reading is a whole number (a converter's raw counts?).
+std::vector<std::string> unit_doubts(const RunFit& fit, double peak, bool whole_numbers = false);
 
 // The largest difference, over the times tau (s after the cut), between two fitted models'
 // curves in the reading's unit (k: reading per rad/s), or a value at least `enough` as soon as one
