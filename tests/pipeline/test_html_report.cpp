@@ -197,11 +197,24 @@ TEST(CoefficientTrend, RunsFarApartWidenTheMeanAndAreSaid) {
   EXPECT_NEAR(two.mean_stderr, 5e-5, 1e-7);        // half the spread, not 0.7e-6
   EXPECT_NE(two.words.find("the runs disagree far beyond their errors (0.0001 to 0.0002 N*m"), std::string::npos)
       << two.words;
-  // A step in four runs is not "steady within its uncertainty".
+  // A step in four runs is not "steady within its uncertainty", nor a drift: it is named, with where
+  // (issue 43: a semester across a repair "stepped up between week 4 and week 5", not "not steady").
   const auto step = coefficient_trend("c4", "N*m", "run", {1, 2, 3, 4}, {1.14e-4, 1.14e-4, 2.5e-4, 2.5e-4},
                                       {3e-7, 3e-7, 3e-7, 3e-7});
   EXPECT_EQ(step.words.find("steady within"), std::string::npos) << step.words;
-  EXPECT_NE(step.words.find("disagree"), std::string::npos) << step.words;
+  EXPECT_TRUE(step.stepped);
+  EXPECT_FALSE(step.drifting);
+  EXPECT_NE(step.words.find("stepped up 119 % between run 2 and run 3"), std::string::npos) << step.words;
+  // With wall-clock days, the step names the dates of the sessions either side.
+  const double day0 = 1729555200;  // 2024-10-22 00:00 UTC
+  const auto weeks = coefficient_trend("c4", "N*m", "day", {0, 0.01, 7, 7.01, 14, 14.01}, {1.14e-4, 1.15e-4, 1.14e-4,
+                                       1.15e-4, 1.94e-4, 1.95e-4}, {1e-6, 1e-6, 1e-6, 1e-6, 1e-6, 1e-6}, {}, day0);
+  EXPECT_NE(weeks.words.find("between 2024-10-29 and 2024-11-05"), std::string::npos) << weeks.words;
+  // A steady rise is still a drift, not a step.
+  const auto rise = coefficient_trend("c4", "N*m", "day", {0, 7, 14, 21, 28, 35}, {1.0e-4, 1.1e-4, 1.2e-4, 1.3e-4,
+                                      1.4e-4, 1.5e-4}, {1e-6, 1e-6, 1e-6, 1e-6, 1e-6, 1e-6}, {}, day0);
+  EXPECT_TRUE(rise.drifting) << rise.words;
+  EXPECT_FALSE(rise.stepped) << rise.words;
   // Runs that agree keep their own small error.
   const auto agree = coefficient_trend("c4", "N*m", "run", {1, 2}, {1.000e-4, 1.001e-4}, {1e-6, 1e-6});
   EXPECT_NEAR(agree.mean_stderr, 1e-6 / std::sqrt(2.0), 1e-9);

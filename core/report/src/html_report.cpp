@@ -342,7 +342,7 @@ std::string trend_cell(const CoefficientTrend& t) {
                                          lab->pretty)
                            : value_unit(t.slope, t.slope_stderr, t.unit),
                        esc(t.x_unit));
-  out += fmt::format("<br><span class=\"{}\">{}</span>", t.drifting ? "drift" : t.enough ? "steady" : "noref",
+  out += fmt::format("<br><span class=\"{}\">{}</span>", t.drifting || t.stepped ? "drift" : t.enough ? "steady" : "noref",
                      esc(t.words));
   return out;
 }
@@ -378,10 +378,11 @@ std::string summary_section(const SessionReport& report) {
   std::string s = "<section id=\"summary\">\n<h2>Summary across benches and runs</h2>\n";
   std::size_t drifting = 0;
   for (const auto& b : report.benches) drifting += b.viscous.drifting || b.coulomb.drifting;
-  s += fmt::format("<p>{} run{} on {} bench{}; {} bench{} with drifting friction. Friction c3 (viscous) and c4 "
+  s += fmt::format("<p>{} run{} on {} bench{}; friction drifts on {} bench{}. Friction c3 (viscous) and c4 "
                    "(dry, Coulomb) come from the combined model; a trend is a weighted straight line through the runs in "
-                   "time order, its error widened by the run-to-run scatter; it is called drifting when it is more "
-                   "than 3 standard errors from flat and changes the coefficient by 10 % or more.</p>\n",
+                   "time order, its error widened by the run-to-run scatter; it is called a drift when it is more "
+                   "than 3 standard errors from flat and changes the coefficient by 10 % or more, and a step when "
+                   "the runs before and after one session agree on two levels far better than with any line.</p>\n",
                    report.runs.size(), report.runs.size() == 1 ? "" : "s", report.benches.size(),
                    report.benches.size() == 1 ? "" : "es", drifting, drifting == 1 ? "" : "es");
   s += "<table class=\"summary\">\n<tr><th>bench</th><th>runs</th><th>health (worst run)</th><th>reference</th>"

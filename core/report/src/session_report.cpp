@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <ctime>
 #include <fmt/format.h>
 #include <numeric>
+#include <optional>
 
 #include "spindown/fit_report.hpp"
 
@@ -13,10 +15,69 @@ namespace {
 
 std::string percent(double x) { return fmt::format("{:.0f} %", 100 * x); }
 
+// "2024-10-22" of a day number (wall-clock runs), "run 7" otherwise.
+std::string x_words(const std::string& x_unit, double x, double x0_unix) {
+  if (x_unit != "day" || x0_unix <= 0) return fmt::format("run {:g}", x);
+  const std::time_t t = static_cast<std::time_t>(x0_unix + x * 86400.0);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[16];
+  std::strftime(buf, sizeof buf, "%Y-%m-%d", &tm);
+  return buf;
+}
+
+struct Step {
+  double x, before, after, last_before, first_after;
+};
+
+// The best split of the points (sorted by x) between two sessions into two weighted levels; a step
+// when it leaves χ² at most a quarter of the line's and the levels lie more than drift_sigma of
+// their errors (widened by the runs' scatter about them, a motor's run-to-run variation) and
+// drift_fraction apart. Two runs a side at least: one stray run is no step.
+std::optional<Step> find_step(const CoefficientTrend& t, const std::vector<double>& w, std::size_t n, double chi2_line,
+                              const TrendRules& rules) {
+  if (n < 4) return std::nullopt;
+  std::vector<std::size_t> order(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return t.x[a] < t.x[b]; });
+  const double session_gap = t.x_unit == "day" ? 0.25 : 0.5;
+  std::optional<Step> best;
+  double best_chi2 = INFINITY, best_se = 0;
+  for (std::size_t k = 2; k + 2 <= n; ++k) {  // at least two runs a side
+    if (t.x[order[k]] - t.x[order[k - 1]] < session_gap) continue;  // not between sessions
+    double sw[2] = {0, 0}, swy[2] = {0, 0};
+    for (std::size_t j = 0; j < n; ++j) {
+      const int side = j < k ? 0 : 1;
+      sw[side] += w[order[j]];
+      swy[side] += w[order[j]] * t.value[order[j]];
+    }
+    const double m0 = swy[0] / sw[0], m1 = swy[1] / sw[1];
+    double c2 = 0;
+    for (std::size_t j = 0; j < n; ++j) {
+      const double r = t.value[order[j]] - (j < k ? m0 : m1);
+      c2 += w[order[j]] * r * r;
+    }
+    if (c2 < best_chi2) {
+      best_chi2 = c2;
+      best_se = std::sqrt(1 / sw[0] + 1 / sw[1]);
+      best = Step{0.5 * (t.x[order[k - 1]] + t.x[order[k]]), m0, m1, t.x[order[k - 1]], t.x[order[k]]};
+    }
+  }
+  if (!best) return std::nullopt;
+  const double scatter = std::sqrt(best_chi2 / double(n - 2));
+  const double se = best_se * std::max(1.0, scatter);
+  const double jump = best->after - best->before;
+  if (best_chi2 > 0.25 * chi2_line || std::abs(jump) <= rules.drift_sigma * se ||
+      std::abs(jump) < rules.drift_fraction * std::abs(best->before))
+    return std::nullopt;
+  return best;
+}
+
 }  // namespace
 
 CoefficientTrend coefficient_trend(std::string name, std::string unit, std::string x_unit, std::vector<double> x,
-                                   std::vector<double> value, std::vector<double> std_error, const TrendRules& rules) {
+                                   std::vector<double> value, std::vector<double> std_error, const TrendRules& rules,
+                                   double x0_unix) {
   CoefficientTrend t;
   t.name = std::move(name);
   t.unit = std::move(unit);
@@ -99,6 +160,21 @@ CoefficientTrend coefficient_trend(std::string name, std::string unit, std::stri
                                                        : fmt::format("{} runs", n);
   const std::string over = t.x_unit == "day" ? fmt::format("over {:.3g} days ({} runs, {})", span, n, sessions_text)
                                              : fmt::format("over {} runs", n);
+  // A step between two sessions: each side's runs agree on a level (within the scatter a motor has
+  // from run to run), the two levels far apart, and the two levels fit far better than the line.
+  if (const auto st = find_step(t, w, n, chi2, rules)) {
+    t.stepped = true;
+    t.drifting = false;
+    t.step_x = st->x;
+    t.level_before = st->before;
+    t.level_after = st->after;
+    const double rel = st->after / st->before - 1.0;
+    t.words = fmt::format("{} stepped {} {} between {} and {} ({:.3g} to {:.3g} {}; the runs on either side agree): a "
+                          "change made then (a repair, a part replaced, another motor), not a drift",
+                          what, rel >= 0 ? "up" : "down", percent(std::abs(rel)), x_words(t.x_unit, st->last_before, x0_unix),
+                          x_words(t.x_unit, st->first_after, x0_unix), st->before, st->after, t.unit);
+    return t;
+  }
   // A line that leaves the runs far beyond their errors (a step, a stray run) is no evidence of
   // steadiness: "steady" only when the runs agree with the line.
   const bool line_misses = birge > rules.disagree_scatter;
@@ -171,8 +247,8 @@ void summarize_session(SessionReport& report) {
       for (std::size_t i : b.runs)
         if (combined_friction(report.runs[i].fit)) x.push_back(static_cast<double>(report.runs[i].order));
     }
-    b.viscous = coefficient_trend("c3", "N*m*s/rad", x_unit, x, cv, cv_se);
-    b.coulomb = coefficient_trend("c4", "N*m", x_unit, x, cc, cc_se);
+    b.viscous = coefficient_trend("c3", "N*m*s/rad", x_unit, x, cv, cv_se, {}, x_unit == "day" ? t0 : 0);
+    b.coulomb = coefficient_trend("c4", "N*m", x_unit, x, cc, cc_se, {}, x_unit == "day" ? t0 : 0);
   }
 }
 

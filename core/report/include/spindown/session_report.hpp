@@ -68,6 +68,11 @@ struct CoefficientTrend {
   double relative_change = 0, relative_change_stderr = 0;  // change / mean
   bool enough = false;            // at least min_runs points with a spread in x
   bool drifting = false;          // |slope| > drift_sigma·stderr and |relative change| ≥ drift_fraction
+  // A step between two sessions (a repair, a part replaced): the runs before and after each agree
+  // on a level, far better than with any straight line. Then it is no drift.
+  bool stepped = false;
+  double step_x = 0;              // where: midway between the last point before and the first after
+  double level_before = 0, level_after = 0;
   std::string words;              // "dry friction rose 35 % ± 6 % over 5 runs: drifting"
 };
 
@@ -80,9 +85,10 @@ struct TrendRules {
   double disagree_scatter = 5.0;
 };
 
+// x0_unix: the wall-clock time of x = 0 when x_unit is "day" (to name a step's dates), else 0.
 CoefficientTrend coefficient_trend(std::string name, std::string unit, std::string x_unit, std::vector<double> x,
                                    std::vector<double> value, std::vector<double> std_error,
-                                   const TrendRules& rules = {});
+                                   const TrendRules& rules = {}, double x0_unix = 0);
 
 struct BenchSummary {
   std::string bench;
