@@ -379,9 +379,11 @@ TEST(MotorHealthConfig, ExampleBenchFileDocumentsEveryKeyAndLoads) {
 }
 
 TEST(HealthBaseline, WeightedMeanOfGoodRuns) {
-  std::vector<BaselineRun> runs = {{"a", 1.0e-7, 1e-9, 1.0e-4, 1e-6, J}, {"b", 1.2e-7, 2e-9, 1.1e-4, 1e-6, J}};
+  std::vector<BaselineRun> runs = {{"a", 1.0e-7, 1e-9, 1.0e-4, 1e-6, J, 344}, {"b", 1.2e-7, 2e-9, 1.1e-4, 1e-6, J, 348}};
   const auto b = make_baseline(runs, "2024-09-14", "test");
   ASSERT_TRUE(b);
+  EXPECT_NEAR(b->omega0, 346, 1e-9);
+  EXPECT_NEAR(b->omega0_spread, std::sqrt(8.0), 1e-9);
   EXPECT_NEAR(b->c_coulomb, 1.05e-4, 1e-12);
   // Inverse-variance weights 4:1 for c_v.
   EXPECT_NEAR(b->c_viscous, (4 * 1.0e-7 + 1.2e-7) / 5, 1e-15);
@@ -410,7 +412,9 @@ c_coulomb_n_m = 1e-4
 [health]
 check_ratio = 1.6
 )";
-  const HealthBaseline b = lab_baseline();
+  HealthBaseline b = lab_baseline();
+  b.omega0 = 346.0;  // the runs' speed at the cut, written and read back
+  b.omega0_spread = 1.5;
   std::string why;
   const auto updated = with_baseline_section(original, b, &why);
   ASSERT_TRUE(updated) << why;
@@ -424,6 +428,8 @@ check_ratio = 1.6
   EXPECT_DOUBLE_EQ(cfg.baseline->c_coulomb, cc0);
   EXPECT_DOUBLE_EQ(cfg.baseline->c_viscous_stderr, 2e-9);
   EXPECT_EQ(cfg.baseline->date, "2024-09-14");
+  EXPECT_DOUBLE_EQ(cfg.baseline->omega0, 346.0);
+  EXPECT_DOUBLE_EQ(cfg.baseline->omega0_spread, 1.5);
   EXPECT_DOUBLE_EQ(cfg.thresholds.check_ratio, 1.6);
 
   // No [baseline] yet: appended.
@@ -576,6 +582,30 @@ TEST(MotorHealth, BothFrictionsTheSameRoundMultipleIsATimeUnitNotWear) {
   EXPECT_NE(v.reason.find("time unit"), std::string::npos) << v.reason;
   const HealthVerdict j = assess_health(combined_fit(0.37 * cv0, 2e-9, 0.37 * cc0, 4e-7), cfg);
   EXPECT_NE(j.level, HealthLevel::not_judged) << j.reason;
+}
+
+}  // namespace
+}  // namespace spindown
+
+namespace spindown {
+namespace {
+
+// A 3.3 V board running the lab's sketch written for 5 V: every reading 1.52x the back-EMF. Dry
+// friction reads 1.52x, viscous friction as it was, and the speed at the cut 1.52x what the same
+// supply gave the baseline runs: the reading's scale is named, not bearings. The same dry friction
+// at the baseline's speed (a worn bearing) stays "bearings".
+TEST(MotorHealth, DryFrictionAndTheCutSpeedScaledAlikeIsTheReadingsScale) {
+  MotorHealthConfig cfg;
+  cfg.baseline = lab_baseline();
+  cfg.baseline->omega0 = w0;
+  cfg.baseline->omega0_spread = 2.0;
+  const HealthVerdict v = assess_health(combined_fit(cv0, 2e-9, 1.52 * cc0, 5e-7, 1.52 * w0), cfg);
+  EXPECT_NE(v.reason.find("the reading's scale"), std::string::npos) << v.reason;
+  const auto scale = v.reason.find("the reading's scale"), bearings = v.reason.find("bearings");
+  EXPECT_TRUE(bearings == std::string::npos || scale < bearings) << v.reason;
+  const HealthVerdict worn = assess_health(combined_fit(cv0, 2e-9, 1.52 * cc0, 5e-7, w0), cfg);
+  EXPECT_EQ(worn.reason.find("the reading's scale"), std::string::npos) << worn.reason;
+  EXPECT_NE(worn.reason.find("bearings"), std::string::npos) << worn.reason;
 }
 
 }  // namespace

@@ -80,7 +80,8 @@ MotorHealthConfig load_motor_health_config(const std::string& path) {
   r.only_keys("motor", {"speed_constant_rpm_per_v", "no_load_speed_rpm", "no_load_current_a",
                         "torque_constant_nm_per_a", "rotor_inertia_kg_m2"});
   r.only_keys("baseline", {"c_viscous_n_m_s", "c_viscous_stderr", "c_viscous_spread", "c_coulomb_n_m",
-                           "c_coulomb_stderr", "c_coulomb_spread", "runs", "date", "inertia_kg_m2", "source"});
+                           "c_coulomb_stderr", "c_coulomb_spread", "runs", "date", "inertia_kg_m2", "source",
+                           "omega0_rad_s", "omega0_spread"});
   r.only_keys("health", {"check_ratio", "service_ratio", "significance_sigma", "max_slowdown_s",
                          "slowdown_fraction", "max_stop_s", "stop_change_fraction"});
 
@@ -110,6 +111,8 @@ MotorHealthConfig load_motor_health_config(const std::string& path) {
     b.c_viscous_spread = r.non_negative("baseline.c_viscous_spread").value_or(0);
     b.c_coulomb_spread = r.non_negative("baseline.c_coulomb_spread").value_or(0);
     b.inertia_kg_m2 = r.non_negative("baseline.inertia_kg_m2").value_or(0);
+    b.omega0 = r.non_negative("baseline.omega0_rad_s").value_or(0);
+    b.omega0_spread = r.non_negative("baseline.omega0_spread").value_or(0);
     if (const auto* n = r.at("baseline.runs")) {
       if (!n->is_integer() || n->value<long long>().value() < 1) r.fail("baseline.runs", "is not a positive integer");
       b.runs = static_cast<int>(std::min<long long>(n->value<long long>().value(), 1'000'000));

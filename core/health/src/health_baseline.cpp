@@ -110,6 +110,7 @@ std::optional<BaselineRun> baseline_run(const RunFit& fit, std::string source, s
   r.c_coulomb = cc->value;
   r.c_coulomb_stderr = cc->std_error;
   r.inertia_kg_m2 = fit.bench.inertia_kg_m2;
+  r.omega0 = std::isfinite(m->omega0) && m->omega0 > 0 ? m->omega0 : 0;
   return r;
 }
 
@@ -199,13 +200,17 @@ std::optional<HealthBaseline> make_baseline(std::span<const BaselineRun> all_run
     }
   }
   std::vector<double> cv, cv_se, cc, cc_se;
-  double J = 0;
+  double J = 0, w0 = 0, w0_sq = 0;
+  bool every_w0 = true;
   for (const auto& r : runs) {
     cv.push_back(r.c_viscous);
     cv_se.push_back(r.c_viscous_stderr);
     cc.push_back(r.c_coulomb);
     cc_se.push_back(r.c_coulomb_stderr);
     J += r.inertia_kg_m2;
+    w0 += r.omega0;
+    w0_sq += r.omega0 * r.omega0;
+    every_w0 = every_w0 && r.omega0 > 0;
   }
   const Mean v = weighted_mean(cv, cv_se);
   const Mean c = weighted_mean(cc, cc_se);
@@ -219,6 +224,11 @@ std::optional<HealthBaseline> make_baseline(std::span<const BaselineRun> all_run
   b.runs = static_cast<int>(runs.size());
   b.date = std::move(date);
   b.inertia_kg_m2 = J / double(runs.size());
+  if (every_w0) {
+    const double n = double(runs.size());
+    b.omega0 = w0 / n;
+    b.omega0_spread = n > 1 ? std::sqrt(std::max(0.0, (w0_sq - n * b.omega0 * b.omega0) / (n - 1))) : 0;
+  }
   b.source = std::move(source);
   if (!(b.c_coulomb >= 0 && b.c_viscous >= 0))
     return fail(why, fmt::format("mean coefficients are negative (c3 {:.4g}, c4 {:.4g}): not a usable baseline",
@@ -242,6 +252,11 @@ std::string baseline_toml_section(const HealthBaseline& b) {
   out += fmt::format("runs = {}\n", b.runs);
   out += fmt::format("date = {}\n", toml_string(b.date));
   if (b.inertia_kg_m2 > 0) out += fmt::format("inertia_kg_m2 = {}\n", toml_number(b.inertia_kg_m2));
+  if (b.omega0 > 0) {
+    out += "# mean speed at the cut as read (the lab's supply gives about the same every run), and its spread\n";
+    out += fmt::format("omega0_rad_s = {}\n", toml_number(b.omega0));
+    out += fmt::format("omega0_spread = {}\n", toml_number(b.omega0_spread));
+  }
   if (!b.source.empty()) out += fmt::format("source = {}\n", toml_string(b.source));
   return out;
 }

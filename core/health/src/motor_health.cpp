@@ -157,7 +157,26 @@ HealthFinding note_finding(std::string what, HealthLevel level, std::string reas
 // speed, and divides the terminal voltage that is read, so dry friction reads lower; grease and
 // wear never lower dry friction. So the first advice is the leads. (Viscous up with dry friction
 // as it was stays "lubrication": too thick a grease does that too.)
-void name_the_cause(HealthFinding& dry, HealthFinding& viscous) {
+//
+// Dry friction changed while viscous friction did not, and the speed at the cut reads changed by
+// the same factor: the reading's scale (K_b, a divider, the converter's reference: a 3.3 V board
+// running a sketch written for 5 V). A reading k times the back-EMF leaves the exponential's rate
+// (c3) alone, scales the linear fall (c4) by k, and reads the speed at the cut k times what the
+// same supply gives; worn bearings change none but the friction.
+void name_the_cause(HealthFinding& dry, HealthFinding& viscous, double omega0, const HealthBaseline& b) {
+  const double w_ratio = b.omega0 > 0 && omega0 > 0 ? omega0 / b.omega0 : 0;
+  const double w_tol = b.omega0 > 0 ? std::max(0.05, 2.0 * b.omega0_spread / b.omega0) : 0;
+  if (dry.level != HealthLevel::ok && std::fabs(viscous.ratio - 1.0) <= std::max(2.0 * viscous.ratio_std_error, 0.1) &&
+      w_ratio > 0 && std::fabs(w_ratio - 1.0) > w_tol && std::fabs(w_ratio / dry.ratio - 1.0) <= std::max(w_tol, 0.1)) {
+    dry.reason = fmt::format(
+        "dry friction {} the baseline (±{:.2g}) with viscous friction as it was ({}) and the speed at the cut read {} "
+        "the baseline runs' ({:.0f} rad/s against {:.0f}): the reading's scale, not friction — the same supply gives "
+        "the same speed, and a reading k times the back-EMF scales the linear fall (c4) and the speed by k and leaves "
+        "the exponential's rate (c3) alone; check K_b, a divider on the input and the converter's reference (a 3.3 V "
+        "board running a sketch written for 5 V)",
+        times(dry.ratio), dry.ratio_std_error, times(viscous.ratio), times(w_ratio), omega0, b.omega0);
+    return;
+  }
   const bool dry_down = dry.ratio < 1.0 - std::max(2.0 * dry.ratio_std_error, 0.05);
   if (viscous.level == HealthLevel::ok || viscous.ratio <= 1 || !dry_down) return;
   viscous.reason = fmt::format(
@@ -220,7 +239,7 @@ void compare_with_baseline(const FittedFriction& fr, double J, const HealthBasel
     out.push_back(
         note_finding("viscous friction", HealthLevel::ok, "baseline viscous friction is not positive: not compared"));
 
-  if (ref_c.value > 0 && ref_v.value > 0) name_the_cause(out[out.size() - 2], out.back());
+  if (ref_c.value > 0 && ref_v.value > 0) name_the_cause(out[out.size() - 2], out.back(), fr.omega0, b);
 
   // What the known-good motor would have done from this run's speed at the cut.
   const double t_run = coast_time(fr.viscous.value, fr.coulomb.value, J, fr.omega0, 0);

@@ -22,6 +22,7 @@ struct BaselineRun {
   double c_viscous = 0, c_viscous_stderr = 0;
   double c_coulomb = 0, c_coulomb_stderr = 0;
   double inertia_kg_m2 = 0;
+  double omega0 = 0;  // speed at the cut (rad/s), as read
 };
 
 // The run's combined fit when it converged with finite coefficients on a whole coast (its cut

@@ -59,6 +59,10 @@ struct HealthBaseline {
   std::string date;             // when it was made (ISO 8601)
   double inertia_kg_m2 = 0;     // J the runs were fitted with (0 = not recorded)
   std::string source;           // what it was made from (file, bench)
+  // The runs' mean speed at the cut as read (rad/s; 0 = not recorded): the lab's supply drives
+  // the motor to about the same speed every run, so a run that reads another speed at the cut
+  // with its dry friction changed by the same factor has a reading scaled, not friction changed.
+  double omega0 = 0, omega0_spread = 0;
 };
 
 struct HealthThresholds {
