@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <cmath>
 #include <exception>
+#include <iostream>
 #include <ostream>
 #include <stdexcept>
 #include <fmt/format.h>
@@ -151,7 +152,9 @@ BenchFiles bench_files_from(const InputOptions& o, std::ostream& err) {
 
 BenchNaming naming_from(const InputOptions& o, const std::string& fixed_bench) {
   try {
-    return BenchNaming(o.roster, o.bench_pattern, fixed_bench);
+    BenchNaming naming(o.roster, o.bench_pattern, fixed_bench);
+    for (const std::string& s : naming.roster_skipped()) std::cerr << s << '\n';  // a points row, no hand-in
+    return naming;
   } catch (const std::invalid_argument& e) {
     bad_usage(e.what());
   } catch (const std::exception& e) {

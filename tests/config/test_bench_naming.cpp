@@ -209,3 +209,26 @@ TEST(FileStem, DropsFoldersAndTheLastExtension) {
 
 }  // namespace
 }  // namespace spindown
+
+namespace spindown {
+namespace {
+
+// A Canvas gradebook export made into a roster: a byte-order mark, "Müller, Anna" quoted, a
+// "Points Possible" row and a test student without a file. Rows without a file are skipped and
+// named; the rest is read (before: refused, exit 2, until hand-edited).
+TEST_F(BenchNamingTest, RowsWithoutAFileAreSkippedAndNamed) {
+  const std::string roster = write("canvas.csv", "\xEF\xBB\xBFStudent,ID,file,bench\n"
+                                                 "Points Possible,,,\n"
+                                                 "\"M\xC3\xBCller, Anna\",101,anna.txt,bench1\n"
+                                                 "\"Student, Test\",999,,\n");
+  const BenchNaming naming(roster, "");
+  const BenchName a = naming.name((dir / "anna.txt").string());
+  EXPECT_EQ(a.bench, "bench1") << a.problem;
+  ASSERT_EQ(naming.roster_skipped().size(), 2u);
+  EXPECT_NE(naming.roster_skipped()[0].find(":2: no file (Points Possible): skipped"), std::string::npos)
+      << naming.roster_skipped()[0];
+  EXPECT_NE(naming.roster_skipped()[1].find("(Student, Test)"), std::string::npos) << naming.roster_skipped()[1];
+}
+
+}  // namespace
+}  // namespace spindown

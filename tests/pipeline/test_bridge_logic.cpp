@@ -452,3 +452,13 @@ TEST(BridgeLogic, ABootMessageBeforeTheLabLinesIsNoTable) {
   EXPECT_EQ(sink.flat().size(), 10u);
   EXPECT_EQ(b.protocol(), WireProtocol::lab);
 }
+
+TEST(BridgeLogic, SerialPlotterLabelsAreReadAsFitReadsThem) {
+  std::string bytes;
+  for (int i = 0; i < 60; ++i) {
+    char line[64];
+    std::snprintf(line, sizeof line, "millis:%d,volts:%.2f\r\n", 2020 + 20 * i, i < 20 ? 0.0 : 2.8 - 0.01 * (i - 20));
+    bytes += line;
+  }
+  expect_bridge_reads_as_fit(bytes, 60);
+}

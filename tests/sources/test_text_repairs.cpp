@@ -117,3 +117,17 @@ TEST(TextRepairs, SerialMonitorTimestampsOfValuesAloneBecomeTheirTime) {
   ASSERT_EQ(notes.size(), 1u);
   EXPECT_NE(notes[0].find("is its time"), std::string::npos) << notes[0];
 }
+
+// The Arduino IDE's Serial Plotter labels ("millis:2020,volts:0.00"): a header of the labels and
+// the values beneath it; a clock ("10:21:38") is no label.
+TEST(TextRepairs, SerialPlotterLabelsBecomeAHeader) {
+  std::string text = "millis:2020,volts:0.00\r\nmillis:2040,volts:2.80\r\nmillis:2060\tvolts:2.79\r\nmillis:2080 volts:2.78\r\n";
+  ASSERT_TRUE(needs_text_repair(text));
+  const auto notes = repair_text(text);
+  EXPECT_EQ(text, "millis,volts\n2020,0.00\n2040,2.80\n2060,2.79\n2080,2.78\n");
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("Serial Plotter"), std::string::npos);
+  std::string labels, values;
+  EXPECT_FALSE(plotter_labels("10:21:38.234 -> 2.64", &labels, &values));
+  EXPECT_FALSE(plotter_labels("5234\t2.80", &labels, &values));
+}

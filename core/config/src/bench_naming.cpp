@@ -93,11 +93,21 @@ ClassRoster load_class_roster(const std::string& path) {
     const std::vector<std::string> f = split_row(line);
     // A spreadsheet's empty rows (";;;;", ",,,"): nothing in them.
     if (std::all_of(f.begin(), f.end(), [](const std::string& x) { return x.empty(); })) return;
-    if (f.size() <= std::max(*col_file, *col_bench))
+    if (f.size() <= *col_bench && f.size() > *col_file && !trim(f[*col_file]).empty())
       throw at(fmt::format("{} field{} where the header has {}: '{}'", f.size(), f.size() == 1 ? "" : "s", columns, line));
+    if (f.size() <= *col_file || trim(f[*col_file]).empty()) {  // a points row, a student without a file
+      std::string who;
+      for (const auto& x : f)
+        if (!trim(x).empty()) {
+          who = std::string(trim(x));
+          break;
+        }
+      roster.skipped.push_back(fmt::format("{}:{}: no file{}: skipped", path, number,
+                                           who.empty() ? std::string() : fmt::format(" ({})", nfc(who))));
+      return;
+    }
     RosterEntry e{nfc(f[*col_file]), f[*col_bench], nfc(col_student && *col_student < f.size() ? f[*col_student] : ""),
                   static_cast<std::size_t>(number)};
-    if (e.file.empty()) throw at("no file named");
     std::string bad;
     if (!is_valid_bench_id(e.bench, &bad)) throw at(fmt::format("bench '{}': {}", e.bench, bad));
     for (const auto& other : roster.entries)

@@ -9,6 +9,7 @@
 #include "spindown/host_name.hpp"
 #include "spindown/lab_line.hpp"
 #include "spindown/lcm_status.hpp"
+#include "spindown/text_repairs.hpp"
 
 namespace spindown {
 
@@ -211,14 +212,21 @@ void SerialBridge::hold_for_layout(std::string_view text, std::int64_t now_us) {
 }
 
 void SerialBridge::learn_layout(std::int64_t now_us) {
-  std::string text;
-  for (const HeldLine& h : held_) (text += h.text) += '\n';
+  // The Serial Plotter's labelled values ("millis:2020,volts:0.00"): read under a header of their
+  // labels, as the file reader reads them (text_repairs.hpp).
+  std::string labels, values;
+  std::size_t labelled = 0;
+  for (const HeldLine& h : held_) labelled += plotter_labels(h.text, &labels, &values);
+  plotter_ = labelled * 2 > held_.size();
+  std::string text = plotter_ ? labels + '\n' : std::string();
+  for (const HeldLine& h : held_) (text += plotter_ && plotter_labels(h.text, nullptr, &values) ? values : h.text) += '\n';
   DelimitedLayout layout;
   const Recording rec = read_delimited_text(text, s_.device, {}, &layout);
   // A table when nearly every held line is one of its rows (a header and a units row aside):
   // boot messages and noise are reported as before.
   if (rec.has_errors() || rec.size() + 2 < held_.size()) {
     held_.clear();
+    plotter_ = false;
     return;
   }
   counters_.lines_bad -= static_cast<std::int64_t>(held_.size());  // read again below, by the layout
@@ -244,7 +252,7 @@ void SerialBridge::learn_layout(std::int64_t now_us) {
   held_.clear();
   bool rows = false;
   for (const HeldLine& h : held) {
-    if (!rows && !table_->read(h.text).ok) {
+    if (!rows && !plotter_ && !table_->read(h.text).ok) {
       good_line(h.recv_us);  // the header: used, it named the columns
       continue;
     }
@@ -258,6 +266,8 @@ void SerialBridge::on_table_line(std::string_view text, std::int64_t now_us, std
     ++counters_.lines_blank;
     return;
   }
+  std::string values;
+  if (plotter_ && plotter_labels(text, nullptr, &values)) text = values;
   const DelimitedRowReader::Row row = table_->read(text);
   if (!row.ok) {
     bad_line(text, row.why, now_us, line_no);

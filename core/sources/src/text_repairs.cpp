@@ -161,6 +161,16 @@ std::size_t count_bytes_literals(std::string_view text, std::size_t* lines) {
   return n;
 }
 
+bool plotter_lines_to_unlabel(std::string_view text) {
+  std::size_t lines = 0, labelled = 0;
+  each_line(text, head_bytes, [&](std::string_view line, std::size_t) {
+    if (line.empty() || line == "\r") return;
+    ++lines;
+    labelled += plotter_labels(line, nullptr, nullptr);
+  });
+  return labelled >= 3 && labelled * 2 >= lines;
+}
+
 bool bytes_literals_to_unwrap(std::string_view text) {
   std::size_t lines = 0;
   const std::size_t n = count_bytes_literals(text, &lines);
@@ -185,9 +195,38 @@ EncodingGuess encoding_to_undo(std::string_view text) {
 
 }  // namespace
 
+bool plotter_labels(std::string_view line, std::string* labels, std::string* values) {
+  while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t' || line.back() == ','))
+    line.remove_suffix(1);
+  if (line.empty()) return false;
+  std::string names, nums;
+  std::size_t fields = 0, at = 0;
+  while (at <= line.size()) {
+    std::size_t end = line.find_first_of(",\t ", at);
+    if (end == std::string_view::npos) end = line.size();
+    const std::string_view f = line.substr(at, end - at);
+    if (!f.empty()) {
+      const std::size_t colon = f.find(':');
+      if (colon == 0 || colon == std::string_view::npos || colon + 1 == f.size()) return false;
+      const std::string_view name = f.substr(0, colon), num = f.substr(colon + 1);
+      if (name.find_first_of("0123456789.") == 0) return false;  // "10:21:38" is a clock, not a label
+      for (const char c : num)
+        if (!is_digit(c) && c != '.' && c != '-' && c != '+' && c != 'e' && c != 'E') return false;
+      (names += fields ? "," : "") += name;
+      (nums += fields ? "," : "") += num;
+      ++fields;
+    }
+    at = end + 1;
+  }
+  if (fields < 2) return false;
+  if (labels) *labels = std::move(names);
+  if (values) *values = std::move(nums);
+  return true;
+}
+
 bool needs_text_repair(std::string_view text) {
   if (needs_decoding(encoding_to_undo(text))) return true;
-  if (bytes_literals_to_unwrap(text)) return true;
+  if (bytes_literals_to_unwrap(text) || plotter_lines_to_unlabel(text)) return true;
   const HeadCounts c = count_head(text);
   return timestamps_to_strip(c) || commas_to_read(c);
 }
@@ -215,6 +254,29 @@ std::vector<std::string> repair_text(std::string& text) {
     notes.push_back(fmt::format("Python bytes literals (b'5234\\t2.80\\r\\n', as print(ser.readline()) of a pyserial "
                                 "script writes them) unwrapped in {} lines",
                                 unwrapped));
+  }
+  if (plotter_lines_to_unlabel(text)) {
+    std::string out, labels, values, header;
+    out.reserve(text.size());
+    std::size_t unlabelled = 0;
+    each_line(text, text.size(), [&](std::string_view line, std::size_t pos) {
+      if (plotter_labels(line, &labels, &values)) {
+        if (header.empty()) {  // the labels once, as the header the values are read under
+          header = labels;
+          out += header + '\n';
+        }
+        out += values;
+        ++unlabelled;
+      } else {
+        out.append(line);
+      }
+      if (pos + line.size() < text.size()) out += '\n';
+    });
+    text.swap(out);
+    notes.push_back(fmt::format("the Serial Plotter's labelled values (\"{}:…\") in {} lines: read as a table with "
+                                "columns {} (its header put above them: later line numbers count one more than the "
+                                "file's)",
+                                header.substr(0, header.find(',')), unlabelled, header));
   }
   const HeadCounts c = count_head(text);
   const bool strip = timestamps_to_strip(c), commas = commas_to_read(c);

@@ -613,15 +613,19 @@ CASES.record = async () => {
   const showsC3 = () => p.evaluate(x => [...document.querySelectorAll('[data-field="c3"]')].some(e => window.__h.vis(e) && e.innerText.includes(x)), A.c3_digits);
   let ok = await waitFor(showsC3, 8000);
   let how = 'as the page opened';
+  const bad = [];
   if (!ok) {
-    // the student picks the run to print in the session's runs
+    // the student picks the run to print in the session's runs: a control of its row (view/show/print/its number), else the row
     const picked = await p.evaluate(run => {
       const h = window.__h;
       const row = [...document.querySelectorAll('[data-run]')].find(e => String(e.dataset.run) === String(run) && h.vis(e));
       if (!row) return null;
-      const c = [...row.querySelectorAll('a,button,[role="button"],input')].find(e => h.vis(e) && !/csv/i.test([e.innerText, e.getAttribute('href'), e.getAttribute('download')].join(' ')));
-      (c || row).setAttribute('data-h44-pick', '1');
-      return ((c && (c.innerText || c.value)) || 'the row').trim().slice(0, 40);
+      const cs = [...row.querySelectorAll('a,button,[role="button"],input,select')].filter(e => h.vis(e) && !/csv/i.test([e.innerText, e.getAttribute('href'), e.getAttribute('download')].join(' ')));
+      const lbl = e => [e.innerText, e.value, e.title, e.getAttribute('aria-label'), e.getAttribute('href')].filter(Boolean).join(' ');
+      const c = cs.find(e => /view|show|open|print|select|detail|record|report/i.test(lbl(e))) || cs.find(e => new RegExp('(^|\\D)' + run + '(\\D|$)').test(lbl(e))) ||
+                (row.cells && row.cells[0]) || cs[0] || row;
+      c.setAttribute('data-h44-pick', '1');
+      return (lbl(c) || c.innerText || 'the row').trim().slice(0, 40);
     }, A.run).catch(() => null);
     if (picked !== null) {
       await p.click('[data-h44-pick]').catch(() => {});
@@ -629,7 +633,7 @@ CASES.record = async () => {
       how = `after choosing run ${A.run} ("${picked}") in the session's runs`;
     }
   }
-  if (!ok) return out(false, `while run ${A.run + 1} coasts the bench page does not show run ${A.run}'s fit (c3 ${A.c3_digits}) to print, not even after choosing run ${A.run} in the session's runs`);
+  if (!ok) bad.push(`while run ${A.run + 1} coasts the bench page does not show run ${A.run}'s fit (c3 ${A.c3_digits}) to print, not even after choosing run ${A.run} in the session's runs`);
   await p.evaluate(HELPERS).catch(() => {});
   await sleep(1500);
   const stBefore = await api(p, A.port);
@@ -640,12 +644,11 @@ CASES.record = async () => {
   const pdf = await p.pdf({format: 'A4', printBackground: true});
   await p.emulateMediaType('screen');
   const pages = pdfPages(pdf);
-  const bad = [];
   const flat = text.replace(/\s+/g, ' ');
   if (pages !== 1) bad.push(`the print is ${pages} A4 pages, not one`);
-  if (liveState && liveState !== 'stopped' && new RegExp(`\\b${liveState}\\b`, 'i').test(flat)) bad.push(`the record of run ${A.run} prints the bench's live state "${liveState}" (run ${A.run} is stopped)`);
+  if (ok && liveState && liveState !== 'stopped' && new RegExp(`\\b${liveState}\\b`, 'i').test(flat)) bad.push(`the record of run ${A.run} prints the bench's live state "${liveState}" (run ${A.run} is stopped)`);
   if (!new RegExp(`\\brun\\s*(#|no\\.?|number)?\\s*${A.run}\\b`, 'i').test(flat)) bad.push(`the record does not name run ${A.run}`);
-  if (!flat.includes(A.c3_digits)) bad.push(`the record lacks run ${A.run}'s c3 ${A.c3_digits}`);
+  if (ok && !flat.includes(A.c3_digits)) bad.push(`the record lacks run ${A.run}'s c3 ${A.c3_digits}`);
   if (!hasAny(flat, todayPatterns())) bad.push("no date of the run (today's) on the record");
   if (!/\b\d{1,2}:\d{2}\b/.test(flat)) bad.push('no time of day of the run on the record');
   if (!flat.includes(A.lab)) bad.push(`no lab name ("${A.lab}") on the record`);

@@ -55,6 +55,7 @@ wait_link() { local i; for ((i = 0; i < 40; i++)); do [ -e "$1" ] && return 0; s
 # browser NAME KIND LIMIT_S JSON: one Chromium check, bounded
 browser() {
   local name=$1 kind=$2 lim=$3 args=$4 line
+  if [ -n "${H44_ONLY:-}" ] && ! [[ $name =~ $H44_ONLY ]]; then return 0; fi   # debugging: only some cases
   say "start $name"
   args=$(python3 -c 'import json,sys; a=json.loads(sys.argv[1]); a["name"]=sys.argv[2]; a["limit_s"]=int(sys.argv[3]); print(json.dumps(a))' "$args" "$name" "$lim")
   line=$(cd "$SCR" && HOME="$SCR" timeout -k 5 $((lim + 15)) node "$HERE/check.js" "$kind" "$args" 2> "$LOGS/node-$name.log" | grep -E "^(PASS|FAIL) $name:" | head -1)

@@ -30,6 +30,9 @@ struct RosterEntry {
 struct ClassRoster {
   std::string path;
   std::vector<RosterEntry> entries;
+  // Rows without a file, skipped and named ("roster.csv:3: no file (Points Possible): skipped"): a
+  // learning-management system's export holds a points row and students who handed nothing in.
+  std::vector<std::string> skipped;
 };
 
 // Reads a roster. Throws std::runtime_error naming the file and line (a missing column, a bad
@@ -52,6 +55,11 @@ class BenchNaming {
   BenchNaming(const std::string& roster_path, const std::string& pattern, const std::string& fixed_bench = {});
 
   bool active() const { return roster_.has_value() || pattern_.has_value() || !fixed_.empty(); }
+  // The roster's rows skipped for having no file (said once, by whoever reads the roster).
+  const std::vector<std::string>& roster_skipped() const {
+    static const std::vector<std::string> none;
+    return roster_ ? roster_->skipped : none;
+  }
   // The roster first, then the pattern, then the fixed bench. A file neither names gets
   // fallback (the caller's: "" or the file's name) and a problem.
   BenchName name(const std::string& path, const std::string& fallback = {}) const;

@@ -130,6 +130,7 @@ class SerialBridge {
   std::vector<HeldLine> held_;                 // lines waiting for a layout (at most layout_lines)
   std::optional<DelimitedRowReader> table_;    // the layout learned: every line is read by it
   std::int64_t table_tick_us_ = 1000;          // µs per device tick of the table's time column
+  bool plotter_ = false;                       // the lines are the Serial Plotter's label:value pairs
   double table_ticks_per_unit_ = 1;
 
   samples_t batch_{};
