@@ -232,3 +232,22 @@ TEST_F(BenchNamingTest, RowsWithoutAFileAreSkippedAndNamed) {
 
 }  // namespace
 }  // namespace spindown
+
+namespace spindown {
+namespace {
+
+// Two students' putty.log listed by folder; a third putty.log from a folder the roster does not
+// list is never put on a bench made up of its name ("putty", which merged two benches' students).
+TEST_F(BenchNamingTest, ANameSeveralFilesShareIsNoBench) {
+  const std::string roster = write("roster.csv", "file,bench,student\nclass/anna/putty.log,bench1,Anna\n"
+                                                 "class/ben/putty.log,bench2,Ben\n");
+  const BenchNaming naming(roster, "");
+  EXPECT_EQ(naming.name((dir / "class" / "ben" / "putty.log").string()).bench, "bench2");
+  const BenchName stray = naming.name((dir / "class" / "carl" / "putty.log").string(), "putty");
+  EXPECT_EQ(stray.bench, "");
+  EXPECT_NE(stray.problem.find("several files named 'putty.log'"), std::string::npos) << stray.problem;
+  EXPECT_NE(stray.problem.find("no bench"), std::string::npos) << stray.problem;
+}
+
+}  // namespace
+}  // namespace spindown

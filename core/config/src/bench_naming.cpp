@@ -143,6 +143,7 @@ BenchNaming::BenchNaming(const std::string& roster_path, const std::string& patt
 BenchName BenchNaming::name(const std::string& path, const std::string& fallback) const {
   namespace fs = std::filesystem;
   std::vector<std::string> problems;
+  bool shared_name = false;
   if (roster_) {
     // Paths and names compared in NFC: a roster typed on Windows and folders unzipped on a Mac
     // (NFD) spell "Jürgen" with different bytes (unicode_nfc.hpp).
@@ -165,6 +166,8 @@ BenchName BenchNaming::name(const std::string& path, const std::string& fallback
     }
     const RosterEntry* hit = by_path ? by_path : by_name.size() == 1 ? by_name.front() : nullptr;
     if (hit) return {hit->bench, hit->student, fmt::format("roster {}:{}", roster_->path, hit->line), {}};
+    // A name the roster gives several students' files (putty.log, log.txt) is no bench's name.
+    if (by_name.size() > 1) shared_name = true;
     problems.push_back(by_name.size() > 1
                            ? fmt::format("the roster {} lists several files named '{}' (lines {} and {}): give its "
                                          "folder too",
@@ -186,6 +189,10 @@ BenchName BenchNaming::name(const std::string& path, const std::string& fallback
   if (!fixed_.empty()) return {fixed_, "", "--bench", {}};
   std::string problem;
   for (const auto& p : problems) problem += (problem.empty() ? "" : "; ") + p;
+  if (shared_name) {  // never a bench made up of a name several students' files share
+    problem += "; reported under no bench";
+    return {"", "", "", problem};
+  }
   if (!problem.empty())
     problem += fallback.empty() ? "" : fmt::format("; reported as bench '{}' (its file name)", fallback);
   return {fallback, "", "", problem};

@@ -8,7 +8,6 @@ socket has a timeout. Run inside the test's network namespace (127.0.0.1 and LAN
 """
 import os
 import re
-import select
 import signal
 import socket
 import sys
@@ -44,6 +43,17 @@ def request(addr, port, path, host, timeout=3.0, read_s=2.0):
         return (int(m.group(1)) if m else None), body[:4096]
     finally:
         s.close()
+
+
+def listen_queue(port):
+    """Connections waiting in the accept queue of the LISTEN socket on 127.0.0.1:port (/proc/net/tcp rx_queue)."""
+    want = "0100007F:%04X" % port
+    with open("/proc/net/tcp") as f:
+        for line in f.readlines()[1:]:
+            x = line.split()
+            if x[1] == want and x[3] == "0A":
+                return int(x[4].split(":")[1], 16)
+    return -1
 
 
 def leaks(body):
@@ -85,10 +95,12 @@ def main():
     if served:
         bad.append(f"{len(served)} requests with a foreign Host header answered (want 4xx, no data): " + "; ".join(served[:6]) + (" …" if len(served) > 6 else ""))
 
-    # 3. a class opening the page at the same moment while the server is busy for 2.5 s
+    # 3. a class opening the page at the same moment while the server is busy for 2.5 s: how many
+    #    connections the kernel holds for the server (the LISTEN socket's accept queue in /proc/net/tcp;
+    #    a client's own "connected" is no measure: its final ACK may have been dropped by a full queue)
     n = 32
     socks = []
-    established = 0
+    queued = -1
     os.kill(pid, signal.SIGSTOP)
     try:
         for _ in range(n):
@@ -99,24 +111,14 @@ def main():
             except BlockingIOError:
                 pass
             socks.append(c)
-        end = time.monotonic() + 2.5
-        pending = set(socks)
-        while pending and time.monotonic() < end:
-            _, w, _ = select.select([], list(pending), [], 0.2)
-            for c in w:
-                if c.getsockopt(socket.SOL_SOCKET, socket.SO_ERROR) == 0:
-                    try:
-                        c.getpeername()
-                        established += 1
-                    except OSError:
-                        pass
-                pending.discard(c)
+        time.sleep(2.5)
+        queued = listen_queue(lport)
     finally:
         os.kill(pid, signal.SIGCONT)
         for c in socks:
             c.close()
-    if established < n:
-        bad.append(f"of {n} pages opened at once while the server was busy 2.5 s, {established} connected (the rest wait for SYN retries: listen backlog too small)")
+    if queued < n:
+        bad.append(f"of {n} pages opened at once while the server was busy 2.5 s, {queued} were queued for it (the rest wait for SYN retries: listen backlog too small)")
 
     # 4. the docs say what the web page exposes and how
     try:
@@ -141,7 +143,7 @@ def main():
     if bad:
         print(f"FAIL {NAME}: " + " | ".join(bad))
     else:
-        print(f"PASS {NAME}: own and LAN Host served; {len(evil) * len(paths) + 2} foreign-Host requests refused; {established}/{n} connected at once; docs cover the page")
+        print(f"PASS {NAME}: own and LAN Host served; {len(evil) * len(paths) + 2} foreign-Host requests refused; {queued}/{n} queued at once; docs cover the page")
 
 
 if __name__ == "__main__":
