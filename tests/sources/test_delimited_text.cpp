@@ -460,3 +460,23 @@ TEST(DelimitedText, AScopesStartAndIncrementTimeItsSamples) {
   ASSERT_EQ(followed.size(), 200u);
   EXPECT_NEAR(followed.t_s[50], 1.0, 1e-12);
 }
+
+// A capture with a header that names no units (CoolTerm, a logger's "t,a,b"): the column proposal
+// carries every option that reading it needs, the value's unit too; followed, it reads the file
+// (before, the next refusal asked for --value-unit).
+TEST(DelimitedText, AProposalCarriesTheValueUnitTheHeaderDoesNotGive) {
+  std::string text = "stamp,ch0,ch1\n";
+  for (int i = 0; i < 200; ++i)
+    text += fmt::format("{},{},{:.3f}\n", 1000 + 20 * i, 500 + (i % 7), i < 20 ? 0.0 : 2.8 * std::exp(-(i - 20) / 60.0));
+  const Recording refused = read_delimited_text(text, "coolterm.csv");
+  EXPECT_TRUE(refused.empty());
+  const std::string why = all_diagnostics(refused);
+  EXPECT_NE(why.find("--time-column 1 --time-unit ms --value-column 3 --value-unit V"), std::string::npos) << why;
+  DelimitedTextOptions o;
+  o.time_column = "1";
+  o.time_unit = TimeUnit::ms;
+  o.value_column = "3";
+  o.quantity = Quantity::back_emf_volts;
+  const Recording r = read_delimited_text(text, "coolterm.csv", o);
+  EXPECT_EQ(r.size(), 200u) << all_diagnostics(r);
+}

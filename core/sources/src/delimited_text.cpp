@@ -223,8 +223,19 @@ class DelimitedReader {
   }
   const ColumnGuess& guess();
   std::string proposal() {
-    const auto p = column_proposal(guess());
+    const auto p = full_proposal();
     return p ? "; " + *p : std::string();
+  }
+  // column_proposal, with the value's unit when the header would not give it (a header whose value
+  // column names no unit asks for one next): every option a refusal proposes, at once.
+  std::optional<std::string> full_proposal() {
+    auto p = column_proposal(guess());
+    const int v = guess().value;
+    if (p && have_header_ && v >= 0 && static_cast<std::size_t>(v) < cols_.size() && guess().value_peak <= 30 &&
+        !o_.quantity && !implied_value_unit(cols_[static_cast<std::size_t>(v)]) &&
+        p->find("--value-unit") == std::string::npos)
+      *p += " --value-unit V";
+    return p;
   }
 
   std::string_view text_;
@@ -458,15 +469,15 @@ std::optional<std::string> DelimitedReader::choose_columns() {
     } else if (cols_.size() == 2) {
       tcol_ = vcol_ == 0 ? 1 : 0;
       if (guess().time_counter && guess().time == tcol_)
-        if (const auto p = column_proposal(guess())) return fmt::format("no clock in the file{}: {}", unnamed, *p);
+        if (const auto p = full_proposal()) return fmt::format("no clock in the file{}: {}", unnamed, *p);
       // Two unnamed columns the other way round (volts<TAB>millis): the numbers say the time is the
       // other one. Refused with the options that read it, never fitted from the wrong column.
       if (!have_header_ && vcol_ < 0 && guess().time == 1)
-        if (const auto p = column_proposal(guess()))
+        if (const auto p = full_proposal())
           return fmt::format("column 1 is no time (it does not rise steadily) but column 2 does: the columns are not "
                              "time, value in that order{}: {}",
                              unnamed, *p);
-    } else if (const auto p = column_proposal(guess()))
+    } else if (const auto p = full_proposal())
       return fmt::format("cannot tell which of the {} columns is the time{}: {}", cols_.size(), unnamed, *p);
     else
       return fmt::format("cannot tell which of the {} columns is the time{} ({}); name it (time column)", cols_.size(),
@@ -479,7 +490,7 @@ std::optional<std::string> DelimitedReader::choose_columns() {
     else if (c.size() > 1)
       return fmt::format("columns {} could each be the value; name one (value column){}", names_of(c), proposal());
     else if (cols_.size() == 2) vcol_ = tcol_ == 0 ? 1 : 0;
-    else if (const auto p = column_proposal(guess()); p && guess().time == tcol_)
+    else if (const auto p = full_proposal(); p && guess().time == tcol_)
       return fmt::format("cannot tell which of the {} columns is the value{}: {}", cols_.size(), unnamed, *p);
     else
       return fmt::format("cannot tell which of the {} columns is the value{} ({}); name it (value column)",
