@@ -37,6 +37,10 @@ std::optional<int> parse_options(int argc, char** argv, spindown::WebServiceOpti
                             "serve on this listening TCP socket, inherited from the caller (deploy/run-lab), "
                             "instead of --listen")
                   ->check(CLI::Range(3, 1 << 20));
+  app.add_option("--allow-host", o.server.allow_hosts,
+                 "a name the pages may be asked for beside IP addresses, localhost and this PC's name (repeat for "
+                 "more): a lab that reaches the page as http://lab-pc.school.example:8080/ gives that name; any other "
+                 "Host is refused (421), so a page elsewhere cannot read the lab's data through a student's browser");
   app.add_option("--bench-config", bench_configs,
                  "bench TOML file(s) or a directory of them (/etc/spindown/benches): those benches have a tile from "
                  "the start, silent until heard");

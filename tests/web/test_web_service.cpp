@@ -41,7 +41,10 @@ struct Served {
     o.server.host = "127.0.0.1";
     o.server.port = 0;
     service = std::make_unique<WebService>(std::move(o));
-    server = std::make_unique<WebServer>(service->lab(), service->mutex(), service->fanout(), WebServerOptions{"127.0.0.1", 0});
+    WebServerOptions so;
+    so.host = "127.0.0.1";
+    so.port = 0;
+    server = std::make_unique<WebServer>(service->lab(), service->mutex(), service->fanout(), so);
     std::string why;
     EXPECT_TRUE(server->bind(&why)) << why;
     server->start();
@@ -221,6 +224,36 @@ TEST(WebService, ARefusedOrBrokenMessageIsNeverShown) {
   EXPECT_EQ(st["lab"]["refused_messages"], 1);
   EXPECT_NE(st["lab"]["last_refused"].get<std::string>().find("not signed"), std::string::npos);
   EXPECT_EQ(st["lab"]["bad_messages"], 1);
+}
+
+// DNS rebinding: a page elsewhere whose name resolves to this PC asks with its own Host. Only IP
+// literals, localhost, this PC's name and --allow-host names are served; others get 421 and no
+// data. A class opening the page at once finds room in the accept queue (not cpp-httplib's 5).
+TEST(WebService, OnlyThisServersNamesAreServed) {
+  EXPECT_TRUE(host_allowed("127.0.0.1:8080", {}));
+  EXPECT_TRUE(host_allowed("10.44.0.5", {}));
+  EXPECT_TRUE(host_allowed("[::1]:8080", {}));
+  EXPECT_TRUE(host_allowed("LocalHost:8080", {}));
+  EXPECT_TRUE(host_allowed("", {}));
+  EXPECT_TRUE(host_allowed("lab-pc.school.example:8080", {"Lab-PC.school.example"}));
+  EXPECT_FALSE(host_allowed("attacker.example", {}));
+  EXPECT_FALSE(host_allowed("127.0.0.1.attacker.example:8080", {}));
+  EXPECT_FALSE(host_allowed("localhost.attacker.example", {}));
+  EXPECT_FALSE(host_allowed("[not-an-address]:80", {}));
+
+  Served s;
+  auto c = s.client();
+  auto ok = c.Get("/api/state");
+  ASSERT_TRUE(ok);
+  EXPECT_EQ(ok->status, 200);
+  httplib::Headers evil{{"Host", "attacker.example:8080"}};
+  for (const char* path : {"/", "/api/state", "/bench/b1"}) {
+    auto refused = c.Get(path, evil);
+    ASSERT_TRUE(refused) << path;
+    EXPECT_EQ(refused->status, 421) << path;
+    EXPECT_NE(refused->body.find("--allow-host attacker.example"), std::string::npos) << refused->body;
+    EXPECT_EQ(refused->body.find("{"), std::string::npos) << "no data: " << refused->body;
+  }
 }
 
 TEST(WebService, ListenAddresses) {

@@ -85,18 +85,41 @@ const spindown = (() => {
   }
 
   // The live stream: handlers.snapshot/bench/samples/detail/roster/lab(data). Reconnects by
-  // itself (EventSource), and after a refusal (503: too many pages) every 5 s.
+  // itself (EventSource), and after a refusal (503: too many pages) every 5 s. The server sends
+  // something (an event, else a "tick") at least every 2 s: heard nothing for 6 s, the page says
+  // it is stale and for how long, whatever the socket claims (a frozen server, a network gone).
   function live(bench, handlers) {
     const url = "/events" + (bench ? "?bench=" + encodeURIComponent(bench) : "");
     let source = null;
+    let heard = Date.now();
+    let stale = false;
     const status = document.getElementById("connection");
     const connected = (yes, text) => {
       document.body.setAttribute("data-connected", yes ? "true" : "false");
       if (status) status.textContent = text;
     };
+    const fresh = () => {
+      heard = Date.now();
+      if (stale) {
+        stale = false;
+        document.body.removeAttribute("data-stale");
+        connected(true, "live");
+      }
+    };
+    setInterval(() => {
+      const quiet = (Date.now() - heard) / 1000;
+      if (quiet < 6) return;
+      stale = true;
+      document.body.setAttribute("data-stale", "true");
+      connected(false, `stale: nothing heard from spindown-web for ${Math.round(quiet)} s — what is shown may be old`);
+    }, 1000);
     const open = () => {
       source = new EventSource(url);
-      source.onopen = () => connected(true, "live");
+      source.onopen = () => {
+        fresh();
+        connected(true, "live");
+      };
+      source.addEventListener("tick", fresh);
       source.onerror = () => {
         connected(false, "reconnecting…");
         if (source.readyState === EventSource.CLOSED) {
@@ -106,6 +129,7 @@ const spindown = (() => {
       };
       for (const name of ["snapshot", "bench", "samples", "detail", "roster", "lab"]) {
         source.addEventListener(name, (ev) => {
+          fresh();
           if (!handlers[name]) return;
           let data;
           try {

@@ -6,9 +6,15 @@
 #include <fmt/format.h>
 #include <thread>
 
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+
 #include <arpa/inet.h>
+#include <netdb.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
+#include <unistd.h>
 
 #include <httplib.h>
 
@@ -76,6 +82,45 @@ bool listening_address(int fd, std::string& host, int& port) {
   return true;
 }
 
+// A listening TCP socket on host:port (port 0: any) with its own backlog (cpp-httplib's is 5: a
+// class opening the page at once found the queue full); -1 and *why when it cannot be had.
+int open_listening_socket(const std::string& host, int port, int backlog, std::string* why) {
+  addrinfo hints{};
+  hints.ai_family = AF_UNSPEC;
+  hints.ai_socktype = SOCK_STREAM;
+  hints.ai_flags = AI_PASSIVE | AI_NUMERICSERV;
+  addrinfo* found = nullptr;
+  const std::string service = std::to_string(port);
+  std::string h = host;
+  if (h.size() > 2 && h.front() == '[' && h.back() == ']') h = h.substr(1, h.size() - 2);
+  if (const int rc = ::getaddrinfo(h.empty() ? nullptr : h.c_str(), service.c_str(), &hints, &found); rc != 0) {
+    if (why) *why = fmt::format("cannot listen on {}:{}: {}", host, port, ::gai_strerror(rc));
+    return -1;
+  }
+  int fd = -1;
+  std::string last = "no address";
+  for (addrinfo* a = found; a && fd < 0; a = a->ai_next) {
+    fd = ::socket(a->ai_family, a->ai_socktype | SOCK_CLOEXEC, a->ai_protocol);
+    if (fd < 0) continue;
+    const int one = 1;
+    ::setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof one);
+    if (::bind(fd, a->ai_addr, a->ai_addrlen) != 0 || ::listen(fd, backlog) != 0) {
+      last = std::strerror(errno);
+      ::close(fd);
+      fd = -1;
+    }
+  }
+  ::freeaddrinfo(found);
+  if (fd < 0 && why)
+    *why = fmt::format("cannot listen on {}:{} ({}: in use, or not an address of this host)", host, port, last);
+  return fd;
+}
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c);
+  return s;
+}
+
 }  // namespace
 
 bool parse_listen_address(std::string_view text, std::string& host, int& port, std::string* why) {
@@ -92,6 +137,31 @@ bool parse_listen_address(std::string_view text, std::string& host, int& port, s
   host = std::string(h);
   port = value;
   return true;
+}
+
+bool host_allowed(std::string_view host_header, const std::vector<std::string>& allowed) {
+  std::string_view h = host_header;
+  while (!h.empty() && (h.back() == ' ' || h.back() == '\t')) h.remove_suffix(1);
+  while (!h.empty() && (h.front() == ' ' || h.front() == '\t')) h.remove_prefix(1);
+  if (h.empty()) return true;  // HTTP/1.0: no name to check
+  if (h.front() == '[') {      // [v6]:port
+    const auto close = h.find(']');
+    if (close == std::string_view::npos) return false;
+    const std::string v6(h.substr(1, close - 1));
+    in6_addr a6{};
+    return ::inet_pton(AF_INET6, v6.c_str(), &a6) == 1;
+  }
+  const auto colon = h.rfind(':');
+  std::string name = lower(std::string(colon == std::string_view::npos ? h : h.substr(0, colon)));
+  if (!name.empty() && name.back() == '.') name.pop_back();  // "localhost." is localhost
+  in_addr a4{};
+  if (::inet_pton(AF_INET, name.c_str(), &a4) == 1 || name == "localhost") return true;
+  char self[256] = {};
+  if (::gethostname(self, sizeof self - 1) == 0 && self[0]) {
+    const std::string me = lower(self);
+    if (name == me || name == me + ".local") return true;
+  }
+  return std::any_of(allowed.begin(), allowed.end(), [&](const std::string& a) { return lower(a) == name; });
 }
 
 // cpp-httplib's server, able to serve on a listening socket it did not open (one inherited from
@@ -131,9 +201,18 @@ void WebServer::Impl::routes() {
   server.set_default_headers({{"Content-Security-Policy", content_security_policy},
                               {"X-Content-Type-Options", "nosniff"},
                               {"Referrer-Policy", "no-referrer"}});
-  server.set_pre_routing_handler([this](const httplib::Request&, httplib::Response&) {
+  server.set_pre_routing_handler([this](const httplib::Request& req, httplib::Response& res) {
     ++requests;
-    return httplib::Server::HandlerResponse::Unhandled;
+    const std::string host = req.get_header_value("Host");
+    if (host_allowed(host, opt.allow_hosts)) return httplib::Server::HandlerResponse::Unhandled;
+    res.status = 421;  // Misdirected Request: not this server's name
+    const std::string name = host.substr(0, std::min<std::size_t>(host.rfind(':'), 100));
+    res.set_content(fmt::format("spindown-web: the page was asked for as '{}', which is not this PC's name; if the "
+                                "lab reaches it by that name, start spindown-web with --allow-host {} (a page "
+                                "elsewhere whose name resolves here may not read the lab's data)\n",
+                                host.substr(0, 100), name),
+                    "text/plain; charset=utf-8");
+    return httplib::Server::HandlerResponse::Handled;
   });
   server.set_error_handler([](const httplib::Request& req, httplib::Response& res) {
     if (!res.body.empty()) return;
@@ -204,7 +283,8 @@ void WebServer::Impl::routes() {
 }
 
 // One page's event stream: its snapshot, then what changes; a page that fell behind gets a new
-// snapshot; a comment every keepalive_s when nothing happens (a dead page's socket then fails).
+// snapshot; a "tick" every keepalive_s when nothing happens (the page knows the stream is alive;
+// a dead page's socket fails).
 void WebServer::Impl::events(const httplib::Request& req, httplib::Response& res) {
   const std::string bench = req.get_param_value("bench");
   std::string why;
@@ -244,7 +324,7 @@ void WebServer::Impl::events(const httplib::Request& req, httplib::Response& res
             fanout.resync(client, lab.snapshot_event(*b, wall_us()));
             return true;
           }
-          case EventFanout::Next::idle: out = ": keep-alive\n\n"; break;
+          case EventFanout::Next::idle: out = fmt::format("event: tick\ndata: {}\n\n", wall_us()); break;
           case EventFanout::Next::events: break;
         }
         return sink.write(out.data(), out.size());
@@ -269,17 +349,15 @@ bool WebServer::bind(std::string* why) {
     impl_->server.adopt(impl_->opt.listen_fd);
     return true;
   }
-  if (impl_->opt.port == 0) {
-    impl_->port = impl_->server.bind_to_any_port(impl_->opt.host);
-  } else {
-    impl_->port = impl_->server.bind_to_port(impl_->opt.host, impl_->opt.port) ? impl_->opt.port : -1;
-  }
-  if (impl_->port < 0) {
-    if (why)
-      *why = fmt::format("cannot listen on {}:{} (in use, or not an address of this host)", impl_->opt.host,
-                         impl_->opt.port);
+  const int fd = open_listening_socket(impl_->opt.host, impl_->opt.port, impl_->opt.backlog, why);
+  if (fd < 0) return false;
+  std::string bound_host;
+  if (!listening_address(fd, bound_host, impl_->port)) {
+    ::close(fd);
+    if (why) *why = fmt::format("cannot listen on {}:{}", impl_->opt.host, impl_->opt.port);
     return false;
   }
+  impl_->server.adopt(fd);
   return true;
 }
 

@@ -16,6 +16,7 @@
 #include <memory>
 #include <mutex>
 #include <string>
+#include <vector>
 #include <string_view>
 
 #include "spindown/event_fanout.hpp"
@@ -29,8 +30,19 @@ struct WebServerOptions {
   int listen_fd = -1;            // >= 0: serve on this listening socket, inherited (host and port unused)
   std::size_t spare_threads = 16;  // beside one per event stream, for pages, JSON and assets
   double write_timeout_s = 5;    // a page that takes no bytes this long is dropped
-  double keepalive_s = 15;       // a comment on an idle event stream this often (finds dead pages)
+  // A "tick" event on an idle event stream this often: the page calls itself stale when it hears
+  // nothing for three of them, and a dead page's socket fails.
+  double keepalive_s = 2;
+  int backlog = 128;             // connections waiting to be accepted (a class opening the page at once)
+  // Host names the pages may be asked for beside IP literals, "localhost" and this PC's own name
+  // (--allow-host): any other Host header is refused (421), so a web page elsewhere whose name
+  // resolves to this PC (DNS rebinding) cannot read the lab's data in a student's browser.
+  std::vector<std::string> allow_hosts;
 };
+
+// Whether a request's Host header names this server: empty (HTTP/1.0), an IP literal (with or
+// without a port), "localhost", this PC's host name (also with ".local"), or one of allowed.
+bool host_allowed(std::string_view host_header, const std::vector<std::string>& allowed);
 
 // "ADDR:PORT" → host and port: "0.0.0.0:8080", "192.168.1.10:80", "[::]:8080", "localhost:8080".
 bool parse_listen_address(std::string_view text, std::string& host, int& port, std::string* why = nullptr);
