@@ -1,5 +1,6 @@
 // spindown::SerialBridge driven directly: bytes in, samples_t/config_t/status_t out.
 #include <gtest/gtest.h>
+#include <fmt/format.h>
 
 #include <cmath>
 #include <cstdio>
@@ -461,4 +462,19 @@ TEST(BridgeLogic, SerialPlotterLabelsAreReadAsFitReadsThem) {
     bytes += line;
   }
   expect_bridge_reads_as_fit(bytes, 60);
+}
+
+// spindown-v1's port with lines broken on the wire ("12,345678,512*3F" without its "S,"): never
+// taken for a sketch's table; the protocol stays spindown-v1.
+TEST(BridgeLogic, BrokenSpindownLinesAreNoTable) {
+  CaptureSink sink;
+  BridgeSettings s = settings();
+  s.baud = 115200;
+  SerialBridge b(s, sink);
+  b.start(T0);
+  b.connected(T0);
+  b.feed("# spindown-coast v1 adc_bits=10 vref=5.000\r\n", T0);
+  for (int i = 0; i < 12; ++i) b.feed(fmt::format("{},{},{}*3F\r\n", i, 1000 + 2000 * i, 512 - i), T0 + i);
+  EXPECT_NE(b.protocol(), WireProtocol::lab);
+  EXPECT_TRUE(sink.flat().empty());
 }

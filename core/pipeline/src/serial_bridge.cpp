@@ -207,6 +207,11 @@ constexpr std::size_t layout_lines = 8;
 
 void SerialBridge::hold_for_layout(std::string_view text, std::int64_t now_us) {
   bad_line(text, parse_lab_line(text).why, now_us);  // said at once; taken back if a layout reads it
+  // spindown-v1's port (its lines end in a checksum, "*3F"): a broken line of it is no table.
+  if (protocol_ == WireProtocol::spindown_v1 || text.find('*') != std::string_view::npos) {
+    held_.clear();
+    return;
+  }
   held_.push_back({std::string(text), now_us, lines_seen_});
   if (held_.size() >= layout_lines) learn_layout(now_us);
 }

@@ -552,8 +552,10 @@ struct SampleStream {
   template <class Message, class Sink>
   bool take_over(Other& o, const Message& m, std::size_t n, std::int64_t recv_us, Sink& sink) {
     if (jump_.active) adopt_jump(recv_us, sink);
+    if (starting_) begin_stream(std::numeric_limits<std::int64_t>::max(), sink);  // the old one's start
     release_waiting(std::numeric_limits<std::int64_t>::max(), sink);  // the old stream's, to its end
     waiting_.clear();  // and its losses: the new source numbers its own
+    starting_ = false;
     sink.problem(SampleProblem::new_source, 0,
                  fmt::format("a new source: {} after {} went quiet {:.1f} s ago (the bridge restarted or the board was "
                              "replugged); a new stream starts here and no run spans it",
