@@ -161,6 +161,22 @@ std::size_t count_bytes_literals(std::string_view text, std::size_t* lines) {
   return n;
 }
 
+// Each line of text given to f(line, out), which appends its new text to out and returns true,
+// or false to keep the line as it is; line ends stay where they were. How many f rewrote.
+template <class F>
+std::size_t rewrite_lines(std::string& text, F&& f) {
+  std::string out;
+  out.reserve(text.size());
+  std::size_t rewritten = 0;
+  each_line(text, text.size(), [&](std::string_view line, std::size_t pos) {
+    if (f(line, out)) ++rewritten;
+    else out.append(line);
+    if (pos + line.size() < text.size()) out += '\n';
+  });
+  text.swap(out);
+  return rewritten;
+}
+
 bool plotter_lines_to_unlabel(std::string_view text) {
   std::size_t lines = 0, labelled = 0;
   each_line(text, head_bytes, [&](std::string_view line, std::size_t) {
@@ -238,41 +254,27 @@ std::vector<std::string> repair_text(std::string& text) {
     if (std::string note = decoding_note(g); !note.empty()) notes.push_back(std::move(note));
   }
   if (bytes_literals_to_unwrap(text)) {
-    std::string out, content;
-    out.reserve(text.size());
-    std::size_t unwrapped = 0;
-    each_line(text, text.size(), [&](std::string_view line, std::size_t pos) {
-      if (bytes_literal(line, &content)) {
-        out += content;
-        ++unwrapped;
-      } else {
-        out.append(line);
-      }
-      if (pos + line.size() < text.size()) out += '\n';
+    std::string content;
+    const std::size_t unwrapped = rewrite_lines(text, [&](std::string_view line, std::string& out) {
+      if (!bytes_literal(line, &content)) return false;
+      out += content;
+      return true;
     });
-    text.swap(out);
     notes.push_back(fmt::format("Python bytes literals (b'5234\\t2.80\\r\\n', as print(ser.readline()) of a pyserial "
                                 "script writes them) unwrapped in {} lines",
                                 unwrapped));
   }
   if (plotter_lines_to_unlabel(text)) {
-    std::string out, labels, values, header;
-    out.reserve(text.size());
-    std::size_t unlabelled = 0;
-    each_line(text, text.size(), [&](std::string_view line, std::size_t pos) {
-      if (plotter_labels(line, &labels, &values)) {
-        if (header.empty()) {  // the labels once, as the header the values are read under
-          header = labels;
-          out += header + '\n';
-        }
-        out += values;
-        ++unlabelled;
-      } else {
-        out.append(line);
+    std::string labels, values, header;
+    const std::size_t unlabelled = rewrite_lines(text, [&](std::string_view line, std::string& out) {
+      if (!plotter_labels(line, &labels, &values)) return false;
+      if (header.empty()) {  // the labels once, as the header the values are read under
+        header = labels;
+        out += header + '\n';
       }
-      if (pos + line.size() < text.size()) out += '\n';
+      out += values;
+      return true;
     });
-    text.swap(out);
     notes.push_back(fmt::format("the Serial Plotter's labelled values (\"{}:…\") in {} lines: read as a table with "
                                 "columns {} (its header put above them: later line numbers count one more than the "
                                 "file's)",
