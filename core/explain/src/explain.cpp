@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "explain_residuals.hpp"
+#include "spindown/fit_checks.hpp"
 #include "spindown/reading_noise.hpp"
 
 namespace spindown {
@@ -62,6 +63,8 @@ class Explainer {
   void try_candidates(ExplainStep& st) const;
   double effective_n(const ExplainStep& st) const;
   void rule_out_impossible(ExplainStep& st) const;
+  std::string unresolved(const CandidateTrial& t, double n_eff) const;
+  bool beyond_rounding(const EffectFit& f, double n_eff, std::string* said) const;
   CandidateTrial* score(ExplainStep& st, const ResidualBins& bins, double mass, double n_eff) const;
   CandidateTrial* look_ahead(ExplainStep& st, CandidateTrial* best, const ResidualBins& bins, double n_eff);
   std::vector<CandidateTrial*> twins_of(ExplainStep& st, CandidateTrial*& best) const;
@@ -209,14 +212,18 @@ bool Explainer::step(int number) {
   if (where.empty() && mass_significant(mass, bins.mean.size()))
     // Spread out rather than concentrated: show where it is largest at a lower threshold.
     where = locate(bins, bins.bin_se, 0.6 * opt_.systematic_z, out_.tau, res, speed_, run_.t_cut_s);
-  if (where.empty() && !mass_significant(mass, bins.mean.size()) && !pending_) {
+  // No stretch stands out and the bins together look like noise: the candidates are still tried,
+  // and one is added only on its own evidence (a short coast's bend spans a few bins, whose jumps
+  // are the misfit itself and pass for the bins' noise).
+  const bool quiet = where.empty() && !mass_significant(mass, bins.mean.size()) && !pending_;
+  const auto nothing_remains = [&] {
     out_.remaining = where;
     out_.conclusion = fmt::format(
         "nothing significant remains: no {:.2g}-s stretch of the residual is beyond {:.0f}x a bin's noise ({:.2g} {}), "
         "and the bins together are consistent with noise",
         double(m_) * period_, opt_.systematic_z, bins.bin_se, out_.unit);
     return false;
-  }
+  };
   if (number >= opt_.max_steps) {
     out_.remaining = where;
     out_.conclusion = fmt::format("stopped after {} added effects; disagreement remains", number);
@@ -228,6 +235,7 @@ bool Explainer::step(int number) {
   st.bin_noise = bins.bin_se;
   st.where = where;
   try_candidates(st);
+  if (quiet && st.trials.empty()) return nothing_remains();
   if (st.trials.empty()) {
     out_.remaining = where;
     out_.conclusion = "disagreement remains, but every candidate effect is already in the model";
@@ -257,8 +265,13 @@ bool Explainer::step(int number) {
   // its second on the step's own BIC.
   const bool enough =
       best && (pending_ || (best->delta_bic > opt_.min_delta_bic &&
-                            (forced || (best->systematic_after < max_left && best->change >= 0.5 * quantum_))));
+                            (forced || (best->systematic_after < max_left && best->unresolved.empty()))));
   if (!enough) pending_ = nullptr;
+  if (quiet && !enough) return nothing_remains();
+  if (quiet)
+    st.overall = fmt::format("no {:.2g}-s stretch stands out beyond {:.0f}x a bin's noise ({:.2g} {}), but a "
+                             "candidate fits the whole run better on its own evidence",
+                             double(m_) * period_, opt_.systematic_z, bins.bin_se, out_.unit);
   write_verdicts(st, best, twins, enough);
   if (!enough) {
     out_.remaining = where;
@@ -315,6 +328,49 @@ void Explainer::rule_out_impossible(ExplainStep& st) const {
   }
 }
 
+// Whether the readings resolve a change from the current model to f beyond rounding: a change of
+// half a reading step somewhere, or, smaller, evidence (effective-sample BIC, as a step needs)
+// from the bins where rounding is noise alone (evidence_beyond_rounding). *said: what was measured.
+bool Explainer::beyond_rounding(const EffectFit& f, double n_eff, std::string* said) const {
+  const double change = largest_change(current_, f, m_);
+  if (change >= 0.5 * quantum_) return true;
+  const RoundingFree ev = evidence_beyond_rounding(out_.y, out_.weight, current_, f, m_, quantum_, out_.reading_noise);
+  const double scale = n_ > 0 ? n_eff / static_cast<double>(n_) : 1.0;
+  const int extra = static_cast<int>(f.theta.size()) - static_cast<int>(current_.theta.size());
+  const double evidence = ev.chi2_drop * scale - extra * std::log(std::max(scale * double(ev.samples), 2.0));
+  if (ev.samples > 0 && evidence > opt_.min_delta_bic) return true;
+  if (said)
+    *said = ev.samples == 0
+                ? fmt::format("changes the model by {:.2g} {} at most, less than half the reading's resolution {:.2g} {}, "
+                              "and the readings dwell on each step (rounding's error is not noise there)",
+                              change, out_.unit, quantum_, out_.unit)
+                : fmt::format("changes the model by {:.2g} {} at most, less than half the reading's resolution {:.2g} {}, "
+                              "and where the readings move a step a sample and rounding is noise ({} samples) the "
+                              "evidence is {:.1f}",
+                              change, out_.unit, quantum_, out_.unit, ev.samples, evidence);
+  return false;
+}
+
+// Why the readings cannot tell a trial's change from their own artefacts, "" when they can:
+// rounding (beyond_rounding), or dry friction beside viscous that only acts like an offset of the
+// coast's tail within a converter's own (spindown fit's rule, check_fit: 2 reading steps or 0.2 %
+// of the reading at the cut).
+std::string Explainer::unresolved(const CandidateTrial& t, double n_eff) const {
+  std::string said;
+  if (!beyond_rounding(t.fit, n_eff, &said)) return said;
+  const Parameter* dry = t.fit.param("c4");
+  const Parameter* viscous = t.fit.param("c3");
+  if (t.effect == "coulomb" && dry && viscous && viscous->value > 0) {
+    const double offset = std::abs(k_ * dry->value / viscous->value);
+    const double allowed = std::max(2.0 * quantum_, offset_allowance_fraction * std::abs(k_ * t.fit.omega0));
+    if (offset <= allowed)
+      return fmt::format("its dry friction acts like an offset of {:.2g} {} at the coast's end, within what a sensor "
+                         "offset imitates (±{:.2g} {}: 2 reading steps or 0.2 % of the reading at the cut)",
+                         offset, out_.unit, allowed, out_.unit);
+  }
+  return {};
+}
+
 // Each trial's evidence (BIC at the effective sample size), the disagreement it leaves and how
 // far it moves the model; the best possible one by BIC.
 CandidateTrial* Explainer::score(ExplainStep& st, const ResidualBins& bins, double mass, double n_eff) const {
@@ -330,6 +386,7 @@ CandidateTrial* Explainer::score(ExplainStep& st, const ResidualBins& bins, doub
     const ResidualBins tb = bin_residuals(residual_of(out_.y, t.fit), m_, out_.reading_noise);
     t.systematic_after = mass > 0 ? systematic_mass(tb, bins.bin_se) / mass : 0.0;
     t.change = largest_change(current_, t.fit, m_);
+    t.unresolved = unresolved(t, n_eff);
     if (t.impossible.empty() && (!best || t.delta_bic > best->delta_bic)) best = &t;
   }
   return best;
@@ -367,7 +424,7 @@ CandidateTrial* Explainer::look_ahead(ExplainStep& st, CandidateTrial* best, con
       const double d = n_eff * std::log(current_.sse / f.sse) - extra * std::log(n_eff);
       const double margin = more ? opt_.min_delta_bic : 3.0;
       if (d > best->delta_bic + margin && d - std::max(a.delta_bic, b.delta_bic) > opt_.min_delta_bic &&
-          largest_change(current_, f, m_) >= 0.5 * quantum_)
+          beyond_rounding(f, n_eff, nullptr))
         pairs.push_back({&a, &b, d, f.theta.size()});
     }
   const Pair* chosen = nullptr;
@@ -395,7 +452,7 @@ std::vector<CandidateTrial*> Explainer::twins_of(ExplainStep& st, CandidateTrial
   for (auto& t : st.trials)
     if (&t != best && t.impossible.empty() && std::isfinite(t.delta_bic) &&
         std::abs(t.delta_bic - best->delta_bic) < 3 && t.fit.theta.size() == best->fit.theta.size() &&
-        t.systematic_after < max_left && t.change >= 0.5 * quantum_)
+        t.systematic_after < max_left && t.unresolved.empty())
       twins.push_back(&t);
   if (twins.empty()) return twins;
   const auto rank = [](const CandidateTrial* t) {
@@ -430,10 +487,8 @@ void Explainer::write_verdicts(ExplainStep& st, const CandidateTrial* best, cons
                                                  unit, t.delta_bic)
                                    : fmt::format("too little evidence (dBIC {:.1f} < {:.0f}, RMSE {:.4g} {})",
                                                  t.delta_bic, opt_.min_delta_bic, t.fit.rmse, unit);
-    else if (t.change < 0.5 * quantum_)
-      t.verdict = fmt::format("changes the model by {:.2g} {} at most, less than half the reading's resolution {:.2g} {} "
-                              "(dBIC {:.1f})",
-                              t.change, unit, quantum_, unit, t.delta_bic);
+    else if (!t.unresolved.empty())
+      t.verdict = fmt::format("{} (dBIC {:.1f})", t.unresolved, t.delta_bic);
     else if (t.systematic_after >= max_left)
       t.verdict = fmt::format("fits the noise, not the disagreement ({:.0f}% of it left, dBIC {:.1f})",
                               100 * t.systematic_after, t.delta_bic);

@@ -104,6 +104,36 @@ double largest_change(const EffectFit& a, const EffectFit& b, std::size_t m) {
   return worst;
 }
 
+RoundingFree evidence_beyond_rounding(std::span<const double> y, std::span<const double> weight, const EffectFit& a,
+                                      const EffectFit& b, std::size_t m, double q, double sigma) {
+  RoundingFree out;
+  const std::size_t n = std::min({a.simulated.size(), b.simulated.size(), y.size()});
+  if (!(sigma > 0)) return out;
+  // Σw, Σw·r and Σw·r² of each model's residual over the bins where rounding is noise.
+  double sw = 0, sa = 0, sb = 0, saa = 0, sbb = 0;
+  for (std::size_t i = 0; i < n; i += m) {
+    const std::size_t e = std::min(i + m, n);
+    std::size_t stepping = 0;  // samples that moved a step or more from the one before
+    for (std::size_t j = i + 1; j < e; ++j) stepping += std::abs(y[j] - y[j - 1]) >= q * (1 - 1e-9);
+    if (2 * stepping < e - i) continue;  // dwells: rounding's error there is deterministic
+    for (std::size_t j = i; j < e; ++j) {
+      const double w = j < weight.size() ? weight[j] : 1.0;
+      const double ra = y[j] - a.simulated[j], rb = y[j] - b.simulated[j];
+      sw += w, sa += w * ra, sb += w * rb, saa += w * ra * ra, sbb += w * rb * rb;
+    }
+    out.samples += e - i;
+  }
+  if (!(sw > 0)) return out;
+  // A converter that truncates reads up to a step low while it dithers: a shift of each
+  // residual, up to half a step, is the converter's, not the model's.
+  const auto left = [&](double s, double ss) {
+    const double shift = std::clamp(s / sw, -0.5 * q, 0.5 * q);
+    return ss - 2 * shift * s + shift * shift * sw;
+  };
+  out.chi2_drop = (left(sa, saa) - left(sb, sbb)) / (sigma * sigma);
+  return out;
+}
+
 bool contains(const std::vector<const Effect*>& v, const Effect* e) {
   return std::find(v.begin(), v.end(), e) != v.end();
 }

@@ -29,6 +29,19 @@ std::vector<Disagreement> locate(const ResidualBins& b, double bin_se, double z_
 double reading_quantum(std::span<const double> y);
 // Largest change (bin means of m samples) a candidate makes to the current model's simulation.
 double largest_change(const EffectFit& a, const EffectFit& b, std::size_t m);
+// Rounding to the reading's step q is noise only where the readings cross steps at unrelated
+// phases: in bins where most samples moved a step or more from the one before (a fast coast, or
+// noise that dithers). Where they dwell (a staircase, or a converter's step printed at two
+// decimals beating with the print's) its error is deterministic, speed-dependent, up to half a
+// step, and a model can fit it. How much better b fits than a over the bins where rounding is
+// noise: the drop in Σ w·r²/σ² there, each residual less its own mean up to half a step (a
+// truncating converter's bias while it dithers), and how many samples those bins hold.
+struct RoundingFree {
+  double chi2_drop = 0;
+  std::size_t samples = 0;
+};
+RoundingFree evidence_beyond_rounding(std::span<const double> y, std::span<const double> weight, const EffectFit& a,
+                                      const EffectFit& b, std::size_t m, double q, double sigma);
 bool contains(const std::vector<const Effect*>& v, const Effect* e);
 // The model plus one effect, in library order (so names and parameters read the same way).
 std::vector<const Effect*> with_effect(const std::vector<const Effect*>& model, const Effect* e);

@@ -119,6 +119,7 @@ ExplainJson explain_run_json(const ExplainResult& r, std::string_view bench, con
                      {"rmse_before", number(s.rmse_before)},
                      {"rmse_after", number(s.rmse_after)},
                      {"where", where_json(s.where)},
+                     {"overall", s.overall},
                      {"why", s.why},
                      {"meaning", s.meaning},
                      {"signature", s.signature},
@@ -212,6 +213,7 @@ std::string format_explain(const ExplainResult& r, std::string_view bench, const
     }
     out += fmt::format("\n  step {}: where the model and the data disagree ({})\n", number, bin_noise_text(r, s.bin_noise));
     out += where_text(s.where, u, "    ");
+    if (!s.overall.empty()) out += fmt::format("    {}\n", s.overall);
     const Effect* e = find_effect(s.added);
     out += fmt::format("  missing effect: {}", s.added);
     if (e)

@@ -64,6 +64,7 @@ struct CandidateTrial {
   double delta_bic = 0;       // effective-sample BIC improvement over the current model (> 0 better)
   double systematic_after = 0;  // share of the systematic disagreement left (binned chi-square excess)
   double change = 0;            // largest change it makes to the model (bin means, reading unit)
+  std::string unresolved;       // why the readings cannot tell its change from their own artefacts ("" when they can)
   std::string verdict;        // "added", or why it was rejected
   std::string impossible;     // why its fitted numbers cannot be physical ("" when they can)
 };
@@ -75,6 +76,7 @@ struct ExplainStep {
   double rmse_before = 0, rmse_after = 0;
   double bin_noise = 0;             // noise SE of a bin mean in the residual before the step
   std::vector<Disagreement> where;  // before the step
+  std::string overall;              // when no stretch stands out: the residual's spread against the noise
   std::vector<CandidateTrial> trials;
   std::string why;
   // Effects added earlier that the new one made unnecessary (backward check after each step).
