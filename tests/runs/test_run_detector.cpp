@@ -284,3 +284,32 @@ TEST(RunDetector, PeriodIsTheMedianOfAllCoastPeriods) {
     }
   }
 }
+
+// Issue 41 (a real 200 W dyno, pgrady3/dev 20V200W_wspindown): the speed read 0 rpm, then 12.56 a
+// sample later, fell for 1.35 s under 3–8 A and rose into the real spin-up. A speed sensor reads
+// the motor at rest: no spin-up, no cut, no standstill — not a run. A back-EMF reading of the same
+// shape is the handout's A0 connected after the cut and a coast cut short by the power: a run.
+TEST(RunDetector, ASpeedSensorsStepFromRestThatRisesAgainIsNoRunButABackEmfPinsIs) {
+  const auto recording = [](Quantity q) {
+    Recording rec;
+    rec.quantity = q;
+    double t = 0;
+    const auto at = [&](double v) { rec.push(t, v), t += 0.02; };
+    for (int k = 0; k < 200; ++k) at(0.0);
+    for (int k = 0; k < 67; ++k) at(std::round(100 * 12.56 * std::exp(-0.18 * 0.02 * k)) / 100);  // the blip
+    std::uint32_t seed = 7;
+    const auto noise = [&] { return (seed = seed * 1664525u + 1013904223u) / 4294967296.0 - 0.5; };
+    for (int k = 0; k < 400; ++k) at(1041.0 - 996.0 * std::exp(-0.02 * k / 1.5) + noise());  // spin-up, held
+    for (int k = 0; k < 1500; ++k) at(std::max(0.0, std::round(100 * (1041.0 - 1.4 * k + noise())) / 100));  // coast
+    for (int k = 0; k < 200; ++k) at(0.0);
+    return rec;
+  };
+  const Segmentation speed = find_runs(recording(Quantity::rpm));
+  ASSERT_EQ(speed.runs.size(), 1u);
+  EXPECT_NEAR(speed.runs[0].t_cut_s, 0.02 * 666.5, 0.05);
+  bool said = false;
+  for (const auto& d : speed.diagnostics) said = said || d.message.find("read the motor at rest") != std::string::npos;
+  EXPECT_TRUE(said);
+  const Segmentation volts = find_runs(recording(Quantity::back_emf_volts));
+  EXPECT_EQ(volts.runs.size(), 2u);
+}

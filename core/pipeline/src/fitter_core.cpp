@@ -399,6 +399,7 @@ void FitterCore::restart_clock(Bench& b, std::int64_t recv_utime) {
   if (b.pending_restart) restart_clock(b, recv_utime);
   if (!b.sampled) [[unlikely]] {  // its first sample: one flag on the hot path, not a call
     b.sampled = true;
+    b.detector.set_quantity(b.stream.quantity);
     if (seq > 0) b.detector.joined_stream();  // the bridge's stream began before this fitter heard it
   }
   ++counters_.samples;

@@ -950,6 +950,7 @@ void RunDetector::new_source(const std::string& why) { impl_->new_source(why); }
 void RunDetector::finish() { impl_->finish(); }
 void RunDetector::went_silent(double silent_s) { impl_->went_silent(silent_s); }
 void RunDetector::joined_stream() { impl_->joined_stream(); }
+void RunDetector::set_quantity(Quantity q) { impl_->set_quantity(q); }
 std::vector<RunEvent> RunDetector::take_events() { return impl_->take_events(); }
 bool RunDetector::has_events() const { return impl_->has_events(); }
 RunDetector::State RunDetector::state() const { return impl_->state(); }

@@ -38,6 +38,7 @@ class RunDetector::Impl {
   void finish();
   void went_silent(double silent_s);
   void joined_stream() { joined_stream_ = true; }
+  void set_quantity(Quantity q) { speed_reading_ = q != Quantity::back_emf_volts; }
   std::vector<RunEvent> take_events();
   bool has_events() const { return !events_.empty(); }
   State state() const { return state_; }
@@ -424,6 +425,7 @@ class RunDetector::Impl {
   double tail_until_s_ = 0;   // the tail ends then (t_stop + tail_s, longer on floor_doubt_)
   double stop_approach_t_ = 0;  // found_standstill's approach t-value of the run's standstill
   double stop_floor_t_ = 0;     // … and the t-value of the rate it met its floor at (floor_rate_t)
+  bool speed_reading_ = false;        // a speed sensor's reading (set_quantity): its zeros are the motor at rest
   bool restarted_mid_coast_ = false;  // the clock restarted while a coast was open: its rest is a fragment
   bool joined_stream_ = false;        // the samples began part-way into a stream (joined_stream())
   // A coast closed by went_silent(): until the reading rises above silence_level_ +

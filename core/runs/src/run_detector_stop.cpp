@@ -181,6 +181,15 @@ void RunDetector::Impl::power_back() {
   if (not_coast_.empty() && run_.partial())
     not_coast_ = "neither its cut nor a standstill was seen (the recording starts on it, and the reading rose again): a "
                  "piece of a coast, or an open pin's wander before it was connected — not a run";
+  // A speed sensor read the motor at rest (zeros) and then straight at the decline's top: its
+  // spin-up was one sample long at most, no cut was seen, and the reading rose again before
+  // standstill: nothing shows a coast (a start-up under power, or a sensor's first readings).
+  if (not_coast_.empty() && speed_reading_ && run_.lead_in == "zeros")
+    not_coast_ = fmt::format(
+        "the speed sensor read the motor at rest and then {:.4g} a sample later (no spin-up, so no cut), and the "
+        "reading rose again {:.3g} s after, before standstill: a start-up under power or a sensor's first readings, "
+        "not a run",
+        v0_, t(at) - run_.t_cut_s);
   // The window ends early, so the result changes: said in the default output.
   run_note_severity_ = Diagnostic::Severity::warning;
   close_unstopped(at,

@@ -73,6 +73,7 @@ Segmentation find_runs(const Recording& rec, const RunOptions& opt) {
   auto next_restart = restarts.begin();
 
   RunDetector det(opt, rec.source);
+  det.set_quantity(rec.quantity);
   auto collect = [&] {
     for (RunEvent& e : det.take_events()) {
       if (e.has_diagnostic) seg.diagnostics.push_back(e.diagnostic);

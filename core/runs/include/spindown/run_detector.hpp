@@ -26,6 +26,7 @@
 #include <string>
 #include <vector>
 
+#include "spindown/quantity.hpp"
 #include "spindown/recording.hpp"
 #include "spindown/runs.hpp"
 
@@ -83,6 +84,10 @@ class RunDetector {
   // A cut found within the first samples with a lead-in too short to judge is then no cut: the
   // coast's start was not seen (a fitter restarted, or slow to start, late in a coast).
   void joined_stream();
+  // What the reading is (before the first sample; find_runs gives the recording's). A speed
+  // sensor (rpm, rad/s) reads the motor all the time: zeros before a step are the motor at rest,
+  // never the handout's A0 left unconnected until the cut (step 6) that a back-EMF reading may show.
+  void set_quantity(Quantity q);
 
   // Events since the last call, oldest first.
   std::vector<RunEvent> take_events();
