@@ -313,3 +313,28 @@ TEST(RunDetector, ASpeedSensorsStepFromRestThatRisesAgainIsNoRunButABackEmfPinsI
   const Segmentation volts = find_runs(recording(Quantity::back_emf_volts));
   EXPECT_EQ(volts.runs.size(), 2u);
 }
+
+// Issue 41 (held out: track-grade-speedup): a cart's cruise control hunts ±1 rpm about 318 rpm at
+// 10 Hz before the throttle is let off; the hunting's first dip was taken for the cut, 7 s early,
+// with nothing said. Friction only takes speed off: a coast that stands at its starting level again
+// 2.5 s later, where its own pace says it must have lost 13 rpm, had not begun.
+TEST(RunDetector, AReadingBackAtTheCutsLevelLongAfterItHadNotBegunItsCoast) {
+  Recording rec;
+  rec.quantity = Quantity::rpm;
+  std::uint32_t seed = 11;
+  const auto noise = [&] { return 0.6 * ((seed = seed * 1664525u + 1013904223u) / 4294967296.0 - 0.5); };
+  const double t_off = 8.3;
+  double w = 318.0;
+  for (int k = 0; k < 900; ++k) {
+    const double t = 0.1 * k;
+    if (t < t_off) {
+      w = 318.0 + 1.0 * std::sin(2 * M_PI * t / 3.1);
+    } else {
+      w = std::max(0.0, w - 0.1 * (5.0 + 0.01 * w + 5e-5 * w * w));  // rpm/s: rolling, driveline, air
+    }
+    rec.push(t, std::round(10 * (w > 0 ? w + noise() : 0.0)) / 10);
+  }
+  const Segmentation seg = find_runs(rec);
+  ASSERT_EQ(seg.runs.size(), 1u);
+  EXPECT_NEAR(seg.runs[0].t_cut_s, t_off, 0.4);
+}

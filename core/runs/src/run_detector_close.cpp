@@ -237,6 +237,7 @@ void RunDetector::Impl::complete_run(std::size_t end) {
   }
   std::size_t coast_end = r.stopped ? r.stop_index : end;
   if (not_coast_.empty() && !fragment_) recut_after_rise(r, coast_end);
+  if (not_coast_.empty() && !fragment_) recut_after_return(r, coast_end);
   if (not_coast_.empty() && !fragment_) recut_at_level_end(r, coast_end);
   if (not_coast_.empty() && !fragment_) recut_after_dwell(r, r.stopped ? r.stop_index : end);
   coast_end = r.stopped ? r.stop_index : end;

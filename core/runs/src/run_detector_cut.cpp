@@ -514,6 +514,97 @@ void RunDetector::Impl::recut_after_rise(Run& r, std::size_t coast_end) {
   }
 }
 
+void RunDetector::Impl::recut_after_return(Run& r, std::size_t coast_end) {
+  const std::size_t c = r.cut_index;
+  if (coast_end < c + 24 || !(v0_ > 0)) return;
+  // Means over whole ripples where the coast shows one (a wheel's once per revolution, a drive's
+  // hunting), else over five samples, and their noise (or a sixth of the print's step: a level read
+  // in whole steps is known no better).
+  const std::size_t mid = c + (coast_end - c) / 2;
+  const LagNoise early = noise_over(c, mid), late = noise_over(mid, coast_end);
+  const LagNoise& noise = early.wander < late.wander ? early : late;
+  const bool rippled = noise.wander > 2.0 * noise.white;
+  const std::size_t len = rippled ? std::max<std::size_t>(5, 2 * noise.wander_lag) : 5;
+  if (coast_end < c + 4 * len) return;
+  const double se =
+      std::max((rippled ? noise.wander : noise.white) / std::sqrt(double(len)), coast_step_ / 6.0);
+  if (!(se > 0)) return;
+  // Readings held at the converter's top (find_pinned_start) are not the motor's: from after them.
+  std::size_t from = c;
+  if (std::isfinite(pin_level_))
+    for (std::size_t k = c; k < coast_end; ++k)
+      if (v(k) >= pin_level_) from = k + 1;
+  if (coast_end < from + 4 * len) return;
+  double top = v(from);
+  for (std::size_t k = from; k < coast_end; ++k) top = std::max(top, v(k));
+  double sum = 0;
+  for (std::size_t k = from; k < from + len; ++k) sum += v(k);
+  // The level the coast began at, read from its first samples (not the cut's line, which a bounce
+  // pulls down and a line fitted to a curve lifts): the highest median of three over its first two
+  // windows (a contact's bounce at the connection reads low, a glitch alone decides nothing).
+  double level = -std::numeric_limits<double>::infinity();
+  for (std::size_t k = from + 1; k + 1 < std::min(from + 2 * len, coast_end); ++k)
+    level = std::max(level, median_of_three(v(k - 1), v(k), v(k + 1)));
+  // The coast's own pace: its whole fall (to the mean of its last samples: its standstill, or where
+  // a coast that did not stop was closed) over its whole time, a quarter of it at most early on
+  // (Stribeck friction, strongest near standstill, makes a coast's start its slowest part).
+  double last = 0;
+  for (std::size_t k = coast_end - len; k < coast_end; ++k) last += v(k);
+  last /= double(len);
+  const double span_s = 0.5 * (t(coast_end - len) + t(coast_end - 1)) - r.t_cut_s;
+  if (!(span_s > 0)) return;
+  const double least_rate = 0.25 * std::max(level - last, 0.0) / span_s;
+  std::size_t back = 0;
+  double at_level = 0, lost = 0;
+  for (std::size_t k = from;; ++k) {  // the window [k, k + len)
+    const double mean = sum / double(len);
+    const double should = least_rate * (0.5 * (t(k) + t(k + len - 1)) - t(from));  // lost since the level was read
+    // Where the coast must have lost ten of its means' noise, it stands within three of the cut's
+    // level — and not mostly within a reading step of the coast's highest reading (a converter's
+    // top, read until the back-EMF comes below it) or on one repeated value (a stall).
+    if (should > 10.0 * se && mean >= level - 3.0 * se && 2 * count_from(top - coast_step_, k, k + len) < len &&
+        2 * count_from(v(k), k, k + len, v(k)) <= len)
+      back = k + len, at_level = mean, lost = should;
+    if (k + len >= coast_end) break;
+    sum += v(k + len) - v(k);
+  }
+  if (back == 0 || back + 6 >= coast_end) return;
+  // The coast after the return: its cut found as any cut is, with the samples before it as lead-in
+  // and the next seconds (a drive's hunting may run on a while below the level before the cut).
+  std::size_t a = back, b = back;
+  while (a > c && t(back) - t(a - 1) <= back_search_s) --a;
+  while (b + 1 < coast_end && t(b + 1) - t(back) <= back_search_s) ++b;
+  if (b < back + 6 || back < a + 4) return;
+  const WindowFit w = window_over(ring_.get(), mask_, 1.0, back, b + 1);
+  const std::size_t keep_lo = search_lo_;
+  search_lo_ = std::max(search_lo_, c);
+  CutSplit sp = split_at_cut(a, b, w);
+  const std::string lead = classify_lead_in(sp);
+  if (lead == "powered" && sp.pre_flat) refine_plateau_cut(sp, b);
+  search_lo_ = keep_lo;
+  if (!(sp.v0 > 0) || sp.cut_index <= c) return;
+  const double t_old = r.t_cut_s;
+  const bool was_partial = r.partial();  // "the recording starts mid-coast": no longer so
+  bounce_.clear();
+  r.cut_index = sp.cut_index;
+  r.t_cut_s = sp.t_cut_s;
+  r.lead_in = lead;
+  v0_ = sp.v0;
+  const std::string said = fmt::format(
+      "the reading stood at {:.4g} until {}, back at the level of the coast taken from {} ({:.4g}), where that coast "
+      "would have lost {:.2g} by then at a quarter of its own pace ({:.0f} times its means' noise {:.2g}): friction "
+      "only takes speed off, so no coast had begun; the coast is taken from {} (lead-in {})",
+      at_level, fmt_s(t(back - 1)), fmt_s(t_old), level, lost, lost / se, se, fmt_s(r.t_cut_s), r.lead_in);
+  run_note_ = run_note_.empty() || was_partial ? said : said + "; " + run_note_;
+  run_note_severity_ = Diagnostic::Severity::warning;
+}
+
+std::size_t RunDetector::Impl::count_from(double lo, std::size_t from, std::size_t to, double hi) const {
+  std::size_t n = 0;
+  for (std::size_t k = from; k < to; ++k) n += v(k) >= lo && v(k) <= hi;
+  return n;
+}
+
 double RunDetector::Impl::rough_sd(std::size_t from, std::size_t to) const {
   // Second differences cancel a smooth curve (a coast, a rise, a slow swing) and keep the
   // sample-to-sample noise: σ = 1.4826·median|Δ²v| / √6. Its own space: the cut search's

@@ -226,6 +226,14 @@ class RunDetector::Impl {
   // noise, what came before the rise was no part of it (an open pin's swing before it was connected,
   // a coast the power came back on unseen). r then starts at the last such rise, with a warning.
   void recut_after_rise(Run& r, std::size_t coast_end);
+  // Friction only takes speed off: a coast never comes back to the level it began at. When the
+  // reading inside r's coast [cut, coast_end), long after the cut, stood at the cut's level again
+  // (within its means' noise) where the coast's own pace says it must have fallen far below it, no
+  // coast had begun (a drive hunting about its setpoint): r starts after the last such return.
+  void recut_after_return(Run& r, std::size_t coast_end);
+  // How many readings in [from, to) lie in [lo, hi].
+  std::size_t count_from(double lo, std::size_t from, std::size_t to,
+                         double hi = std::numeric_limits<double>::infinity()) const;
   // A coast never dwells (run_detector_dwell.cpp): when the reading inside r's coast [cut, coast_end)
   // held a level far longer than the coast then took to fall through it, r starts after that dwell,
   // with a warning.
