@@ -11,6 +11,7 @@
 
 #include "spindown/bridge_settings.hpp"
 #include "spindown/clock.hpp"
+#include "service_command_line.hpp"
 #include "spindown/lab_settings.hpp"
 #include "spindown/lcm_channels.hpp"
 #include "spindown/message_stamp.hpp"
@@ -55,7 +56,6 @@ class LcmSink : public spindown::BridgeSink {
 struct BridgeOptions {
   spindown::BridgeSettings settings;
   std::string lcm_url;
-  std::string lab_option, key_option;
   spindown::LabSettings lab;
   bool exit_on_missing = false;
   double retry_s = 0.25;
@@ -69,9 +69,8 @@ std::optional<int> parse_options(int argc, char** argv, BridgeOptions& o) {
   app.add_option("--device", s.device, "serial device, e.g. /dev/ttyACM0");
   app.add_option("--bench", s.bench, "bench id [A-Za-z0-9_-]{1,32}");
   auto* baud_opt = app.add_option("--baud", s.baud, "baud rate (lab sketch 9600, spindown firmware 115200)");
-  app.add_option("--lcm-url", o.lcm_url, "LCM URL (default: LCM_DEFAULT_URL or LCM's default)");
-  app.add_option("--lab", o.lab_option, spindown::lab_option_help);
-  app.add_option("--key", o.key_option, spindown::key_option_help);
+  spindown::service::LabConnectionOptions connection;
+  connection.add_to(app, /*receives=*/false);
   app.add_option("--config", config_file, "TOML file: bench J, K_b, quantity, ADC, serial (see README)")
       ->check(CLI::ExistingFile);
   bool retry_flag = false;
@@ -80,11 +79,7 @@ std::optional<int> parse_options(int argc, char** argv, BridgeOptions& o) {
       ->excludes(retry);
   app.add_option("--retry-interval", o.retry_s, "seconds between attempts to open the device")
       ->check(CLI::Range(0.01, 0.5));
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e);
-  }
+  if (const auto exit_code = spindown::service::parse(app, argc, argv)) return exit_code;
 
   // CLI beats the file: remember what the command line said before reading the file.
   const spindown::BridgeSettings cli = s;
@@ -92,8 +87,7 @@ std::optional<int> parse_options(int argc, char** argv, BridgeOptions& o) {
     try {
       spindown::load_bridge_settings(config_file, s);
     } catch (const std::exception& e) {
-      fmt::print(stderr, "spindown-bridge: {}\n", e.what());
-      return 2;
+      return spindown::service::bad_usage("spindown-bridge", e.what());
     }
     for (const auto& w : s.warnings) fmt::print(stderr, "spindown-bridge: {}\n", w);
     if (!cli.bench.empty()) s.bench = cli.bench;
@@ -101,16 +95,11 @@ std::optional<int> parse_options(int argc, char** argv, BridgeOptions& o) {
     if (baud_opt->count() > 0) s.baud = cli.baud;
   }
   std::string why;
-  if (!s.is_valid(&why)) {
-    fmt::print(stderr, "spindown-bridge: {}\n", why);
-    return 2;
-  }
-  auto lab = spindown::resolve_lab_settings(o.lab_option, o.key_option, &why);
-  if (!lab) {
-    fmt::print(stderr, "spindown-bridge: {}\n", why);
-    return 2;
-  }
-  o.lab = std::move(*lab);
+  if (!s.is_valid(&why)) return spindown::service::bad_usage("spindown-bridge", why);
+  auto lab = connection.resolve(&why);
+  if (!lab) return spindown::service::bad_usage("spindown-bridge", why);
+  o.lcm_url = lab->lcm_url;
+  o.lab = std::move(lab->lab);
   return std::nullopt;
 }
 

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "fitter_service.hpp"
+#include "service_command_line.hpp"
 #include "spindown/bench.hpp"
 #include "spindown/bench_file.hpp"
 #include "spindown/effects.hpp"
@@ -24,12 +25,9 @@ std::optional<int> parse_options(int argc, char** argv, spindown::FitterServiceO
   CLI::App app{"spindown-fitter: SPINDOWN.<bench>.SAMPLE|CONFIG -> RUN, FIT and STATUS, live"};
   std::vector<std::string> models;
   double kv = 0;
-  long recv_buf = spindown::services_recv_buf_bytes;
   std::vector<std::string> bench_configs;
-  app.add_option("--lcm-url", o.lcm_url, "LCM URL (default: LCM_DEFAULT_URL or LCM's default)");
-  std::string lab_option, key_option;
-  app.add_option("--lab", lab_option, spindown::lab_option_help);
-  app.add_option("--key", key_option, spindown::key_option_help);
+  spindown::service::LabConnectionOptions connection;
+  connection.add_to(app);
   app.add_option("--replay-window", o.core.gate.replay_window_s,
                  "with --key: a signed message sent more than this many seconds from its receive time is refused "
                  "(a replay, or a clock that is off)")
@@ -38,7 +36,6 @@ std::optional<int> parse_options(int argc, char** argv, spindown::FitterServiceO
                  "seconds a bench's source must be quiet before another source on its channel (a restarted bridge) "
                  "starts a new stream; while both send, the second is named and refused")
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--recv-buf", recv_buf, "udpm receive buffer bytes added to the URL (0 = leave the URL alone)");
   app.add_option("--bench", o.core.bench_regex, "benches to fit: regex on the bench id (default all)");
   app.add_option("--instance", o.instance, "instance name: heartbeat on SPINDOWN.<instance>.STATUS")
       ->check([](const std::string& s) {
@@ -81,11 +78,7 @@ std::optional<int> parse_options(int argc, char** argv, spindown::FitterServiceO
                  "per-bench TOML file(s) or a directory of them (/etc/spindown/benches): [motor], [baseline], "
                  "[health] give each fit of that bench a motor health verdict");
   app.add_flag("-v,--verbose", o.verbose, "one line per run event and fit on stderr");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e);
-  }
+  if (const auto exit_code = spindown::service::parse(app, argc, argv)) return exit_code;
 
   if (j->count()) o.core.default_bench.inertia_source = "--inertia";
   if (kb->count()) o.core.default_bench.kb_source = "--kb";
@@ -98,8 +91,8 @@ std::optional<int> parse_options(int argc, char** argv, spindown::FitterServiceO
     for (const auto& name : models) {
       const auto kind = spindown::parse_model(name);
       if (!kind) {
-        fmt::print(stderr, "spindown-fitter: --models: unknown model '{}' (viscous, coulomb, combined)\n", name);
-        return 2;
+        return spindown::service::bad_usage(
+            "spindown-fitter", fmt::format("--models: unknown model '{}' (viscous, coulomb, combined)", name));
       }
       o.core.models.push_back(*kind);
     }
@@ -111,32 +104,22 @@ std::optional<int> parse_options(int argc, char** argv, spindown::FitterServiceO
       o.core.health.emplace(bench, file.health);
     }
   } catch (const std::exception& e) {
-    fmt::print(stderr, "spindown-fitter: --bench-config: {}\n", e.what());
-    return 2;
+    return spindown::service::bad_usage("spindown-fitter", fmt::format("--bench-config: {}", e.what()));
   }
   if (no_explain) {
     o.core.explain_base.clear();
   } else {
     o.core.explain_base = spindown::parse_effect_list(explain_base, &why);
-    if (o.core.explain_base.empty()) {
-      fmt::print(stderr, "spindown-fitter: --explain-base: {}\n", why);
-      return 2;
-    }
+    if (o.core.explain_base.empty()) return spindown::service::bad_usage("spindown-fitter", "--explain-base: " + why);
   }
-  auto lab = spindown::resolve_lab_settings(lab_option, key_option, &why);
-  if (!lab) {
-    fmt::print(stderr, "spindown-fitter: {}\n", why);
-    return 2;
-  }
-  o.lab = *lab;
-  o.lcm_url = spindown::with_receive_buffer(o.lcm_url, recv_buf);
+  const auto lab = connection.resolve(&why);
+  if (!lab) return spindown::service::bad_usage("spindown-fitter", why);
+  o.lab = lab->lab;
+  o.lcm_url = lab->lcm_url;
   const double replay_window_s = o.core.gate.replay_window_s;  // --replay-window
-  o.core.gate = spindown::lab_gate(*lab, o.lcm_url);
+  o.core.gate = lab->gate();
   o.core.gate.replay_window_s = replay_window_s;
-  if (!o.core.is_valid(&why)) {
-    fmt::print(stderr, "spindown-fitter: {}\n", why);
-    return 2;
-  }
+  if (!o.core.is_valid(&why)) return spindown::service::bad_usage("spindown-fitter", why);
 
   return std::nullopt;
 }

@@ -13,6 +13,7 @@
 
 #include "spindown/clock.hpp"
 #include "spindown/event_log_writer.hpp"
+#include "service_command_line.hpp"
 #include "spindown/lab_settings.hpp"
 #include "spindown/lcm_loop.hpp"
 #include "spindown/lcm_status.hpp"
@@ -28,12 +29,10 @@
 namespace {
 
 struct LoggerOptions {
-  std::string lcm_url, channels;
-  std::string lab_option, key_option;
-  spindown::LabSettings lab;
+  std::string channels;
+  spindown::service::LabConnection connection;
   spindown::EventLogWriterOptions writer;
   spindown::LogRecorderOptions recorder;
-  long recv_buf = spindown::services_recv_buf_bytes;
   bool quiet = false;
 };
 
@@ -42,14 +41,14 @@ std::optional<int> parse_options(int argc, char** argv, LoggerOptions& o) {
   CLI::App app{"spindown-logger: LCM traffic -> standard LCM event logs (lcm-logplayer and lcm::LogFile read them)"};
   spindown::EventLogWriterOptions& w = o.writer;
   spindown::LogRecorderOptions& r = o.recorder;
-  app.add_option("--lcm-url", o.lcm_url, "LCM URL (default: LCM_DEFAULT_URL or LCM's default)");
-  app.add_option("--lab", o.lab_option,
-                 "lab name: every message is recorded, and another lab's messages are counted (other_lab) and "
-                 "named; the heartbeat names it (default: $SPINDOWN_LAB, else 'lab')");
-  app.add_option("--key", o.key_option,
-                 "lab key file: every message is recorded, and unsigned, wrongly signed and replayed ones are counted "
-                 "and named; the heartbeat is signed (default: the systemd credential lab-key when loaded); NEW,OLD "
-                 "while keys change: signs with NEW, accepts both");
+  spindown::service::LabConnectionOptions connection;
+  connection.add_to(
+      app, /*receives=*/true,
+      "lab name: every message is recorded, and another lab's messages are counted (other_lab) and named; the "
+      "heartbeat names it (default: $SPINDOWN_LAB, else 'lab')",
+      "lab key file: every message is recorded, and unsigned, wrongly signed and replayed ones are counted and named; "
+      "the heartbeat is signed (default: the systemd credential lab-key when loaded); NEW,OLD while keys change: "
+      "signs with NEW, accepts both");
   app.add_option("--channels", o.channels,
                  "channel regex (default SPINDOWN\\..*, or SPINDOWN\\.<bench>\\..* with --bench)");
   app.add_option("--dir", w.dir, "directory for the logs (must exist)")->capture_default_str();
@@ -78,30 +77,18 @@ std::optional<int> parse_options(int argc, char** argv, LoggerOptions& o) {
   app.add_option("--queue", r.queue_capacity, "events queued for the writer before drops are counted")
       ->capture_default_str()
       ->check(CLI::Range(1, 10000000));
-  app.add_option("--recv-buf", o.recv_buf, "udpm receive buffer bytes added to the URL (0 = leave the URL alone)")
-      ->capture_default_str();
   app.add_option("--status-channel", w.status_channel, "channel of the heartbeat and of the status events in the logs")
       ->capture_default_str();
   app.add_option("--name", w.instance, "status_t.instance (default: the bench, else the prefix)");
   app.add_flag("-q,--quiet", o.quiet, "only errors on stderr");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;  // --help is 0; any bad usage is 2 (design §5)
-  }
+  if (const auto exit_code = spindown::service::parse(app, argc, argv)) return exit_code;
 
   if (o.channels.empty()) o.channels = w.bench.empty() ? "SPINDOWN\\..*" : "SPINDOWN\\." + w.bench + "\\..*";
   std::string why;
-  if (!w.is_valid(&why) || !r.is_valid(&why)) {
-    fmt::print(stderr, "spindown-logger: {}\n", why);
-    return 2;
-  }
-  auto lab = spindown::resolve_lab_settings(o.lab_option, o.key_option, &why);
-  if (!lab) {
-    fmt::print(stderr, "spindown-logger: {}\n", why);
-    return 2;
-  }
-  o.lab = std::move(*lab);
+  if (!w.is_valid(&why) || !r.is_valid(&why)) return spindown::service::bad_usage("spindown-logger", why);
+  auto lab = connection.resolve(&why);
+  if (!lab) return spindown::service::bad_usage("spindown-logger", why);
+  o.connection = std::move(*lab);
   return std::nullopt;
 }
 
@@ -197,7 +184,7 @@ int main(int argc, char** argv) {
   const spindown::LogRecorderOptions& r = o.recorder;
 
   spindown::StopSignals stop({.ignore_sigpipe = true});
-  const std::string url = spindown::with_receive_buffer(o.lcm_url, o.recv_buf);
+  const std::string& url = o.connection.lcm_url;
   spindown::LcmLoop loop(url);
   if (!loop.good()) {
     fmt::print(stderr, "spindown-logger: cannot start LCM at {}\n", url);
@@ -215,9 +202,9 @@ int main(int argc, char** argv) {
   const std::string first_file = writer.current_path();
   spindown::LogRecorder recorder(writer, r);
   recorder.start();
-  spindown::MessageStamp stamp(spindown::this_process_identity(o.lab.lab, url), o.lab.key);
+  spindown::MessageStamp stamp(spindown::this_process_identity(o.connection.lab.lab, url), o.connection.lab.key);
   loop.set_stamp(&stamp);
-  spindown::MessageGate gate(spindown::lab_gate(o.lab, url));
+  spindown::MessageGate gate(o.connection.gate());
   Heartbeat heartbeat(loop, recorder, w.status_channel, gate);
 
   // LCM 1.3.1 drops silently past a subscription's queue capacity (30 unless set): no limit
@@ -247,7 +234,7 @@ int main(int argc, char** argv) {
                first_file, r.flush_interval_s,
                w.rotate_size_mb > 0 ? fmt::format(", rotate at {} MB", w.rotate_size_mb) : "",
                w.rotate_time_s > 0 ? fmt::format(", rotate every {} s", w.rotate_time_s) : "", retention,
-               spindown::lab_settings_text(o.lab));
+               spindown::lab_settings_text(o.connection.lab));
 
   loop.every(1.0, [&](std::int64_t now) { heartbeat.beat(now); }, 0);
   spindown::ServiceNotifier notify;

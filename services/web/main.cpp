@@ -8,9 +8,8 @@
 #include <memory>
 #include <optional>
 
+#include "service_command_line.hpp"
 #include "spindown/bench_file.hpp"
-#include "spindown/lab_settings.hpp"
-#include "spindown/lcm_url.hpp"
 #include "spindown/message_gate.hpp"
 #include "spindown/stop_signal.hpp"
 #include "spindown/web_service.hpp"
@@ -21,14 +20,10 @@ namespace {
 std::optional<int> parse_options(int argc, char** argv, spindown::WebServiceOptions& o) {
   CLI::App app{"spindown-web: the lab in a browser (room page, bench pages, live over Server-Sent Events)"};
   std::string listen = "127.0.0.1:8080";
-  long recv_buf = spindown::services_recv_buf_bytes;
   std::vector<std::string> bench_configs;
   bool si_units = false;
-  std::string lab_option, key_option;
-  app.add_option("--lcm-url", o.lcm_url, "LCM URL (default: LCM_DEFAULT_URL or LCM's default)");
-  app.add_option("--lab", lab_option, spindown::lab_option_help);
-  app.add_option("--key", key_option, spindown::key_option_help);
-  app.add_option("--recv-buf", recv_buf, "udpm receive buffer bytes added to the URL (0 = leave the URL alone)");
+  spindown::service::LabConnectionOptions connection;
+  connection.add_to(app);
   app.add_option("--listen", listen,
                  "ADDR:PORT to serve on: 127.0.0.1:8080 (this PC only), 0.0.0.0:8080 (every network of this PC), "
                  "the lab LAN's address of this PC, [::]:8080")
@@ -61,43 +56,30 @@ std::optional<int> parse_options(int argc, char** argv, spindown::WebServiceOpti
       ->capture_default_str()
       ->check(CLI::Range(1, 1000));
   app.add_flag("--si-units", si_units, "coefficients' text in SI (N·m·s/rad, N·m) instead of the lab's g·cm² units");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;  // --help is 0; any bad usage is 2 (design §5)
-  }
+  if (const auto exit_code = spindown::service::parse(app, argc, argv)) return exit_code;
   std::string why;
-  if (fd->count() == 0 && !spindown::parse_listen_address(listen, o.server.host, o.server.port, &why)) {
-    fmt::print(stderr, "spindown-web: --listen: {}\n", why);
-    return 2;
-  }
+  if (fd->count() == 0 && !spindown::parse_listen_address(listen, o.server.host, o.server.port, &why))
+    return spindown::service::bad_usage("spindown-web", "--listen: " + why);
   try {
     for (auto& [bench, file] : spindown::load_bench_files(bench_configs).files) o.lab.expected_benches.push_back(bench);
   } catch (const std::exception& e) {
-    fmt::print(stderr, "spindown-web: --bench-config: {}\n", e.what());
-    return 2;
+    return spindown::service::bad_usage("spindown-web", fmt::format("--bench-config: {}", e.what()));
   }
   o.lab.lab_units = !si_units;
-  if (!o.lab.is_valid(&why)) {
-    fmt::print(stderr, "spindown-web: {}\n", why);
-    return 2;
-  }
+  if (!o.lab.is_valid(&why)) return spindown::service::bad_usage("spindown-web", why);
   // Only this lab's messages, and with the lab key only signed ones (docs/security.md): the
   // others are counted and named on the pages, never shown as real.
-  const auto lab = spindown::resolve_lab_settings(lab_option, key_option, &why);
-  if (!lab) {
-    fmt::print(stderr, "spindown-web: {}\n", why);
-    return 2;
-  }
-  o.check = [g = std::make_shared<spindown::MessageGate>(spindown::lab_gate(*lab, o.lcm_url))](
+  const auto lab = connection.resolve(&why);
+  if (!lab) return spindown::service::bad_usage("spindown-web", why);
+  o.lcm_url = lab->lcm_url;
+  o.check = [g = std::make_shared<spindown::MessageGate>(lab->gate())](
                 std::string_view channel, const void* data, std::int64_t size,
                 std::int64_t recv_utime) -> std::optional<spindown::GateResult> {
     spindown::GateResult r = g->check(channel, data, size, recv_utime);
     if (r.refused()) return r;
     return std::nullopt;
   };
-  fmt::print(stderr, "spindown-web: {}\n", spindown::lab_settings_text(*lab));
-  o.lcm_url = spindown::with_receive_buffer(o.lcm_url, recv_buf);
+  fmt::print(stderr, "spindown-web: {}\n", spindown::lab_settings_text(lab->lab));
   return std::nullopt;
 }
 
