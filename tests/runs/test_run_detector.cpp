@@ -154,28 +154,32 @@ TEST(RunDetector, MemoryStaysBoundedOverALongIdleStream) {
   EXPECT_FALSE(supply.has_events());
 }
 
-TEST(RunDetector, ACoastLongerThanMaxBufferIsAbandonedNotGrown) {
+// Issue 44: a coast longer than the memory bound is fitted up to it (never stopped), said in a user's
+// words (no option's internal name), and the buffer never grows past the bound.
+TEST(RunDetector, ACoastLongerThanMaxBufferIsFittedUpToItNotGrown) {
   RunOptions opt;
   opt.max_buffer = 500;  // 10 s at 50 Hz, the coast lasts ~27 s
   SyntheticRunSpec spec;
   const SyntheticRun s = make_synthetic_run(spec);
   RunDetector live(opt, "small");
-  std::size_t most = 0;
-  bool abandoned = false, completed = false;
+  std::size_t most = 0, completed = 0;
   for (std::size_t i = 0; i < s.t_ms.size(); ++i) {
     live.push(s.t_ms[i] / 1000.0, s.volts[i]);
     most = std::max(most, live.buffered());
     for (const RunEvent& e : live.take_events()) {
-      if (e.kind == RunEvent::Kind::ignored) {
-        abandoned = true;
-        EXPECT_NE(e.diagnostic.message.find("max_buffer"), std::string::npos);
-      }
-      completed = completed || e.kind == RunEvent::Kind::complete;
+      if (e.kind != RunEvent::Kind::complete) continue;
+      ++completed;
+      EXPECT_FALSE(e.run.stopped);
+      EXPECT_EQ(e.run.end, Run::End::cap);
+      EXPECT_GT(e.run.t_end_s - e.run.t_cut_s, 5.0);  // the buffer holds the lead-in too
+      EXPECT_LE(e.run.t_end_s - e.run.t_cut_s, 10.0);
+      EXPECT_NE(e.diagnostic.message.find("--max-buffer"), std::string::npos) << e.diagnostic.message;
+      EXPECT_EQ(e.diagnostic.message.find("max_buffer"), std::string::npos) << e.diagnostic.message;
     }
   }
   live.finish();
-  EXPECT_TRUE(abandoned);
-  EXPECT_FALSE(completed);
+  for (const RunEvent& e : live.take_events()) completed += e.kind == RunEvent::Kind::complete;
+  EXPECT_EQ(completed, 1u);  // the rest of the decay is no run
   EXPECT_LE(most, opt.max_buffer + 1);
 }
 
@@ -191,7 +195,7 @@ TEST(RunDetector, MaxCoastClosesARunAsNeverStoppedAndTheRestOfTheDecayIsNoNewRun
   EXPECT_FALSE(seg.runs[0].stopped);
   EXPECT_NEAR(rec.t_s[seg.runs[0].end_index - 1] - seg.runs[0].t_cut_s, 8.0, 0.05);
   const bool noted = std::any_of(seg.diagnostics.begin(), seg.diagnostics.end(), [](const Diagnostic& d) {
-    return d.message.find("max_coast_s") != std::string::npos;
+    return d.message.find("--max-coast") != std::string::npos;
   });
   EXPECT_TRUE(noted);
 }

@@ -308,3 +308,42 @@ TEST(WebLab, APlotPointIsShortAndReadsBackAsTheDecimal) {
 
 }  // namespace
 }  // namespace spindown
+
+namespace spindown {
+namespace {
+
+using namespace spindown::test;
+
+// Issue 44 item 3: a run closed early (a reset cut the coast short) or one the fitter doubts never
+// takes the tile's headline from the last whole run; it shows only while no whole run has.
+TEST(WebLab, ARunClosedEarlyOrDoubtedNeverTakesTheHeadlineFromAWholeRun) {
+  const SimulatedRun whole = simulated_run(7, 1);
+  WebLab lab;
+  std::int64_t now = feed_run(lab, whole);
+  fit_t stub = whole.fit;
+  stub.run = 2;
+  stub.t_cut_s = whole.fit.t_cut_s + 40;
+  stub.end = "clock restart";
+  for (auto& p : stub.param_value) p *= 3;
+  lab.on_fit("b1", stub, now += sec_us);
+  EXPECT_EQ(bench_of(lab.state_json(now), "b1")["last_fit"]["run"], 1);
+  fit_t doubted = whole.fit;
+  doubted.run = 3;
+  doubted.t_cut_s = whole.fit.t_cut_s + 80;
+  doubted.ndoubts = 1;
+  doubted.doubts = {"readings of at most 0.1 V"};
+  lab.on_fit("b1", doubted, now += sec_us);
+  EXPECT_EQ(bench_of(lab.state_json(now), "b1")["last_fit"]["run"], 1);
+  fit_t next = whole.fit;
+  next.run = 4;
+  next.t_cut_s = whole.fit.t_cut_s + 120;
+  lab.on_fit("b1", next, now += sec_us);
+  EXPECT_EQ(bench_of(lab.state_json(now), "b1")["last_fit"]["run"], 4);
+
+  WebLab fresh;  // no whole run yet: the stub is what there is
+  fresh.on_fit("b2", stub, now);
+  EXPECT_EQ(bench_of(fresh.state_json(now), "b2")["last_fit"]["run"], 2);
+}
+
+}  // namespace
+}  // namespace spindown

@@ -387,6 +387,7 @@ void LabTable::on_fit(std::string_view bench, const fit_t& msg, std::int64_t now
   ++r.fits;
   r.fit_run = msg.run;
   r.fit_partial = msg.lead_in == "none";
+  r.fit_end = msg.end;
   r.best = msg.best;
   r.coefficients = fit_coefficients_text(msg, opt_.lab_units, false);
   const ParamValue c3 = model_param(msg, "combined", "c3", opt_.lab_units), c4 = model_param(msg, "combined", "c4", opt_.lab_units);

@@ -15,15 +15,16 @@ using namespace detector_tuning;
 
 void RunDetector::Impl::coast_too_long(std::size_t i) {
   if (buffered() > opt_.max_buffer) {
-    RunEvent e;
-    e.kind = RunEvent::Kind::ignored;
-    e.run = run_;
-    e.has_diagnostic = true;
-    e.diagnostic = {Diagnostic::Severity::warning, source_, 0,
-                    fmt::format("run cut at {}: coast longer than max_buffer ({} samples) abandoned",
-                                fmt_s(run_.t_cut_s), opt_.max_buffer)};
-    events_.push_back(std::move(e));
-    to_idle(i + 1, true);
+    // The memory bound: the coast so far is fitted (never stopped), as at the time bound below; what
+    // it does after is not a run.
+    run_note_severity_ = Diagnostic::Severity::warning;
+    close_unstopped(i, fmt::format("no standstill within the {} samples ({:.0f} s at this rate) the fitter keeps of "
+                                   "one coast (--max-buffer): closed there as never stopped, the coast fitted up to "
+                                   "there; the rest of this coast is not a run",
+                                   opt_.max_buffer, t(i - 1) - run_.t_cut_s),
+                    Run::End::cap);
+    to_idle(i, true);
+    block_until_rise(v(i - 1));
     return;
   }
   // The coast was within max_coast_s until one step jumped past it: a gap in the recording
@@ -44,8 +45,8 @@ void RunDetector::Impl::coast_too_long(std::size_t i) {
   }
   run_note_severity_ = Diagnostic::Severity::warning;
   close_unstopped(i + 1,
-                  fmt::format("no standstill within max_coast_s ({:g} s): closed there as never stopped; the rest of "
-                              "this coast is not a run",
+                  fmt::format("no standstill within {:g} s, the longest coast the fitter keeps (--max-coast): closed "
+                              "there as never stopped, the coast fitted up to there; the rest of this coast is not a run",
                               opt_.max_coast_s),
                   Run::End::cap);
   to_idle(i + 1, true);

@@ -143,7 +143,11 @@
     } else {
       setText($("run-title"), `Run ${run.number}${run.partial ? " (partial: the cut was not seen)" : ""} · ${run.state}`);
     }
-    setText($("run-note"), run ? run.note : "Spin the motor up and cut the supply: the run appears here as it coasts.");
+    // A run longer than this page keeps is said where its plot is: the plot and the CSV are its start only.
+    const cut = run && run.truncated
+      ? `The plot and the CSV hold only the first ${run.kept} of this run's ${run.samples} samples (spindown-web keeps that many a run: --max-run-samples); the fit uses them all. `
+      : "";
+    setText($("run-note"), run ? cut + (run.note || "") : "Spin the motor up and cut the supply: the run appears here as it coasts.");
     // Markers present once the fitter found them.
     const markers = [];
     if (run && run.markers.cut !== null) markers.push(el("li", { "data-marker": "cut" }, `cut at t = ${run.t_cut_s.toFixed(3)} s`));
@@ -220,8 +224,26 @@
   function fmt(v) { return v === null || v === undefined ? "?" : Number(v).toPrecision(3); }
 
   // Every kept run of the session, the current one first: its fit, and a box to overlay it.
+  // Why a run is not a whole one (abandoned, or its window closed before the stop), in words; "" when whole.
+  const endWords = { "clock restart": "cut short: the board reset (clock restart)", "new source": "cut short: another source took over",
+    "power back": "closed early: the reading rose again (power back)", "silent": "cut short: the bench went silent",
+    "cap": "closed early: coast longer than the fitter keeps", "gap": "cut short: a gap in the samples",
+    "end of data": "cut short: the samples ended before the stop" };
+  function notWhole(r) {
+    if (r.state === "abandoned") return `abandoned${r.note ? ": " + r.note : ""}`;
+    const end = r.fit && r.fit.end;
+    if (end && endWords[end]) return endWords[end];
+    return r.partial ? "partial: its cut was not seen" : "";
+  }
+
   function showRuns(earlier, current) {
-    const all = (current ? [current] : []).concat(earlier.slice().reverse());
+    // Newest first; a number the fitter gave again after abandoning a run is listed once (its latest).
+    const seen = new Set();
+    const all = (current ? [current] : []).concat(earlier.slice().reverse()).filter((r) => {
+      if (seen.has(r.number)) return false;
+      seen.add(r.number);
+      return true;
+    });
     const rows = all.map((r) => {
       const f = r.fit;
       const isCurrent = current && r.key === current.key;
@@ -231,9 +253,10 @@
         compare.checked = overlays.has(r.number);
         compare.addEventListener("change", () => toggleOverlay(r.number, compare.checked));
       }
+      const why = notWhole(r);
       return el("tr", { "data-run": r.number, class: isCurrent ? "current" : null },
         el("td", {}, `${r.number}${r.partial ? " (partial)" : ""}`),
-        el("td", {}, f ? f.best || "–" : r.state),
+        el("td", {}, f ? f.best || "–" : r.state, why ? el("div", { class: "why-not-whole" }, why) : null),
         el("td", { "data-si": f && f.c3 ? f.c3.value : null }, f && f.c3 ? f.c3.text : "–"),
         el("td", { "data-si": f && f.c4 ? f.c4.value : null }, f && f.c4 ? f.c4.text : "–"),
         el("td", {}, f ? f.health : "–"),

@@ -41,6 +41,8 @@ BenchState bench_state(const LabBenchRow* row, const BenchActivity& a, std::int6
       std::isfinite(a.last_value) && std::fabs(a.last_value - a.zero_level) > standstill_threshold(a.quantity);
   if (row && row->has_run && row->run_state == run_t::STATE_COASTING)
     return row->run_partial ? BenchState::partial : BenchState::coasting;
+  // A coast longer than the fitter keeps was fitted up to its bound ("cap") and goes on: still coasting.
+  if (turning && row && row->has_fit && row->fit_end == "cap" && row->fit_run == row->run) return BenchState::coasting;
   if (turning) return BenchState::powered;
   if (row && row->has_run && row->run_state == run_t::STATE_STOPPED)
     return row->run_partial ? BenchState::partial : BenchState::stopped;

@@ -189,6 +189,13 @@ void WebLab::on_run(std::string_view id, const run_t& msg, std::int64_t now_us) 
   b.detail_changed = true;
 }
 
+// A run the fitter saw from its cut to its end: stopped (or its decay lost in the noise, or its
+// sensor giving up at low speed), its cut seen, and nothing doubted.
+static bool whole_run(const fit_t& msg) {
+  const bool ended = msg.end == "stopped" || msg.end == "asymptotic" || msg.end == "signal lost";
+  return ended && msg.lead_in != "none" && msg.ndoubts == 0;
+}
+
 void WebLab::on_fit(std::string_view id, const fit_t& msg, std::int64_t now_us) {
   table_.on_fit(id, msg, now_us);
   Bench& b = bench(id);
@@ -206,8 +213,15 @@ void WebLab::on_fit(std::string_view id, const fit_t& msg, std::int64_t now_us) 
     r->curves = nullptr;
     table_.on_bad_message(fmt::format("SPINDOWN.{}.FIT run {}: {}", id, msg.run, why), now_us);
   }
-  b.last_fit = r->fit;
-  b.last_fit_curve = best_curve_json(msg, tile_curve_points);
+  // The headline is the last whole run's: a run closed early (a reset, a new source, the power back,
+  // silence, the memory cap), one whose cut was not seen or one the fitter doubts never replaces it
+  // (a floating pin's hum cut as a run, a stub after a reset); it shows only while no whole run has.
+  const bool whole = whole_run(msg);
+  if (whole || !b.last_fit_whole) {
+    b.last_fit = r->fit;
+    b.last_fit_curve = best_curve_json(msg, tile_curve_points);
+    b.last_fit_whole = whole;
+  }
   if (std::isfinite(msg.zero_level)) b.activity.zero_level = msg.zero_level;
   b.detail_changed = true;
 }
@@ -246,6 +260,7 @@ Json WebLab::run_summary_json(const Bench& b, const WebRun& r, bool counts) cons
   j["t_stop_s"] = json_number(r.t_stop_s);
   if (counts) {  // not in a tile's pushed summary: it would change with every sample
     j["samples"] = r.trace.received();
+    j["kept"] = r.trace.kept();
     j["truncated"] = r.trace.truncated();
   }
   j["csv"] = fmt::format("/bench/{}/runs/{}.csv", b.id, r.number);

@@ -63,6 +63,7 @@ struct LabBenchRow {
   bool has_fit = false;
   std::int32_t fit_run = 0;
   bool fit_partial = false;          // fitted from its first sample: the cut was not seen
+  std::string fit_end;               // why the fitted window ends ("stopped", "cap", "clock restart", …)
   std::string fit_doubt;             // why this fit may not be the lab fitter's ("" when nothing says so)
   std::int32_t fits = 0;             // FIT messages seen
   std::string best;                  // best model ("" when none converged)

@@ -133,7 +133,9 @@ class WebLab {
     std::deque<TracePoint> lead;  // samples while no run is open (the next run's preroll)
     std::deque<WebRun> runs;      // oldest first; back() is the current run
     std::int64_t next_key = 1;
-    Json last_fit = nullptr;      // the latest FIT's summary (the room's tile), even of a run no longer kept
+    Json last_fit = nullptr;      // the room tile's headline FIT summary, even of a run no longer kept: the
+                                  // latest whole run's (whole_run()), else the latest of any
+    bool last_fit_whole = false;  // the headline is a whole run's
     Json last_fit_curve = Json::array();
     // What the pages were last sent.
     std::string sent_summary;
