@@ -262,6 +262,8 @@ TEST(BridgeLogic, DisconnectDropsThePartialLineAndReconnectIsCounted) {
   b.open_failed(T0 + 2000, "cannot open /dev/ttyTEST: No such file or directory");
   b.connected(T0 + 3000);
   EXPECT_EQ(sink.statuses.back().state, "connected");
+  // Issue 44: plugged back, the device's error is over; the heartbeat (and the pages) stop saying it.
+  EXPECT_EQ(sink.statuses.back().last_error, "");
   b.feed("8\t0.50\r\n", T0 + 4000);  // without the reset the two halves would merge
   const auto f = sink.flat();
   ASSERT_EQ(f.size(), 2u);

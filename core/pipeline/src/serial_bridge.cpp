@@ -75,6 +75,9 @@ void SerialBridge::connected(std::int64_t now_us) {
   connected_ = true;
   forget_wrong_baud();
   state_ = "connected";
+  // The device is there again: its error is over (the heartbeat and the pages stop showing
+  // "cannot open"; the logs and stderr keep it). Other errors stay until replaced.
+  if (device_error_) last_error_.clear(), last_error_utime_ = 0, device_error_ = false;
   next_status_us_ = now_us;  // say so now, not at the next heartbeat
   tick(now_us);
 }
@@ -87,6 +90,7 @@ void SerialBridge::disconnected(std::int64_t now_us, std::string_view why) {
   forget_wrong_baud();
   state_ = "disconnected";
   error(std::string(why), now_us);
+  device_error_ = true;
   next_status_us_ = now_us;
   tick(now_us);
 }
@@ -99,12 +103,14 @@ void SerialBridge::open_failed(std::int64_t now_us, std::string_view why) {
     next_status_us_ = now_us;
   }
   error(std::string(why), now_us);
+  device_error_ = true;
   tick(now_us);
 }
 
 void SerialBridge::error(std::string text, std::int64_t now_us) {
   last_error_ = std::move(text);
   last_error_utime_ = now_us;
+  device_error_ = false;
 }
 
 void SerialBridge::feed(std::string_view bytes, std::int64_t now_us) {

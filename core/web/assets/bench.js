@@ -145,7 +145,7 @@
     }
     // A run longer than this page keeps is said where its plot is: the plot and the CSV are its start only.
     const cut = run && run.truncated
-      ? `The plot and the CSV hold only the first ${run.kept} of this run's ${run.samples} samples (spindown-web keeps that many a run: --max-run-samples); the fit uses them all. `
+      ? `The plot and the CSV hold only the first ${run.kept} of this run's ${run.samples} samples (this page keeps that many of a run); the fit uses them all. `
       : "";
     setText($("run-note"), run ? cut + (run.note || "") : "Spin the motor up and cut the supply: the run appears here as it coasts.");
     // Markers present once the fitter found them.

@@ -48,7 +48,8 @@
     const t = tile(s.id);
     t.summary = s;
     t.root.setAttribute("data-state", s.state);
-    setText(t.state, s.state);
+    t.silentSince = s.state === "silent" && s.last_sample_unix_ms ? s.last_sample_unix_ms : null;
+    setText(t.state, stateText(t));
     const fit = s.last_fit;
     const run = s.run;
     let runText = run ? `run ${run.number}${run.partial ? " (partial)" : ""}: ${run.state}` : "no run yet";
@@ -63,6 +64,19 @@
     setText(t.bridgeInfo, s.refused ? `its samples are refused: ${s.refused}` : bridgeDetail(s.bridge));
     t.dirty = true;
   }
+
+  // "silent · last sample 14 s ago" while a bench is silent (counted on this page's clock).
+  function ageText(ms) {
+    const s = Math.max(0, Math.round(ms / 1000));
+    return s < 120 ? `${s} s` : s < 7200 ? `${Math.floor(s / 60)} min ${s % 60} s` : `${Math.floor(s / 3600)} h`;
+  }
+  function stateText(t) {
+    const s = t.summary ? t.summary.state : "…";
+    return t.silentSince ? `${s} · last sample ${ageText(Date.now() - t.silentSince)} ago` : s;
+  }
+  setInterval(() => {
+    for (const t of tiles.values()) if (t.silentSince) setText(t.state, stateText(t));
+  }, 1000);
 
   function takeSamples(all) {
     for (const [id, p] of Object.entries(all.benches || {})) {

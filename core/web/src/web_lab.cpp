@@ -276,6 +276,9 @@ Json WebLab::summary_json(const Bench& b, std::int64_t now_us, bool counters) co
   j["state"] = refused ? std::string("refused")
                        : std::string(bench_state_name(bench_state(row, b.activity, now_us, opt_.silent_after_s)));
   j["refused"] = refused ? row->refused : std::string();
+  // While silent, when its last sample came (host time, ms since 1970): the page counts its age
+  // (fixed while silent, so the pushed summary does not change with the clock).
+  if (j["state"] == "silent" && b.activity.last_sample_us > 0) j["last_sample_unix_ms"] = b.activity.last_sample_us / 1000;
   j["expected"] = b.expected;
   j["unit"] = std::string(unit_of(b.activity.quantity));
   Json bridge;

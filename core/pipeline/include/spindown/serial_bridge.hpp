@@ -144,6 +144,7 @@ class SerialBridge {
   std::string state_ = "starting";
   std::string last_error_;
   std::int64_t last_error_utime_ = 0;
+  bool device_error_ = false;  // last_error_ is the device's (cannot open it, it went away): over once connected
   std::int64_t lines_seen_ = 0;
   std::int64_t bytes_since_good_ = 0;    // bytes since the last valid line (or the connect)
   std::int64_t nontext_since_good_ = 0;  // of them, not printable ASCII, tab, CR or LF
