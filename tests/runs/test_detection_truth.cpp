@@ -73,7 +73,7 @@ TEST(DetectionTruth, ACappedCoastIsOneRun) {
     EXPECT_EQ(seg.runs[0].end, Run::End::cap);
     bool warned = false;
     for (const Diagnostic& d : seg.diagnostics)
-      warned = warned || (d.severity == Diagnostic::Severity::warning && d.message.find("--max-coast") != std::string::npos);
+      warned = warned || (d.severity == Diagnostic::Severity::warning && d.message.find("the longest coast kept") != std::string::npos);
     EXPECT_TRUE(warned);
   }
 }

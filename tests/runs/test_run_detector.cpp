@@ -173,7 +173,8 @@ TEST(RunDetector, ACoastLongerThanMaxBufferIsFittedUpToItNotGrown) {
       EXPECT_EQ(e.run.end, Run::End::cap);
       EXPECT_GT(e.run.t_end_s - e.run.t_cut_s, 5.0);  // the buffer holds the lead-in too
       EXPECT_LE(e.run.t_end_s - e.run.t_cut_s, 10.0);
-      EXPECT_NE(e.diagnostic.message.find("--max-buffer"), std::string::npos) << e.diagnostic.message;
+      EXPECT_NE(e.diagnostic.message.find("samples (7 s at this rate) kept of one coast"), std::string::npos)
+          << e.diagnostic.message;
       EXPECT_EQ(e.diagnostic.message.find("max_buffer"), std::string::npos) << e.diagnostic.message;
     }
   }
@@ -195,7 +196,7 @@ TEST(RunDetector, MaxCoastClosesARunAsNeverStoppedAndTheRestOfTheDecayIsNoNewRun
   EXPECT_FALSE(seg.runs[0].stopped);
   EXPECT_NEAR(rec.t_s[seg.runs[0].end_index - 1] - seg.runs[0].t_cut_s, 8.0, 0.05);
   const bool noted = std::any_of(seg.diagnostics.begin(), seg.diagnostics.end(), [](const Diagnostic& d) {
-    return d.message.find("--max-coast") != std::string::npos;
+    return d.message.find("the longest coast kept") != std::string::npos;
   });
   EXPECT_TRUE(noted);
 }

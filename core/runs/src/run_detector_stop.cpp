@@ -18,9 +18,9 @@ void RunDetector::Impl::coast_too_long(std::size_t i) {
     // The memory bound: the coast so far is fitted (never stopped), as at the time bound below; what
     // it does after is not a run.
     run_note_severity_ = Diagnostic::Severity::warning;
-    close_unstopped(i, fmt::format("no standstill within the {} samples ({:.0f} s at this rate) the fitter keeps of "
-                                   "one coast (--max-buffer): closed there as never stopped, the coast fitted up to "
-                                   "there; the rest of this coast is not a run",
+    close_unstopped(i, fmt::format("no standstill within the {} samples ({:.0f} s at this rate) kept of one coast: "
+                                   "closed there as never stopped, the coast fitted up to there; the rest of this "
+                                   "coast is not a run",
                                    opt_.max_buffer, t(i - 1) - run_.t_cut_s),
                     Run::End::cap);
     to_idle(i, true);
@@ -45,8 +45,8 @@ void RunDetector::Impl::coast_too_long(std::size_t i) {
   }
   run_note_severity_ = Diagnostic::Severity::warning;
   close_unstopped(i + 1,
-                  fmt::format("no standstill within {:g} s, the longest coast the fitter keeps (--max-coast): closed "
-                              "there as never stopped, the coast fitted up to there; the rest of this coast is not a run",
+                  fmt::format("no standstill within {:g} s, the longest coast kept: closed there as never stopped, "
+                              "the coast fitted up to there; the rest of this coast is not a run",
                               opt_.max_coast_s),
                   Run::End::cap);
   to_idle(i + 1, true);

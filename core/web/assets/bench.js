@@ -19,6 +19,7 @@
   // What the page knows.
   let trace = { key: 0, n: 0, x: [], y: [] };
   let detail = null;              // the current run's detail event
+  let lastSummary = null;         // the bench's latest summary: what is known of its messages' sources
   const overlays = new Map();     // run number -> {points, color}
   let plot = null, residualPlot = null, dirty = true;
 
@@ -160,7 +161,7 @@
     setCoefficient($("c3"), fit ? fit.c3 : null, fit ? fit.run : undefined);
     setCoefficient($("c4"), fit ? fit.c4 : null, fit ? fit.run : undefined);
     setHealth($("health"), fit);
-    setDoubts($("doubts"), fit);
+    setDoubts($("doubts"), fit, lastSummary);
     $("best-reason").textContent = fit ? fit.best_reason : "";
     $("health-reason").textContent = fit && fit.health_reason ? `health: ${fit.health_reason}` : "";
     // One legend entry per model the FIT carries.
@@ -286,6 +287,8 @@
   // ---- the stream ---------------------------------------------------------------------------
   function showSummary(s) {
     if (s.id !== id) return;
+    lastSummary = s;
+    setDoubts($("doubts"), detail && detail.run ? detail.run.fit : null, s);
     head.setAttribute("data-state", s.state);
     setText($("state"), s.state);
     setBridge($("bridge"), s.bridge);

@@ -47,8 +47,13 @@ const spindown = (() => {
     e.title = fit && fit.health_reason ? fit.health_reason : "";
   }
 
-  function setDoubts(e, fit) {
-    const doubts = fit && fit.doubts ? fit.doubts : [];
+  // The fit's doubts, after what is known of its source: a fit no fitter of the lab vouches for, and
+  // messages for the bench the lab's gate refused (summary: the bench's summary, when known).
+  function setDoubts(e, fit, summary) {
+    const doubts = [];
+    if (fit && fit.not_verified) doubts.push(`NOT VERIFIED: ${fit.not_verified}`);
+    if (summary && summary.refused_recent) doubts.push(`messages for this bench refused: ${summary.refused_recent}`);
+    if (fit && fit.doubts) doubts.push(...fit.doubts);
     e.setAttribute("data-count", String(doubts.length));
     const now = Array.from(e.children).map((c) => c.textContent);
     if (now.length === doubts.length && now.every((t, i) => t === doubts[i])) return;

@@ -48,7 +48,7 @@
     const t = tile(s.id);
     t.summary = s;
     t.root.setAttribute("data-state", s.state);
-    t.silentSince = s.state === "silent" && s.last_sample_unix_ms ? s.last_sample_unix_ms : null;
+    t.silentSince = s.last_sample_unix_ms || null;  // sent while the bench is silent or unplugged
     setText(t.state, stateText(t));
     const fit = s.last_fit;
     const run = s.run;
@@ -59,7 +59,7 @@
     setCoefficient(t.c3, fit ? fit.c3 : null, fit ? fit.run : undefined);
     setCoefficient(t.c4, fit ? fit.c4 : null, fit ? fit.run : undefined);
     setHealth(t.health, fit);
-    setDoubts(t.doubts, fit);
+    setDoubts(t.doubts, fit, s);
     setBridge(t.bridge, s.bridge);
     setText(t.bridgeInfo, s.refused ? `its samples are refused: ${s.refused}` : bridgeDetail(s.bridge));
     t.dirty = true;

@@ -205,6 +205,12 @@ void WebLab::on_fit(std::string_view id, const fit_t& msg, std::int64_t now_us) 
   r->partial = msg.lead_in == "none";
   if (std::isfinite(msg.t_stop_s)) r->t_stop_s = msg.t_stop_s;
   r->fit = fit_summary_json(msg, opt_.lab_units);
+  // Whatever watch knows about the message's source is where its numbers are (issue 44 item 2): a
+  // FIT from a session no fitter announced (any laptop) is marked, and never takes the headline
+  // from a whole run the lab's fitter made.
+  const LabBenchRow* row = table_.bench(id);
+  const std::string doubt = row ? row->fit_doubt : std::string();
+  if (!doubt.empty()) r->fit["not_verified"] = doubt;
   std::string why;
   auto curves = fit_curves_json(msg, &r->trace, opt_.curve_points, opt_.max_display_points, &why);
   if (curves) {
@@ -216,7 +222,7 @@ void WebLab::on_fit(std::string_view id, const fit_t& msg, std::int64_t now_us) 
   // The headline is the last whole run's: a run closed early (a reset, a new source, the power back,
   // silence, the memory cap), one whose cut was not seen or one the fitter doubts never replaces it
   // (a floating pin's hum cut as a run, a stub after a reset); it shows only while no whole run has.
-  const bool whole = whole_run(msg);
+  const bool whole = whole_run(msg) && doubt.empty();
   if (whole || !b.last_fit_whole) {
     b.last_fit = r->fit;
     b.last_fit_curve = best_curve_json(msg, tile_curve_points);
@@ -278,11 +284,17 @@ Json WebLab::summary_json(const Bench& b, std::int64_t now_us, bool counters) co
   j["refused"] = refused ? row->refused : std::string();
   // While silent, when its last sample came (host time, ms since 1970): the page counts its age
   // (fixed while silent, so the pushed summary does not change with the clock).
-  if (j["state"] == "silent" && b.activity.last_sample_us > 0) j["last_sample_unix_ms"] = b.activity.last_sample_us / 1000;
+  const std::string_view health = bridge_health(row, b.activity, now_us, opt_.silent_after_s);
+  if ((j["state"] == "silent" || health == "unplugged") && b.activity.last_sample_us > 0)
+    j["last_sample_unix_ms"] = b.activity.last_sample_us / 1000;
+  // Messages for this bench the gate refused in the last ten minutes (unsigned, another key, a
+  // replay, …): said on its tile and page, where its numbers are, not only in the footer.
+  if (row && row->refused_us > 0 && now_us - row->refused_us <= 600'000'000)
+    j["refused_recent"] = fmt::format("{}: {}", row->refused_kind, row->refused);
   j["expected"] = b.expected;
   j["unit"] = std::string(unit_of(b.activity.quantity));
   Json bridge;
-  bridge["health"] = std::string(bridge_health(row, b.activity, now_us, opt_.silent_after_s));
+  bridge["health"] = std::string(health);
   bridge["state"] = row && row->has_bridge ? row->bridge_state : std::string();
   bridge["reconnects"] = b.activity.reconnects;
   bridge["rate_hz"] = row && row->has_bridge ? std::round(row->rate_hz) : 0.0;
