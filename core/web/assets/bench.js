@@ -25,7 +25,7 @@
 
   // ---- the main plot ------------------------------------------------------------------------
   function series() {
-    const s = [{ label: "s after the cut" }, { label: "reading", stroke: "#222", width: 1.5, points: { show: false } }];
+    const s = [{ label: "s after the cut" }, { label: "reading", stroke: getComputedStyle(document.documentElement).getPropertyValue("--data").trim() || "#222", width: 1.5, points: { show: false } }];
     const models = curveModels();
     for (const m of models) s.push({ label: m.name, stroke: colors[m.name] || "#555", width: m.name === bestName() ? 3 : 2,
                                      dash: m.name === "viscous" ? [8, 4] : m.name === "coulomb" ? [3, 3] : undefined,

@@ -120,7 +120,7 @@
     const px = (v) => 4 + (w - 8) * (v - x0) / (x1 - x0);
     const py = (v) => h - 4 - (h - 8) * (v - y0) / (y1 - y0);
     g.lineWidth = 1.5;
-    g.strokeStyle = "#333";
+    g.strokeStyle = getComputedStyle(document.documentElement).getPropertyValue("--data").trim() || "#333";
     g.beginPath();
     for (let i = 0; i < x.length; i++) (i ? g.lineTo : g.moveTo).call(g, px(x[i]), py(y[i]));
     g.stroke();

@@ -59,6 +59,7 @@ bool WebLabOptions::is_valid(std::string* why) const {
 WebLab::WebLab(WebLabOptions options) : opt_(std::move(options)), table_([&] {
   LabTableOptions t;
   t.lab_units = opt_.lab_units;
+  t.signatures_checked = opt_.signatures_checked;
   t.stale_s = opt_.silent_after_s;
   t.max_benches = opt_.max_benches;
   return t;
