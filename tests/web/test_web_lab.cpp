@@ -347,3 +347,30 @@ TEST(WebLab, ARunClosedEarlyOrDoubtedNeverTakesTheHeadlineFromAWholeRun) {
 
 }  // namespace
 }  // namespace spindown
+
+namespace spindown {
+namespace {
+
+using namespace spindown::test;
+
+// Issue 44 item 2: a refused FIT for a bench (unsigned, another key) is said on that bench's tile,
+// and a refused message naming a bench the lab does not have makes no tile.
+TEST(WebLab, ARefusedFitIsSaidOnItsBenchsTileAndMakesNoNewTile) {
+  const SimulatedRun whole = simulated_run(7, 1);
+  WebLab lab;
+  std::int64_t now = feed_run(lab, whole);
+  GateResult g;
+  g.verdict = GateVerdict::not_signed;
+  g.text = "SPINDOWN.b1.FIT from laptop-17: not signed";
+  lab.on_refused(g, now += sec_us, {}, "b1");
+  const Json state = lab.state_json(now);
+  const Json& b = bench_of(state, "b1");
+  ASSERT_TRUE(b.contains("refused_recent"));
+  EXPECT_NE(b["refused_recent"].get<std::string>().find("laptop-17"), std::string::npos);
+  EXPECT_EQ(b["last_fit"]["run"], 1);  // the headline stays the fitter's
+  lab.on_refused(g, now, {}, "ghost");
+  EXPECT_EQ(lab.bench_count(), 1u);
+}
+
+}  // namespace
+}  // namespace spindown

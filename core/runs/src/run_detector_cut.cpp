@@ -569,27 +569,11 @@ void RunDetector::Impl::recut_after_return(Run& r, std::size_t coast_end) {
     sum += v(k + len) - v(k);
   }
   if (back == 0 || back + 6 >= coast_end) return;
-  // The coast after the return: its cut found as any cut is, with the samples before it as lead-in
-  // and the next seconds (a drive's hunting may run on a while below the level before the cut).
-  std::size_t a = back, b = back;
-  while (a > c && t(back) - t(a - 1) <= back_search_s) --a;
-  while (b + 1 < coast_end && t(b + 1) - t(back) <= back_search_s) ++b;
-  if (b < back + 6 || back < a + 4) return;
-  const WindowFit w = window_over(ring_.get(), mask_, 1.0, back, b + 1);
-  const std::size_t keep_lo = search_lo_;
-  search_lo_ = std::max(search_lo_, c);
-  CutSplit sp = split_at_cut(a, b, w);
-  const std::string lead = classify_lead_in(sp);
-  if (lead == "powered" && sp.pre_flat) refine_plateau_cut(sp, b);
-  search_lo_ = keep_lo;
-  if (!(sp.v0 > 0) || sp.cut_index <= c) return;
+  // The coast after the return, with the next seconds (a drive's hunting may run on a while below
+  // the level before the cut).
   const double t_old = r.t_cut_s;
   const bool was_partial = r.partial();  // "the recording starts mid-coast": no longer so
-  bounce_.clear();
-  r.cut_index = sp.cut_index;
-  r.t_cut_s = sp.t_cut_s;
-  r.lead_in = lead;
-  v0_ = sp.v0;
+  if (!recut_from(r, back, coast_end, back_search_s, 4)) return;
   const std::string said = fmt::format(
       "the reading stood at {:.4g} until {}, back at the level of the coast taken from {} ({:.4g}), where that coast "
       "would have lost {:.2g} by then at a quarter of its own pace ({:.0f} times its means' noise {:.2g}): friction "
@@ -597,6 +581,28 @@ void RunDetector::Impl::recut_after_return(Run& r, std::size_t coast_end) {
       at_level, fmt_s(t(back - 1)), fmt_s(t_old), level, lost, lost / se, se, fmt_s(r.t_cut_s), r.lead_in);
   run_note_ = run_note_.empty() || was_partial ? said : said + "; " + run_note_;
   run_note_severity_ = Diagnostic::Severity::warning;
+}
+
+bool RunDetector::Impl::recut_from(Run& r, std::size_t at, std::size_t coast_end, double ahead_s, std::size_t min_lead) {
+  const std::size_t c = r.cut_index;
+  std::size_t a = at, b = at;
+  while (a > c && t(at) - t(a - 1) <= back_search_s) --a;
+  while (b + 1 < coast_end && t(b + 1) - t(at) <= ahead_s) ++b;
+  if (b < at + 6 || at < a + min_lead) return false;
+  const WindowFit w = window_over(ring_.get(), mask_, 1.0, at, b + 1);
+  const std::size_t keep_lo = search_lo_;
+  search_lo_ = std::max(search_lo_, c);
+  CutSplit sp = split_at_cut(a, b, w);
+  const std::string lead = classify_lead_in(sp);
+  if (lead == "powered" && sp.pre_flat) refine_plateau_cut(sp, b);
+  search_lo_ = keep_lo;
+  if (!(sp.v0 > 0) || sp.cut_index <= c) return false;
+  bounce_.clear();
+  r.cut_index = sp.cut_index;
+  r.t_cut_s = sp.t_cut_s;
+  r.lead_in = lead;
+  v0_ = sp.v0;
+  return true;
 }
 
 std::size_t RunDetector::Impl::count_from(double lo, std::size_t from, std::size_t to, double hi) const {

@@ -101,24 +101,8 @@ void RunDetector::Impl::recut_after_dwell(Run& r, std::size_t coast_end) {
   const std::size_t at = dwell_end(c, coast_end, h, from);
   if (at == 0 || frozen(from, at)) return;
   // The coast after the dwell: its cut found as any cut is, the dwell its lead-in.
-  std::size_t a = at, b = at;
-  while (a > c && t(at) - t(a - 1) <= back_search_s) --a;
-  while (b + 1 < coast_end && t(b + 1) - t(at) <= 1.0) ++b;
-  if (b < at + 6 || at < a + 8) return;
-  const WindowFit w = window_over(ring_.get(), mask_, 1.0, at, b + 1);
-  const std::size_t keep_lo = search_lo_;
-  search_lo_ = std::max(search_lo_, c);
-  CutSplit sp = split_at_cut(a, b, w);
-  const std::string lead = classify_lead_in(sp);
-  if (lead == "powered" && sp.pre_flat) refine_plateau_cut(sp, b);
-  search_lo_ = keep_lo;
-  if (!(sp.v0 > 0) || sp.cut_index <= c) return;
   const double t_old = r.t_cut_s;
-  bounce_.clear();
-  r.cut_index = sp.cut_index;
-  r.t_cut_s = sp.t_cut_s;
-  r.lead_in = lead;
-  v0_ = sp.v0;
+  if (!recut_from(r, at, coast_end, 1.0, 8)) return;
   const std::string said = fmt::format(
       "the reading held at {:.4g} ± {:.2g} or above from {} to {}, inside the coast taken from {}, and then fell {:.2g} "
       "times as far in a twentieth of that time or less: a coast never dwells, so the coast is taken from {} (lead-in {})",

@@ -231,6 +231,10 @@ class RunDetector::Impl {
   // (within its means' noise) where the coast's own pace says it must have fallen far below it, no
   // coast had begun (a drive hunting about its setpoint): r starts after the last such return.
   void recut_after_return(Run& r, std::size_t coast_end);
+  // r's cut moved to the coast after sample `at` inside it, found as any cut is: the samples up to
+  // back_search_s before it (at least min_lead) as lead-in, ahead_s after it; false when there is
+  // no such cut after r's (r unchanged).
+  bool recut_from(Run& r, std::size_t at, std::size_t coast_end, double ahead_s, std::size_t min_lead);
   // How many readings in [from, to) lie in [lo, hi].
   std::size_t count_from(double lo, std::size_t from, std::size_t to,
                          double hi = std::numeric_limits<double>::infinity()) const;

@@ -245,10 +245,17 @@ void WebLab::on_explain(std::string_view id, const explain_t& msg, std::int64_t)
 
 void WebLab::on_bad_message(std::string text, std::int64_t now_us) { table_.on_bad_message(std::move(text), now_us); }
 
-void WebLab::on_refused(const GateResult& refused, std::int64_t now_us, std::string_view id) {
+void WebLab::on_refused(const GateResult& refused, std::int64_t now_us, std::string_view id, std::string_view about) {
   ++refused_;
   last_refused_ = refused.text;
-  if (id.empty() || refused.verdict == GateVerdict::other_lab) return;
+  if (refused.verdict == GateVerdict::other_lab) return;
+  if (id.empty()) {
+    if (auto it = benches_.find(std::string(about)); it != benches_.end()) {
+      it->second.refused_other = fmt::format("{}: {}", gate_verdict_name(refused.verdict), refused.text);
+      it->second.refused_other_us = now_us;
+    }
+    return;
+  }
   bench(id);  // a tile for a bench whose every sample is refused (the summary says so)
   table_.on_refused(refused, now_us, id);
 }
@@ -290,7 +297,9 @@ Json WebLab::summary_json(const Bench& b, std::int64_t now_us, bool counters) co
     j["last_sample_unix_ms"] = b.activity.last_sample_us / 1000;
   // Messages for this bench the gate refused in the last ten minutes (unsigned, another key, a
   // replay, …): said on its tile and page, where its numbers are, not only in the footer.
-  if (row && row->refused_us > 0 && now_us - row->refused_us <= 600'000'000)
+  if (b.refused_other_us > 0 && (!row || b.refused_other_us >= row->refused_us) && now_us - b.refused_other_us <= 600'000'000)
+    j["refused_recent"] = b.refused_other;
+  else if (row && row->refused_us > 0 && now_us - row->refused_us <= 600'000'000)
     j["refused_recent"] = fmt::format("{}: {}", row->refused_kind, row->refused);
   j["expected"] = b.expected;
   j["unit"] = std::string(unit_of(b.activity.quantity));

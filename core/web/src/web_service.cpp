@@ -42,7 +42,8 @@ void WebService::take(std::string_view channel, const void* data, std::int64_t s
   std::lock_guard lock(mutex_);
   if (opt_.check) {
     if (auto refused = opt_.check(channel, data, size, now)) {
-      lab_.on_refused(*refused, now, parsed->kind == ChannelKind::sample ? parsed->bench : std::string());
+      const bool sample = parsed->kind == ChannelKind::sample;
+      lab_.on_refused(*refused, now, sample ? parsed->bench : std::string(), sample ? std::string() : parsed->bench);
       return;
     }
   }

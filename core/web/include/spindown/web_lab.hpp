@@ -98,7 +98,10 @@ class WebLab {
   void on_bad_message(std::string text, std::int64_t now_us);
   // A message refused before decoding (signature, lab): never shown as data; counted and named.
   // bench: a refused SAMPLE's bench: unless another lab's, its tile says it is refused, and why.
-  void on_refused(const GateResult& refused, std::int64_t now_us, std::string_view bench = {});
+  // bench: a refused sample's bench (a tile for it, its state); about: the bench another refused
+  // message names (a FIT, a RUN …): said on that bench's tile if it has one, never a new tile.
+  void on_refused(const GateResult& refused, std::int64_t now_us, std::string_view bench = {},
+                  std::string_view about = {});
 
   // GET /api/state: {"benches":[summary…],"lab":{…}}; summaries with their counters.
   Json state_json(std::int64_t now_us) const;
@@ -129,6 +132,8 @@ class WebLab {
   struct Bench {
     std::string id;
     bool expected = false;
+    std::string refused_other;     // the last refused message naming it that was not a sample
+    std::int64_t refused_other_us = 0;
     BenchActivity activity;
     SampleStream stream;
     std::deque<TracePoint> lead;  // samples while no run is open (the next run's preroll)
