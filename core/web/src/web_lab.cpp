@@ -190,11 +190,14 @@ void WebLab::on_run(std::string_view id, const run_t& msg, std::int64_t now_us) 
   b.detail_changed = true;
 }
 
-// A run the fitter saw from its cut to its end: stopped (or its decay lost in the noise, or its
-// sensor giving up at low speed), its cut seen, and nothing doubted.
+// A run that may take the headline: its cut seen, nothing doubted, and not ended by something that
+// says the decline may be no coast at all: the reading rising again (a floating pin's hum closed at
+// "power back") or the board resetting (a brown-out as the supply is switched: the stub before it
+// is the board's, not the motor's). A coast whose samples stopped (its bench went silent, its bridge
+// restarted, a gap, the memory bound) is still the coast it was, cut short and said so.
 static bool whole_run(const fit_t& msg) {
-  const bool ended = msg.end == "stopped" || msg.end == "asymptotic" || msg.end == "signal lost";
-  return ended && msg.lead_in != "none" && msg.ndoubts == 0;
+  const bool interrupted = msg.end == "power back" || msg.end == "clock restart";
+  return !interrupted && msg.lead_in != "none" && msg.ndoubts == 0;
 }
 
 void WebLab::on_fit(std::string_view id, const fit_t& msg, std::int64_t now_us) {
