@@ -345,14 +345,6 @@ TEST(WebLab, ARunClosedEarlyOrDoubtedNeverTakesTheHeadlineFromAWholeRun) {
   EXPECT_EQ(bench_of(fresh.state_json(now), "b2")["last_fit"]["run"], 2);
 }
 
-}  // namespace
-}  // namespace spindown
-
-namespace spindown {
-namespace {
-
-using namespace spindown::test;
-
 // Issue 44 item 2: a refused FIT for a bench (unsigned, another key) is said on that bench's tile,
 // and a refused message naming a bench the lab does not have makes no tile.
 TEST(WebLab, ARefusedFitIsSaidOnItsBenchsTileAndMakesNoNewTile) {
