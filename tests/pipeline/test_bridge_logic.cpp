@@ -68,6 +68,12 @@ BridgeSettings settings() {
 
 constexpr std::int64_t T0 = 1'700'000'000'000'000;
 
+// A bridge started and its port connected at T0, as after a board is plugged in.
+void start_connected(SerialBridge& b) {
+  b.start(T0);
+  b.connected(T0);
+}
+
 }  // namespace
 
 TEST(BridgeLogic, LabLinesBecomeSamplesWithGaplessSeq) {
@@ -188,8 +194,7 @@ TEST(BridgeLogic, TenMegabyteLineKeepsMemoryBounded) {
   BridgeSettings s = settings();
   s.max_line_bytes = 256;
   SerialBridge b(s, sink);
-  b.start(T0);
-  b.connected(T0);
+  start_connected(b);
   const std::string chunk(64 * 1024, '7');  // digits: would be "a number" if kept
   for (int i = 0; i < 160; ++i) {  // 10 MiB, no newline
     b.feed(chunk, T0);
@@ -473,8 +478,7 @@ TEST(BridgeLogic, BrokenSpindownLinesAreNoTable) {
   BridgeSettings s = settings();
   s.baud = 115200;
   SerialBridge b(s, sink);
-  b.start(T0);
-  b.connected(T0);
+  start_connected(b);
   b.feed("# spindown-coast v1 adc_bits=10 vref=5.000\r\n", T0);
   for (int i = 0; i < 12; ++i) b.feed(fmt::format("{},{},{}*3F\r\n", i, 1000 + 2000 * i, 512 - i), T0 + i);
   EXPECT_NE(b.protocol(), WireProtocol::lab);
