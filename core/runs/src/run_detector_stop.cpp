@@ -277,13 +277,30 @@ void RunDetector::Impl::found_standstill(std::size_t i, bool at_end) {
 
 std::size_t RunDetector::Impl::standstill_start(std::size_t i, double z, double band) const {
   // First sample of the standstill that contains the hold window (an isolated sample outside
-  // the band is noise; two in a row are the coast).
+  // the band is noise; two in a row are the coast, unless the readings before them come back to
+  // the standstill: a coast only gets further from its standstill going back in time, noise
+  // returns). The band is three times a noise measured from the hold window's few readings (10
+  // at 10 Hz), which often reads it low, so "come back" is judged by that noise's upper 95 %
+  // bound: the mean of a hold window's worth of readings before the pair within three of its
+  // standard errors of the standstill's level. A slow coast, whose readings a second back lie
+  // above the level by more than that, still ends the standstill; so does a pair inside the hold
+  // window, and a pair a whole step of the reading off a standstill quieter than that step (the
+  // coast's last step down).
+  const std::size_t h0 = std::min(hold_.first, i), lookback = i + 1 - h0;
+  const auto in_band = [&](std::size_t k) { return std::abs(v(k) - z) <= band; };
   std::size_t first_in = i + 1;
   while (first_in > run_.cut_index + 1) {
-    if (std::abs(v(first_in - 1) - z) <= band) {
+    if (in_band(first_in - 1)) {
       --first_in;
-    } else if (first_in - 1 > run_.cut_index + 1 && std::abs(v(first_in - 2) - z) <= band && first_in - 1 < i + 1) {
+    } else if (first_in - 1 > run_.cut_index + 1 && in_band(first_in - 2) && first_in - 1 < i + 1) {
       first_in -= 2;  // lone outlier
+    } else if (lookback >= 4 && first_in <= h0 + 1 && first_in - 1 > run_.cut_index + 1 + lookback) {
+      const std::size_t pair = first_in - 2;  // the first of the two out of the band
+      if (band < coast_step_) break;
+      double sum = 0;
+      for (std::size_t k = pair - lookback; k < pair; ++k) sum += v(k) - z;
+      if (std::abs(sum) > band * noise_upper_bound(lookback) * std::sqrt(double(lookback))) break;
+      first_in = pair;  // noise: the walk goes on before the pair
     } else {
       break;
     }
