@@ -517,10 +517,85 @@ void RunDetector::Impl::recut_after_rise(Run& r, std::size_t coast_end) {
 void RunDetector::Impl::recut_after_return(Run& r, std::size_t coast_end) {
   const std::size_t c = r.cut_index;
   if (coast_end < c + 24 || !(v0_ > 0)) return;
-  // Means over whole ripples where the coast shows one (a wheel's once per revolution, a drive's
-  // hunting), else over five samples, and their noise (or a sixth of the print's step: a level read
-  // in whole steps is known no better).
+  // Readings held at the converter's top (find_pinned_start) are not the motor's: from after them.
+  std::size_t from = c;
+  if (std::isfinite(pin_level_))
+    for (std::size_t k = c; k < coast_end; ++k)
+      if (v(k) >= pin_level_) from = k + 1;
+  double top = v(from < coast_end ? from : c);
+  for (std::size_t k = from; k < coast_end; ++k) top = std::max(top, v(k));
+  // The scan over means of len readings, their noise se: the last window [back - len, back) that
+  // stands back at the coast's level, where it must have lost `lost`; back 0 when none does. With
+  // se 0, whether any window could for some noise: a return needs lost > 10 se and a mean above
+  // level - 3 se, so above level - 0.3 lost, and se is at least a sixth of the reading's step.
+  std::size_t back = 0;
+  double at_level = 0, lost = 0, level = 0;
+  double* prefix = nullptr;  // sums of the readings [from, from + j), j = 0 … coast_end - from
+  const auto scan = [&](std::size_t len, double se) {
+    back = 0;
+    if (coast_end < from + 4 * len) return;
+    double sum = 0;
+    for (std::size_t k = from; k < from + len; ++k) sum += v(k);
+    // The level the coast began at, read from its first samples (not the cut's line, which a bounce
+    // pulls down and a line fitted to a curve lifts): the highest median of three over its first
+    // two windows (a contact's bounce at the connection reads low, a glitch alone decides nothing).
+    level = -std::numeric_limits<double>::infinity();
+    for (std::size_t k = from + 1; k + 1 < std::min(from + 2 * len, coast_end); ++k)
+      level = std::max(level, median_of_three(v(k - 1), v(k), v(k + 1)));
+    // The coast's own pace: its whole fall (to the mean of its last samples: its standstill, or
+    // where a coast that did not stop was closed) over its whole time, a quarter of it at most
+    // early on (Stribeck friction, strongest near standstill, makes a coast's start its slowest part).
+    double last = 0;
+    for (std::size_t k = coast_end - len; k < coast_end; ++k) last += v(k);
+    last /= double(len);
+    const double span_s = 0.5 * (t(coast_end - len) + t(coast_end - 1)) - r.t_cut_s;
+    if (!(span_s > 0)) return;
+    const double least_rate = 0.25 * std::max(level - last, 0.0) / span_s;
+    if (se == 0) {  // the same test from the prefix sums, with a margin for their rounding
+      const Sample* ring = ring_.get();
+      const std::size_t mask = mask_;
+      const double t_from = t(from), n = double(len), rate = 0.5 * least_rate, least = 10.0 * coast_step_ / 6.0;
+      const double margin = 1e-9 * n * (std::abs(level) + std::abs(v0_));
+      for (std::size_t k = from; k + len <= coast_end; ++k) {
+        const double should = rate * (ring[k & mask].t + ring[(k + len - 1) & mask].t) - least_rate * t_from;
+        if (prefix[k + len - from] - prefix[k - from] + margin >= n * (level - 0.3 * should) && should > least) {
+          back = k + len;
+          return;
+        }
+      }
+      return;
+    }
+    for (std::size_t k = from;; ++k) {  // the window [k, k + len)
+      const double mean = sum / double(len);
+      const double should = least_rate * (0.5 * (t(k) + t(k + len - 1)) - t(from));  // lost since the level was read
+      if (should > 10.0 * se && mean >= level - 3.0 * se &&
+                 2 * count_from(top - coast_step_, k, k + len) < len && 2 * count_from(v(k), k, k + len, v(k)) <= len) {
+        // Where the coast must have lost ten of its means' noise, it stands within three of the
+        // cut's level — and not mostly within a reading step of the coast's highest reading (a
+        // converter's top, read until the back-EMF comes below it) or on one repeated value (a stall).
+        back = k + len, at_level = mean, lost = should;
+      }
+      if (k + len >= coast_end) break;
+      sum += v(k + len) - v(k);
+    }
+  };
+  // The means are over whole ripples where the coast shows one (a wheel's once per revolution, a
+  // drive's hunting: 2 to 256 readings, twice the lag of the largest noise up to half a second),
+  // else over five readings. Most coasts fall well below their level at every length: then their
+  // noise (most of this search's time) is not needed.
   const std::size_t mid = c + (coast_end - c) / 2;
+  const std::size_t max_len = 2 * std::max(noise_max_lag(c, mid), noise_max_lag(mid, coast_end));
+  if (coast_end < from + 20) return;
+  prefix = scratch(coast_end - from + 1);
+  prefix[0] = 0;
+  for (std::size_t k = from; k < coast_end; ++k) prefix[k + 1 - from] = prefix[k - from] + v(k);
+  bool could = false;
+  for (std::size_t len = 5; len <= std::max<std::size_t>(max_len, 5) && !could; len = len == 5 ? 8 : 2 * len) {
+    scan(len, 0.0);
+    could = back != 0;
+  }
+  if (!could) return;
+  // The means' noise (or a sixth of the print's step: a level read in whole steps is known no better).
   const LagNoise early = noise_over(c, mid), late = noise_over(mid, coast_end);
   const LagNoise& noise = early.wander < late.wander ? early : late;
   const bool rippled = noise.wander > 2.0 * noise.white;
@@ -529,45 +604,7 @@ void RunDetector::Impl::recut_after_return(Run& r, std::size_t coast_end) {
   const double se =
       std::max((rippled ? noise.wander : noise.white) / std::sqrt(double(len)), coast_step_ / 6.0);
   if (!(se > 0)) return;
-  // Readings held at the converter's top (find_pinned_start) are not the motor's: from after them.
-  std::size_t from = c;
-  if (std::isfinite(pin_level_))
-    for (std::size_t k = c; k < coast_end; ++k)
-      if (v(k) >= pin_level_) from = k + 1;
-  if (coast_end < from + 4 * len) return;
-  double top = v(from);
-  for (std::size_t k = from; k < coast_end; ++k) top = std::max(top, v(k));
-  double sum = 0;
-  for (std::size_t k = from; k < from + len; ++k) sum += v(k);
-  // The level the coast began at, read from its first samples (not the cut's line, which a bounce
-  // pulls down and a line fitted to a curve lifts): the highest median of three over its first two
-  // windows (a contact's bounce at the connection reads low, a glitch alone decides nothing).
-  double level = -std::numeric_limits<double>::infinity();
-  for (std::size_t k = from + 1; k + 1 < std::min(from + 2 * len, coast_end); ++k)
-    level = std::max(level, median_of_three(v(k - 1), v(k), v(k + 1)));
-  // The coast's own pace: its whole fall (to the mean of its last samples: its standstill, or where
-  // a coast that did not stop was closed) over its whole time, a quarter of it at most early on
-  // (Stribeck friction, strongest near standstill, makes a coast's start its slowest part).
-  double last = 0;
-  for (std::size_t k = coast_end - len; k < coast_end; ++k) last += v(k);
-  last /= double(len);
-  const double span_s = 0.5 * (t(coast_end - len) + t(coast_end - 1)) - r.t_cut_s;
-  if (!(span_s > 0)) return;
-  const double least_rate = 0.25 * std::max(level - last, 0.0) / span_s;
-  std::size_t back = 0;
-  double at_level = 0, lost = 0;
-  for (std::size_t k = from;; ++k) {  // the window [k, k + len)
-    const double mean = sum / double(len);
-    const double should = least_rate * (0.5 * (t(k) + t(k + len - 1)) - t(from));  // lost since the level was read
-    // Where the coast must have lost ten of its means' noise, it stands within three of the cut's
-    // level — and not mostly within a reading step of the coast's highest reading (a converter's
-    // top, read until the back-EMF comes below it) or on one repeated value (a stall).
-    if (should > 10.0 * se && mean >= level - 3.0 * se && 2 * count_from(top - coast_step_, k, k + len) < len &&
-        2 * count_from(v(k), k, k + len, v(k)) <= len)
-      back = k + len, at_level = mean, lost = should;
-    if (k + len >= coast_end) break;
-    sum += v(k + len) - v(k);
-  }
+  scan(len, se);
   if (back == 0 || back + 6 >= coast_end) return;
   // The coast after the return, with the next seconds (a drive's hunting may run on a while below
   // the level before the cut).
@@ -622,16 +659,21 @@ double RunDetector::Impl::rough_sd(std::size_t from, std::size_t to) const {
   return 1.4826 * d[d.size() / 2] / std::sqrt(6.0);
 }
 
+std::size_t RunDetector::Impl::noise_max_lag(std::size_t from, std::size_t to) const {
+  if (to <= from + 2) return 1;
+  const double period = (t(to - 1) - t(from)) / double(to - 1 - from);
+  return period > 0 ? std::size_t(std::clamp(0.5 / period, 1.0, 128.0)) : 1;
+}
+
 LagNoise RunDetector::Impl::noise_over(std::size_t from, std::size_t to) const {
   std::vector<double> x;
   x.reserve(to > from ? to - from : 0);
   for (std::size_t k = from; k < to; ++k) x.push_back(v(k));
-  std::size_t max_lag = 1;
-  if (to > from + 2) {
-    const double period = (t(to - 1) - t(from)) / double(to - 1 - from);
-    if (period > 0) max_lag = std::size_t(std::clamp(0.5 / period, 1.0, 128.0));
-  }
-  return measure_lag_noise(x, max_lag);
+  const std::size_t max_lag = noise_max_lag(from, to);
+  // Each lag's noise from at most 255 second differences spread over the stretch (as
+  // sampled_rough_sd): a median of that many is as good a scale, and 4096 of them at every lag
+  // cost a lab run's find_runs twice its time.
+  return measure_lag_noise(x, max_lag, 255);
 }
 
 double RunDetector::Impl::smoothed(std::size_t k, std::size_t lo, std::size_t hi) const {

@@ -289,6 +289,8 @@ class RunDetector::Impl {
   // The noise of [from, to) at every lag up to half a second (lag_noise.hpp): what a rise or a step
   // inside a coast must stand above to be evidence in this recording (a ripple included).
   LagNoise noise_over(std::size_t from, std::size_t to) const;
+  // The longest lag noise_over looks at over [from, to): half a second of samples, 1 to 128.
+  std::size_t noise_max_lag(std::size_t from, std::size_t to) const;
   // The same for a coast found while after_silence_: the silenced coast's rest, from the first
   // sample after the silence; empty only when nothing of it is held.
   std::string rest_after_silence(CutSplit& sp);
