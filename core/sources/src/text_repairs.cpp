@@ -90,26 +90,6 @@ void each_line(std::string_view text, std::size_t limit, F&& f) {
   }
 }
 
-struct HeadCounts {
-  std::size_t lines = 0, timestamped = 0, value_only = 0, comma = 0, point = 0;
-};
-
-HeadCounts count_head(std::string_view text) {
-  HeadCounts c;
-  each_line(text, head_bytes, [&](std::string_view line, std::size_t) {
-    if (line.empty() || line == "\r") return;
-    ++c.lines;
-    const std::size_t skip = timestamp_prefix(line);
-    c.timestamped += skip > 0;
-    line.remove_prefix(skip);
-    c.value_only += skip > 0 && one_number(line);
-    std::size_t comma = 0;
-    c.comma += comma_sample(line, &comma);
-    c.point += point_sample(line);
-  });
-  return c;
-}
-
 // A Python bytes literal as print(ser.readline()) writes it: b'5234\t2.80\r\n' (or in double
 // quotes). Its content, unescaped, into out; false when line is not one.
 bool bytes_literal(std::string_view line, std::string* out) {
@@ -150,15 +130,28 @@ bool bytes_literal(std::string_view line, std::string* out) {
   return true;
 }
 
-std::size_t count_bytes_literals(std::string_view text, std::size_t* lines) {
-  std::size_t n = 0;
-  *lines = 0;
+// What the head of a text (its first head_bytes) shows, line by line, in one pass: every check of
+// whether a text needs repair reads these counts (an ordinary file is read once more, not five times).
+struct HeadCounts {
+  std::size_t lines = 0, timestamped = 0, value_only = 0, comma = 0, point = 0, bytes_literals = 0, plotter = 0;
+};
+
+HeadCounts count_head(std::string_view text) {
+  HeadCounts c;
   each_line(text, head_bytes, [&](std::string_view line, std::size_t) {
     if (line.empty() || line == "\r") return;
-    ++*lines;
-    n += bytes_literal(line, nullptr);
+    ++c.lines;
+    c.bytes_literals += bytes_literal(line, nullptr);
+    c.plotter += plotter_labels(line, nullptr, nullptr);
+    const std::size_t skip = timestamp_prefix(line);
+    c.timestamped += skip > 0;
+    line.remove_prefix(skip);
+    c.value_only += skip > 0 && one_number(line);
+    std::size_t comma = 0;
+    c.comma += comma_sample(line, &comma);
+    c.point += point_sample(line);
   });
-  return n;
+  return c;
 }
 
 // Each line of text given to f(line, out), which appends its new text to out and returns true,
@@ -177,21 +170,8 @@ std::size_t rewrite_lines(std::string& text, F&& f) {
   return rewritten;
 }
 
-bool plotter_lines_to_unlabel(std::string_view text) {
-  std::size_t lines = 0, labelled = 0;
-  each_line(text, head_bytes, [&](std::string_view line, std::size_t) {
-    if (line.empty() || line == "\r") return;
-    ++lines;
-    labelled += plotter_labels(line, nullptr, nullptr);
-  });
-  return labelled >= 3 && labelled * 2 >= lines;
-}
-
-bool bytes_literals_to_unwrap(std::string_view text) {
-  std::size_t lines = 0;
-  const std::size_t n = count_bytes_literals(text, &lines);
-  return n >= 3 && n * 2 >= lines;
-}
+bool plotter_lines_to_unlabel(const HeadCounts& c) { return c.plotter >= 3 && c.plotter * 2 >= c.lines; }
+bool bytes_literals_to_unwrap(const HeadCounts& c) { return c.bytes_literals >= 3 && c.bytes_literals * 2 >= c.lines; }
 
 bool timestamps_to_strip(const HeadCounts& c) { return c.timestamped >= 3 && c.timestamped * 2 >= c.lines; }
 bool commas_to_read(const HeadCounts& c) { return c.comma >= 5 && c.point == 0; }
@@ -242,9 +222,8 @@ bool plotter_labels(std::string_view line, std::string* labels, std::string* val
 
 bool needs_text_repair(std::string_view text) {
   if (needs_decoding(encoding_to_undo(text))) return true;
-  if (bytes_literals_to_unwrap(text) || plotter_lines_to_unlabel(text)) return true;
   const HeadCounts c = count_head(text);
-  return timestamps_to_strip(c) || commas_to_read(c);
+  return bytes_literals_to_unwrap(c) || plotter_lines_to_unlabel(c) || timestamps_to_strip(c) || commas_to_read(c);
 }
 
 std::vector<std::string> repair_text(std::string& text) {
@@ -253,7 +232,7 @@ std::vector<std::string> repair_text(std::string& text) {
     text = decode_text(text, g);
     if (std::string note = decoding_note(g); !note.empty()) notes.push_back(std::move(note));
   }
-  if (bytes_literals_to_unwrap(text)) {
+  if (bytes_literals_to_unwrap(count_head(text))) {
     std::string content;
     const std::size_t unwrapped = rewrite_lines(text, [&](std::string_view line, std::string& out) {
       if (!bytes_literal(line, &content)) return false;
@@ -264,7 +243,7 @@ std::vector<std::string> repair_text(std::string& text) {
                                 "script writes them) unwrapped in {} lines",
                                 unwrapped));
   }
-  if (plotter_lines_to_unlabel(text)) {
+  if (plotter_lines_to_unlabel(count_head(text))) {
     std::string labels, values, header;
     const std::size_t unlabelled = rewrite_lines(text, [&](std::string_view line, std::string& out) {
       if (!plotter_labels(line, &labels, &values)) return false;
