@@ -41,11 +41,11 @@ RunDetector::Impl::WindowFit RunDetector::Impl::window_over(const Sample* ring, 
 }
 
 void RunDetector::Impl::rebuild(WindowFit& w, std::size_t from, std::size_t to) {
-  w = window_over(ring_.get(), mask_, w.span_s, from, to);
+  w = window_over(store_.data(), store_.mask(), w.span_s, from, to);
 }
 
 void RunDetector::Impl::reset_window(WindowFit& w, std::size_t lo, std::size_t end) {
-  lo = std::max(lo, base_);
+  lo = std::max(lo, store_.base());
   if (lo >= end) {
     w.clear(end, 0.0);
     return;
@@ -88,7 +88,7 @@ void RunDetector::Impl::reset_window(WindowFit& w, std::size_t lo, std::size_t e
 }
 
 [[gnu::always_inline]] inline void RunDetector::Impl::advance(WindowFit& w, std::size_t i, Sample s) {
-  advance(w, ring_.get(), mask_, i, s);
+  advance(w, store_.data(), store_.mask(), i, s);
 }
 
 [[gnu::always_inline]] inline void RunDetector::Impl::coast_step(std::size_t i, Sample s, double prev_t) {
@@ -158,8 +158,6 @@ void RunDetector::Impl::act_on(const CoastVerdict& v, std::size_t i, bool at_end
 
 RunDetector::Impl::Impl(RunOptions opt, std::string source) : opt_(std::move(opt)), source_(std::move(source)) {
   set_spans(0.0);
-  ring_ = std::make_unique_for_overwrite<Sample[]>(initial_ring_size);
-  mask_ = initial_ring_size - 1;
 }
 
 // The windows' spans for a stream sampled every period_s (0: fast enough for the spans in seconds):
@@ -189,16 +187,6 @@ double RunDetector::Impl::shortest_period(const WindowFit& w) const {
   double p = std::numeric_limits<double>::infinity();
   for (std::size_t k = w.first + 1; k < w.end; ++k) p = std::min(p, t(k) - t(k - 1));
   return std::isfinite(p) ? p : 0.0;
-}
-
-void RunDetector::Impl::grow_ring() {
-  // Keep [base_, next_index_) at the same positions modulo the new, doubled size.
-  const std::size_t size = 2 * ring_size();
-  auto bigger = std::make_unique_for_overwrite<Sample[]>(size);
-  const std::size_t mask = size - 1;
-  for (std::size_t k = base_; k + 1 < next_index_; ++k) bigger[k & mask] = ring_[k & mask_];
-  ring_ = std::move(bigger);
-  mask_ = mask;
 }
 
 std::vector<RunEvent> RunDetector::Impl::take_events() {
@@ -265,8 +253,8 @@ double RunDetector::Impl::median_period(std::size_t from, std::size_t to) {
     // not once h + 1 are below it.
     constexpr std::size_t chunk = 256;
     for (std::size_t k = from + 1; k < to;) {
-      const std::size_t stretch_end = std::min({to, (k | mask_) + 1, k + chunk});
-      count_periods(ring_.get() + (k & mask_), stretch_end - k, guess, prev, below, at_or_below);
+      const std::size_t stretch_end = std::min({to, (k | store_.mask()) + 1, k + chunk});
+      count_periods(store_.data() + (k & store_.mask()), stretch_end - k, guess, prev, below, at_or_below);
       k = stretch_end;
       const std::size_t counted = k - from - 1, at_or_above = counted - below;
       if (h < below) break;
@@ -319,8 +307,8 @@ void RunDetector::Impl::count_periods(const Sample* p, std::size_t m, double gue
 }
 
 // Track readings pinned at one positive value (a clipped converter) so the lead-in before a
-// long clip is still buffered when the coast leaves it. last_v is v(i - 1) when i > base_, NaN
-// when i == base_ (so a new reading there starts a run of its own). A changed reading is a run
+// long clip is still buffered when the coast leaves it. last_v is v(i - 1) when i > store_.base(), NaN
+// when i == store_.base() (so a new reading there starts a run of its own). A changed reading is a run
 // of one: only a repeated one can make a plateau.
 [[gnu::always_inline]] inline void RunDetector::Impl::track_repeats(std::size_t i, double value, std::size_t& same_start,
                                                               double& last_v) {
@@ -342,10 +330,8 @@ void RunDetector::Impl::push(double t_s, double value) {
   if (t_s < last_t_) [[unlikely]] time_went_back(t_s);  // never for the first sample: last_t_ is -inf
   const double prev_t = last_t_;  // -inf for a stream's first sample
   last_t_ = t_s;
-  const std::size_t i = next_index_++;
-  if (next_index_ - base_ > ring_size()) [[unlikely]] grow_ring();
   const Sample s{t_s, value};
-  ring_[i & mask_] = s;
+  const std::size_t i = store_.push(s);
   track_repeats(i, value, same_start_, last_v_);
   switch (state_) {
     case State::idle: idle_step(i, s, prev_t); break;
@@ -382,16 +368,16 @@ std::size_t RunDetector::Impl::coast_run(const double* t_s, const double* value,
 template <bool LongLive>
 std::size_t RunDetector::Impl::coast_loop(const double* t_s, const double* value, std::size_t k, const std::size_t n) {
   const CoastLimits c = coast_limits();
-  Sample* const ring = ring_.get();  // c.ring, writable: the loop stores each sample
-  const std::size_t mask = c.mask, capacity = ring_size();
-  std::size_t i = next_index_, same_start = same_start_;
+  Sample* const ring = store_.data();  // c.ring, writable: the loop stores each sample
+  const std::size_t mask = c.mask, capacity = store_.capacity();
+  std::size_t i = store_.end(), same_start = same_start_;
   double last_t = last_t_, last_v = last_v_, level_min = level_min_;
   int rising = rising_;
   WindowFit h = hold_;
   WindowFit hl;
   if constexpr (LongLive) hl = hold_long_;
   const auto put_back = [&] {
-    next_index_ = i;
+    store_.set_end(i);
     same_start_ = same_start;
     last_t_ = last_t;
     last_v_ = last_v;
@@ -426,7 +412,7 @@ std::size_t RunDetector::Impl::coast_loop(const double* t_s, const double* value
 [[gnu::cold, gnu::noinline]] void RunDetector::Impl::time_went_back(double t_s) {
   emit_diag(Diagnostic::Severity::note,
             fmt::format("time went back from {} to {} at sample {}: taken as a clock restart", fmt_s(last_t_),
-                        fmt_s(t_s), next_index_));
+                        fmt_s(t_s), store_.end()));
   clock_restart();
 }
 
@@ -444,49 +430,49 @@ void RunDetector::Impl::restart_stream(const std::string& why, Run::End reason) 
   // a sensor held on its last value for longer than the coast's own fall allows (it gave up), may
   // have stopped before the restart: the hold window decides, as at a recording's end. Any other
   // is cut short.
-  if (state_ == State::coasting && next_index_ > run_.cut_index + 2) {
-    const std::size_t last = next_index_ - 1;
+  if (state_ == State::coasting && store_.end() > run_.cut_index + 2) {
+    const std::size_t last = store_.end() - 1;
     const double band = std::max({4.0 * coast_sd_, 3.0 * coast_step_, 1e-9 * std::abs(v0_)});
-    if (std::abs(v(last) - motor_zero()) <= band || held_into(run_.cut_index, next_index_) < next_index_)
-      coast_checks(last, ring_[last & mask_], true);
+    if (std::abs(v(last) - motor_zero()) <= band || held_into(run_.cut_index, store_.end()) < store_.end())
+      coast_checks(last, store_.at(last), true);
   }
   restarted_mid_coast_ = state_ == State::coasting;
   after_silence_ = false;  // a new timeline: nothing on it continues the silenced coast
   if (state_ == State::coasting) {
     run_note_severity_ = Diagnostic::Severity::warning;  // the run is cut short: it changes the result
-    close_unstopped(next_index_, why, reason);
+    close_unstopped(store_.end(), why, reason);
   }
-  else if (state_ == State::tail) complete_run(next_index_);
-  base_ = next_index_;
-  time_cursor_ = next_index_;
+  else if (state_ == State::tail) complete_run(store_.end());
+  store_.drop_before(store_.end());
+  time_cursor_ = store_.end();
   have_plateau_ = false;
   need_rise_ = false;
-  stream_start_ = next_index_;
+  stream_start_ = store_.end();
   stream_after_restart_ = reason == Run::End::clock_restart;
   resume_index_ = 0;
   last_t_ = -std::numeric_limits<double>::infinity();
   last_v_ = std::numeric_limits<double>::quiet_NaN();
   state_ = State::idle;
-  lo_ = search_lo_ = next_index_;
+  lo_ = search_lo_ = store_.end();
   rest_level_ = std::numeric_limits<double>::infinity();
   need_quiet_ = false;
-  short_.clear(next_index_, 0.0);
-  long_.clear(next_index_, 0.0);
-  vlong_.clear(next_index_, 0.0);
-  hold_long_.clear(next_index_, 0.0);
+  short_.clear(store_.end(), 0.0);
+  long_.clear(store_.end(), 0.0);
+  vlong_.clear(store_.end(), 0.0);
+  hold_long_.clear(store_.end(), 0.0);
   set_spans(0.0);  // a new stream: its rate is learnt afresh
   slow_last_ = SIZE_MAX;
   quiet_until_s_ = -std::numeric_limits<double>::infinity();
-  hold_.clear(next_index_, 0.0);
+  hold_.clear(store_.end(), 0.0);
 }
 
 void RunDetector::Impl::finish() {
   // A recording that ends soon after the stop: the hold window alone decides.
-  if (state_ == State::coasting && next_index_ > base_)
-    coast_checks(next_index_ - 1, ring_[(next_index_ - 1) & mask_], true);
-  if (state_ == State::coasting) close_unstopped(next_index_, "the recording ends mid-coast (never reached standstill)", Run::End::end_of_data);
-  else if (state_ == State::tail) complete_run(next_index_);
-  if (state_ != State::idle) to_idle(next_index_, false);
+  if (state_ == State::coasting && store_.end() > store_.base())
+    coast_checks(store_.end() - 1, store_.at((store_.end() - 1)), true);
+  if (state_ == State::coasting) close_unstopped(store_.end(), "the recording ends mid-coast (never reached standstill)", Run::End::end_of_data);
+  else if (state_ == State::tail) complete_run(store_.end());
+  if (state_ != State::idle) to_idle(store_.end(), false);
   if (non_finite_ > 0) {
     emit_diag(Diagnostic::Severity::warning,
               fmt::format("{} non-finite sample(s) (NaN/inf time or value) ignored", non_finite_));
@@ -495,27 +481,27 @@ void RunDetector::Impl::finish() {
 }
 
 void RunDetector::Impl::went_silent(double silent_s) {
-  if (state_ == State::coasting && next_index_ > base_) coast_checks(next_index_ - 1, ring_[(next_index_ - 1) & mask_], true);
+  if (state_ == State::coasting && store_.end() > store_.base()) coast_checks(store_.end() - 1, store_.at((store_.end() - 1)), true);
   if (state_ == State::coasting) {
     // Where the coast was when the samples stopped: what resumes below it is the same coast.
     after_silence_ = true;
     silenced_run_ = run_.number;
     silence_s_ = silent_s;
-    silence_level_ = next_index_ > base_ ? v(next_index_ - 1) : v0_;
+    silence_level_ = store_.end() > store_.base() ? v(store_.end() - 1) : v0_;
     silence_band_ = std::max({4.0 * coast_sd_, 3.0 * coast_step_, 0.02 * std::abs(v0_)});
     run_note_severity_ = Diagnostic::Severity::warning;
-    close_unstopped(next_index_,
+    close_unstopped(store_.end(),
                     fmt::format("no samples for {:g} s: the bench went silent mid-coast; fitted to its last sample, "
                                 "and samples after the silence are not in this run",
                                 silent_s),
                     Run::End::silent);
-    to_idle(next_index_, false);
+    to_idle(store_.end(), false);
     // What comes after is found afresh: a coast going on is partial, from its first sample.
-    resume_index_ = next_index_;
+    resume_index_ = store_.end();
     resume_pause_s_ = silent_s;
   } else if (state_ == State::tail) {
-    complete_run(next_index_);
-    to_idle(next_index_, false);
+    complete_run(store_.end());
+    to_idle(store_.end(), false);
   }
 }
 
@@ -540,41 +526,41 @@ void RunDetector::Impl::to_idle(std::size_t lo, bool need_quiet, std::size_t sea
   rise_level_ = run_.zero_level + depart_band_;
   state_ = State::idle;
   lo_ = lo;
-  search_lo_ = std::max(std::min(search_from, lo), base_);
+  search_lo_ = std::max(std::min(search_from, lo), store_.base());
   need_quiet_ = need_quiet;
   rising_ = departing_ = 0;
-  reset_window(short_, lo, next_index_);
-  reset_window(long_, lo, next_index_);
-  reset_window(vlong_, lo, next_index_);
+  reset_window(short_, lo, store_.end());
+  reset_window(long_, lo, store_.end());
+  reset_window(vlong_, lo, store_.end());
   trim_idle();
 }
 
 void RunDetector::Impl::trim_idle() {
-  if (next_index_ == base_) return;
+  if (store_.end() == store_.base()) return;
   // Enough for the longest window and a few doublings of the back-search.
   const double keep_s = idle_keep_s;
-  const double t_now = t(next_index_ - 1);
+  const double t_now = t(store_.end() - 1);
   // The first sample within keep_s only moves forward: amortized O(1) per sample.
-  time_cursor_ = std::max({time_cursor_, search_lo_, base_});
-  while (time_cursor_ + 1 < next_index_ && t_now - t(time_cursor_) > keep_s) ++time_cursor_;
+  time_cursor_ = std::max({time_cursor_, search_lo_, store_.base()});
+  while (time_cursor_ + 1 < store_.end() && t_now - t(time_cursor_) > keep_s) ++time_cursor_;
   std::size_t keep_from = time_cursor_;
   // Keep enough samples for a slow loop's back-search, and what the windows still use.
   const std::size_t min_keep = back_search_min_samples + 16;
-  if (next_index_ - keep_from < min_keep) keep_from = next_index_ > min_keep ? next_index_ - min_keep : 0;
-  keep_from = std::max(keep_from, base_);
+  if (store_.end() - keep_from < min_keep) keep_from = store_.end() > min_keep ? store_.end() - min_keep : 0;
+  keep_from = std::max(keep_from, store_.base());
   keep_from = std::min({keep_from, short_.first, long_.first, vlong_.first});
   // A recent pinned stretch shorter than keep_s may be a clip the coast has yet to leave.
-  if (have_plateau_ && plateau_end_ >= base_ && plateau_start_ >= base_ && t_now - t(plateau_end_) <= keep_s &&
+  if (have_plateau_ && plateau_end_ >= store_.base() && plateau_start_ >= store_.base() && t_now - t(plateau_end_) <= keep_s &&
       t(plateau_end_) - t(plateau_start_) <= keep_s)
-    keep_from = std::min(keep_from, std::max(base_, plateau_start_ >= back_search_min_samples
+    keep_from = std::min(keep_from, std::max(store_.base(), plateau_start_ >= back_search_min_samples
                                                         ? plateau_start_ - back_search_min_samples
                                                         : std::size_t{0}));
   // Bounded memory whatever the timing.
-  if (next_index_ - keep_from > opt_.max_buffer) keep_from = next_index_ - opt_.max_buffer;
-  base_ = std::max(base_, keep_from);
-  if (short_.first < base_) reset_window(short_, base_, next_index_);
-  if (long_.first < base_) reset_window(long_, base_, next_index_);
-  if (vlong_.first < base_) reset_window(vlong_, base_, next_index_);
+  if (store_.end() - keep_from > opt_.max_buffer) keep_from = store_.end() - opt_.max_buffer;
+  store_.drop_before(keep_from);
+  if (short_.first < store_.base()) reset_window(short_, store_.base(), store_.end());
+  if (long_.first < store_.base()) reset_window(long_, store_.base(), store_.end());
+  if (vlong_.first < store_.base()) reset_window(vlong_, store_.base(), store_.end());
 }
 
 [[gnu::always_inline]] inline bool RunDetector::Impl::confirms_decline(const WindowFit& w) const {
@@ -607,7 +593,7 @@ bool RunDetector::Impl::smooth_curve(const WindowFit& w, double mu, double drop)
   // line follows a coast's bend within the window closely enough, and a powered nudge's fall
   // would pass for a coast (the truth corpus's 'nudge before a run': 2 more invented at 64).
   return w.n >= 8 && w.n <= 32 && w.span_s >= 1.0 &&
-         rough_sd(w.first, w.end) <= confirm_max_roughness * std::max(mu, drop);
+         rough_sd(store_, w.first, w.end) <= confirm_max_roughness * std::max(mu, drop);
 }
 
 void RunDetector::Impl::idle_step(std::size_t i, Sample s, double prev_t) {
@@ -721,26 +707,9 @@ bool RunDetector::Impl::rises_steadily(std::size_t from, std::size_t to) const {
   // A line through [from, to) rising by confirm_t_stat of its standard errors, the samples about it
   // no rougher from sample to sample than about the line (a swing of an open pin's hum is not).
   if (to < from + 8) return false;
-  const WindowFit f = window_over(ring_.get(), mask_, 1e300, from, to);
+  const WindowFit f = window_over(store_.data(), store_.mask(), 1e300, from, to);
   const double e = f.resid_sd();
-  return f.sxx() > 0 && e > 0 && f.slope() * std::sqrt(f.sxx()) > confirm_t_stat * e && rough_sd(from, to) <= e;
-}
-
-bool RunDetector::Impl::flickers(std::size_t from, std::size_t to) const {
-  if (to < from + 8) return false;  // a few samples of a rise can lie within three of their steps
-  double lo = v(from), hi = v(from);
-  for (std::size_t k = from; k < to; ++k) lo = std::min(lo, v(k)), hi = std::max(hi, v(k));
-  const double step = reading_step(from, to);
-  return step > 0 && hi - lo <= 3.0 * step;
-}
-
-double RunDetector::Impl::reading_step(std::size_t from, std::size_t to) const {
-  double step = std::numeric_limits<double>::infinity();
-  for (std::size_t k = from + 1; k < to; ++k) {
-    const double d = std::abs(v(k) - v(k - 1));
-    if (d > 0) step = std::min(step, d);
-  }
-  return std::isfinite(step) ? step : 0.0;
+  return f.sxx() > 0 && e > 0 && f.slope() * std::sqrt(f.sxx()) > confirm_t_stat * e && rough_sd(store_, from, to) <= e;
 }
 
 // ---- calls of the per-sample path from the cut and the stop (inlined here) ----------------
@@ -808,7 +777,7 @@ void RunDetector::Impl::retract_stop(std::size_t i, Sample s) {
 bool RunDetector::Impl::try_start_coast(std::size_t i, const WindowFit& w) {
   const std::size_t b = i;
   const std::size_t w0 = w.first;
-  const std::size_t lower = std::max(search_lo_, base_);
+  const std::size_t lower = std::max(search_lo_, store_.base());
   double span = std::max(back_search_s, 2.0 * w.span_s);
   CutSplit sp;
   std::string lead;
@@ -865,7 +834,7 @@ bool RunDetector::Impl::try_start_coast(std::size_t i, const WindowFit& w) {
   if (lead == "none") plausible = plausible && !unseen.empty();  // a stream that starts mid-coast, or a pause
   // A rough "plateau" is no motor's (a twentieth of the reading), unless the reading only flickers
   // within three of its own printed steps: a per-pulse tachometer's whole-millisecond periods.
-  if (lead == "powered" && sp.pre_sd > 0.05 * scale && !flickers(sp.a, sp.pre_end)) plausible = false;
+  if (lead == "powered" && sp.pre_sd > 0.05 * scale && !flickers(store_, sp.a, sp.pre_end)) plausible = false;
   // A coast from a motor at rest starts well above the zeros it leaves. A floating pin (the
   // handout's step 6: A0 is connected only after the cut) reads anywhere in 0.5–2.5 V, above or
   // below the back-EMF it is connected to: its coast needs no step, only the smooth decline the
@@ -917,7 +886,7 @@ bool RunDetector::Impl::try_start_coast(std::size_t i, const WindowFit& w) {
   v0_ = sp.v0;
   standstill_ceiling_ = v0_ > 0 ? standstill_max_fraction * v0_ : std::numeric_limits<double>::infinity();
   coast_sd_ = sp.sd_post;
-  coast_step_ = reading_step(sp.cut_index, i + 1);
+  coast_step_ = reading_step(store_, sp.cut_index, i + 1);
   lead_in_zero_ = lead == "zeros" ? sp.pre_mean : std::numeric_limits<double>::quiet_NaN();
   rise_jump_ = std::max(0.1 * std::abs(v0_), 8.0 * coast_sd_);
   level_min_ = std::numeric_limits<double>::infinity();
@@ -932,7 +901,7 @@ bool RunDetector::Impl::try_start_coast(std::size_t i, const WindowFit& w) {
   half_cursor_ = run_.cut_index;
   hold_long_live_ = false;  // built when the coast gets low (saves work on the way down)
   creeping_ = false;
-  coast_checks(i, ring_[i & mask_]);
+  coast_checks(i, store_.at(i));
   return true;
 }
 

@@ -48,7 +48,7 @@ void RunDetector::Impl::scan_coast(Run& r, std::size_t coast_end) {
   double longest = 0;
   const double said = std::max(1.0, 25.0 * r.period_s);  // a shorter silence is not said: not looked for
   const double floor = std::max(10.0 * coast_sd_, 5.0 * coast_step_);
-  const Sample* ring = ring_.get();
+  const Sample* ring = store_.data();
   std::string where;
   std::size_t shown = 0;
   const auto outlier = [&](std::size_t k, double a, double c, double b, double tk) {
@@ -64,8 +64,8 @@ void RunDetector::Impl::scan_coast(Run& r, std::size_t coast_end) {
   const std::size_t before = r.outliers.size();  // the coast's bounce at its start, already out
   std::size_t k = before ? r.outliers.back() + 2 : r.cut_index + 1;
   while (k + 1 < coast_end) {
-    const std::size_t at = (k - 1) & mask_;
-    const std::size_t n = std::min(coast_end - 1 - k, ring_size() - 2 - std::min(at, ring_size() - 2));
+    const std::size_t at = (k - 1) & store_.mask();
+    const std::size_t n = std::min(coast_end - 1 - k, store_.capacity() - 2 - std::min(at, store_.capacity() - 2));
     if (n == 0) {  // the triple wraps: one sample the slow way
       if (t(k) - t(k - 1) > std::max(longest, said)) longest = t(k) - t(k - 1), gap_at = k;
       outlier(k, v(k - 1), v(k), v(k + 1), t(k));

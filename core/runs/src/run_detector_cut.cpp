@@ -19,15 +19,6 @@ namespace {
 
 constexpr double z_one_in_1000 = -3.090232306167813;  // the standard normal's 0.1 % quantile
 
-// The χ² distribution's lower quantile at the normal quantile z, for dof degrees of freedom
-// (Wilson–Hilferty: within a few percent from 3 degrees of freedom).
-double chi2_lower_tail(double dof, double z) {
-  if (dof < 1) return 0.0;
-  const double c = 2.0 / (9.0 * dof);
-  const double q = 1.0 - c + z * std::sqrt(c);
-  return q > 0 ? dof * q * q * q : 0.0;
-}
-
 }  // namespace
 
 RunDetector::Impl::CutSplit RunDetector::Impl::split_at_cut(std::size_t a, std::size_t b, const WindowFit& w) {
@@ -40,7 +31,7 @@ RunDetector::Impl::CutSplit RunDetector::Impl::split_at_cut(std::size_t a, std::
 
 bool RunDetector::Impl::split_at_top(CutSplit& sp, std::size_t a, std::size_t b, const WindowFit& w) {
   // A reading pinned at its maximum and left without a step: the converter's top.
-  const std::size_t lower = std::max(search_lo_, base_);
+  const std::size_t lower = std::max(search_lo_, store_.base());
   double m = v(a);
   for (std::size_t k = a; k <= b; ++k) m = std::max(m, v(k));
   std::size_t p = b + 1;  // last pinned sample
@@ -55,12 +46,12 @@ bool RunDetector::Impl::split_at_top(CutSplit& sp, std::size_t a, std::size_t b,
   while (q > lower && v(q - 1) == m) --q;
   // Quantized data plateaus too; a clipped reading is pinned much longer than the longest
   // plateau of the coast after it.
-  const std::size_t longest = longest_hold(p + 1, b);
+  const std::size_t longest = longest_hold(store_, p + 1, b);
   const std::size_t pinned = p - q + 1;
   const double leave = m - v(p + 1);
   // … and much longer than one step of the reading lasts at the coast's start: a heavy
   // flywheel's coast holds its first printed value for a second, unclipped.
-  const double slope = w.slope(), step = std::max(reading_step(p + 1, b + 1), leave);
+  const double slope = w.slope(), step = std::max(reading_step(store_, p + 1, b + 1), leave);
   const double period = b > p + 1 ? (t(b) - t(p + 1)) / double(b - p - 1) : 0.0;
   const double step_lasts = slope < 0 && period > 0 && step > 0 ? step / -slope / period : 0.0;
   if (!(q > lower && pinned >= 5 && pinned >= 3 * longest && pinned >= 3.0 * step_lasts && leave > 0 &&
@@ -97,7 +88,7 @@ bool RunDetector::Impl::pinned_lead_in(CutSplit& sp, std::size_t b) {
   std::size_t at_top = 0;
   for (std::size_t k = sp.a; k < sp.pre_end; ++k) at_top += v(k) == m;
   if (10 * at_top < 9 * sp.npre) return false;
-  const std::size_t hold = 3 * longest_hold(sp.pre_end, b, m);
+  const std::size_t hold = 3 * longest_hold(store_, sp.pre_end, b, m);
   std::size_t first = sp.a, run = 0;  // first: the first reading below the top after a hold
   for (std::size_t k = sp.a; k <= b; ++k) {
     if (v(k) == m) {
@@ -136,9 +127,9 @@ void RunDetector::Impl::find_pinned_start(std::size_t b) {
   for (std::size_t k = c; k <= b; ++k)
     if (v(k) == m) end = k + 1, ++at_top;
   if (end > b || at_top < 5 || 2 * at_top < end - c || v(c) < m - 0.5 * (m - v(end))) return;
-  const std::size_t longest = longest_hold(end, b);
-  const WindowFit after = window_over(ring_.get(), mask_, 1e300, end, b + 1);
-  const double slope = after.slope(), step = reading_step(c, b + 1);
+  const std::size_t longest = longest_hold(store_, end, b);
+  const WindowFit after = window_over(store_.data(), store_.mask(), 1e300, end, b + 1);
+  const double slope = after.slope(), step = reading_step(store_, c, b + 1);
   const double period = b > end ? (t(b) - t(end)) / double(b - end) : 0.0;
   const double step_lasts = slope < 0 && period > 0 && step > 0 ? step / -slope / period : 0.0;
   if (!(slope < 0) || at_top < 3 * longest || double(at_top) < 3.0 * step_lasts) return;
@@ -257,9 +248,9 @@ void RunDetector::Impl::split_two_segments(CutSplit& sp, std::size_t a, std::siz
   // window's line, drawn back.
   if (const double e = w.resid_sd();
       w.n >= 6 && w.first >= a + k + 4 && sums.post_line(k).sd > 2.0 * e + 1e-12 &&
-      rough_sd(a + k, w.first) > 3.0 * std::max(rough_sd(w.first, b + 1), 0.5 * e) &&
-      rough_sd(a, a + k) > 3.0 * std::max(rough_sd(w.first, b + 1), 0.5 * e)) {
-    const double tol = std::max(4.0 * e, 2.0 * reading_step(w.first, b + 1));
+      rough_sd(store_, a + k, w.first) > 3.0 * std::max(rough_sd(store_, w.first, b + 1), 0.5 * e) &&
+      rough_sd(store_, a, a + k) > 3.0 * std::max(rough_sd(store_, w.first, b + 1), 0.5 * e)) {
+    const double tol = std::max(4.0 * e, 2.0 * reading_step(store_, w.first, b + 1));
     const double slope = w.slope(), t_mid = w.t0 + w.st() / w.n, mid = w.mean();
     std::size_t j = w.first;
     while (j > a + k && std::abs(v(j - 1) - (mid + slope * (t(j - 1) - t_mid))) <= tol) --j;
@@ -271,10 +262,10 @@ void RunDetector::Impl::split_two_segments(CutSplit& sp, std::size_t a, std::siz
   sp.v0 = l.v0;
   sp.post_slope = l.slope;
   sp.sd_post = l.sd;
-  sp.post_rough = rough_sd(c, b + 1);
+  sp.post_rough = rough_sd(store_, c, b + 1);
   sp.cut_index = c;
   sp.pre_end = c;
-  const bool sample_before = c > base_ && c > stream_start_ && c - 1 >= search_lo_;
+  const bool sample_before = c > store_.base() && c > stream_start_ && c - 1 >= search_lo_;
   sp.t_cut_s = sample_before ? 0.5 * (t(c - 1) + t(c)) : t(c);
 }
 
@@ -290,7 +281,7 @@ void RunDetector::Impl::describe_lead_in(CutSplit& sp) const {
     sp.pre_max = std::max(sp.pre_max, v(k));
   }
   sp.pre_mean = f.mean();
-  sp.pre_rough = rough_sd(sp.a, sp.pre_end);
+  sp.pre_rough = rough_sd(store_, sp.a, sp.pre_end);
   sp.pre_sd = std::sqrt(std::max(f.svv() / f.n - sp.pre_mean * sp.pre_mean, 0.0));
   // A lead-in falling at a good part of the coast's own rate is more coast: the cut lies
   // further back.
@@ -313,12 +304,12 @@ void RunDetector::Impl::take_bounce(CutSplit& sp, const WindowFit& w) {
   // bouncing as a wire is pushed in (the handout's step 6 connects the pin to the motor by hand).
   // The coast starts at the first of them; they are left out of the fit as outliers.
   constexpr std::size_t most = 3, local = 8;
-  const std::size_t c = sp.cut_index, lower = std::max({search_lo_, base_, sp.a});
+  const std::size_t c = sp.cut_index, lower = std::max({search_lo_, store_.base(), sp.a});
   if (sp.clipped || w.end < c + most + local + 1 || c < lower + local + 1) return;
-  const double step = reading_step(c, std::min(w.end, c + 4 * local));
+  const double step = reading_step(store_, c, std::min(w.end, c + 4 * local));
   // The course of [from, from + local) at sample j, and how far from it a sample is off it.
   const auto course = [&](std::size_t from, std::size_t j, double& off) {
-    const WindowFit f = window_over(ring_.get(), mask_, 1e300, from, from + local);
+    const WindowFit f = window_over(store_.data(), store_.mask(), 1e300, from, from + local);
     const double at = f.mean() + f.slope() * (t(j) - f.t0 - f.st() / f.n);
     off = std::max({5.0 * f.resid_sd(), 0.03 * std::abs(at), 2.0 * step});
     return at;
@@ -347,7 +338,7 @@ void RunDetector::Impl::take_bounce(CutSplit& sp, const WindowFit& w) {
   sp.cut_index = first;
   sp.pre_end = first;
   sp.npre = first > sp.a ? first - sp.a : 0;
-  sp.t_cut_s = first > base_ && first > stream_start_ ? 0.5 * (t(first - 1) + t(first)) : t(first);
+  sp.t_cut_s = first > store_.base() && first > stream_start_ ? 0.5 * (t(first - 1) + t(first)) : t(first);
 }
 
 void RunDetector::Impl::refine_plateau_cut(CutSplit& sp, std::size_t b) {
@@ -432,7 +423,7 @@ void RunDetector::Impl::recut_after_rise(Run& r, std::size_t coast_end) {
   const double least = std::max(0.05 * std::abs(amp), 3.0 * coast_step_);
   double rose = 0;
   if (last_jump(least, rose) == 0) return;
-  const double white = rough_sd(c, coast_end);
+  const double white = rough_sd(store_, c, coast_end);
   const std::size_t rise = last_jump(std::max(8.0 * white, least), rose);
   if (rise == 0) return;
   // What made it evidence, said with it: the jump in units of the reading's noise.
@@ -446,7 +437,7 @@ void RunDetector::Impl::recut_after_rise(Run& r, std::size_t coast_end) {
   // whole ripple after it stands apart from the level over a whole ripple before it, by more than
   // those means' own noise allows.
   const std::size_t mid = c + (coast_end - c) / 2;
-  const LagNoise early = noise_over(c, mid), late = noise_over(mid, coast_end);
+  const LagNoise early = noise_over(store_, c, mid), late = noise_over(store_, mid, coast_end);
   const LagNoise& noise = early.wander < late.wander ? early : late;
   // (After a floating lead-in the hum may go on past the cut found: a rise there is the connection.)
   if (noise.wander > 2.0 * noise.white && r.lead_in != "floating") {
@@ -480,7 +471,7 @@ void RunDetector::Impl::recut_after_rise(Run& r, std::size_t coast_end) {
   while (a > c && t(rise) - t(a - 1) <= back_search_s) --a;
   while (b + 1 < coast_end && t(b + 1) - t(rise) <= 1.0) ++b;
   if (b < rise + 6 || rise < a + 4) return;
-  const WindowFit w = window_over(ring_.get(), mask_, 1.0, rise, b + 1);
+  const WindowFit w = window_over(store_.data(), store_.mask(), 1.0, rise, b + 1);
   const std::size_t keep_lo = search_lo_;
   search_lo_ = std::max(search_lo_, c);
   CutSplit sp = split_at_cut(a, b, w);
@@ -552,8 +543,8 @@ void RunDetector::Impl::recut_after_return(Run& r, std::size_t coast_end) {
     if (!(span_s > 0)) return;
     const double least_rate = 0.25 * std::max(level - last, 0.0) / span_s;
     if (se == 0) {  // the same test from the prefix sums, with a margin for their rounding
-      const Sample* ring = ring_.get();
-      const std::size_t mask = mask_;
+      const Sample* ring = store_.data();
+      const std::size_t mask = store_.mask();
       const double t_from = t(from), n = double(len), rate = 0.5 * least_rate, least = 10.0 * coast_step_ / 6.0;
       const double margin = 1e-9 * n * (std::abs(level) + std::abs(v0_));
       for (std::size_t k = from; k + len <= coast_end; ++k) {
@@ -569,7 +560,7 @@ void RunDetector::Impl::recut_after_return(Run& r, std::size_t coast_end) {
       const double mean = sum / double(len);
       const double should = least_rate * (0.5 * (t(k) + t(k + len - 1)) - t(from));  // lost since the level was read
       if (should > 10.0 * se && mean >= level - 3.0 * se &&
-                 2 * count_from(top - coast_step_, k, k + len) < len && 2 * count_from(v(k), k, k + len, v(k)) <= len) {
+                 2 * count_from(store_, top - coast_step_, k, k + len) < len && 2 * count_from(store_, v(k), k, k + len, v(k)) <= len) {
         // Where the coast must have lost ten of its means' noise, it stands within three of the
         // cut's level — and not mostly within a reading step of the coast's highest reading (a
         // converter's top, read until the back-EMF comes below it) or on one repeated value (a stall).
@@ -584,7 +575,7 @@ void RunDetector::Impl::recut_after_return(Run& r, std::size_t coast_end) {
   // else over five readings. Most coasts fall well below their level at every length: then their
   // noise (most of this search's time) is not needed.
   const std::size_t mid = c + (coast_end - c) / 2;
-  const std::size_t max_len = 2 * std::max(noise_max_lag(c, mid), noise_max_lag(mid, coast_end));
+  const std::size_t max_len = 2 * std::max(noise_max_lag(store_, c, mid), noise_max_lag(store_, mid, coast_end));
   if (coast_end < from + 20) return;
   prefix = scratch(coast_end - from + 1);
   prefix[0] = 0;
@@ -596,7 +587,7 @@ void RunDetector::Impl::recut_after_return(Run& r, std::size_t coast_end) {
   }
   if (!could) return;
   // The means' noise (or a sixth of the print's step: a level read in whole steps is known no better).
-  const LagNoise early = noise_over(c, mid), late = noise_over(mid, coast_end);
+  const LagNoise early = noise_over(store_, c, mid), late = noise_over(store_, mid, coast_end);
   const LagNoise& noise = early.wander < late.wander ? early : late;
   const bool rippled = noise.wander > 2.0 * noise.white;
   const std::size_t len = rippled ? std::max<std::size_t>(5, 2 * noise.wander_lag) : 5;
@@ -626,7 +617,7 @@ bool RunDetector::Impl::recut_from(Run& r, std::size_t at, std::size_t coast_end
   while (a > c && t(at) - t(a - 1) <= back_search_s) --a;
   while (b + 1 < coast_end && t(b + 1) - t(at) <= ahead_s) ++b;
   if (b < at + 6 || at < a + min_lead) return false;
-  const WindowFit w = window_over(ring_.get(), mask_, 1.0, at, b + 1);
+  const WindowFit w = window_over(store_.data(), store_.mask(), 1.0, at, b + 1);
   const std::size_t keep_lo = search_lo_;
   search_lo_ = std::max(search_lo_, c);
   CutSplit sp = split_at_cut(a, b, w);
@@ -642,56 +633,6 @@ bool RunDetector::Impl::recut_from(Run& r, std::size_t at, std::size_t coast_end
   return true;
 }
 
-std::size_t RunDetector::Impl::count_from(double lo, std::size_t from, std::size_t to, double hi) const {
-  std::size_t n = 0;
-  for (std::size_t k = from; k < to; ++k) n += v(k) >= lo && v(k) <= hi;
-  return n;
-}
-
-double RunDetector::Impl::rough_sd(std::size_t from, std::size_t to) const {
-  // Second differences cancel a smooth curve (a coast, a rise, a slow swing) and keep the
-  // sample-to-sample noise: σ = 1.4826·median|Δ²v| / √6. Its own space: the cut search's
-  // prefix sums live in scratch().
-  if (to < from + 3) return 0.0;
-  std::vector<double> d(to - from - 2);
-  for (std::size_t j = 0; j < d.size(); ++j) d[j] = std::abs(v(from + j + 2) - 2.0 * v(from + j + 1) + v(from + j));
-  std::nth_element(d.begin(), d.begin() + std::ptrdiff_t(d.size() / 2), d.end());
-  return 1.4826 * d[d.size() / 2] / std::sqrt(6.0);
-}
-
-std::size_t RunDetector::Impl::noise_max_lag(std::size_t from, std::size_t to) const {
-  if (to <= from + 2) return 1;
-  const double period = (t(to - 1) - t(from)) / double(to - 1 - from);
-  return period > 0 ? std::size_t(std::clamp(0.5 / period, 1.0, 128.0)) : 1;
-}
-
-LagNoise RunDetector::Impl::noise_over(std::size_t from, std::size_t to) const {
-  std::vector<double> x;
-  x.reserve(to > from ? to - from : 0);
-  for (std::size_t k = from; k < to; ++k) x.push_back(v(k));
-  const std::size_t max_lag = noise_max_lag(from, to);
-  // Each lag's noise from at most 255 second differences spread over the stretch (as
-  // sampled_rough_sd): a median of that many is as good a scale, and 4096 of them at every lag
-  // cost a lab run's find_runs twice its time.
-  return measure_lag_noise(x, max_lag, 255);
-}
-
-double RunDetector::Impl::smoothed(std::size_t k, std::size_t lo, std::size_t hi) const {
-  const std::size_t from = k > lo ? k - 1 : k, to = std::min(k + 2, hi + 1);
-  double sum = 0;
-  for (std::size_t j = from; j < to; ++j) sum += v(j);
-  return sum / double(to - from);
-}
-
-std::size_t RunDetector::Impl::longest_hold(std::size_t from, std::size_t last, double except) const {
-  std::size_t longest = 1, cur = 1;
-  for (std::size_t k = from + 1; k <= last; ++k) {
-    cur = v(k) == v(k - 1) ? cur + 1 : 1;
-    if (!(v(k) == except)) longest = std::max(longest, cur);
-  }
-  return longest;
-}
-
 std::size_t RunDetector::Impl::level_end(std::size_t r, std::size_t p, std::size_t b) {
   // [r, b] split into a level and the coast's line by least squares (the coast's start is close to
   // a line), the level reaching from r past the peak p …
@@ -703,10 +644,10 @@ std::size_t RunDetector::Impl::level_end(std::size_t r, std::size_t p, std::size
   // falls by 4 standard errors of its slope, and the readings from the peak to the split are
   // shown to be flat beside it (at a third of its slope, within two standard errors), as a
   // powered lead-in is.
-  const WindowFit coast = window_over(ring_.get(), mask_, 1e300, c, b + 1);
+  const WindowFit coast = window_over(store_.data(), store_.mask(), 1e300, c, b + 1);
   const double slope = coast.slope();
   if (coast.n < 6 || t(b) - t(c) < 1.0 || !(-slope > 4.0 * coast.slope_se())) return p;
-  const WindowFit held = window_over(ring_.get(), mask_, 1e300, p, c);
+  const WindowFit held = window_over(store_.data(), store_.mask(), 1e300, p, c);
   return std::abs(held.slope()) + 2.0 * held.slope_se() <= 0.3 * -slope ? c : p;
 }
 
@@ -720,13 +661,13 @@ void RunDetector::Impl::recut_at_level_end(Run& r, std::size_t coast_end) {
   for (std::size_t k = p; k < coast_end; ++k) low = std::min(low, v(k));
   const double quarter = v0_ - 0.25 * (v0_ - low);
   std::size_t b = p + 16;
-  while (b + 1 < coast_end && smoothed(b, p, coast_end - 1) > quarter) ++b;
+  while (b + 1 < coast_end && smoothed(store_, b, p, coast_end - 1) > quarter) ++b;
   const std::size_t c = level_end(p, p, b);
   if (c == p) return;
   const double held = t(c) - t(p);
   r.cut_index = c;
   r.t_cut_s = t(c);
-  v0_ = smoothed(c, p, coast_end - 1);
+  v0_ = smoothed(store_, c, p, coast_end - 1);
   const std::string said = fmt::format(
       "the reading held the level it rose to for {:.3g} s after its peak: the coast is taken from where it "
       "leaves that level, {}",
@@ -744,13 +685,13 @@ bool RunDetector::Impl::at_peak(CutSplit& sp, std::size_t b, bool rising_lead) {
   // The highest reading (a 3-sample mean, so one noisy sample does not make the peak) from the
   // cut found to the newest sample.
   std::size_t p = sp.cut_index;
-  double top3 = 3.0 * smoothed(p, sp.cut_index, b);  // three times the mean: sums compared, no division
+  double top3 = 3.0 * smoothed(store_, p, sp.cut_index, b);  // three times the mean: sums compared, no division
   for (std::size_t k = sp.cut_index + 1; k < b; ++k) {
     const double m3 = v(k - 1) + v(k) + v(k + 1);
     if (m3 > top3) top3 = m3, p = k;
   }
   const double top = top3 / 3.0;
-  if (top > smoothed(sp.cut_index, sp.cut_index, b) + thr && p < b) {
+  if (top > smoothed(store_, sp.cut_index, sp.cut_index, b) + thr && p < b) {
     // A rise after the cut found: the coast starts where the level it rose to ends, and what came
     // before is the rise. That level's highest 3-sample mean is only where its noise peaked (a
     // per-pulse sensor's reading alternates between neighbouring periods for seconds): from where
@@ -764,7 +705,7 @@ bool RunDetector::Impl::at_peak(CutSplit& sp, std::size_t b, bool rising_lead) {
       std::nth_element(after.begin(), after.begin() + std::ptrdiff_t(after.size() / 2), after.end());
       const double mid = after[after.size() / 2];
       std::size_t r = sp.cut_index;
-      while (r < p && smoothed(r, sp.cut_index, b) < mid) ++r;
+      while (r < p && smoothed(store_, r, sp.cut_index, b) < mid) ++r;
       const std::size_t e = level_end(r, p, b);
       level = e > p;
       p = e;
@@ -786,7 +727,7 @@ bool RunDetector::Impl::at_peak(CutSplit& sp, std::size_t b, bool rising_lead) {
   // A lead-in that climbs into the cut: its last samples rise to the coast's start.
   const std::size_t c = sp.cut_index;
   if (c < sp.a + 6) return false;
-  const double before = smoothed(c - 5, sp.a, b), last = smoothed(c - 2, sp.a, b);
+  const double before = smoothed(store_, c - 5, sp.a, b), last = smoothed(store_, c - 2, sp.a, b);
   return last > before + thr && last >= sp.v0 - thr && before < sp.v0 - 2.0 * thr;
 }
 
@@ -804,7 +745,7 @@ std::string RunDetector::Impl::start_not_seen(CutSplit& sp) {
   const std::size_t seen = c - seen_from;  // samples before the cut since the stream's start
   const bool too_short =
       joined_stream_ && !after_pause && stream_start_ == 0 && seen < 2 * min_lead_samples;
-  if (!too_short && std::max(sp.a, base_) > seen_from) return {};
+  if (!too_short && std::max(sp.a, store_.base()) > seen_from) return {};
   // From there to the cut found, a "lead-in" that lies on the coast's line is more coast.
   const std::size_t a = seen_from;
   if (c > a && !too_short) {
@@ -818,13 +759,13 @@ std::string RunDetector::Impl::start_not_seen(CutSplit& sp) {
     // … and is not clearly flatter than the coast (a noisy plateau within the tolerance is a
     // lead-in, its step hidden in the noise).
     if (c - a >= 5) {
-      const WindowFit pre = window_over(ring_.get(), mask_, 1e300, a, c);
+      const WindowFit pre = window_over(store_.data(), store_.mask(), 1e300, a, c);
       // The question is whether these samples are more coast: if they are, their noise is the
       // coast's, measured over its many samples. Far quieter than that, beyond chance (χ² at 1 in
       // 1,000), they are no coast: a level held (a reading pinned at the converter's top).
       // A quantized reading's spread is at least the step's, however often it repeats a value.
       const double post_noise = sp.post_rough > 0 ? std::min(sp.sd_post, sp.post_rough) : sp.sd_post;
-      const double e_pre = std::max(pre.resid_sd(), reading_step(a, c + 1) * step_sd);
+      const double e_pre = std::max(pre.resid_sd(), reading_step(store_, a, c + 1) * step_sd);
       const double dof = double(c - a) - 2.0;
       if (post_noise > 0 && dof * (e_pre * e_pre) / (post_noise * post_noise) < chi2_lower_tail(dof, z_one_in_1000))
         return {};
@@ -835,7 +776,7 @@ std::string RunDetector::Impl::start_not_seen(CutSplit& sp) {
       // Nor can a span over which the coast's line falls less than two of the reading's steps show
       // a level: the print cannot tell a plateau there from the coast.
       const double fall = -sp.post_slope * (t(c - 1) - t(a));
-      const bool resolvable = fall >= 2.0 * reading_step(a, next_index_);
+      const bool resolvable = fall >= 2.0 * reading_step(store_, a, store_.end());
       if (resolvable && s - sp.post_slope > 3.0 * se && s > 0.5 * sp.post_slope) return {};
     }
   }
@@ -859,8 +800,8 @@ std::string RunDetector::Impl::start_not_seen(CutSplit& sp) {
 std::string RunDetector::Impl::rest_after_silence(CutSplit& sp) {
   // The coast that went silent goes on: taken from the first sample after the silence (or the
   // oldest still held), its cut long before and not in this stream.
-  const std::size_t a = std::max({resume_index_, base_, lo_});
-  if (a >= next_index_) return {};
+  const std::size_t a = std::max({resume_index_, store_.base(), lo_});
+  if (a >= store_.end()) return {};
   const std::size_t c = sp.cut_index;
   sp.v0 = sp.v0 + sp.post_slope * (t(a) - t(c));
   sp.cut_index = a;

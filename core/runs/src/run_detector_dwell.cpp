@@ -23,7 +23,7 @@ std::size_t RunDetector::Impl::dwell_end(std::size_t c, std::size_t e, double h,
   const std::size_t n = e - c;
   double* lo = scratch(2 * n);
   double* hi = lo + n;
-  const auto med3 = [&](std::size_t k) { return median3(k, c, e); };
+  const auto med3 = [&](std::size_t k) { return median3(store_, k, c, e); };
   for (std::size_t k = 0; k < n; ++k) lo[k] = std::min(k ? lo[k - 1] : med3(c), med3(c + k));
   for (std::size_t k = n; k-- > 0;) hi[k] = std::max(k + 1 < n ? hi[k + 1] : med3(e - 1), med3(c + k));
   // For each new low (level L = lo(k) − h, the band [L − h, L + h]): the dwell D from k to the last
@@ -44,46 +44,13 @@ std::size_t RunDetector::Impl::dwell_end(std::size_t c, std::size_t e, double h,
   return found;
 }
 
-double RunDetector::Impl::sampled_rough_sd(std::size_t from, std::size_t to) const {
-  // rough_sd's estimate (σ = 1.4826·median|Δ²v|/√6) from at most 255 second differences spread
-  // evenly over [from, to): a median of that many is as good a scale, and a whole coast's would
-  // cost a lab run's fit a tenth more time.
-  constexpr std::size_t most = 255;
-  double d[most];
-  if (to < from + 3) return 0.0;
-  const std::size_t triples = to - from - 2, m = std::min(triples, most);
-  for (std::size_t j = 0; j < m; ++j) {
-    const std::size_t k = from + j * triples / m;
-    d[j] = std::abs(v(k + 2) - 2.0 * v(k + 1) + v(k));
-  }
-  std::nth_element(d, d + m / 2, d + m);
-  return 1.4826 * d[m / 2] / std::sqrt(6.0);
-}
-
-bool RunDetector::Impl::frozen(std::size_t from, std::size_t to) const {
-  // A reading that repeats one value exactly for half the dwell or more is a sensor or converter
-  // that stopped updating (a stall of the stream), not a drive holding a speed: under power the
-  // reading shows its noise (held_plateau's one_value, the same judgement).
-  std::size_t longest = 1, run = 1;
-  for (std::size_t k = from + 1; k < to; ++k) {
-    run = v(k) == v(k - 1) ? run + 1 : 1;
-    longest = std::max(longest, run);
-  }
-  return 2 * longest >= to - from;
-}
-
-double RunDetector::Impl::median3(std::size_t k, std::size_t c, std::size_t e) const {
-  if (k <= c || k + 1 >= e) return v(k);  // the span's ends have one neighbour inside it
-  return median_of_three(v(k - 1), v(k), v(k + 1));
-}
-
 bool RunDetector::Impl::falls_faster_later(std::size_t c, std::size_t e, double margin) const {
   // A free coast falls at least as far in each third of its time as in the next: friction takes
   // more speed off at a higher speed (viscous, windage) or as much (Coulomb). A dwell makes an
   // earlier third fall less than a later one; only then is the coast searched for it (the search
   // would cost every run's detection a tenth more time). Stribeck friction near standstill also
   // passes here; the search then finds no dwell. Medians of three: one glitch decides nothing.
-  const auto med3 = [&](std::size_t k) { return median3(k, c, e); };
+  const auto med3 = [&](std::size_t k) { return median3(store_, k, c, e); };
   const std::size_t n = e - c;
   const double v0 = med3(c), v1 = med3(c + n / 3), v2 = med3(c + 2 * n / 3), v3 = med3(e - 1);
   const double d1 = v0 - v1, d2 = v1 - v2, d3 = v2 - v3;
@@ -95,11 +62,11 @@ void RunDetector::Impl::recut_after_dwell(Run& r, std::size_t coast_end) {
   if (coast_end < c + 16) return;
   // First the cheap look (the noise near the cut for a margin), then the coast's own noise.
   if (!falls_faster_later(c, coast_end, 2.0 * std::max(4.0 * coast_sd_, coast_step_))) return;
-  const double h = std::max(4.0 * sampled_rough_sd(c, coast_end), coast_step_);
+  const double h = std::max(4.0 * sampled_rough_sd(store_, c, coast_end), coast_step_);
   if (!(h > 0)) return;
   std::size_t from = c;
   const std::size_t at = dwell_end(c, coast_end, h, from);
-  if (at == 0 || frozen(from, at)) return;
+  if (at == 0 || 2 * longest_hold(store_, from, at - 1) >= at - from) return;  // a frozen reading
   // The coast after the dwell: its cut found as any cut is, the dwell its lead-in.
   const double t_old = r.t_cut_s;
   if (!recut_from(r, at, coast_end, 1.0, 8)) return;

@@ -12,27 +12,11 @@
 #include <vector>
 
 #include "spindown/lag_noise.hpp"
+#include "spindown/reading_scale.hpp"
 #include "spindown/run_detector.hpp"
+#include "spindown/sample_store.hpp"
 
 namespace spindown {
-
-// Medians by min and max (readings are finite: the detector takes no other), the same value a
-// sort gives.
-inline double median_of_three(double a, double b, double c) {
-  return std::max(std::min(a, b), std::min(std::max(a, b), c));
-}
-inline double median_of_five(double a, double b, double c, double d, double e) {
-  return median_of_three(c, std::max(std::min(a, b), std::min(d, e)), std::min(std::max(a, b), std::max(d, e)));
-}
-
-// How far a standard deviation measured from n samples may lie below the true one: the factor
-// to its upper 95 % bound (Wilson–Hilferty's χ² quantile: 1.65 for 10 samples, 1.13 for 100); 1
-// for fewer than 4 samples (nothing to bound).
-inline double noise_upper_bound(std::size_t n) {
-  if (n < 4) return 1.0;
-  const double dof = double(n - 1), c = 2.0 / (9.0 * dof), q = 1.0 - c - 1.6448536269514722 * std::sqrt(c);
-  return q > 0 ? 1.0 / std::sqrt(q * q * q) : 1.0;
-}
 
 class RunDetector::Impl {
  public:
@@ -51,8 +35,8 @@ class RunDetector::Impl {
   std::vector<RunEvent> take_events();
   bool has_events() const { return !events_.empty(); }
   State state() const { return state_; }
-  std::size_t samples_seen() const { return next_index_; }
-  std::size_t buffered() const { return next_index_ - base_; }
+  std::size_t samples_seen() const { return store_.end(); }
+  std::size_t buffered() const { return store_.size(); }
 
  private:
   // Least-squares line over a sliding time window of the buffer, O(1) per sample. The sums are
@@ -109,16 +93,10 @@ class RunDetector::Impl {
     }
   };
 
-  // The buffer: a ring indexed by absolute sample index, holding [base_, next_index_).
-  struct Sample {  // no initializers: a new ring is not written before it is used
-    double t, v;
-  };
-  double t(std::size_t i) const { return ring_[i & mask_].t; }
-  double v(std::size_t i) const { return ring_[i & mask_].v; }
-  std::size_t ring_size() const { return mask_ + 1; }
-  void grow_ring();
-  // The ring's first size: a lab run (30 s at 50 Hz) fits without growing.
-  static constexpr std::size_t initial_ring_size = 2048;
+  // The samples held (sample_store.hpp).
+  using Sample = SampleStore::Sample;
+  double t(std::size_t i) const { return store_.t(i); }
+  double v(std::size_t i) const { return store_.v(i); }
   // Moves w on to end at sample i (s), reading older samples from ring. Static, with the ring
   // passed in: a window that is a local of a loop then stays in registers.
   static inline void advance(WindowFit& w, const Sample* ring, std::size_t mask, std::size_t i, Sample s);
@@ -148,7 +126,7 @@ class RunDetector::Impl {
     double max_coast_s, t_cut_s, hold_half_s, hold_full_s, rise_jump, standstill_ceiling, v0, plateau_check_t;
   };
   CoastLimits coast_limits() const {
-    return {ring_.get(), mask_, base_, opt_.max_buffer, run_.cut_index, opt_.max_coast_s, run_.t_cut_s, hold_half_s_,
+    return {store_.data(), store_.mask(), store_.base(), opt_.max_buffer, run_.cut_index, opt_.max_coast_s, run_.t_cut_s, hold_half_s_,
             hold_full_s_, rise_jump_, standstill_ceiling_, v0_, plateau_check_t_};
   }
   // What the checks of a coasting sample decided: nothing (the usual case), or one of the rare
@@ -244,9 +222,6 @@ class RunDetector::Impl {
   // back_search_s before it (at least min_lead) as lead-in, ahead_s after it; false when there is
   // no such cut after r's (r unchanged).
   bool recut_from(Run& r, std::size_t at, std::size_t coast_end, double ahead_s, std::size_t min_lead);
-  // How many readings in [from, to) lie in [lo, hi].
-  std::size_t count_from(double lo, std::size_t from, std::size_t to,
-                         double hi = std::numeric_limits<double>::infinity()) const;
   // A coast never dwells (run_detector_dwell.cpp): when the reading inside r's coast [cut, coast_end)
   // held a level far longer than the coast then took to fall through it, r starts after that dwell,
   // with a warning.
@@ -254,15 +229,9 @@ class RunDetector::Impl {
   // Whether a later third of the coast [c, e) falls more than an earlier one by over margin (the
   // cheap look before the dwell search).
   bool falls_faster_later(std::size_t c, std::size_t e, double margin) const;
-  // The median of readings k-1, k, k+1 inside [c, e) (the reading itself at its ends).
-  double median3(std::size_t k, std::size_t c, std::size_t e) const;
   // One past the last sample of the last such dwell in [c, e) (bands of half-width h), or 0; from:
   // where that dwell began.
   std::size_t dwell_end(std::size_t c, std::size_t e, double h, std::size_t& from);
-  // Whether [from, to) repeats one value for half its samples or more (a frozen reading).
-  bool frozen(std::size_t from, std::size_t to) const;
-  // rough_sd() from a few hundred second differences spread over [from, to).
-  double sampled_rough_sd(std::size_t from, std::size_t to) const;
   // Why the coast in sp has no recorded cut (the stream begins on it, or a pause hides it), with
   // sp moved to the coast's first sample; empty when its cut is in the data.
   std::string start_not_seen(CutSplit& sp);
@@ -284,18 +253,9 @@ class RunDetector::Impl {
   // The first sample of the value held up to sample to (after from) when it held longer than the
   // coast's fall over the second before it allows (a sensor that holds its last reading); else to.
   std::size_t held_into(std::size_t from, std::size_t to) const;
-  // The sample-to-sample noise of [from, to) (second differences; 0 for fewer than 3 samples).
-  double rough_sd(std::size_t from, std::size_t to) const;
-  // The noise of [from, to) at every lag up to half a second (lag_noise.hpp): what a rise or a step
-  // inside a coast must stand above to be evidence in this recording (a ripple included).
-  LagNoise noise_over(std::size_t from, std::size_t to) const;
-  // The longest lag noise_over looks at over [from, to): half a second of samples, 1 to 128.
-  std::size_t noise_max_lag(std::size_t from, std::size_t to) const;
   // The same for a coast found while after_silence_: the silenced coast's rest, from the first
   // sample after the silence; empty only when nothing of it is held.
   std::string rest_after_silence(CutSplit& sp);
-  // The mean of samples k-1..k+1 within [lo, hi].
-  double smoothed(std::size_t k, std::size_t lo, std::size_t hi) const;
   // Whether the coast found in sp follows a rise straight into its peak (a spin-up): a rise after
   // the cut moves the cut to the peak.
   // rising_lead: the lead-in is known to rise into the cut (judged against the finer noise).
@@ -377,15 +337,6 @@ class RunDetector::Impl {
   // An event of the open run (its cut, its stop), as the run stands now.
   void emit_run_event(RunEvent::Kind kind);
   double median_of(std::size_t from, std::size_t to);
-  // The smallest positive change between consecutive readings in [from, to): the converter's or
-  // the printing's step on quantized readings; 0 when none changes.
-  double reading_step(std::size_t from, std::size_t to) const;
-  // The most readings in a row that hold one value in [from, last] (runs of `except` not counted):
-  // how long one printed value lasts there.
-  std::size_t longest_hold(std::size_t from, std::size_t last,
-                           double except = std::numeric_limits<double>::quiet_NaN()) const;
-  // Whether samples [from, to) only flicker between printed values at most three steps apart.
-  bool flickers(std::size_t from, std::size_t to) const;
   // Whether samples [from, to) rise steadily: a line's slope far beyond its error, and no hum.
   bool rises_steadily(std::size_t from, std::size_t to) const;
   // The median of the sample periods in [from, to) (at least two samples), as nth_element picks it.
@@ -398,10 +349,7 @@ class RunDetector::Impl {
   RunOptions opt_;
   std::string source_;
   State state_ = State::idle;
-  std::unique_ptr<Sample[]> ring_;
-  std::size_t mask_ = 0;
-  std::size_t base_ = 0;        // absolute index of the oldest buffered sample
-  std::size_t next_index_ = 0;  // absolute index of the next sample
+  SampleStore store_;
   std::size_t time_cursor_ = 0;  // first buffered sample within the idle keep time
   std::size_t lo_ = 0;          // earliest index a window that confirms a coast may start at
   std::size_t search_lo_ = 0;   // earliest index the current lead-in search may use (<= lo_): after a

@@ -65,7 +65,7 @@ std::string RunDetector::Impl::swing_reason(std::size_t at) const {
   const double fall = v0_ - level_min_;
   if (!(fall > 0) || !std::isfinite(fall) || at <= cut) return {};
   constexpr double look_s = 10.0;
-  const std::size_t lower = std::max({base_, stream_start_});
+  const std::size_t lower = std::max({store_.base(), stream_start_});
   std::size_t from = cut;
   while (from > lower && t(cut) - t(from - 1) <= look_s) --from;
   if (cut < from + 8) return {};
@@ -73,9 +73,9 @@ std::string RunDetector::Impl::swing_reason(std::size_t at) const {
   // extreme against the direction before it (the first move counts as one).
   const double h = std::max({0.3 * fall, 4.0 * coast_sd_, 3.0 * coast_step_});
   int turns = 0, dir = 0;
-  double x0 = smoothed(from, from, cut - 1), top = x0, bottom = x0, hi = x0, lo = x0;
+  double x0 = smoothed(store_, from, from, cut - 1), top = x0, bottom = x0, hi = x0, lo = x0;
   for (std::size_t k = from + 1; k < cut; ++k) {
-    const double x = smoothed(k, from, cut - 1);
+    const double x = smoothed(store_, k, from, cut - 1);
     hi = std::max(hi, x), lo = std::min(lo, x);
     top = std::max(top, x), bottom = std::min(bottom, x);
     if (dir >= 0 && top - x >= h) ++turns, dir = -1, bottom = x;      // a fall from the last top
@@ -97,8 +97,8 @@ std::string RunDetector::Impl::stall_reason(std::size_t at) const {
   const std::size_t cut = run_.cut_index;
   if (at < cut + 24) return {};
   const std::size_t third = (at - cut) / 3;
-  const WindowFit first = window_over(ring_.get(), mask_, 1e300, cut, cut + third);
-  const WindowFit last = window_over(ring_.get(), mask_, 1e300, at - third, at);
+  const WindowFit first = window_over(store_.data(), store_.mask(), 1e300, cut, cut + third);
+  const WindowFit last = window_over(store_.data(), store_.mask(), 1e300, at - third, at);
   const double rate0 = -first.slope(), rate1 = -last.slope();
   const double se1 = last.sxx() > 0 ? last.resid_sd() / std::sqrt(last.sxx()) : INFINITY;
   const double se0 = first.sxx() > 0 ? first.resid_sd() / std::sqrt(first.sxx()) : INFINITY;
@@ -215,7 +215,7 @@ void RunDetector::Impl::standstill_checks(std::size_t i, bool at_end, double mu,
     // A quantized reading can sit on one value for the whole window (e = 0) while the motor still
     // turns: its resolution is at best the step's uniform spread. A coast so slow that its first
     // samples showed no step yet learns it here, once.
-    if (coast_step_ == 0) coast_step_ = reading_step(run_.cut_index, i + 1);
+    if (coast_step_ == 0) coast_step_ = reading_step(store_, run_.cut_index, i + 1);
     const double e_eff = std::max(e, coast_step_ * step_sd);
     resolved = sxx > 0 && e_eff / std::sqrt(sxx) <= slope_resolution * mean_rate;
   }
@@ -404,7 +404,7 @@ void RunDetector::Impl::close_asymptotic(std::size_t i, bool at_end, double z, d
   const bool held_long = held_jump && i + 1 - held_from >= 5 * longest;
   if (held_jump && !held_long && !at_end) return;  // wait and see how long it holds
   std::string floor_said;
-  const double band = std::max({3.0 * sd_z, 0.01 * std::abs(v0_), reading_step(hold_.first, i + 1)});
+  const double band = std::max({3.0 * sd_z, 0.01 * std::abs(v0_), reading_step(store_, hold_.first, i + 1)});
   if (held_long) {
     run_.zero_level = motor_zero();
     floor_said = fmt::format(", the last reading of a sensor that holds it ({} samples from {}, where no value "
@@ -478,11 +478,11 @@ std::size_t RunDetector::Impl::held_into(std::size_t from, std::size_t to) const
   // The coast's own fall over the second before it (5 samples at least) …
   std::size_t lo = held;
   while (lo > from && (t(held) - t(lo - 1) <= 1.0 || held - lo < 5)) --lo;
-  const WindowFit f = window_over(ring_.get(), mask_, 1.0, lo, held);
+  const WindowFit f = window_over(store_.data(), store_.mask(), 1.0, lo, held);
   if (f.n < 5) return to;
   // … would have moved the reading by two of its steps there (or three of its noise) while it held.
   const double moved = std::max(-f.slope(), 0.0) * (t(last) - t(held));
-  const double local_step = reading_step(lo, held + 1);
+  const double local_step = reading_step(store_, lo, held + 1);
   return moved > std::max(2.0 * (local_step > 0 ? local_step : coast_step_), 3.0 * f.resid_sd()) ? held : to;
 }
 
@@ -523,7 +523,7 @@ bool RunDetector::Impl::signal_lost(std::size_t i, std::size_t first_in, double 
   // before the held value, per period.
   std::size_t from = held;  // the second before the held value, found from its end
   while (from > run_.cut_index && t(held) - t(from - 1) <= 1.0) --from;
-  WindowFit f = window_over(ring_.get(), mask_, 1.0, from, held);
+  WindowFit f = window_over(store_.data(), store_.mask(), 1.0, from, held);
   if (f.n < 5) return false;  // too few samples to know how fast friction lets it fall
   // A sensor that gives up reads zero (the motor's, when the lead-in showed it) after it.
   if (std::abs(z - zero) > 0.05 * amp) return false;
@@ -570,7 +570,7 @@ bool RunDetector::Impl::still_falling(std::size_t i) const {
   // allows a level reading, and at least a third of the approach's: the "standstill" was a slow
   // exponential's stretch (a viscous coast at a fraction of its start), not a stop.
   if (i < run_.stop_index + 8) return false;
-  const WindowFit w = window_over(ring_.get(), mask_, 1e300, run_.stop_index, i + 1);
+  const WindowFit w = window_over(store_.data(), store_.mask(), 1e300, run_.stop_index, i + 1);
   const double sxx = w.sxx();
   if (!(sxx > 0)) return false;
   const double slope = w.slope();
