@@ -235,12 +235,8 @@ void RunDetector::Impl::complete_run(std::size_t end) {
     r.stop_index = end;
     r.t_stop_s = std::numeric_limits<double>::quiet_NaN();
   }
-  std::size_t coast_end = r.stopped ? r.stop_index : end;
-  if (not_coast_.empty() && !fragment_) recut_after_rise(r, coast_end);
-  if (not_coast_.empty() && !fragment_) recut_after_return(r, coast_end);
-  if (not_coast_.empty() && !fragment_) recut_at_level_end(r, coast_end);
-  if (not_coast_.empty() && !fragment_) recut_after_dwell(r, r.stopped ? r.stop_index : end);
-  coast_end = r.stopped ? r.stop_index : end;
+  recut_coast(r, end);  // why a cut moved: run_detector_recut.cpp
+  const std::size_t coast_end = r.stopped ? r.stop_index : end;
   if (coast_end > r.cut_index + 1) r.period_s = median_period(r.cut_index, coast_end);
   const std::size_t coast_n = coast_end - r.cut_index;
   const double coast_s = (r.stopped ? r.t_stop_s : (end > r.cut_index ? t(end - 1) : r.t_cut_s)) - r.t_cut_s;

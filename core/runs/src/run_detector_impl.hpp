@@ -209,6 +209,9 @@ class RunDetector::Impl {
   std::size_t plateau_from_ = 0;  // the hold window's first sample at the first hit
   std::size_t half_cursor_ = 0;   // the open coast's first sample within a quarter of its fall of the level held now
   std::string not_coast_;  // set: the open run is ignored with this warning when it completes
+  // Every re-cut of the closed coast r (ending at sample end), in order (run_detector_recut.cpp):
+  // the one place a cut moves after it was found.
+  void recut_coast(Run& r, std::size_t end);
   // A coast never rises: when the reading rose inside r's coast [cut, coast_end) by far more than its
   // noise, what came before the rise was no part of it (an open pin's swing before it was connected,
   // a coast the power came back on unseen). r then starts at the last such rise, with a warning.

@@ -1,0 +1,392 @@
+// Why a coast's cut was moved after it was found: every re-cut of a closed coast, in the order
+// complete_run() applies them (recut_coast). Each says what it measured, in the recording's own
+// noise and step, with the run:
+//  * a coast never rises (recut_after_rise): a jump far beyond the reading's noise inside it means
+//    what came before was no part of it (an open pin's swing before it was connected, a coast the
+//    power came back on unseen);
+//  * a coast never comes back to its level (recut_after_return): standing at the cut's level again
+//    where its own pace says it must have fallen far below it, no coast had begun (a drive hunting
+//    about its setpoint);
+//  * a spin-up's peak held as a level (recut_at_level_end): the coast starts where the level ends;
+//  * a coast never dwells (recut_after_dwell): a level held far longer than the coast then took to
+//    fall through it was a drive under power (a start-up overshoot settling on its setpoint).
+// Each moves the cut as any cut is found (recut_from: the two-segment split, the lead-in named).
+#include "run_detector_impl.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <fmt/format.h>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "run_detector_tuning.hpp"
+
+namespace spindown {
+
+using namespace detector_tuning;
+
+void RunDetector::Impl::recut_coast(Run& r, std::size_t end) {
+  if (!not_coast_.empty() || fragment_) return;
+  const std::size_t coast_end = r.stopped ? r.stop_index : end;
+  recut_after_rise(r, coast_end);
+  if (!not_coast_.empty() || fragment_) return;
+  recut_after_return(r, coast_end);
+  if (!not_coast_.empty() || fragment_) return;
+  recut_at_level_end(r, coast_end);
+  if (!not_coast_.empty() || fragment_) return;
+  recut_after_dwell(r, r.stopped ? r.stop_index : end);
+}
+
+void RunDetector::Impl::recut_after_rise(Run& r, std::size_t coast_end) {
+  const std::size_t c = r.cut_index;
+  if (coast_end < c + 16) return;
+  const double zero = r.stopped ? r.zero_level : motor_zero();
+  const double amp = v0_ - zero;
+  // Medians of five: a dropout or two (a loose wire's zeros) are neither a rise nor a step down.
+  // Each sample's is taken once: both searches below read it, three times a sample (a sort of
+  // five per look was a third of `spindown fit`'s time).
+  median5_.resize(coast_end - c);
+  for (std::size_t k = c + 2; k + 2 < coast_end; ++k)
+    median5_[k - c] = median_of_five(v(k - 2), v(k - 1), v(k), v(k + 1), v(k + 2));
+  const auto med5 = [&](std::size_t k) { return median5_[k - c]; };
+  // The last rise of more than thr above the lowest reading before it, or a later step down.
+  const auto last_jump = [&](double thr, double& rose) {
+    double low = std::numeric_limits<double>::infinity(), rose_from = 0;
+    std::size_t rise = 0;
+    for (std::size_t k = c + 2; k + 2 < coast_end; ++k) {
+      const double m = med5(k);
+      if (m - low > thr) {
+        if (rise == 0 || k > rise + 1) rose_from = low;
+        rise = k, rose = m - rose_from, low = m;
+      } else {
+        low = std::min(low, m);
+      }
+    }
+    // A step down: a fall within three samples far steeper than the coast's own pace on either
+    // side of it (an open pin above the back-EMF, then connected to the motor).
+    if (coast_end >= c + 24) {
+      for (std::size_t k = c + 10; k + 10 < coast_end; ++k) {
+        const double drop = med5(k - 2) - med5(k + 1);
+        if (!(drop > thr)) continue;
+        const double before = (med5(k - 8) - med5(k - 2)) / (t(k - 2) - t(k - 8));
+        const double after = (med5(k + 1) - med5(k + 7)) / (t(k + 7) - t(k + 1));
+        const double pace = std::max({before, after, 0.0}) * (t(k + 1) - t(k - 2));
+        if (drop > 4.0 * pace + thr && k > rise) rise = k - 1, rose = -drop;
+      }
+    }
+    return rise;
+  };
+  // A jump is far beyond the coast's sample-to-sample noise (the median over the whole coast: a
+  // rough stretch before the rise, an open pin's hum, does not set it), a twentieth of the coast's
+  // height and three steps of the print. Most coasts have no jump even of that least size: then
+  // the noise (a median over the whole coast, most of this search's time) is not needed, as a
+  // higher threshold finds no jump where a lower one found none.
+  const double least = std::max(0.05 * std::abs(amp), 3.0 * coast_step_);
+  double rose = 0;
+  if (last_jump(least, rose) == 0) return;
+  const double white = rough_sd(store_, c, coast_end);
+  const std::size_t rise = last_jump(std::max(8.0 * white, least), rose);
+  if (rise == 0) return;
+  // What made it evidence, said with it: the jump in units of the reading's noise.
+  std::string evidence = white > 0 ? fmt::format(" ({:.0f} times the reading's sample-to-sample noise {:.2g})",
+                                                 std::abs(rose) / white, white)
+                                   : std::string(" (the reading shows no noise)");
+  // A ripple (a wheel's once per revolution, a commutator's) moves neighbouring samples together:
+  // its crests stand above its troughs by far more than the sample-to-sample noise says. Where the
+  // coast shows one all along (the smaller of its two halves': an open pin's hum before a
+  // connection is in one of them only), a rise or a step is evidence only when the level over a
+  // whole ripple after it stands apart from the level over a whole ripple before it, by more than
+  // those means' own noise allows.
+  const std::size_t mid = c + (coast_end - c) / 2;
+  const LagNoise early = noise_over(store_, c, mid), late = noise_over(store_, mid, coast_end);
+  const LagNoise& noise = early.wander < late.wander ? early : late;
+  // (After a floating lead-in the hum may go on past the cut found: a rise there is the connection.)
+  if (noise.wander > 2.0 * noise.white && r.lead_in != "floating") {
+    const std::size_t len = std::max<std::size_t>(5, 2 * noise.wander_lag);
+    if (rise < c + len || rise + len > coast_end) return;
+    double before = 0, after = 0;
+    for (std::size_t k = rise - len; k < rise; ++k) before += v(k);
+    for (std::size_t k = rise; k < rise + len; ++k) after += v(k);
+    const double shift = (after - before) / double(len);
+    const double se = noise.wander * std::sqrt(2.0 / double(len));
+    // … and only on a coast: the means over whole ripples before the rise fall, each within those
+    // means' noise of the one before (an open pin's swing rises and falls by far more).
+    bool falls = true;
+    double prev = std::numeric_limits<double>::infinity();
+    for (std::size_t k0 = c; k0 + len <= rise && falls; k0 += len) {
+      double m = 0;
+      for (std::size_t k = k0; k < k0 + len; ++k) m += v(k);
+      m /= double(len);
+      falls = m <= prev + 4.0 * se;
+      prev = m;
+    }
+    if (falls) {
+      const double moved = rose > 0 ? shift : -shift;  // in the jump's own direction
+      if (!(moved > std::max(4.0 * se, least))) return;
+      evidence = fmt::format(" (its level over whole ripples of {} samples moved {:.3g}, {:.0f} times those means' noise)",
+                             len, shift, std::abs(shift) / se);
+    }
+  }
+  // The coast after the rise: its cut found as any cut is, with the samples before the rise as lead-in.
+  std::size_t a = rise, b = rise;
+  while (a > c && t(rise) - t(a - 1) <= back_search_s) --a;
+  while (b + 1 < coast_end && t(b + 1) - t(rise) <= 1.0) ++b;
+  if (b < rise + 6 || rise < a + 4) return;
+  const WindowFit w = window_over(store_.data(), store_.mask(), 1.0, rise, b + 1);
+  const std::size_t keep_lo = search_lo_;
+  search_lo_ = std::max(search_lo_, c);
+  CutSplit sp = split_at_cut(a, b, w);
+  search_lo_ = keep_lo;
+  if (!(sp.v0 > 0) || sp.cut_index <= c) return;
+  const double t_old = r.t_cut_s;
+  bounce_.clear();
+  take_bounce(sp, w);
+  r.cut_index = sp.cut_index;
+  r.t_cut_s = sp.t_cut_s;
+  r.lead_in = classify_lead_in(sp);
+  v0_ = sp.v0;
+  const std::string said = fmt::format(
+      "the reading {} by {:.3g}{} at {}, inside the coast taken from {}: a coast never {}, so the coast is taken "
+      "from {} (the pin connected to the motor then? the power back on?), lead-in {}",
+      rose > 0 ? "rose" : "stepped down", std::abs(rose), evidence, fmt_s(t(rise)), fmt_s(t_old),
+      rose > 0 ? "rises" : "jumps", fmt_s(r.t_cut_s), r.lead_in);
+  run_note_ = run_note_.empty() ? said : said + "; " + run_note_;
+  run_note_severity_ = Diagnostic::Severity::warning;
+  // The standstill was judged against the old cut: from the new one, a coast whose last quarter
+  // creeps in is an exponential's (pure viscous friction), not a stop.
+  if (r.stopped && creeps_in(r.t_cut_s, last_quarter_time(c, r.stop_index, r.zero_level + 0.25 * (v0_ - r.zero_level)),
+                             r.t_stop_s)) {
+    r.stopped = false;
+    r.end = Run::End::asymptotic;
+    r.stop_index = r.end_index;
+    r.t_stop_s = std::numeric_limits<double>::quiet_NaN();
+    run_note_ += fmt::format("; from there the coast approaches its floor ({:g}) asymptotically, as pure viscous "
+                             "friction does: treated as never stopped, coast closed at {}",
+                             r.zero_level, fmt_s(r.t_end_s));
+  }
+}
+
+void RunDetector::Impl::recut_after_return(Run& r, std::size_t coast_end) {
+  const std::size_t c = r.cut_index;
+  if (coast_end < c + 24 || !(v0_ > 0)) return;
+  // Readings held at the converter's top (find_pinned_start) are not the motor's: from after them.
+  std::size_t from = c;
+  if (std::isfinite(pin_level_))
+    for (std::size_t k = c; k < coast_end; ++k)
+      if (v(k) >= pin_level_) from = k + 1;
+  double top = v(from < coast_end ? from : c);
+  for (std::size_t k = from; k < coast_end; ++k) top = std::max(top, v(k));
+  // The scan over means of len readings, their noise se: the last window [back - len, back) that
+  // stands back at the coast's level, where it must have lost `lost`; back 0 when none does. With
+  // se 0, whether any window could for some noise: a return needs lost > 10 se and a mean above
+  // level - 3 se, so above level - 0.3 lost, and se is at least a sixth of the reading's step.
+  std::size_t back = 0;
+  double at_level = 0, lost = 0, level = 0;
+  double* prefix = nullptr;  // sums of the readings [from, from + j), j = 0 … coast_end - from
+  const auto scan = [&](std::size_t len, double se) {
+    back = 0;
+    if (coast_end < from + 4 * len) return;
+    double sum = 0;
+    for (std::size_t k = from; k < from + len; ++k) sum += v(k);
+    // The level the coast began at, read from its first samples (not the cut's line, which a bounce
+    // pulls down and a line fitted to a curve lifts): the highest median of three over its first
+    // two windows (a contact's bounce at the connection reads low, a glitch alone decides nothing).
+    level = -std::numeric_limits<double>::infinity();
+    for (std::size_t k = from + 1; k + 1 < std::min(from + 2 * len, coast_end); ++k)
+      level = std::max(level, median_of_three(v(k - 1), v(k), v(k + 1)));
+    // The coast's own pace: its whole fall (to the mean of its last samples: its standstill, or
+    // where a coast that did not stop was closed) over its whole time, a quarter of it at most
+    // early on (Stribeck friction, strongest near standstill, makes a coast's start its slowest part).
+    double last = 0;
+    for (std::size_t k = coast_end - len; k < coast_end; ++k) last += v(k);
+    last /= double(len);
+    const double span_s = 0.5 * (t(coast_end - len) + t(coast_end - 1)) - r.t_cut_s;
+    if (!(span_s > 0)) return;
+    const double least_rate = 0.25 * std::max(level - last, 0.0) / span_s;
+    if (se == 0) {  // the same test from the prefix sums, with a margin for their rounding
+      const Sample* ring = store_.data();
+      const std::size_t mask = store_.mask();
+      const double t_from = t(from), n = double(len), rate = 0.5 * least_rate, least = 10.0 * coast_step_ / 6.0;
+      const double margin = 1e-9 * n * (std::abs(level) + std::abs(v0_));
+      for (std::size_t k = from; k + len <= coast_end; ++k) {
+        const double should = rate * (ring[k & mask].t + ring[(k + len - 1) & mask].t) - least_rate * t_from;
+        if (prefix[k + len - from] - prefix[k - from] + margin >= n * (level - 0.3 * should) && should > least) {
+          back = k + len;
+          return;
+        }
+      }
+      return;
+    }
+    for (std::size_t k = from;; ++k) {  // the window [k, k + len)
+      const double mean = sum / double(len);
+      const double should = least_rate * (0.5 * (t(k) + t(k + len - 1)) - t(from));  // lost since the level was read
+      if (should > 10.0 * se && mean >= level - 3.0 * se &&
+                 2 * count_from(store_, top - coast_step_, k, k + len) < len && 2 * count_from(store_, v(k), k, k + len, v(k)) <= len) {
+        // Where the coast must have lost ten of its means' noise, it stands within three of the
+        // cut's level — and not mostly within a reading step of the coast's highest reading (a
+        // converter's top, read until the back-EMF comes below it) or on one repeated value (a stall).
+        back = k + len, at_level = mean, lost = should;
+      }
+      if (k + len >= coast_end) break;
+      sum += v(k + len) - v(k);
+    }
+  };
+  // The means are over whole ripples where the coast shows one (a wheel's once per revolution, a
+  // drive's hunting: 2 to 256 readings, twice the lag of the largest noise up to half a second),
+  // else over five readings. Most coasts fall well below their level at every length: then their
+  // noise (most of this search's time) is not needed.
+  const std::size_t mid = c + (coast_end - c) / 2;
+  const std::size_t max_len = 2 * std::max(noise_max_lag(store_, c, mid), noise_max_lag(store_, mid, coast_end));
+  if (coast_end < from + 20) return;
+  prefix = scratch(coast_end - from + 1);
+  prefix[0] = 0;
+  for (std::size_t k = from; k < coast_end; ++k) prefix[k + 1 - from] = prefix[k - from] + v(k);
+  bool could = false;
+  for (std::size_t len = 5; len <= std::max<std::size_t>(max_len, 5) && !could; len = len == 5 ? 8 : 2 * len) {
+    scan(len, 0.0);
+    could = back != 0;
+  }
+  if (!could) return;
+  // The means' noise (or a sixth of the print's step: a level read in whole steps is known no better).
+  const LagNoise early = noise_over(store_, c, mid), late = noise_over(store_, mid, coast_end);
+  const LagNoise& noise = early.wander < late.wander ? early : late;
+  const bool rippled = noise.wander > 2.0 * noise.white;
+  const std::size_t len = rippled ? std::max<std::size_t>(5, 2 * noise.wander_lag) : 5;
+  if (coast_end < c + 4 * len) return;
+  const double se =
+      std::max((rippled ? noise.wander : noise.white) / std::sqrt(double(len)), coast_step_ / 6.0);
+  if (!(se > 0)) return;
+  scan(len, se);
+  if (back == 0 || back + 6 >= coast_end) return;
+  // The coast after the return, with the next seconds (a drive's hunting may run on a while below
+  // the level before the cut).
+  const double t_old = r.t_cut_s;
+  const bool was_partial = r.partial();  // "the recording starts mid-coast": no longer so
+  if (!recut_from(r, back, coast_end, back_search_s, 4)) return;
+  const std::string said = fmt::format(
+      "the reading stood at {:.4g} until {}, back at the level of the coast taken from {} ({:.4g}), where that coast "
+      "would have lost {:.2g} by then at a quarter of its own pace ({:.0f} times its means' noise {:.2g}): friction "
+      "only takes speed off, so no coast had begun; the coast is taken from {} (lead-in {})",
+      at_level, fmt_s(t(back - 1)), fmt_s(t_old), level, lost, lost / se, se, fmt_s(r.t_cut_s), r.lead_in);
+  run_note_ = run_note_.empty() || was_partial ? said : said + "; " + run_note_;
+  run_note_severity_ = Diagnostic::Severity::warning;
+}
+
+bool RunDetector::Impl::recut_from(Run& r, std::size_t at, std::size_t coast_end, double ahead_s, std::size_t min_lead) {
+  const std::size_t c = r.cut_index;
+  std::size_t a = at, b = at;
+  while (a > c && t(at) - t(a - 1) <= back_search_s) --a;
+  while (b + 1 < coast_end && t(b + 1) - t(at) <= ahead_s) ++b;
+  if (b < at + 6 || at < a + min_lead) return false;
+  const WindowFit w = window_over(store_.data(), store_.mask(), 1.0, at, b + 1);
+  const std::size_t keep_lo = search_lo_;
+  search_lo_ = std::max(search_lo_, c);
+  CutSplit sp = split_at_cut(a, b, w);
+  const std::string lead = classify_lead_in(sp);
+  if (lead == "powered" && sp.pre_flat) refine_plateau_cut(sp, b);
+  search_lo_ = keep_lo;
+  if (!(sp.v0 > 0) || sp.cut_index <= c) return false;
+  bounce_.clear();
+  r.cut_index = sp.cut_index;
+  r.t_cut_s = sp.t_cut_s;
+  r.lead_in = lead;
+  v0_ = sp.v0;
+  return true;
+}
+
+void RunDetector::Impl::recut_at_level_end(Run& r, std::size_t coast_end) {
+  // A coast taken from a spin-up's peak whose reading held that level for a while: the coast starts
+  // where the level ends, judged now on the coast's first quarter (the cut judged on the samples
+  // up to the window that confirmed the coast may have had too little coast to tell).
+  const std::size_t p = r.cut_index;
+  if (r.lead_in != "spin-up" || coast_end < p + 24) return;
+  double low = v(p);
+  for (std::size_t k = p; k < coast_end; ++k) low = std::min(low, v(k));
+  const double quarter = v0_ - 0.25 * (v0_ - low);
+  std::size_t b = p + 16;
+  while (b + 1 < coast_end && smoothed(store_, b, p, coast_end - 1) > quarter) ++b;
+  const std::size_t c = level_end(p, p, b);
+  if (c == p) return;
+  const double held = t(c) - t(p);
+  r.cut_index = c;
+  r.t_cut_s = t(c);
+  v0_ = smoothed(store_, c, p, coast_end - 1);
+  const std::string said = fmt::format(
+      "the reading held the level it rose to for {:.3g} s after its peak: the coast is taken from where it "
+      "leaves that level, {}",
+      held, fmt_s(r.t_cut_s));
+  run_note_ = run_note_.empty() ? said : said + "; " + run_note_;
+}
+
+// A coast never dwells (recut_after_dwell): a free coast's speed falls at every level it passes
+// (friction takes speed off at every speed), so it crosses a band of its own noise in about the
+// time its rate takes to fall that far. A "coast" whose reading held a level (or came back to it)
+// far longer than that, and then fell through the same span fast, was under power while it held:
+// the coast begins at the end of the dwell (a start-up overshoot that settled on the setpoint,
+// taken for a cut at its peak).
+std::size_t RunDetector::Impl::dwell_end(std::size_t c, std::size_t e, double h, std::size_t& from) {
+  // Envelopes of the readings (medians of three: a single glitch makes no dwell): the lowest so far
+  // from the cut (lo) and the highest from here to the coast's end (hi). A coast's level L is first
+  // reached at the first k with lo(k) <= L + h and left for good after the last j with hi(j) >= L - h.
+  const std::size_t n = e - c;
+  double* lo = scratch(2 * n);
+  double* hi = lo + n;
+  const auto med3 = [&](std::size_t k) { return median3(store_, k, c, e); };
+  for (std::size_t k = 0; k < n; ++k) lo[k] = std::min(k ? lo[k - 1] : med3(c), med3(c + k));
+  for (std::size_t k = n; k-- > 0;) hi[k] = std::max(k + 1 < n ? hi[k + 1] : med3(e - 1), med3(c + k));
+  // For each new low (level L = lo(k) − h, the band [L − h, L + h]): the dwell D from k to the last
+  // j still at L − h or above, and the time T the coast then takes to fall dwell_fall_bands more
+  // bands. Both pointers only move on, as the level only falls.
+  std::size_t found = 0, j = 0, j2 = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    if (k > 0 && !(lo[k] < lo[k - 1])) continue;
+    const double leave = lo[k] - 2.0 * h, fallen = leave - 2.0 * h * dwell_fall_bands;
+    j = std::max(j, k);
+    while (j + 1 < n && hi[j + 1] >= leave) ++j;
+    j2 = std::max(j2, j);
+    while (j2 + 1 < n && hi[j2 + 1] >= fallen) ++j2;
+    if (j2 + 1 >= n) break;  // the coast never falls that far after this level: nor after any lower
+    const double dwell = t(c + j) - t(c + k), then = std::max(t(c + j2 + 1) - t(c + j), t(c + j + 1) - t(c + j));
+    if (dwell > dwell_max_ratio * then && c + j + 1 > found) found = c + j + 1, from = c + k;
+  }
+  return found;
+}
+
+bool RunDetector::Impl::falls_faster_later(std::size_t c, std::size_t e, double margin) const {
+  // A free coast falls at least as far in each third of its time as in the next: friction takes
+  // more speed off at a higher speed (viscous, windage) or as much (Coulomb). A dwell makes an
+  // earlier third fall less than a later one; only then is the coast searched for it (the search
+  // would cost every run's detection a tenth more time). Stribeck friction near standstill also
+  // passes here; the search then finds no dwell. Medians of three: one glitch decides nothing.
+  const auto med3 = [&](std::size_t k) { return median3(store_, k, c, e); };
+  const std::size_t n = e - c;
+  const double v0 = med3(c), v1 = med3(c + n / 3), v2 = med3(c + 2 * n / 3), v3 = med3(e - 1);
+  const double d1 = v0 - v1, d2 = v1 - v2, d3 = v2 - v3;
+  return d2 > d1 + margin || d3 > d2 + margin || d3 > d1 + margin;
+}
+
+void RunDetector::Impl::recut_after_dwell(Run& r, std::size_t coast_end) {
+  const std::size_t c = r.cut_index;
+  if (coast_end < c + 16) return;
+  // First the cheap look (the noise near the cut for a margin), then the coast's own noise.
+  if (!falls_faster_later(c, coast_end, 2.0 * std::max(4.0 * coast_sd_, coast_step_))) return;
+  const double h = std::max(4.0 * sampled_rough_sd(store_, c, coast_end), coast_step_);
+  if (!(h > 0)) return;
+  std::size_t from = c;
+  const std::size_t at = dwell_end(c, coast_end, h, from);
+  if (at == 0 || 2 * longest_hold(store_, from, at - 1) >= at - from) return;  // a frozen reading
+  // The coast after the dwell: its cut found as any cut is, the dwell its lead-in.
+  const double t_old = r.t_cut_s;
+  if (!recut_from(r, at, coast_end, 1.0, 8)) return;
+  const std::string said = fmt::format(
+      "the reading held at {:.4g} ± {:.2g} or above from {} to {}, inside the coast taken from {}, and then fell {:.2g} "
+      "times as far in a twentieth of that time or less: a coast never dwells, so the coast is taken from {} (lead-in {})",
+      v(from), 2.0 * h, fmt_s(t(from)), fmt_s(t(at - 1)), fmt_s(t_old), 2.0 * dwell_fall_bands, fmt_s(r.t_cut_s),
+      r.lead_in);
+  run_note_ = run_note_.empty() ? said : said + "; " + run_note_;
+  run_note_severity_ = Diagnostic::Severity::warning;
+}
+
+}  // namespace spindown
