@@ -176,13 +176,12 @@ void refuse_swapped_columns(std::string_view bytes, Recording& rec) {
 // no coast rises from rest in it. Read as their magnitude, and said.
 void read_negative_as_magnitude(Recording& rec) {
   std::size_t negative = 0, positive = 0;
-  double lowest = 0;
-  for (const double v : rec.value) {
+  for (const double v : rec.value) {  // counts only: the loop vectorizes
     negative += v < 0;
     positive += v > 0;
-    lowest = std::min(lowest, v);
   }
   if (negative < 20 || positive * 20 > negative) return;
+  const double lowest = *std::min_element(rec.value.begin(), rec.value.end());
   // A coast, not a rest's noise a step below zero: it passes through many values.
   std::vector<double> levels;
   for (const double v : rec.value)

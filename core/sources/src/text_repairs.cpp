@@ -192,6 +192,7 @@ EncodingGuess encoding_to_undo(std::string_view text) {
 }  // namespace
 
 bool plotter_labels(std::string_view line, std::string* labels, std::string* values) {
+  if (line.find(':') == std::string_view::npos) return false;  // the usual line, at once
   while (!line.empty() && (line.back() == '\r' || line.back() == ' ' || line.back() == '\t' || line.back() == ','))
     line.remove_suffix(1);
   if (line.empty()) return false;
