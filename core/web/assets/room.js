@@ -23,7 +23,8 @@
       el("header", {}, name, state),
       run,
       canvas,
-      el("dl", {}, el("dt", {}, "best"), best, el("dt", {}, "c3"), c3, el("dt", {}, "c4"), c4, el("dt", {}, "health"), health),
+      el("dl", {}, el("dt", { "data-term": "best" }, "best"), best, el("dt", {}, "c3"), c3, el("dt", {}, "c4"), c4,
+        el("dt", { "data-term": "health" }, "health"), health),
       doubts,
       el("footer", {}, "bridge ", bridge, " ", bridgeInfo));
     const t = { id, root, state, run, canvas, best, c3, c4, health, doubts, bridge, bridgeInfo, summary: null,
@@ -33,13 +34,67 @@
     return t;
   }
 
+  // A room on one screen (a projector, a wide monitor): the tiles share the window, as many
+  // columns as make them largest, and show as much as fits at a font of at least 14 px — the
+  // whole tile, then name, state, c3, c4, health and the first doubt (compact), then name, state,
+  // c3 and c4 (dense). A phone, or a room too big for its screen even so, scrolls as a list.
+  const minFont = 14;
+  let fitWanted = true;
+  function overflows(t) {
+    const r = t.root;
+    return r.scrollHeight > r.clientHeight + 1 || r.scrollWidth > r.clientWidth + 1;
+  }
+  function unfit() {
+    delete tilesBox.dataset.fit;
+    delete tilesBox.dataset.density;
+    tilesBox.style.removeProperty("--cols");
+    tilesBox.style.removeProperty("--tile-h");
+    tilesBox.style.removeProperty("--tile-font");
+  }
+  function fitRoom() {
+    fitWanted = false;
+    const n = tiles.size;
+    if (n === 0 || window.innerWidth < 700) return unfit();
+    const main = tilesBox.parentElement, ms = getComputedStyle(main), bs = getComputedStyle(tilesBox);
+    const above = tilesBox.getBoundingClientRect().top + window.scrollY;
+    const below = document.querySelector(".bottom").offsetHeight + parseFloat(ms.paddingBottom);
+    const W = tilesBox.clientWidth, H = window.innerHeight - above - below;
+    const gapX = parseFloat(bs.columnGap) || 0, gapY = parseFloat(bs.rowGap) || 0;
+    let best = null;
+    for (let c = 1; c <= n; c++) {
+      const r = Math.ceil(n / c), w = (W - gapX * (c - 1)) / c, h = Math.floor((H - gapY * (r - 1)) / r);
+      if (w < 150 || h < 3.2 * minFont * 1.35) continue;
+      const size = Math.min(w, 1.7 * h);
+      if (!best || size > best.size) best = { c, h, size };
+    }
+    if (!best) return unfit();
+    tilesBox.dataset.fit = "";
+    tilesBox.style.setProperty("--cols", String(best.c));
+    tilesBox.style.setProperty("--tile-h", best.h + "px");
+    const top = Math.max(minFont, Math.min(26, Math.floor(best.h / 5)));
+    for (const density of ["full", "compact", "dense"]) {
+      tilesBox.dataset.density = density;
+      for (let f = top; f >= minFont; f--) {
+        tilesBox.style.setProperty("--tile-font", f + "px");
+        let all = true;
+        for (const t of tiles.values()) if (overflows(t)) { all = false; break; }
+        if (all) {
+          for (const t of tiles.values()) t.dirty = true;
+          return;
+        }
+      }
+    }
+    // Nothing fits whole: the dense tiles at the least font, each cut at its own edge.
+  }
+
   function placeTiles() {
-    const ids = Array.from(tiles.keys()).sort();
+    const ids = Array.from(tiles.keys()).sort((a, b) => a.localeCompare(b, undefined, { numeric: true }));  // bench-2 before bench-10
     ids.forEach((id, i) => {
       const root = tiles.get(id).root;
       if (tilesBox.children[i] !== root) tilesBox.insertBefore(root, tilesBox.children[i] || null);
     });
     document.getElementById("empty").hidden = tiles.size > 0;
+    fitWanted = true;
   }
 
   function tile(id) { return tiles.get(id) || makeTile(id); }
@@ -63,6 +118,7 @@
     setBridge(t.bridge, s.bridge);
     setText(t.bridgeInfo, s.refused ? `its samples are refused: ${s.refused}` : bridgeDetail(s.bridge));
     t.dirty = true;
+    t.check = true;  // new text may not fit the tile's room any more
   }
 
   // "silent · last sample 14 s ago" while a bench is silent (counted on this page's clock).
@@ -93,6 +149,7 @@
   // The sparkline: the run's readings, and the best model's curve when the fit is this run's.
   function draw(t) {
     const c = t.canvas;
+    if (!c.offsetParent) return;  // not shown (a compact tile)
     const w = c.clientWidth || 300, h = c.clientHeight || 80;
     const dpr = window.devicePixelRatio || 1;
     if (c.width !== Math.round(w * dpr) || c.height !== Math.round(h * dpr)) {
@@ -134,6 +191,9 @@
   }
 
   function frame() {
+    if (!fitWanted && tilesBox.dataset.fit !== undefined)
+      for (const t of tiles.values()) if (t.check) { t.check = false; if (overflows(t)) fitWanted = true; }
+    if (fitWanted) fitRoom();
     for (const t of tiles.values()) if (t.dirty) { t.dirty = false; draw(t); }
     requestAnimationFrame(frame);
   }
@@ -163,6 +223,6 @@
     },
     lab: showLab,
   });
-  window.addEventListener("resize", () => { for (const t of tiles.values()) t.dirty = true; });
+  window.addEventListener("resize", () => { fitWanted = true; for (const t of tiles.values()) t.dirty = true; });
   requestAnimationFrame(frame);
 })();
