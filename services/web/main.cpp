@@ -72,7 +72,8 @@ std::optional<int> parse_options(int argc, char** argv, spindown::WebServiceOpti
   const auto lab = connection.resolve(&why);
   if (!lab) return spindown::service::bad_usage("spindown-web", why);
   o.lcm_url = lab->lcm_url;
-  o.lab.signatures_checked = lab->lab.key.has_value();  // the gate below refuses what the key did not sign
+  o.lab.signatures_checked = lab->lab.key.has_value();
+  o.lab.lab_name = lab->lab.lab;  // the gate below refuses what the key did not sign
   o.check = [g = std::make_shared<spindown::MessageGate>(lab->gate())](
                 std::string_view channel, const void* data, std::int64_t size,
                 std::int64_t recv_utime) -> std::optional<spindown::GateResult> {

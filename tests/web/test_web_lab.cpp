@@ -63,6 +63,19 @@ TEST(WebLab, TheFitOnThePageIsTheFitMessagesOwnNumbers) {
   EXPECT_NE(c4_text.find("g·cm²·rad·s⁻²"), std::string::npos) << c4_text;
   EXPECT_NEAR(std::stod(c4_text), f2["c4"]["value"].get<double>() * 1e7, 0.01 * 1139) << c4_text;
   EXPECT_EQ(f2["health"], "not judged");  // no bench file: never "ok"
+  // What the printed lab record needs: J and K_b the fit used, where they came from, and when.
+  EXPECT_EQ(f2["inertia_kg_m2"].get<double>(), r.fit.inertia_kg_m2);
+  EXPECT_EQ(f2["kb_v_s_per_rad"].get<double>(), r.fit.kb_v_s_per_rad);
+  EXPECT_EQ(f2["inertia_source"], r.fit.inertia_source);
+  EXPECT_EQ(f2["kb_source"], r.fit.kb_source);
+  EXPECT_EQ(f2["unix_ms"].get<std::int64_t>(), r.fit.utime / 1000);
+}
+
+TEST(WebLab, TheLabsNameIsOnEveryPage) {
+  WebLabOptions o;
+  o.lab_name = "phys-2b";
+  WebLab lab(o);
+  EXPECT_EQ(lab.state_json(1)["lab"]["name"], "phys-2b");
 }
 
 TEST(WebLab, TheModelsCurvesRunThroughTheReadingsWithinTheirNoise) {

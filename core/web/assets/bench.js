@@ -21,6 +21,8 @@
   let detail = null;              // the current run's detail event
   let lastSummary = null;         // the bench's latest summary: what is known of its messages' sources
   const overlays = new Map();     // run number -> {points, color}
+  let labName = "";               // the lab's name (--lab of spindown-web)
+  let chosen = null;              // a finished run chosen in the runs table to show and print (its row)
   let plot = null, residualPlot = null, dirty = true;
 
   // ---- the main plot ------------------------------------------------------------------------
@@ -141,7 +143,7 @@
     setText($("unit"), d.unit || "V");
     if (!run) {
       setText($("run-title"), "Waiting for a run");
-    } else {
+    } else if (!chosen) {
       setText($("run-title"), `Run ${run.number}${run.partial ? " (partial: the cut was not seen)" : ""} · ${run.state}`);
     }
     // A run longer than this page keeps is said where its plot is: the plot and the CSV are its start only.
@@ -155,21 +157,23 @@
     if (run && run.markers.stop !== null) markers.push(el("li", { "data-marker": "stop" },
       `stop at t = ${run.t_stop_s.toFixed(3)} s (${run.markers.stop.toFixed(2)} s after the ${run.partial ? "first sample" : "cut"})`));
     $("markers").replaceChildren(...markers);
-    // The fit.
+    // The fit (a run chosen in the runs table keeps its own until "back to the live run").
     const fit = run ? run.fit : null;
-    setText($("best"), fit ? (fit.best || "no model converged") : "–");
-    setCoefficient($("c3"), fit ? fit.c3 : null, fit ? fit.run : undefined);
-    setCoefficient($("c4"), fit ? fit.c4 : null, fit ? fit.run : undefined);
-    setHealth($("health"), fit);
-    setDoubts($("doubts"), fit, lastSummary);
-    $("best-reason").textContent = fit ? fit.best_reason : "";
-    $("health-reason").textContent = fit && fit.health_reason ? `health: ${fit.health_reason}` : "";
+    if (!chosen) {
+      showFit(fit);
+      setText($("record"), recordText(run, fit));
+    }
     // One legend entry per model the FIT carries.
     const legend = [el("li", {}, el("span", { class: "swatch" }), "readings")];
     if (run && run.curves) for (const m of run.curves.models) {
       const rmse = m.rmse === null ? "" : ` RMSE ${m.rmse.toPrecision(3)} ${fit.residual_unit}`;
       legend.push(el("li", { "data-curve": m.name, "data-converged": m.converged ? "true" : "false", class: m.name === fit.best ? "best" : null },
         el("span", { class: "swatch" }), m.name + (m.converged ? rmse : ": did not converge") + (m.name === fit.best ? " (best)" : "")));
+    }
+    for (const [n, o] of overlays) {
+      const sw = el("span", { class: "swatch" });
+      sw.style.background = o.color;
+      legend.push(el("li", { "data-overlay": String(n) }, sw, `run ${n}`));
     }
     $("legend").replaceChildren(...legend);
     // CSV of this run.
@@ -191,6 +195,50 @@
       dirty = true;
     }, 0);
   }
+
+  // The lab record's line: which run, where, when, and the J and K_b its numbers rest on.
+  function when(ms) {
+    if (!ms) return "";
+    const d = new Date(ms), p = (n) => String(n).padStart(2, "0");
+    return `${d.getFullYear()}-${p(d.getMonth() + 1)}-${p(d.getDate())} ${p(d.getHours())}:${p(d.getMinutes())}`;
+  }
+  function g(v, digits = 3) { return Number(v).toPrecision(digits).replace(/\.?0+(e|$)/, "$1"); }
+  function recordText(run, fit) {
+    if (!run) return "";
+    const parts = [`Run ${run.number} of ${id}`];
+    if (labName) parts.push(`lab ${labName}`);
+    if (fit && fit.unix_ms) parts.push(when(fit.unix_ms));
+    if (fit && fit.inertia_kg_m2) parts.push(`J = ${g(fit.inertia_kg_m2)} kg·m² (${g(fit.inertia_kg_m2 * 1e7)} g·cm²), from ${fit.inertia_source || fit.bench_source || "?"}`);
+    if (fit && fit.kb_v_s_per_rad) parts.push(`K_b = ${g(fit.kb_v_s_per_rad)} V·s/rad (${g(fit.kb_v_s_per_rad * 1e3)} mV·s/rad), from ${fit.kb_source || fit.bench_source || "?"}`);
+    return parts.join(" · ");
+  }
+
+  // The numbers of the run shown: the live run's, or a finished run chosen in the runs table.
+  function showFit(fit) {
+    setText($("best"), fit ? (fit.best || "no model converged") : "–");
+    setCoefficient($("c3"), fit ? fit.c3 : null, fit ? fit.run : undefined);
+    setCoefficient($("c4"), fit ? fit.c4 : null, fit ? fit.run : undefined);
+    setHealth($("health"), fit);
+    setDoubts($("doubts"), fit, lastSummary);
+    $("best-reason").textContent = fit ? fit.best_reason : "";
+    $("health-reason").textContent = fit && fit.health_reason ? `health: ${fit.health_reason}` : "";
+  }
+  function choose(r) {
+    chosen = r;
+    document.body.setAttribute("data-chosen-run", String(r.number));
+    $("back-live").hidden = false;
+    setText($("run-title"), `Run ${r.number}${r.partial ? " (partial: the cut was not seen)" : ""} · ${r.state} (chosen in this session's runs)`);
+    setText($("record"), recordText(r, r.fit));
+    showFit(r.fit);
+    for (const tr of $("runs").children) tr.classList.toggle("chosen", tr.getAttribute("data-run") === String(r.number));
+    if (!overlays.has(r.number)) toggleOverlay(r.number, true);
+  }
+  $("back-live").addEventListener("click", () => {
+    chosen = null;
+    document.body.removeAttribute("data-chosen-run");
+    $("back-live").hidden = true;
+    if (detail) showDetail(detail);
+  });
 
   function showExplain(x) {
     const list = $("explain");
@@ -255,16 +303,23 @@
         compare.addEventListener("change", () => toggleOverlay(r.number, compare.checked));
       }
       const why = notWhole(r);
-      return el("tr", { "data-run": r.number, class: isCurrent ? "current" : null },
+      let show = "";
+      if (!isCurrent && r.fit) {
+        show = el("button", { type: "button", class: "show-run", "aria-label": `show run ${r.number} to print` }, `show run ${r.number}`);
+        show.addEventListener("click", () => choose(r));
+      }
+      const cls = [isCurrent ? "current" : "", chosen && chosen.number === r.number ? "chosen" : ""].join(" ").trim();
+      return el("tr", { "data-run": r.number, class: cls || null },
         el("td", {}, `${r.number}${r.partial ? " (partial)" : ""}`),
         el("td", {}, f ? f.best || "–" : r.state, why ? el("div", { class: "why-not-whole" }, why) : null),
         el("td", { "data-si": f && f.c3 ? f.c3.value : null }, f && f.c3 ? f.c3.text : "–"),
         el("td", { "data-si": f && f.c4 ? f.c4.value : null }, f && f.c4 ? f.c4.text : "–"),
         el("td", {}, f ? f.health : "–"),
+        el("td", {}, show),
         el("td", {}, compare),
         el("td", {}, el("a", { href: r.csv, download: `${id}-run${r.number}.csv` }, "CSV")));
     });
-    if (rows.length === 0) rows.push(el("tr", {}, el("td", { colspan: 7 }, "no run yet")));
+    if (rows.length === 0) rows.push(el("tr", {}, el("td", { colspan: 8 }, "no run yet")));
     $("runs").replaceChildren(...rows);
     // Overlays of runs no longer kept go.
     const kept = new Set(earlier.map((r) => r.number));
@@ -279,6 +334,7 @@
       const j = await r.json();
       overlays.set(n, { points: j.points, color: overlayColors[overlays.size % overlayColors.length] });
       rebuildPlot();
+      if (detail) showDetail(detail);  // its legend entry
     } catch (e) {
       // the run is gone (no longer kept): nothing to overlay
     }
@@ -316,6 +372,7 @@
       else { head.setAttribute("data-state", "silent"); setText($("state"), "not heard yet"); }
       trace = { key: -1, n: 0, x: [], y: [] };
       takeSamples({ benches: d.samples || {} });
+      labName = (d.lab && d.lab.name) || "";
       showDetail(d.detail || { bench: id, run: null, earlier: [] });
       setText($("connection"), "live");
     },
@@ -325,6 +382,29 @@
   });
 
   $("print").addEventListener("click", () => window.print());
+  // The plot as a PNG for the written report: white ground, the record line above it, the legend's
+  // names below (the canvas has the curves and axes; the legend is HTML).
+  $("png").addEventListener("click", () => {
+    if (!plot) return;
+    const src = plot.ctx.canvas, pad = 8, line = 22;
+    const names = Array.from($("legend").children).map((li) => li.textContent);
+    const out = document.createElement("canvas");
+    out.width = Math.max(src.width, 800);
+    out.height = src.height + 2 * line + pad * 3;
+    const c = out.getContext("2d");
+    c.fillStyle = "#fff";
+    c.fillRect(0, 0, out.width, out.height);
+    c.fillStyle = "#000";
+    c.font = "15px sans-serif";
+    c.fillText($("record").textContent || $("run-title").textContent, pad, pad + 14);
+    c.drawImage(src, 0, line + pad);
+    c.font = "13px sans-serif";
+    c.fillText(names.join("   ·   "), pad, line + 2 * pad + src.height + 14);
+    const a = el("a", { href: out.toDataURL("image/png"), download: `${id}-run${chosen ? chosen.number : (detail && detail.run ? detail.run.number : 0)}.png` });
+    document.body.append(a);
+    a.click();
+    a.remove();
+  });
   const resize = () => { if (plot) plot.setSize(plotSize(plotBox, 340)); if (residualPlot) residualPlot.setSize(plotSize(residualBox, 180)); };
   window.addEventListener("resize", resize);
   window.addEventListener("beforeprint", resize);

@@ -132,6 +132,12 @@ Json fit_summary_json(const fit_t& msg, bool lab_units) {
   j["end"] = msg.end;
   j["bench_source"] = msg.bench_source;
   j["samples"] = msg.samples;
+  // What the lab record prints: J and K_b the fit used and where they came from, and when.
+  j["inertia_kg_m2"] = json_number(msg.inertia_kg_m2);
+  j["kb_v_s_per_rad"] = json_number(msg.kb_v_s_per_rad);
+  j["inertia_source"] = msg.inertia_source;
+  j["kb_source"] = msg.kb_source;
+  j["unix_ms"] = msg.utime > 0 ? Json(msg.utime / 1000) : Json(nullptr);  // the FIT's time (the fitter's clock)
   return j;
 }
 

@@ -399,6 +399,7 @@ Json WebLab::lab_json(std::int64_t now_us) const {
   j["refused_messages"] = refused_;
   j["last_refused"] = last_refused_;
   j["lab_units"] = opt_.lab_units;
+  j["name"] = opt_.lab_name;
   return j;
 }
 

@@ -48,6 +48,7 @@ struct WebLabOptions {
   double preroll_s = 2.0;               // seconds before the cut a run's trace starts
   std::size_t lead_samples = 1000;      // samples kept between runs (for the next run's preroll)
   bool lab_units = true;                // coefficients' text in g·cm² units (SI otherwise)
+  std::string lab_name;                 // the lab's name (--lab), on the pages and the printed record
   bool signatures_checked = false;      // the messages passed a gate with the lab key (a signed fit is the lab's)
   std::vector<std::string> expected_benches;  // shown from the start (bench files), silent until heard
   bool is_valid(std::string* why) const;
