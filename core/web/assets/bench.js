@@ -159,10 +159,7 @@
     $("markers").replaceChildren(...markers);
     // The fit (a run chosen in the runs table keeps its own until "back to the live run").
     const fit = run ? run.fit : null;
-    if (!chosen) {
-      showFit(fit);
-      setText($("record"), recordText(run, fit));
-    }
+    if (!chosen) showLatestFit();
     // One legend entry per model the FIT carries.
     const legend = [el("li", {}, el("span", { class: "swatch" }), "readings")];
     if (run && run.curves) for (const m of run.curves.models) {
@@ -223,11 +220,29 @@
     $("best-reason").textContent = fit ? fit.best_reason : "";
     $("health-reason").textContent = fit && fit.health_reason ? `health: ${fit.health_reason}` : "";
   }
+  // The live run's fit; while it has none (it coasts), the bench's last whole run's, said so (as
+  // the room's tile shows it).
+  function showLatestFit() {
+    const run = detail && detail.run, fit = run ? run.fit : null;
+    const last = lastSummary && lastSummary.last_fit;
+    const shown = fit || (last && (!run || last.run !== run.number) ? last : null);
+    showFit(shown);
+    const earlier = !fit && shown && run;
+    setText($("fit-of"), earlier ? `of run ${shown.run}, the last whole run (run ${run.number} is ${run.state})` : "");
+    // The record is of the run whose numbers are shown; printed then, the page is that run's record
+    // (the live run's title, plot and state are not printed: spindown.css).
+    if (earlier) document.body.setAttribute("data-fit-of", String(shown.run));
+    else document.body.removeAttribute("data-fit-of");
+    for (const tr of $("runs").children) tr.classList.toggle("chosen", !!earlier && tr.getAttribute("data-run") === String(shown.run));
+    setText($("record"), earlier ? recordText({ number: shown.run }, shown) : recordText(run, fit));
+  }
   function choose(r) {
     chosen = r;
     document.body.setAttribute("data-chosen-run", String(r.number));
+    document.body.removeAttribute("data-fit-of");
     $("back-live").hidden = false;
     setText($("run-title"), `Run ${r.number}${r.partial ? " (partial: the cut was not seen)" : ""} · ${r.state} (chosen in this session's runs)`);
+    setText($("fit-of"), "");
     setText($("record"), recordText(r, r.fit));
     showFit(r.fit);
     for (const tr of $("runs").children) tr.classList.toggle("chosen", tr.getAttribute("data-run") === String(r.number));
@@ -308,7 +323,8 @@
         show = el("button", { type: "button", class: "show-run", "aria-label": `show run ${r.number} to print` }, `show run ${r.number}`);
         show.addEventListener("click", () => choose(r));
       }
-      const cls = [isCurrent ? "current" : "", chosen && chosen.number === r.number ? "chosen" : ""].join(" ").trim();
+      const printed = chosen ? chosen.number : Number(document.body.getAttribute("data-fit-of") || NaN);
+      const cls = [isCurrent ? "current" : "", printed === r.number ? "chosen" : ""].join(" ").trim();
       return el("tr", { "data-run": r.number, class: cls || null },
         el("td", {}, `${r.number}${r.partial ? " (partial)" : ""}`),
         el("td", {}, f ? f.best || "–" : r.state, why ? el("div", { class: "why-not-whole" }, why) : null),
@@ -344,7 +360,8 @@
   function showSummary(s) {
     if (s.id !== id) return;
     lastSummary = s;
-    setDoubts($("doubts"), detail && detail.run ? detail.run.fit : null, s);
+    if (chosen) setDoubts($("doubts"), chosen.fit, s);
+    else showLatestFit();
     head.setAttribute("data-state", s.state);
     setText($("state"), s.state);
     setBridge($("bridge"), s.bridge);
@@ -396,7 +413,9 @@
     c.fillRect(0, 0, out.width, out.height);
     c.fillStyle = "#000";
     c.font = "15px sans-serif";
-    c.fillText($("record").textContent || $("run-title").textContent, pad, pad + 14);
+    // the plot is the live run's unless a run was chosen: its title then, not the last whole run's record
+    const live = !chosen && document.body.hasAttribute("data-fit-of");
+    c.fillText(`${id} · ` + (live ? $("run-title").textContent : $("record").textContent || $("run-title").textContent), pad, pad + 14);
     c.drawImage(src, 0, line + pad);
     c.font = "13px sans-serif";
     c.fillText(names.join("   ·   "), pad, line + 2 * pad + src.height + 14);
