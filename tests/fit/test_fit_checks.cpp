@@ -213,3 +213,18 @@ TEST(FitChecks, UncertaintyOfJAndKbIsCarriedIntoTheCoefficients) {
   // Exact J and K_b (the default): nothing added.
   EXPECT_EQ(fit_of(make_case(SyntheticRunSpec{}), c.run.volts).model(ModelKind::combined)->param("c3")->bench_error, 0.0);
 }
+
+// Whole numbers in the thousands read as volts: a speed in rpm, or whole millivolts (a sketch
+// printing analogRead(A0) * 5000L / 1023): both are proposed, the user knows which.
+TEST(FitChecks, WholeNumbersInTheThousandsProposeRpmOrMillivolts) {
+  RunFit fit;
+  fit.quantity = Quantity::back_emf_volts;
+  fit.bench.kb_v_s_per_rad = 0.00809262;
+  const auto d = unit_doubts(fit, 3216.0, true);
+  ASSERT_EQ(d.size(), 1u);
+  EXPECT_NE(d[0].find("--value-unit rpm"), std::string::npos) << d[0];
+  EXPECT_NE(d[0].find("--value-unit mV if they are millivolts"), std::string::npos) << d[0];
+  const auto f = unit_doubts(fit, 3216.5, false);  // fractions: no whole millivolts
+  ASSERT_EQ(f.size(), 1u);
+  EXPECT_EQ(f[0].find("mV if"), std::string::npos) << f[0];
+}

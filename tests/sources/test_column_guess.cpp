@@ -46,6 +46,7 @@ TEST(ColumnGuess, TimeInSecondsAndTheSpeedOfADynoLog) {
   ASSERT_TRUE(p);
   EXPECT_NE(p->find("--time-column 2 --time-unit s --value-column 3"), std::string::npos) << *p;
   EXPECT_NE(p->find("--value-unit rpm"), std::string::npos) << *p;  // 2800 is no back-EMF in volts
+  EXPECT_NE(p->find("--value-unit mV if they are millivolts"), std::string::npos) << *p;  // or whole millivolts
 }
 
 TEST(ColumnGuess, MillisAndMicrosFromTheirSteps) {

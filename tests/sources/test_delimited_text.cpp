@@ -480,3 +480,21 @@ TEST(DelimitedText, AProposalCarriesTheValueUnitTheHeaderDoesNotGive) {
   const Recording r = read_delimited_text(text, "coolterm.csv", o);
   EXPECT_EQ(r.size(), 200u) << all_diagnostics(r);
 }
+
+// micros() as a CSV's whole-µs time column wraps at 2^32 µs (71.6 min after the board's reset):
+// unwrapped as the lab's millis() is, never taken for a reset. Seconds with fractions (a PC's
+// logger) never wrap.
+TEST(DelimitedText, MicrosWrappingInACsvIsUnwrapped) {
+  std::string text = "micros,volts\n";
+  const double wrap = 4294967296.0;
+  for (int k = 0; k < 200; ++k) {
+    const double t = std::fmod(wrap - 2'000'000.0 + 20'000.0 * k, wrap);
+    text += fmt::format("{:.0f},{:.3f}\n", t, 2.8 - 0.005 * k);
+  }
+  const Recording r = read_delimited_text(text, "micros.csv");
+  SCOPED_TRACE(all_diagnostics(r));
+  ASSERT_EQ(r.size(), 200u);
+  EXPECT_TRUE(r.clock_restarts.empty());
+  for (std::size_t i = 1; i < r.size(); ++i) ASSERT_NEAR(r.t_s[i] - r.t_s[i - 1], 0.02, 1e-9) << i;
+  EXPECT_TRUE(mentions(r, "wrapped"));
+}

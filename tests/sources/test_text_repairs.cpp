@@ -2,6 +2,7 @@
 // decimal comma, undone line for line, each said in a note; the lab's own text left alone.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <string>
 
 #include "spindown/arduino_text.hpp"
@@ -130,4 +131,23 @@ TEST(TextRepairs, SerialPlotterLabelsBecomeAHeader) {
   std::string labels, values;
   EXPECT_FALSE(plotter_labels("10:21:38.234 -> 2.64", &labels, &values));
   EXPECT_FALSE(plotter_labels("5234\t2.80", &labels, &values));
+}
+
+// LabVIEW's "Write to Measurement File" without X columns: the readings alone, their period in the
+// channel header (Delta_X). Each reading gets X0 + k·Delta_X; every line stays where it was.
+TEST(TextRepairs, ALabViewMeasurementFileGetsItsTimesFromItsHeader) {
+  std::string text =
+      "LabVIEW Measurement\t\r\nWriter_Version\t2\r\nSeparator\tTab\r\nDecimal_Separator\t.\r\nX_Columns\tNo\r\n"
+      "***End_of_Header***\t\r\n\t\r\nChannels\t1\t\r\nY_Unit_Label\tVolts\t\r\nX0\t0.0000000000000000E+0\t\r\n"
+      "Delta_X\t0.010000\t\r\n***End_of_Header***\t\r\nVoltage\tComment\r\n2.450000\t\r\n2.440000\t\r\n2.430000\t\r\n";
+  const std::size_t lines = std::count(text.begin(), text.end(), '\n');
+  ASSERT_TRUE(needs_text_repair(text));
+  const auto notes = repair_text(text);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("Delta_X 0.01 s"), std::string::npos) << notes[0];
+  EXPECT_EQ(std::size_t(std::count(text.begin(), text.end(), '\n')), lines);
+  EXPECT_NE(text.find("t_s\tVoltage_V\n0\t2.450000\n0.01\t2.440000\n0.02\t2.430000\n"), std::string::npos) << text;
+  // With a decimal comma it is left to the readers (which say why they cannot read it).
+  std::string comma = "LabVIEW Measurement\t\nDecimal_Separator\t,\n***End_of_Header***\t\nDelta_X\t0,01\n***End_of_Header***\t\nVoltage\n2,45\n";
+  EXPECT_TRUE(repair_text(comma).empty());
 }

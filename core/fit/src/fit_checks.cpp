@@ -54,8 +54,11 @@ std::vector<std::string> unit_doubts(const RunFit& fit, double peak, bool whole_
         // Whole numbers within a 10-bit converter's range: the sketch printed analogRead()'s counts
         // (its "* 5.0 / 1023" line left out), the likelier reading on a lab bench than a slow motor in rpm.
         const bool counts = whole_numbers && peak <= 1023;
-        const std::string rpm = fmt::format("a speed in rpm ({:.3g} V at {:.0f} rpm/V): try --value-unit rpm",
-                                            peak / rpm_per_volt, rpm_per_volt);
+        // Whole numbers up to tens of thousands may as well be whole millivolts (a sketch avoiding
+        // floats: analogRead(A0) * 5000L / 1023): both are said, the user knows which.
+        const std::string mv = whole_numbers && peak <= 50000 ? ", or --value-unit mV if they are millivolts" : "";
+        const std::string rpm = fmt::format("a speed in rpm ({:.3g} V at {:.0f} rpm/V): try --value-unit rpm{}",
+                                            peak / rpm_per_volt, rpm_per_volt, mv);
         out.push_back(fmt::format(
             "readings up to {:.6g} V: far beyond any back-EMF a lab bench makes or an Arduino pin reads (0–5 V){} — "
             "the numbers below are not the motor's friction",
@@ -64,7 +67,7 @@ std::vector<std::string> unit_doubts(const RunFit& fit, double peak, bool whole_
                                       "(the sketch's * 5.0 / 1023 left out): try --value-unit counts (x 5/1023 V)",
                                       peak)
             : looks_rpm ? "; they look like " + rpm
-                        : std::string("; check the value's unit (--value-unit V, rpm or rad/s)")));
+                        : std::string("; check the value's unit (--value-unit V, mV, rpm or rad/s)")));
         return out;
       }
       break;

@@ -203,10 +203,12 @@ std::optional<std::string> column_proposal(const ColumnGuess& g) {
   std::string s = fmt::format("column {} {} and column {} {}: try --time-column {} --time-unit {} --value-column {}",
                               g.time + 1, g.time_why, g.value + 1, g.value_why, g.time + 1, time_unit_name(g.time_unit),
                               g.value + 1);
+  // Readings up to tens of thousands are a speed, or a back-EMF printed in whole millivolts (a sketch
+  // avoiding floats: analogRead(A0) * 5000L / 1023): both are said, the user knows which.
   if (g.value_peak > 30)
     s += fmt::format(" --value-unit rpm (readings up to {:g} are no back-EMF in volts; --value-unit rad/s if they "
-                     "are rad/s)",
-                     g.value_peak);
+                     "are rad/s{})",
+                     g.value_peak, g.value_peak <= 50000 ? ", --value-unit mV if they are millivolts" : "");
   return s;
 }
 

@@ -592,7 +592,11 @@ void DelimitedReader::choose_time_unit_and_finish() {
   text::TimelineRules rules;
   rules.units_per_s = time_units_per_second(unit);
   rules.unit = time_unit_name(unit);
-  rules.wrap = 0;
+  // Whole ms or µs are a microcontroller's millis() or micros(): a 32-bit counter that wraps at 2^32
+  // (micros() every 71.6 min). A PC logger's times (fractions, seconds) do not wrap.
+  bool whole = !o_.period_ms && !scope_ && (unit == TimeUnit::ms || unit == TimeUnit::us) && raw_.size() > 0;
+  for (std::size_t i = 0; whole && i < std::min<std::size_t>(raw_.size(), 200); ++i) whole = raw_.t[i] == std::floor(raw_.t[i]);
+  rules.wrap = whole ? 4294967296.0 : 0;
   rules.reset_min_back = rules.units_per_s;
   rules.drop_cut_first = false;
   const text::TimelineCounts timeline = text::build_timeline(raw_, rules, rec_, *reporter_);

@@ -2,6 +2,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <fmt/format.h>
 
 #include "spindown/text_encoding.hpp"
@@ -221,7 +222,88 @@ bool plotter_labels(std::string_view line, std::string* labels, std::string* val
   return true;
 }
 
+namespace {
+
+// A LabVIEW Measurement file (.lvm, "Write to Measurement File"): a file header and a channel
+// header, each closed by ***End_of_Header***, then a line of column names and the rows. With
+// X_Columns No the rows hold the readings alone: their times are X0 + k·Delta_X (the channel
+// header's). The headers become blank lines, the names "t_s" and the channels' names with their
+// unit (Y_Unit_Label), and each row its time in s before its readings: every line stays where it
+// was. Empty: not such a file, or one it cannot read so (a decimal comma, no Delta_X).
+std::string lvm_note(std::string& text) {
+  if (!text.starts_with("LabVIEW Measurement")) return {};
+  std::vector<std::string_view> lines;
+  each_line(text, text.size(), [&](std::string_view line, std::size_t) { lines.push_back(line); });
+  const auto field = [](std::string_view line, std::size_t k) {  // tab-separated field k, trimmed
+    std::size_t at = 0;
+    for (std::size_t i = 0; i < k && at != std::string_view::npos; ++i) {
+      at = line.find('\t', at);
+      if (at != std::string_view::npos) ++at;
+    }
+    if (at == std::string_view::npos) return std::string_view{};
+    std::string_view f = line.substr(at, line.find('\t', at) - at);
+    while (!f.empty() && (f.back() == '\r' || f.back() == ' ')) f.remove_suffix(1);
+    return f;
+  };
+  std::size_t ends = 0, names = 0;
+  std::string x_columns = "One", decimal = ".", unit;
+  double x0 = 0, dx = 0;
+  for (std::size_t i = 0; i < lines.size() && ends < 2; ++i) {
+    const std::string_view key = field(lines[i], 0), value = field(lines[i], 1);
+    if (key.starts_with("***End_of_Header***")) {
+      if (++ends == 2) names = i + 1;
+    } else if (key == "X_Columns") {
+      x_columns = std::string(value);
+    } else if (key == "Decimal_Separator") {
+      decimal = std::string(value);
+    } else if (key == "Delta_X") {
+      dx = std::strtod(std::string(value).c_str(), nullptr);
+    } else if (key == "X0") {
+      x0 = std::strtod(std::string(value).c_str(), nullptr);
+    } else if (key == "Y_Unit_Label") {
+      unit = std::string(value);
+    }
+  }
+  if (ends < 2 || names >= lines.size() || decimal != ".") return {};
+  const bool no_x = x_columns == "No";
+  if (no_x && !(dx > 0)) return {};
+  const std::string suffix = unit == "Volts" || unit == "V" ? "_V" : unit == "mV" ? "_mV" : unit == "RPM" || unit == "rpm" ? "_rpm" : "";
+  std::string out;
+  out.reserve(text.size() + 16 * (lines.size() - names));
+  for (std::size_t i = 0; i < names; ++i) out += '\n';
+  // The column names: X_Value is the time; a trailing Comment column is no reading.
+  std::string head = no_x ? "t_s" : "";
+  for (std::size_t k = 0;; ++k) {
+    std::string_view f = field(lines[names], k);
+    if (f.empty() && k > 0) break;
+    if (f == "Comment") break;
+    if (!head.empty()) head += '\t';
+    head += f == "X_Value" ? std::string("t_s") : std::string(f) + (f.empty() ? "value" : "") + suffix;
+  }
+  out += head;
+  std::size_t rows = 0;
+  for (std::size_t i = names + 1; i < lines.size(); ++i) {
+    out += '\n';
+    std::string_view row = lines[i];
+    while (!row.empty() && (row.back() == '\r' || row.back() == '\t' || row.back() == ' ')) row.remove_suffix(1);
+    if (row.empty()) continue;
+    if (no_x) out += fmt::format("{:.9g}\t", x0 + double(rows) * dx);
+    out.append(row);
+    ++rows;
+  }
+  if (!text.empty() && text.back() == '\n') out += '\n';
+  text.swap(out);
+  return no_x ? fmt::format("a LabVIEW measurement file (.lvm) without a time column: each reading's time from its "
+                            "header, X0 {:g} s + k × Delta_X {:g} s ({} rows)",
+                            x0, dx, rows)
+              : fmt::format("a LabVIEW measurement file (.lvm): its headers skipped, X_Value read as the time in s ({} rows)",
+                            rows);
+}
+
+}  // namespace
+
 bool needs_text_repair(std::string_view text) {
+  if (text.starts_with("LabVIEW Measurement")) return true;
   if (needs_decoding(encoding_to_undo(text))) return true;
   const HeadCounts c = count_head(text);
   return bytes_literals_to_unwrap(c) || plotter_lines_to_unlabel(c) || timestamps_to_strip(c) || commas_to_read(c);
@@ -229,6 +311,7 @@ bool needs_text_repair(std::string_view text) {
 
 std::vector<std::string> repair_text(std::string& text) {
   std::vector<std::string> notes;
+  if (std::string note = lvm_note(text); !note.empty()) notes.push_back(std::move(note));
   if (const EncodingGuess g = encoding_to_undo(text); needs_decoding(g)) {
     text = decode_text(text, g);
     if (std::string note = decoding_note(g); !note.empty()) notes.push_back(std::move(note));
