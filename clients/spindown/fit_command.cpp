@@ -100,6 +100,8 @@ FileFit fit_file(const std::string& path, const FitPlan& plan) {
       if (r.count > 1) out.run_bench.push_back(!r.bench.empty() ? r.bench : r.recording.source);
       // A text file named by the roster or --bench-pattern: its runs carry that bench id too.
       else if (!out.lcm_log && !r.bench.empty()) out.run_bench.push_back(r.bench);
+      out.run_student.resize(out.runs.size());
+      out.run_student.push_back(r.recording.name_before(run.cut_index));
       if (fit.best.empty()) {
         std::string why;
         for (const auto& m : fit.models)

@@ -17,6 +17,7 @@
 
 #include "diagnostic_queries.hpp"
 #include "spindown/arduino_text.hpp"
+#include "spindown/text_support.hpp"
 #include "spindown/synthetic_run.hpp"
 
 using namespace spindown;
@@ -491,4 +492,27 @@ TEST(ArduinoText, MicrosInsteadOfMillisIsReadAsMicroseconds) {
   const Recording slow = read_arduino_text(cadence(5000, 100, 1000), "slow.log");
   ASSERT_EQ(slow.size(), 100u);
   EXPECT_NEAR(slow.t_s[1] - slow.t_s[0], 1.0, 1e-9);
+}
+
+// Names students write in a shared capture belong to the runs after them; garbled bytes, headers,
+// boot messages and readings are no names.
+TEST(ArduinoText, NamesWrittenBetweenTheSamplesAreKeptWithTheSampleAfterThem) {
+  using text::written_name;
+  EXPECT_EQ(written_name("Ben\r"), "Ben");
+  EXPECT_EQ(written_name("# Dmitri run 1"), "Dmitri");
+  EXPECT_EQ(written_name("--- Chloé, 2nd try ---"), "Chloé");
+  EXPECT_EQ(written_name("--- Chloe\xCC\x81 ---"), "Chloe\xCC\x81");  // decomposed, from a Mac's folder name
+  EXPECT_EQ(written_name("Jürgen;"), "Jürgen");
+  EXPECT_EQ(written_name("// Anna Lena Schmidt:"), "Anna Lena Schmidt");
+  for (const char* no : {"millis\tvolts", "Zeit [ms];Spannung [V]", "Ready", "5234\t2.80", "volts", "\xf9\xd2\x86\xb6\xf1",
+                         "ets Jun  8 2016 00:22:57", "x", "Time"})
+    EXPECT_FALSE(written_name(no)) << no;
+  const Recording r = read_arduino_text("0\t0.00\n20\t0.00\nBen\n40\t0.00\n60\t2.80\n# Chloé run 2\n80\t2.79\n", "names.txt");
+  ASSERT_EQ(r.names.size(), 2u);
+  EXPECT_EQ(r.names[0].name, "Ben");
+  EXPECT_EQ(r.names[0].line, 3);
+  EXPECT_EQ(r.name_before(3), "Ben");
+  EXPECT_EQ(r.name_before(4), "Chloé");
+  EXPECT_EQ(r.name_before(1), "");
+  EXPECT_EQ(with(r, Severity::warning).size(), 0u);  // said as notes, not garbled lines
 }

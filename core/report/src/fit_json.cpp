@@ -209,6 +209,7 @@ void write_file_fit(std::string& out, std::size_t indent, const FileFit& file, c
       w.key("health");
       write_health(w, *file.health[i]);
     }
+    if (i < file.run_student.size() && !file.run_student[i].empty()) w.member("student", file.run_student[i]);
     w.end_object();
   }
   w.end_array();

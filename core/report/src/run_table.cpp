@@ -34,7 +34,7 @@ std::vector<Column> row(const FileFit& file, std::size_t i) {
   r.reserve(40);
   r.push_back({"file", file.file});
   r.push_back({"bench", bench});
-  r.push_back({"student", file.student});
+  r.push_back({"student", i < file.run_student.size() && !file.run_student[i].empty() ? file.run_student[i] : file.student});
   r.push_back({"run", static_cast<long long>(run.number)});
   r.push_back({"t_cut_s", run.t_cut_s});
   r.push_back({"t_stop_s", run.stopped ? run.t_stop_s : none});

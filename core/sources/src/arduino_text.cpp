@@ -111,6 +111,13 @@ Recording read_arduino_text(std::string_view text, std::string source, const Ard
       continue;
     }
     if (parsed.kind == LabLine::Kind::garbled) {
+      if (auto name = text::written_name(line)) {
+        rec.names.push_back({raw.size(), *name, n});
+        rec.note(n, fmt::format("{}: a name written between the samples: the runs after it are {}'s",
+                                text::quote_line(line), *name));
+        first_content = false;
+        continue;
+      }
       if (first_content && is_column_header(line)) {
         ++column_headers;
         rec.note(n, fmt::format("column header {} skipped", text::quote_line(line)));

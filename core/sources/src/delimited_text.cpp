@@ -550,6 +550,12 @@ void DelimitedReader::read_rows() {
     const Line& line = content_[i];
     const DelimitedRowReader::Row row = rows_.read(line.text);
     if (!row.ok) {
+      if (auto name = text::written_name(line.text)) {
+        rec_.names.push_back({raw_.size(), *name, line.number});
+        rec_.note(line.number, fmt::format("{}: a name written between the samples: the runs after it are {}'s",
+                                           text::quote_line(line.text), *name));
+        continue;
+      }
       ++bad_;
       reporter_->warn(line.number, fmt::format("{}: {}; skipped", text::quote_line(line.text), row.why));
       continue;

@@ -404,3 +404,81 @@ std::string binary_data_error(std::string_view what, std::size_t control_bytes, 
 }
 
 }  // namespace spindown::text
+
+namespace spindown::text {
+
+std::optional<std::string> written_name(std::string_view line) {
+  const auto trim = [](std::string_view s, std::string_view chars) {
+    while (!s.empty() && chars.find(s.front()) != std::string_view::npos) s.remove_prefix(1);
+    while (!s.empty() && chars.find(s.back()) != std::string_view::npos) s.remove_suffix(1);
+    return s;
+  };
+  // Separators after it (a spreadsheet's empty cells), then a comment's or a heading's marks.
+  std::string_view s = trim(line, " \t\r;,");
+  s = trim(s, " #-=*/>:~");
+  if (s.empty() || s.size() > 60) return std::nullopt;
+  // A line with a field after a delimiter, brackets or a unit is a header or a table's row.
+  if (s.find_first_of("\t;[]()<>{}|\"=") != std::string_view::npos) return std::nullopt;
+  // A letter's length in bytes at i (0: none): ASCII letters, and in UTF-8 the Latin, Greek and
+  // Cyrillic letters and combining accents (a name from a Mac's folder is decomposed). Bytes that
+  // are no such letter (a garbled line's) make no name.
+  const auto letter = [&s](std::size_t i) -> std::size_t {
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    if ((c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z')) return 1;
+    if (c < 0xC2 || c > 0xE1 || i + 1 >= s.size()) return 0;
+    const unsigned char c1 = static_cast<unsigned char>(s[i + 1]);
+    if ((c1 & 0xC0) != 0x80) return 0;
+    if (c < 0xE0) {
+      const unsigned cp = ((c & 0x1Fu) << 6) | (c1 & 0x3Fu);
+      const bool latin = cp >= 0xC0 && cp <= 0x24F && cp != 0xD7 && cp != 0xF7;
+      return latin || (cp >= 0x300 && cp <= 0x36F) || (cp >= 0x370 && cp <= 0x4FF) ? 2 : 0;
+    }
+    if (i + 2 >= s.size() || (static_cast<unsigned char>(s[i + 2]) & 0xC0) != 0x80) return 0;
+    const unsigned cp = ((c & 0x0Fu) << 12) | ((c1 & 0x3Fu) << 6) | (static_cast<unsigned char>(s[i + 2]) & 0x3Fu);
+    return cp >= 0x1E00 && cp <= 0x1EFF ? 3 : 0;  // Latin Extended Additional (Vietnamese, Welsh)
+  };
+  const auto upper = [](unsigned char c) { return (c >= 'A' && c <= 'Z') || c >= 0x80; };
+  std::string name;
+  std::size_t words = 0, at = 0;
+  while (at < s.size() && words < 3) {
+    std::size_t end = at;
+    while (end < s.size()) {
+      if (s[end] == '-' || s[end] == '\'') {
+        ++end;
+      } else if (const std::size_t n = letter(end)) {
+        end += n;
+      } else {
+        break;
+      }
+    }
+    const std::string_view w = s.substr(at, end - at);
+    if (w.empty() || !upper(static_cast<unsigned char>(w.front()))) break;  // "run", "2nd", a number
+    (name += name.empty() ? "" : " ") += w;
+    ++words;
+    at = end;
+    if (at < s.size() && s[at] != ' ') break;  // ", 2nd try", ": run 1"
+    while (at < s.size() && s[at] == ' ') ++at;
+  }
+  if (words == 0 || name.size() < 2) return std::nullopt;
+  // The rest may say which run or try; never a number alone or a reading.
+  if (at < s.size()) {
+    const char c = s[at];
+    if (c != ',' && c != ':' && c != '-' && !(c >= 'a' && c <= 'z')) return std::nullopt;
+    for (std::size_t i = at; i < s.size(); ++i)  // and the rest is text, not bytes
+      if (static_cast<unsigned char>(s[i]) >= 0x80 && letter(i) == 0 && (static_cast<unsigned char>(s[i]) & 0xC0) != 0x80)
+        return std::nullopt;
+  }
+  // Words a device or a header prints, capitalised as names are.
+  static constexpr std::string_view not_names[] = {
+      "Time", "Zeit", "Voltage", "Volts", "Volt", "Spannung", "Millis", "Micros", "Speed", "Value", "Values",
+      "Sample", "Samples", "Channel", "Data", "Ready", "Start", "Starting", "Started", "Stop", "Reset", "Done",
+      "Begin", "End", "Motor", "Arduino", "Error", "Boot", "Hello", "Ok", "OK", "Go", "Run", "Test", "Comment",
+      "Rpm", "RPM", "Counts", "Current", "Strom", "Drehzahl", "Messung", "Measurement", "LabVIEW", "Spin",
+      "Power", "Coast", "Coasting", "Setup", "Loop", "Serial", "Waiting", "Connected", "Sketch", "Version"};
+  const std::string_view first = std::string_view(name).substr(0, name.find(' '));
+  for (const std::string_view n : not_names)
+    if (first == n) return std::nullopt;
+  return name;
+}
+
+}  // namespace spindown::text

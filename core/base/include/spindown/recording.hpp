@@ -30,6 +30,22 @@ struct Recording {
   // Indices where the device clock restarted (Arduino reset): a run never spans one.
   std::vector<std::size_t> clock_restarts;
   std::vector<Diagnostic> diagnostics;
+  // Names written between the samples (a student's name typed into the serial monitor and echoed,
+  // a comment "# Dmitri run 1", a spreadsheet row "Jürgen;"): each with the index of the first
+  // sample after it. A run belongs to the last name written before its cut.
+  struct Name {
+    std::size_t sample;
+    std::string name;
+    std::int64_t line;
+  };
+  std::vector<Name> names;
+  // The name written last before sample index i ("" when none).
+  std::string name_before(std::size_t i) const {
+    std::string out;
+    for (const Name& n : names)
+      if (n.sample <= i) out = n.name;
+    return out;
+  }
   std::size_t lines_read = 0;     // lines (or events) looked at
   std::size_t lines_skipped = 0;  // of those, not used as samples (blank, garbled, header…)
 

@@ -31,6 +31,7 @@ struct FileFit {
   // The bench each run is from (same order as runs) when the file is an LCM log of several
   // benches; empty for a file of one bench. JSON: "bench" -> "id"; text: a "-- bench" line.
   std::vector<std::string> run_bench;
+  std::vector<std::string> run_student;  // a name written in the file before each run's cut ("" none)
   bool lcm_log = false;  // what was read were LCM messages, not text lines
   // Motor health verdict per run (same order as runs) when a bench file was given; empty or
   // nullopt entries: not assessed (no "health" in JSON).

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cstring>
 #include <initializer_list>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -198,6 +199,13 @@ class RawSamples {
   std::vector<Block> blocks_;
   const char* text_end_;
 };
+
+// A person's name written on a line of its own between a recording's samples: a name typed into
+// the serial monitor's send box and echoed by the sketch ("Ben"), a comment ("# Dmitri run 1",
+// "--- Chloé, 2nd try ---", "// Ben"), a spreadsheet row of the name alone ("Jürgen;"). The name:
+// up to three capitalised words of letters (any script), before "run", a number or a comma. None
+// for a column header, a number, a boot message or a word a device prints ("Ready", "Start").
+std::optional<std::string> written_name(std::string_view line);
 
 struct TimelineRules {
   double units_per_s = 1000;      // 1000 for ms
