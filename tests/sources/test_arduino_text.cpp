@@ -515,4 +515,11 @@ TEST(ArduinoText, NamesWrittenBetweenTheSamplesAreKeptWithTheSampleAfterThem) {
   EXPECT_EQ(r.name_before(4), "Chloé");
   EXPECT_EQ(r.name_before(1), "");
   EXPECT_EQ(with(r, Severity::warning).size(), 0u);  // said as notes, not garbled lines
+  // A third column of whose run it is: every sample read, each new name kept where it starts.
+  const Recording c = read_arduino_text("0\t0.00\t\n20\t2.80\tŁukasz\n40\t2.79\tŁukasz\n60\t2.10\tZoë\n", "who.txt");
+  EXPECT_EQ(c.size(), 4u);
+  ASSERT_EQ(c.names.size(), 2u);
+  EXPECT_EQ(c.name_before(2), "Łukasz");
+  EXPECT_EQ(c.name_before(3), "Zoë");
+  EXPECT_EQ(with(c, Severity::warning).size(), 0u);
 }

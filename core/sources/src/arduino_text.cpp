@@ -111,6 +111,24 @@ Recording read_arduino_text(std::string_view text, std::string source, const Ard
       continue;
     }
     if (parsed.kind == LabLine::Kind::garbled) {
+      // A sketch that prints whose run it is as a third column (set from the serial monitor's
+      // send box): millis<TAB>volts<TAB>Łukasz. The sample is read; a new name is kept with it.
+      if (const std::size_t tab1 = line.find('\t'), tab2 = tab1 == std::string_view::npos ? tab1 : line.find('\t', tab1 + 1);
+          tab2 != std::string_view::npos) {
+        const LabLine head = parse_lab_line(line.substr(0, tab2));
+        const std::string_view tail = line.substr(tab2 + 1);
+        const auto name = text::written_name(tail);
+        if (head.kind == LabLine::Kind::sample && name) {
+          if (rec.names.empty() || rec.names.back().name != *name) {
+            rec.names.push_back({raw.size(), *name, n});
+            rec.note(n, fmt::format("{}: a name in a third column: the runs from here are {}'s", text::quote_line(line),
+                                    *name));
+          }
+          raw.add(n, line.data(), static_cast<double>(head.millis), head.value, session_start);
+          session_start = first_content = false;
+          continue;
+        }
+      }
       if (auto name = text::written_name(line)) {
         rec.names.push_back({raw.size(), *name, n});
         rec.note(n, fmt::format("{}: a name written between the samples: the runs after it are {}'s",
