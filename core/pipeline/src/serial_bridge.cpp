@@ -175,6 +175,7 @@ void SerialBridge::bad_line(std::string_view text, std::string_view why, std::in
 
 void SerialBridge::set_protocol(WireProtocol p, std::int64_t now_us) {
   if (p == protocol_) return;
+  if (!lab_held_.empty()) release_lab_held(now_us);  // the lab's samples so far, as millis()
   if (protocol_ != WireProtocol::unknown)
     error(fmt::format("{}: protocol changed from {} to {}", s_.device, wire_protocol_name(protocol_),
                       wire_protocol_name(p)),
@@ -182,6 +183,7 @@ void SerialBridge::set_protocol(WireProtocol p, std::int64_t now_us) {
   protocol_ = p;
   flush();  // a batch holds one protocol's samples
   clock_.set_tick_us(p == WireProtocol::lab ? 1000 : 1);  // millis() vs micros(); a new epoch
+  lab_clock_ = LabClock::unknown;  // the lab's columns: told by their first samples' step
   have_device_seq_ = false;
   next_config_us_ = now_us;  // the config changed: publish it with the next tick
 }
@@ -201,8 +203,60 @@ void SerialBridge::on_lab_line(std::string_view text, std::int64_t now_us) {
     held_.clear();  // a few lines of something else (a boot message) before the lab's lines
   good_line(now_us);
   set_protocol(WireProtocol::lab, now_us);
+  if (lab_clock_ != LabClock::known) [[unlikely]] {
+    lab_sample(static_cast<std::uint64_t>(l.millis), l.value, now_us);
+    return;
+  }
   const auto r = clock_.update(static_cast<std::uint64_t>(l.millis));
   add_sample(r, now_us, l.value, -1);
+}
+
+namespace {
+// The step between two counter readings, across a 32-bit wrap.
+std::uint64_t counter_step(std::uint64_t from, std::uint64_t to) { return (to - from) & 0xFFFF'FFFFull; }
+bool micros_step(std::uint64_t step) { return step >= 4000 && step <= 200000; }
+}  // namespace
+
+void SerialBridge::lab_sample(std::uint64_t ticks, double value, std::int64_t now_us) {
+  if (lab_clock_ == LabClock::unknown && lab_held_.empty() && ticks < 100'000'000) {
+    lab_clock_ = LabClock::provisional;  // millis(), published at once; the next sample checks it
+    lab_first_ticks_ = ticks;
+    add_sample(clock_.update(ticks), now_us, value, -1);
+    return;
+  }
+  if (lab_clock_ == LabClock::provisional) {
+    const std::uint64_t step = counter_step(lab_first_ticks_, ticks);
+    if (ticks > lab_first_ticks_ && step > 200000) {  // no clock's step forward: the first was a line cut
+                                                       // short ("96" of "…664"); told anew (back: a reset)
+      lab_clock_ = LabClock::unknown;
+      lab_held_.push_back({ticks, value, now_us});
+      return;
+    }
+    lab_clock_ = LabClock::known;
+    if (micros_step(step)) use_micros(double(step), now_us);  // the first sample stays in its own epoch
+    add_sample(clock_.update(ticks), now_us, value, -1);
+    return;
+  }
+  lab_held_.push_back({ticks, value, now_us});
+  const std::size_t n = lab_held_.size();
+  if (n < 2) return;
+  const std::uint64_t step = counter_step(lab_held_[n - 2].ticks, ticks);
+  if (micros_step(step)) use_micros(double(step), now_us);
+  if (step < 4000 || micros_step(step) || n >= 5) release_lab_held(now_us);
+}
+
+void SerialBridge::use_micros(double step, std::int64_t now_us) {
+  clock_.set_tick_us(1, 1ull << 32);  // micros() wraps at 2^32 µs
+  error(fmt::format("{}: the times step by ~{:.0f} from sample to sample: micros() (µs), not millis(); read as µs, "
+                    "as spindown fit reads them",
+                    s_.device, step),
+        now_us);
+}
+
+void SerialBridge::release_lab_held(std::int64_t) {
+  lab_clock_ = LabClock::known;
+  for (const HeldSample& h : lab_held_) add_sample(clock_.update(h.ticks), h.recv_us, h.value, -1);
+  lab_held_.clear();
 }
 
 namespace {
@@ -382,6 +436,8 @@ double SerialBridge::latency_quantile_us(double p) const {
 }
 
 void SerialBridge::tick(std::int64_t now_us) {
+  // A single sample of a large count and nothing for a second: millis() after a long uptime.
+  if (!lab_held_.empty() && now_us - lab_held_.front().recv_us >= 1'000'000) release_lab_held(now_us);
   if (now_us >= next_config_us_) {
     sink_.publish(make_config(now_us));
     next_config_us_ = now_us + static_cast<std::int64_t>(s_.config_interval_s * 1e6);

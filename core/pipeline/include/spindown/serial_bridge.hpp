@@ -128,6 +128,22 @@ class SerialBridge {
     std::int64_t recv_us, line_no;
   };
   std::vector<HeldLine> held_;                 // lines waiting for a layout (at most layout_lines)
+  // The lab's two columns from millis() or micros()? Told by the step between samples, as the file
+  // reader tells it (4000 to 200000 ticks: µs). A first sample below 10^8 ticks is taken as millis()
+  // at once (the usual sketch, no delay) and checked at the second; a larger one (micros() after
+  // 100 s, or millis() after 28 h) waits for the second sample, or a second.
+  enum class LabClock { unknown, provisional, known };
+  struct HeldSample {
+    std::uint64_t ticks;
+    double value;
+    std::int64_t recv_us;
+  };
+  LabClock lab_clock_ = LabClock::unknown;
+  std::uint64_t lab_first_ticks_ = 0;
+  std::vector<HeldSample> lab_held_;
+  void lab_sample(std::uint64_t ticks, double value, std::int64_t now_us);
+  void use_micros(double step, std::int64_t now_us);
+  void release_lab_held(std::int64_t now_us);
   std::optional<DelimitedRowReader> table_;    // the layout learned: every line is read by it
   std::int64_t table_tick_us_ = 1000;          // µs per device tick of the table's time column
   bool plotter_ = false;                       // the lines are the Serial Plotter's label:value pairs
