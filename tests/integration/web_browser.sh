@@ -28,23 +28,8 @@ LAB_WORK=$(mktemp -d /tmp/spindown-web-browser.XXXXXX)
 ART=${SPINDOWN_WEB_ARTIFACTS:-$LAB_BIN/../web-browser}
 NODE_MODULES=${SPINDOWN_NODE_MODULES:-/opt/spindown-test-node/node_modules}
 PY=${SPINDOWN_PYTHON:-/usr/bin/python3}
-source "$src/deploy/lab/lab.bash"
-cleanup() {
-  lab_stop_all
-  if [[ -z ${KEEP_WORK:-} ]]; then rm -rf "$LAB_WORK"; else echo "work dir kept: $LAB_WORK"; fi
-}
-trap cleanup EXIT
-fail() {
-  echo "FAIL: $*" >&2
-  for f in "$LAB_WORK"/*.err; do [[ -s $f ]] && { echo "--- $f" >&2; tail -8 "$f" >&2; }; done
-  exit 1
-}
+source "$src/tests/integration/browser_common.bash"
 
-chrome=$(command -v chromium || true)
-[[ -n $chrome ]] || fail "chromium is not installed (deploy/setup --tests installs it)"
-command -v node >/dev/null || fail "node is not installed (deploy/setup --tests installs nodejs)"
-[[ -f $NODE_MODULES/puppeteer-core/package.json ]] ||
-  fail "puppeteer-core is not in $NODE_MODULES (deploy/setup --tests installs it; SPINDOWN_NODE_MODULES names another place)"
 [[ -x $LAB_BIN/spindown-web ]] || fail "$LAB_BIN/spindown-web is missing"
 
 ip link set lo up

@@ -19,22 +19,7 @@ LAB_BIN=${SPINDOWN_BIN_DIR:?SPINDOWN_BIN_DIR not set}
 LAB_WORK=$(mktemp -d /tmp/spindown-web-room.XXXXXX)
 ART=${SPINDOWN_WEB_ARTIFACTS:-$LAB_BIN/../web-room}
 NODE_MODULES=${SPINDOWN_NODE_MODULES:-/opt/spindown-test-node/node_modules}
-source "$src/deploy/lab/lab.bash"
-cleanup() {
-  lab_stop_all
-  if [[ -z ${KEEP_WORK:-} ]]; then rm -rf "$LAB_WORK"; else echo "work dir kept: $LAB_WORK"; fi
-}
-trap cleanup EXIT
-fail() {
-  echo "FAIL: $*" >&2
-  for f in "$LAB_WORK"/*.err; do [[ -s $f ]] && { echo "--- $f" >&2; tail -8 "$f" >&2; }; done
-  exit 1
-}
-chrome=$(command -v chromium || true)
-[[ -n $chrome ]] || fail "chromium is not installed (deploy/setup --tests installs it)"
-command -v node >/dev/null || fail "node is not installed (deploy/setup --tests installs nodejs)"
-[[ -f $NODE_MODULES/puppeteer-core/package.json ]] ||
-  fail "puppeteer-core is not in $NODE_MODULES (deploy/setup --tests installs it)"
+source "$src/tests/integration/browser_common.bash"
 for b in spindown-web spindown-lcm-publish; do [[ -x $LAB_BIN/$b ]] || fail "$LAB_BIN/$b is missing"; done
 
 ip link set lo up

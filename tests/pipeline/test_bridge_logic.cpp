@@ -488,35 +488,32 @@ TEST(BridgeLogic, BrokenSpindownLinesAreNoTable) {
 // A sketch printing micros() instead of millis(): the bridge reads µs as spindown fit does (a step
 // of 4000-200000 ticks), across micros()'s wrap at 2^32 µs (71.6 min after reset).
 TEST(BridgeLogic, MicrosInTheLabsColumnsAreReadAsMicroseconds) {
-  CaptureSink sink;
-  SerialBridge b(settings(), sink);
-  start_connected(b);
-  std::string lines;
+  // The samples a newly plugged-in bridge publishes from lines, and its last error.
+  const auto published = [](const std::string& lines, std::string* error = nullptr) {
+    CaptureSink sink;
+    SerialBridge b(settings(), sink);
+    start_connected(b);
+    b.feed(lines, T0 + 10);
+    if (error) *error = b.last_error();
+    return sink.flat();
+  };
+  std::string lines, error;
   for (int k = 0; k < 6; ++k) lines += fmt::format("{}\t2.{:02d}\r\n", (4294927296ull + 20000ull * k) % 4294967296ull, 80 - k);
-  b.feed(lines, T0 + 10);
-  const auto f = sink.flat();
+  const auto f = published(lines, &error);
   ASSERT_EQ(f.size(), 6u);
   for (std::size_t i = 1; i < f.size(); ++i) {
     EXPECT_EQ(f[i].t_us - f[i - 1].t_us, 20'000) << i;  // µs, unwrapped: not 20 s
     EXPECT_EQ(f[i].epoch, f[0].epoch) << i;
   }
-  EXPECT_NE(b.last_error().find("micros()"), std::string::npos) << b.last_error();
+  EXPECT_NE(error.find("micros()"), std::string::npos) << error;
   // Right after a reset micros() reads small: taken for millis() at its first sample, told at the
   // second; the first stays alone in its epoch, the rest are µs.
-  CaptureSink early;
-  SerialBridge e(settings(), early);
-  start_connected(e);
-  e.feed("2000000\t0.00\r\n2020000\t0.00\r\n2040000\t0.00\r\n", T0 + 10);
-  const auto g = early.flat();
+  const auto g = published("2000000\t0.00\r\n2020000\t0.00\r\n2040000\t0.00\r\n");
   ASSERT_EQ(g.size(), 3u);
   EXPECT_NE(g[1].epoch, g[0].epoch);
   EXPECT_EQ(g[2].t_us - g[1].t_us, 20'000);
   // Joined mid-line: the first "sample" is the end of one ("96" of "4270987596"); the rest are µs.
-  CaptureSink joined;
-  SerialBridge j(settings(), joined);
-  start_connected(j);
-  j.feed("96\t0.00\r\n4270987664\t0.00\r\n4271008004\t0.00\r\n4271028356\t0.00\r\n", T0 + 10);
-  const auto h = joined.flat();
+  const auto h = published("96\t0.00\r\n4270987664\t0.00\r\n4271008004\t0.00\r\n4271028356\t0.00\r\n");
   ASSERT_EQ(h.size(), 4u);
   EXPECT_EQ(h[2].t_us - h[1].t_us, 20'340);
   EXPECT_EQ(h[3].t_us - h[2].t_us, 20'352);
