@@ -175,7 +175,7 @@ void SerialBridge::bad_line(std::string_view text, std::string_view why, std::in
 
 void SerialBridge::set_protocol(WireProtocol p, std::int64_t now_us) {
   if (p == protocol_) return;
-  if (!lab_held_.empty()) release_lab_held(now_us);  // the lab's samples so far, as millis()
+  if (!lab_held_.empty()) release_lab_held();  // the lab's samples so far, as millis()
   if (protocol_ != WireProtocol::unknown)
     error(fmt::format("{}: protocol changed from {} to {}", s_.device, wire_protocol_name(protocol_),
                       wire_protocol_name(p)),
@@ -242,7 +242,7 @@ void SerialBridge::lab_sample(std::uint64_t ticks, double value, std::int64_t no
   if (n < 2) return;
   const std::uint64_t step = counter_step(lab_held_[n - 2].ticks, ticks);
   if (micros_step(step)) use_micros(double(step), now_us);
-  if (step < 4000 || micros_step(step) || n >= 5) release_lab_held(now_us);
+  if (step < 4000 || micros_step(step) || n >= 5) release_lab_held();
 }
 
 void SerialBridge::use_micros(double step, std::int64_t now_us) {
@@ -253,7 +253,7 @@ void SerialBridge::use_micros(double step, std::int64_t now_us) {
         now_us);
 }
 
-void SerialBridge::release_lab_held(std::int64_t) {
+void SerialBridge::release_lab_held() {
   lab_clock_ = LabClock::known;
   for (const HeldSample& h : lab_held_) add_sample(clock_.update(h.ticks), h.recv_us, h.value, -1);
   lab_held_.clear();
@@ -437,7 +437,7 @@ double SerialBridge::latency_quantile_us(double p) const {
 
 void SerialBridge::tick(std::int64_t now_us) {
   // A single sample of a large count and nothing for a second: millis() after a long uptime.
-  if (!lab_held_.empty() && now_us - lab_held_.front().recv_us >= 1'000'000) release_lab_held(now_us);
+  if (!lab_held_.empty() && now_us - lab_held_.front().recv_us >= 1'000'000) release_lab_held();
   if (now_us >= next_config_us_) {
     sink_.publish(make_config(now_us));
     next_config_us_ = now_us + static_cast<std::int64_t>(s_.config_interval_s * 1e6);

@@ -307,7 +307,7 @@ std::string format_file_fit(const FileFit& file, const ReportOptions& opt) {
     if (i < file.run_bench.size() && (i == 0 || file.run_bench[i] != file.run_bench[i - 1]))
       out += fmt::format("\n-- bench {}\n", file.run_bench[i]);
     if (i < file.run_student.size() && !file.run_student[i].empty() &&
-        (i == 0 || i > file.run_student.size() || file.run_student[i] != file.run_student[i - 1]))
+        (i == 0 || file.run_student[i] != file.run_student[i - 1]))
       out += fmt::format("\n-- {} (the name written in the file before the run)\n", file.run_student[i]);
     out += '\n' + format_run_fit(file.runs[i], opt);
     if (i < file.health.size() && file.health[i]) out += format_health_verdict(*file.health[i]);

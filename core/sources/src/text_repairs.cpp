@@ -311,11 +311,11 @@ bool needs_text_repair(std::string_view text) {
 
 std::vector<std::string> repair_text(std::string& text) {
   std::vector<std::string> notes;
-  if (std::string note = lvm_note(text); !note.empty()) notes.push_back(std::move(note));
   if (const EncodingGuess g = encoding_to_undo(text); needs_decoding(g)) {
     text = decode_text(text, g);
     if (std::string note = decoding_note(g); !note.empty()) notes.push_back(std::move(note));
   }
+  if (std::string note = lvm_note(text); !note.empty()) notes.push_back(std::move(note));  // once decoded
   if (bytes_literals_to_unwrap(count_head(text))) {
     std::string content;
     const std::size_t unwrapped = rewrite_lines(text, [&](std::string_view line, std::string& out) {

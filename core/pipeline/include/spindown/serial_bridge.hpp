@@ -143,7 +143,7 @@ class SerialBridge {
   std::vector<HeldSample> lab_held_;
   void lab_sample(std::uint64_t ticks, double value, std::int64_t now_us);
   void use_micros(double step, std::int64_t now_us);
-  void release_lab_held(std::int64_t now_us);
+  void release_lab_held();
   std::optional<DelimitedRowReader> table_;    // the layout learned: every line is read by it
   std::int64_t table_tick_us_ = 1000;          // µs per device tick of the table's time column
   bool plotter_ = false;                       // the lines are the Serial Plotter's label:value pairs
