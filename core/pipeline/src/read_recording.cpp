@@ -175,10 +175,14 @@ void refuse_swapped_columns(std::string_view bytes, Recording& rec) {
 // Every reading negative (a differential probe's leads swapped, a motor turned the other way):
 // no coast rises from rest in it. Read as their magnitude, and said.
 void read_negative_as_magnitude(Recording& rec) {
+  // Counts, stopping as soon as the positive ones are too many for the negative ones ever to be
+  // twenty times as many (at once in a recording of the usual sign).
+  const std::size_t n = rec.value.size();
   std::size_t negative = 0, positive = 0;
-  for (const double v : rec.value) {  // counts only: the loop vectorizes
-    negative += v < 0;
-    positive += v > 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    negative += rec.value[i] < 0;
+    positive += rec.value[i] > 0;
+    if ((i & 63) == 63 && positive * 20 > negative + (n - 1 - i)) return;
   }
   if (negative < 20 || positive * 20 > negative) return;
   const double lowest = *std::min_element(rec.value.begin(), rec.value.end());

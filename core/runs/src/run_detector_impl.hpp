@@ -212,6 +212,12 @@ class RunDetector::Impl {
   // Every re-cut of the closed coast r (ending at sample end), in order (run_detector_recut.cpp):
   // the one place a cut moves after it was found.
   void recut_coast(Run& r, std::size_t end);
+  // The noise of the coast [c, coast_end) at every lag, the quieter (less wander) of its two
+  // halves' (an open pin's hum before a connection is in one of them only). Kept for the re-cuts of
+  // one recut_coast call, which ask it of the same coast (valid while coast_noise_for_ says so).
+  const LagNoise& coast_noise(std::size_t c, std::size_t coast_end);
+  LagNoise coast_noise_;
+  std::size_t coast_noise_for_[2] = {0, 0};  // its c and coast_end; {0, 0}: none kept
   // A coast never rises: when the reading rose inside r's coast [cut, coast_end) by far more than its
   // noise, what came before the rise was no part of it (an open pin's swing before it was connected,
   // a coast the power came back on unseen). r then starts at the last such rise, with a warning.

@@ -30,6 +30,7 @@ using namespace detector_tuning;
 void RunDetector::Impl::recut_coast(Run& r, std::size_t end) {
   if (!not_coast_.empty() || fragment_) return;
   const std::size_t coast_end = r.stopped ? r.stop_index : end;
+  coast_noise_for_[0] = coast_noise_for_[1] = 0;  // the store has changed since any kept
   recut_after_rise(r, coast_end);
   if (!not_coast_.empty() || fragment_) return;
   recut_after_return(r, coast_end);
@@ -37,6 +38,16 @@ void RunDetector::Impl::recut_coast(Run& r, std::size_t end) {
   recut_at_level_end(r, coast_end);
   if (!not_coast_.empty() || fragment_) return;
   recut_after_dwell(r, r.stopped ? r.stop_index : end);
+}
+
+const LagNoise& RunDetector::Impl::coast_noise(std::size_t c, std::size_t coast_end) {
+  if (coast_noise_for_[0] != c || coast_noise_for_[1] != coast_end || coast_end == 0) {
+    const std::size_t mid = c + (coast_end - c) / 2;
+    const LagNoise early = noise_over(store_, c, mid), late = noise_over(store_, mid, coast_end);
+    coast_noise_ = early.wander < late.wander ? early : late;
+    coast_noise_for_[0] = c, coast_noise_for_[1] = coast_end;
+  }
+  return coast_noise_;
 }
 
 void RunDetector::Impl::recut_after_rise(Run& r, std::size_t coast_end) {
@@ -99,11 +110,11 @@ void RunDetector::Impl::recut_after_rise(Run& r, std::size_t coast_end) {
   // connection is in one of them only), a rise or a step is evidence only when the level over a
   // whole ripple after it stands apart from the level over a whole ripple before it, by more than
   // those means' own noise allows.
-  const std::size_t mid = c + (coast_end - c) / 2;
-  const LagNoise early = noise_over(store_, c, mid), late = noise_over(store_, mid, coast_end);
-  const LagNoise& noise = early.wander < late.wander ? early : late;
-  // (After a floating lead-in the hum may go on past the cut found: a rise there is the connection.)
-  if (noise.wander > 2.0 * noise.white && r.lead_in != "floating") {
+  // (After a floating lead-in the hum may go on past the cut found: a rise there is the connection,
+  // and the coast's noise is not asked.)
+  const LagNoise* noise_p = r.lead_in != "floating" ? &coast_noise(c, coast_end) : nullptr;
+  if (noise_p && noise_p->wander > 2.0 * noise_p->white) {
+    const LagNoise& noise = *noise_p;
     const std::size_t len = std::max<std::size_t>(5, 2 * noise.wander_lag);
     if (rise < c + len || rise + len > coast_end) return;
     double before = 0, after = 0;
@@ -184,7 +195,16 @@ void RunDetector::Impl::recut_after_return(Run& r, std::size_t coast_end) {
   // level - 3 se, so above level - 0.3 lost, and se is at least a sixth of the reading's step.
   std::size_t back = 0;
   double at_level = 0, lost = 0, level = 0;
-  double* prefix = nullptr;  // sums of the readings [from, from + j), j = 0 … coast_end - from
+  // The highest reading of each block of 64 from `from` (block_v[b]: readings from + 64 b …), and
+  // the highest over the blocks that hold the readings [from + lo, from + hi): a bound on the mean
+  // of any window there. (Times only grow in the store: a clock going back restarts it.)
+  constexpr std::size_t block = 64;
+  double* block_v = nullptr;
+  const auto block_max = [&](std::size_t lo, std::size_t hi) {
+    double x = block_v[lo / block];
+    for (std::size_t i = lo / block + 1; i <= (hi - 1) / block; ++i) x = std::max(x, block_v[i]);
+    return x;
+  };
   const auto scan = [&](std::size_t len, double se) {
     back = 0;
     if (coast_end < from + 4 * len) return;
@@ -205,16 +225,33 @@ void RunDetector::Impl::recut_after_return(Run& r, std::size_t coast_end) {
     const double span_s = 0.5 * (t(coast_end - len) + t(coast_end - 1)) - r.t_cut_s;
     if (!(span_s > 0)) return;
     const double least_rate = 0.25 * std::max(level - last, 0.0) / span_s;
-    if (se == 0) {  // the same test from the prefix sums, with a margin for their rounding
-      const Sample* ring = store_.data();
-      const std::size_t mask = store_.mask();
-      const double t_from = t(from), n = double(len), rate = 0.5 * least_rate, least = 10.0 * coast_step_ / 6.0;
-      const double margin = 1e-9 * n * (std::abs(level) + std::abs(v0_));
-      for (std::size_t k = from; k + len <= coast_end; ++k) {
-        const double should = rate * (ring[k & mask].t + ring[(k + len - 1) & mask].t) - least_rate * t_from;
-        if (prefix[k + len - from] - prefix[k - from] + margin >= n * (level - 0.3 * should) && should > least) {
-          back = k + len;
-          return;
+    if (se == 0) {  // the same test, rearranged, with a margin for the rounding of sums
+      // With s = t(k) + t(k + len - 1) and the window's sum: should = rate·s − least_rate·t(from),
+      // so "sum ≥ n (level − 0.3 should) and should > least" is "sum + 0.3 n rate s ≥ K and s > S",
+      // K and S the same for every window.
+      const double n = double(len), rate = 0.5 * least_rate, least = 10.0 * coast_step_ / 6.0;
+      if (!(rate > 0)) return;
+      const double c0 = least_rate * t(from), kappa = 0.3 * n * rate;
+      const double margin = 1e-9 * n * (std::abs(level) + std::abs(v0_) + std::abs(kappa * t(coast_end - 1)));
+      const double K = n * level + 0.3 * n * c0 - margin, S = (least + c0) / rate;
+      const double S_low = S - 1e-12 * std::abs(S);
+      // Windows a block at a time: none in a block passes when even its highest reading, as every
+      // reading of a window, and its latest times fall short (most of a coast, far below its level).
+      const std::size_t m = coast_end - from;
+      for (std::size_t j0 = 0; j0 + len <= m; j0 += block) {
+        const std::size_t j1 = std::min(j0 + block, m - len + 1);  // the windows [from + j, from + j + len), j0 ≤ j < j1
+        const double s_hi = t(from + j1 - 1) + t(from + j1 + len - 2);
+        if (!(s_hi > S_low) || n * block_max(j0, j1 + len - 1) + kappa * s_hi + margin < K) continue;
+        double sum_j = 0;
+        for (std::size_t k = from + j0; k < from + j0 + len; ++k) sum_j += v(k);
+        for (std::size_t k = from + j0;; ++k) {  // the window [k, k + len)
+          const double s_k = t(k) + t(k + len - 1);
+          if (sum_j + kappa * s_k >= K && s_k > S_low) {
+            back = k + len;
+            return;
+          }
+          if (k + 1 >= from + j1) break;
+          sum_j += v(k + len) - v(k);
         }
       }
       return;
@@ -240,9 +277,12 @@ void RunDetector::Impl::recut_after_return(Run& r, std::size_t coast_end) {
   const std::size_t mid = c + (coast_end - c) / 2;
   const std::size_t max_len = 2 * std::max(noise_max_lag(store_, c, mid), noise_max_lag(store_, mid, coast_end));
   if (coast_end < from + 20) return;
-  prefix = scratch(coast_end - from + 1);
-  prefix[0] = 0;
-  for (std::size_t k = from; k < coast_end; ++k) prefix[k + 1 - from] = prefix[k - from] + v(k);
+  block_v = scratch((coast_end - from + block - 1) / block);
+  for (std::size_t b = 0, k = from; k < coast_end; ++b) {
+    double x = v(k);
+    for (const std::size_t e = std::min(k + block, coast_end); ++k < e;) x = std::max(x, v(k));
+    block_v[b] = x;
+  }
   bool could = false;
   for (std::size_t len = 5; len <= std::max<std::size_t>(max_len, 5) && !could; len = len == 5 ? 8 : 2 * len) {
     scan(len, 0.0);
@@ -250,8 +290,7 @@ void RunDetector::Impl::recut_after_return(Run& r, std::size_t coast_end) {
   }
   if (!could) return;
   // The means' noise (or a sixth of the print's step: a level read in whole steps is known no better).
-  const LagNoise early = noise_over(store_, c, mid), late = noise_over(store_, mid, coast_end);
-  const LagNoise& noise = early.wander < late.wander ? early : late;
+  const LagNoise& noise = coast_noise(c, coast_end);
   const bool rippled = noise.wander > 2.0 * noise.white;
   const std::size_t len = rippled ? std::max<std::size_t>(5, 2 * noise.wander_lag) : 5;
   if (coast_end < c + 4 * len) return;

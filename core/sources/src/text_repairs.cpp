@@ -305,6 +305,16 @@ std::string lvm_note(std::string& text) {
 bool needs_text_repair(std::string_view text) {
   if (text.starts_with("LabVIEW Measurement")) return true;
   if (needs_decoding(encoding_to_undo(text))) return true;
+  // Each repair needs at least three lines of its kind in the head (five for the decimal commas),
+  // each with a ':' (a timestamp, a plotter's label), a ',' or a quote (a bytes literal): a head
+  // with fewer of those characters needs none, known without reading it line by line.
+  const std::string_view head = text.substr(0, text.size() > head_bytes ? text.find('\n', head_bytes) : text.size());
+  const auto has = [&](char ch, std::size_t n) {  // memchr's pace: most heads have none at all
+    for (std::size_t at = head.find(ch); at != std::string_view::npos; at = head.find(ch, at + 1))
+      if (--n == 0) return true;
+    return false;
+  };
+  if (!has(':', 3) && !has(',', 5) && !has('\'', 3) && !has('"', 3)) return false;
   const HeadCounts c = count_head(text);
   return bytes_literals_to_unwrap(c) || plotter_lines_to_unlabel(c) || timestamps_to_strip(c) || commas_to_read(c);
 }
