@@ -159,14 +159,34 @@ async function waitFor(what, cond, seconds) {
       if (await coasting()) {
         ok(await canvasInk(bench, "[data-plot] canvas") > 500, "the live plot's canvas has the readings drawn while it coasts");
         await bench.screenshot({ path: path.join(out, "bench-coasting.png") });
+        // Paused, the plot keeps what it showed while the readings go on arriving; resumed, it catches up.
+        const view = () => bench.$eval("[data-plot]", (p) => ({ view: p.getAttribute("data-view"), drawn: Number(p.getAttribute("data-drawn")),
+                                                               points: Number(p.getAttribute("data-points")) }));
+        await bench.click("#pause");
+        const p0 = await view();
+        await sleep(1200);
+        const p1 = await view();
+        ok(p0.view === "paused" && p1.drawn === p0.drawn && p1.points > p0.points,
+           `paused, the live plot held ${p0.drawn} readings while ${p1.points - p0.points} more arrived`);
+        await bench.click("#pause");
+        const caught = await waitFor("the plot caught up after resume", async () => { const v = await view(); return v.view === "live" && v.drawn >= p1.points; }, 5);
+        if (caught) ok(true, "resumed, the plot caught up with the readings");
       }
     }
     // Its first fit: the curves, the markers, the residuals, the explain story.
     await waitFor(`${coaster}'s first fit on its page`, () => bench.$$eval("[data-curve]", (c) => c.length === 3), 90);
     await waitFor(`${coaster}'s cut and stop marked`, () => bench.$$eval("[data-marker]", (m) => m.map((x) => x.getAttribute("data-marker")).join() === "cut,stop"), 5);
-    await waitFor(`${coaster}'s explain story`, () => bench.$eval("#explain-final", (e) => /RMSE|noise/.test(e.textContent)), 20);
-    ok(await bench.$$eval("[data-explain-step]", (s) => s.length === 1 && /coulomb/.test(s[0].textContent)),
+    await waitFor(`${coaster}'s explain story`, () => bench.$eval("#explain-final", (e) => /missing by|noise/.test(e.textContent)), 20);
+    ok(await bench.$$eval("[data-explain-step]", (s) => s.length === 1 && s[0].getAttribute("data-explain-step") === "coulomb"),
        `the explain story: one step, adding coulomb (the virtual bench's friction is viscous + Coulomb, the base viscous)`);
+    // … told in a student's words: what was added, how much closer the model came, where it missed;
+    // the statistics (ΔBIC, n_eff) only behind "the statistics".
+    const words = await bench.$eval("[data-explain-step] .step-words", (e) => e.textContent);
+    const where = words.match(/from (-?[\d.]+) to (-?[\d.]+) s after the cut/);
+    const coastS = await bench.$eval('[data-marker="stop"]', (e) => parseFloat(e.textContent.match(/\(([\d.]+) s after/)[1]));
+    ok(/Adding dry \(Coulomb\) friction/.test(words) && /× closer/.test(words) && where && +where[1] >= -0.5 && +where[2] <= coastS + 5 &&
+       !/BIC|n_eff/.test(words),
+       `the step in words: "${words.slice(0, 160)}…"`);
     const fitView = await bench.evaluate(() => ({
       c3: document.querySelector('[data-field="c3"]').textContent, c3si: document.querySelector('[data-field="c3"]').getAttribute("data-si"),
       c4: document.querySelector('[data-field="c4"]').textContent, c4si: document.querySelector('[data-field="c4"]').getAttribute("data-si"),
@@ -199,6 +219,45 @@ async function waitFor(what, cond, seconds) {
     ok(rows[0] === "t_s,value" && rows.length - 1 === fitView.points && rows.slice(1).every((r) => /^[-0-9.e]+,[-0-9.e]+$/.test(r)),
        `the run's CSV: header and ${rows.length - 1} rows (the plot counts ${fitView.points})`);
     await bench.screenshot({ path: path.join(out, "bench-fitted.png"), fullPage: true });
+    // The residuals on a scale with numbers: in mV (a few mV off), several ticks, symmetric about 0.
+    const resAxis = await bench.$eval("[data-residuals]", (r) => ({ ticks: (r.getAttribute("data-y-ticks") || "").split(",").filter((x) => x !== "").map(Number),
+                                                                     label: r.getAttribute("data-unit") }));
+    ok(resAxis.ticks.length >= 3 && resAxis.ticks.some((t) => t < 0) && resAxis.ticks.some((t) => t > 0) && /mV/.test(resAxis.label),
+       `the residual plot's scale: ticks ${resAxis.ticks.join(", ")} mV`);
+    // Zoom: a box dragged on the plot narrows both axes; a double-click shows the whole run again.
+    // Paused first, so that the bench's next run (it goes on) does not replace what is zoomed.
+    await bench.click("#pause");
+    const range = () => bench.$eval("[data-plot]", (p) => ({ view: p.getAttribute("data-view"), zoomed: p.getAttribute("data-zoomed") === "true", x: p.getAttribute("data-x").split(",").map(Number),
+                                                             y: p.getAttribute("data-y").split(",").map(Number) }));
+    const whole = await range();
+    const over = await bench.$eval("[data-plot] .u-over", (o) => { const b = o.getBoundingClientRect(); return { x: b.x, y: b.y, w: b.width, h: b.height }; });
+    await bench.mouse.move(over.x + 0.3 * over.w, over.y + 0.2 * over.h);
+    await bench.mouse.down();
+    await bench.mouse.move(over.x + 0.5 * over.w, over.y + 0.5 * over.h, { steps: 8 });
+    await bench.mouse.move(over.x + 0.6 * over.w, over.y + 0.7 * over.h, { steps: 8 });
+    await bench.mouse.up();
+    await sleep(300);
+    const zoomedIn = await range();
+    ok(zoomedIn.zoomed && zoomedIn.x[1] - zoomedIn.x[0] < 0.5 * (whole.x[1] - whole.x[0]) &&
+       zoomedIn.y[1] - zoomedIn.y[0] < 0.7 * (whole.y[1] - whole.y[0]),
+       `a box dragged zooms both axes: x ${whole.x.map((v) => v.toFixed(1))} → ${zoomedIn.x.map((v) => v.toFixed(1))}, ` +
+       `y ${whole.y.map((v) => v.toFixed(2))} → ${zoomedIn.y.map((v) => v.toFixed(2))}`);
+    await sleep(1000);  // readings arriving meanwhile keep the view
+    ok((await range()).x[0] === zoomedIn.x[0], "the zoomed view stays while readings arrive");
+    await bench.mouse.click(over.x + 0.5 * over.w, over.y + 0.5 * over.h, { clickCount: 2 });
+    await sleep(300);
+    const back = await range();
+    ok(!back.zoomed && back.x[1] - back.x[0] >= 0.9 * (whole.x[1] - whole.x[0]), `double-click: the whole run again (x ${back.x.map((v) => v.toFixed(1))})`);
+    await bench.click("#pause");
+    // The units toggle: SI on a click (the same number, data-si unchanged), the lab's units back on the next.
+    const c3Lab = await bench.$eval('[data-field="c3"]', (e) => [e.textContent, e.getAttribute("data-si")]);
+    await bench.click("#units");
+    const c3Si = await bench.$eval('[data-field="c3"]', (e) => [e.textContent, e.getAttribute("data-si")]);
+    const siText = await bench.$eval("#explain-final", (e) => e.textContent);
+    ok(/N·m/.test(c3Si[0]) && !/g·cm/.test(c3Si[0]) && c3Si[1] === c3Lab[1] && !/g·cm/.test(siText),
+       `units toggle: c3 "${c3Lab[0]}" → "${c3Si[0]}" (explain's numbers too)`);
+    await bench.click("#units");
+    ok((await bench.$eval('[data-field="c3"]', (e) => e.textContent)) === c3Lab[0], "units toggle back: the lab's units again");
 
     // The coaster's last run fitted, with the earlier ones in its table (the README's picture).
     if (await waitFor(`${coaster}'s run ${runs[coaster]} fitted on its page`, () => bench.$eval('[data-field="c3"]',
@@ -222,7 +281,7 @@ async function waitFor(what, cond, seconds) {
       // The other benches ran on meanwhile: a moment when only the one whose bench ended was silent.
       // (Another bench may be silent for its own reason at the same moment, e.g. its cable pulled
       // while the machine is loaded; it comes back, and then the ended bench is silent alone.)
-      const alone = (r) => r.tiles.every(([id, state]) => (id === args.silent) === (state === "silent"));
+      const alone = (r) => r.tiles.length === benches.length && r.tiles.every(([id, state]) => (id === args.silent) === (state === "silent"));
       if (await waitFor(`${args.silent}'s tile silent alone while the others run (timeline: ${args.silent} silent first with ` +
                         JSON.stringify(((await seenOnRoom(([id, state]) => id === args.silent && state === "silent")) || {}).tiles) + ")",
                         async () => (await room.evaluate(() => window.__timeline)).some(alone), 30)) {

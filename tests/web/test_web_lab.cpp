@@ -62,6 +62,13 @@ TEST(WebLab, TheFitOnThePageIsTheFitMessagesOwnNumbers) {
   EXPECT_NE(c4_text.find("±"), std::string::npos) << c4_text;
   EXPECT_NE(c4_text.find("g·cm²·rad·s⁻²"), std::string::npos) << c4_text;
   EXPECT_NEAR(std::stod(c4_text), f2["c4"]["value"].get<double>() * 1e7, 0.01 * 1139) << c4_text;
+  // Both texts, for the page's units toggle: the lab's (g·cm²…) and SI's, the same number.
+  const std::string c4_lab = f2["c4"]["text_lab"], c4_si = f2["c4"]["text_si"];
+  EXPECT_EQ(c4_lab, c4_text);
+  EXPECT_NE(c4_si.find("N·m"), std::string::npos) << c4_si;
+  EXPECT_EQ(c4_si.find("g·cm"), std::string::npos) << c4_si;
+  EXPECT_NEAR(std::stod(c4_si.substr(c4_si.find_first_of("0123456789"))), f2["c4"]["value"].get<double>() * 1e4, 0.01 * 1.139)
+      << c4_si;
   EXPECT_EQ(f2["health"], "not judged");  // no bench file: never "ok"
   // What the printed lab record needs: J and K_b the fit used, where they came from, and when.
   EXPECT_EQ(f2["inertia_kg_m2"].get<double>(), r.fit.inertia_kg_m2);

@@ -94,26 +94,47 @@
     g.restore();
   }
 
+  // Zoom: drag a box (both axes), or along one axis; double-click or "whole run" shows all again.
+  // A zoomed or paused plot keeps its view while readings arrive (they are kept, and shown on resume).
+  let zoomed = false, paused = false, rebuildWanted = false;
+  function showView() {
+    $("zoom-reset").hidden = !zoomed;
+    $("pause").textContent = paused ? "Resume the live plot" : "Pause the live plot";
+    $("pause").setAttribute("aria-pressed", paused ? "true" : "false");
+    plotBox.setAttribute("data-view", paused ? "paused" : "live");
+    plotBox.setAttribute("data-zoomed", zoomed ? "true" : "false");
+  }
   function rebuildPlot() {
     if (typeof uPlot === "undefined") return;
     if (plot) plot.destroy();
     const unit = (detail && detail.unit) || "V";
+    zoomed = false;
+    showView();
     plot = new uPlot({
       ...plotSize(plotBox, 340),
       series: series(),
       scales: { x: { time: false } },
-      axes: [{ label: "s after the cut" }, { label: unit }],
+      // The unit in words beside the axis: a rotated "V" alone reads as ">".
+      axes: [{ label: "s after the cut" }, { label: `reading (${unit})`, size: 60 }],
       legend: { show: false },
-      cursor: { drag: { x: true, y: false } },
-      hooks: { draw: [drawMarkers] },
+      cursor: { drag: { x: true, y: true, uni: 40 } },
+      hooks: {
+        draw: [drawMarkers],
+        setSelect: [(u) => { if (u.select.width > 0 || u.select.height > 0) { zoomed = true; showView(); } }],
+        // The view's ranges, for a reader of the page (and its tests): data-x, data-y "min,max".
+        setScale: [(u, key) => { if (key === "x" || key === "y") plotBox.setAttribute(`data-${key}`, `${u.scales[key].min},${u.scales[key].max}`); }],
+      },
     }, plotData(), plotBox);
+    plot.over.addEventListener("dblclick", () => { zoomed = false; showView(); dirty = true; });
   }
 
   function redraw() {
     dirty = false;
     plotBox.setAttribute("data-points", String(trace.n));
-    if (!plot || plot.series.length !== series().length) rebuildPlot();
-    else plot.setData(plotData());
+    if (paused) { /* the view stays as it was: a new run, its curves and readings show on resume */ }
+    else if (!plot || plot.series.length !== series().length) rebuildPlot();
+    else plot.setData(plotData(), !zoomed);
+    if (!paused) plotBox.setAttribute("data-drawn", String(trace.n));  // the readings the plot shows
   }
 
   // ---- residuals ---------------------------------------------------------------------------
@@ -123,14 +144,23 @@
     setText($("residuals-title"), r ? `of the ${r.model} model, ${r.unit} (reading noise σ ${r.noise === null ? "?" : r.noise.toPrecision(2)} ${r.unit})` : "after the fit");
     residualBox.setAttribute("data-count", r ? String(r.points.length) : "0");
     if (!r || typeof uPlot === "undefined") return;
-    const x = r.points.map((p) => p[0]), y = r.points.map((p) => p[1]);
+    // In mV when the residuals are volts under a tenth of one (the usual: a few mV), so that the
+    // ticks read as numbers; the scale symmetric about 0, at least ±3 σ of the reading's noise.
+    const milli = r.unit === "V" && r.points.every((p) => Math.abs(p[1]) < 0.1);
+    const k = milli ? 1000 : 1, unit = milli ? "mV" : r.unit;
+    const x = r.points.map((p) => p[0]), y = r.points.map((p) => p[1] * k);
+    const reach = Math.max(...y.map(Math.abs), 3 * (r.noise || 0) * k) * 1.1 || 1;
+    residualBox.setAttribute("data-range", String(reach));
+    residualBox.setAttribute("data-unit", unit);
     residualPlot = new uPlot({
-      ...plotSize(residualBox, 180),
+      ...plotSize(residualBox, 200),
       series: [{ label: "s" }, { label: "residual", stroke: colors[r.model] || "#1f77b4", width: 0, paths: () => null,
                                   points: { show: true, size: 2.5, fill: colors[r.model] || "#1f77b4" } },
                { label: "0", stroke: "#888", width: 1 }],
-      scales: { x: { time: false } },
-      axes: [{ label: "s after the cut" }, { label: r.unit }],
+      scales: { x: { time: false }, y: { range: () => [-reach, reach] } },
+      axes: [{ label: "s after the cut" },
+             { label: `residual (${unit})`, size: 56, space: 18,
+               values: (u, splits) => { residualBox.setAttribute("data-y-ticks", splits.join()); return splits.map((v) => String(+v.toPrecision(3))); } }],
       legend: { show: false },
     }, [x, y, x.map(() => 0)], residualBox);
   }
@@ -188,7 +218,8 @@
     // The plots in a task of their own: the numbers, curves' legend and markers show at once.
     setTimeout(() => {
       showResiduals();
-      if (newRun) rebuildPlot();
+      if (newRun && !paused) rebuildPlot();
+      else if (newRun) rebuildWanted = true;
       dirty = true;
     }, 0);
   }
@@ -228,7 +259,7 @@
     const shown = fit || (last && (!run || last.run !== run.number) ? last : null);
     showFit(shown);
     const earlier = !fit && shown && run;
-    setText($("fit-of"), earlier ? `of run ${shown.run}, the last whole run (run ${run.number} is ${run.state})` : "");
+    $("fit-of").textContent = earlier ? `of run ${shown.run}, the last whole run (run ${run.number} is ${run.state})` : "";
     // The record is of the run whose numbers are shown; printed then, the page is that run's record
     // (the live run's title, plot and state are not printed: spindown.css).
     if (earlier) document.body.setAttribute("data-fit-of", String(shown.run));
@@ -242,7 +273,7 @@
     document.body.removeAttribute("data-fit-of");
     $("back-live").hidden = false;
     setText($("run-title"), `Run ${r.number}${r.partial ? " (partial: the cut was not seen)" : ""} · ${r.state} (chosen in this session's runs)`);
-    setText($("fit-of"), "");
+    $("fit-of").textContent = "";
     setText($("record"), recordText(r, r.fit));
     showFit(r.fit);
     for (const tr of $("runs").children) tr.classList.toggle("chosen", tr.getAttribute("data-run") === String(r.number));
@@ -255,6 +286,31 @@
     if (detail) showDetail(detail);
   });
 
+  // What each effect the explain workflow adds is, in a student's words (the models' own meanings,
+  // core/models/src/effects.cpp, shortened); the statistics stay one click away.
+  const effectWords = {
+    viscous: ["viscous friction", "a drag that grows with speed, like oil being sheared"],
+    coulomb: ["dry (Coulomb) friction", "a constant drag, like brushes and bearings rubbing; it is what makes the shaft stop"],
+    stribeck: ["Stribeck friction", "extra friction near standstill, where the lubricant film breaks down"],
+    windage: ["air drag", "drag of the flywheel in the air, growing with the square of the speed"],
+    sensor_offset: ["an offset of the reading", "the reading does not come back to zero when the shaft stands still"],
+  };
+  function stepWords(s, noise, unit, tCut) {  // tCut: the run's cut on the bench's clock (where's times are on it)
+    const [name, meaning] = effectWords[s.added] || [s.added, ""];
+    const before = s.rmse_before, after = s.rmse_after;
+    const parts = [`Adding ${name}${meaning ? ` (${meaning})` : ""}`];
+    if (before > 0 && after > 0) {
+      const ratio = before / after;
+      parts.push(`: the model then misses the readings by ${fmt(after)} ${unit} on average instead of ${fmt(before)} ${unit}` +
+                 (ratio >= 1.05 ? ` (${ratio >= 10 ? ratio.toFixed(0) : ratio.toFixed(1)}× closer)` : ""));
+      if (noise > 0 && after <= 1.5 * noise) parts.push(`, about as close as the reading's own noise (${fmt(noise)} ${unit}) allows`);
+    }
+    const w = (s.where || []).filter((x) => x.mean_residual !== null).sort((a, b) => Math.abs(b.mean_residual) - Math.abs(a.mean_residual))[0];
+    if (w) parts.push(`. Without it the model was furthest off from ${(w.t_from_s - tCut).toFixed(1)} to ${(w.t_to_s - tCut).toFixed(1)} s after the cut, ` +
+                      `where the readings were ${fmt(Math.abs(w.mean_residual))} ${unit} ${w.mean_residual > 0 ? "above" : "below"} it`);
+    return parts.join("") + ".";
+  }
+
   function showExplain(x) {
     const list = $("explain");
     if (!x) {
@@ -263,20 +319,24 @@
       $("explain-final").textContent = "The story arrives after the fit (the fitter's EXPLAIN).";
       return;
     }
-    setText($("explain-base"), `from ${x.base.join("+")}: RMSE ${fmt(x.rmse_base)}`);
+    const unit = (detail && detail.unit) || "V";
+    const baseName = x.base.map((b) => (effectWords[b] || [b])[0]).join(" and ");
+    setText($("explain-base"), `starting from ${baseName} alone, which misses by ${fmt(x.rmse_base)} ${unit}`);
     const base = x.rmse_base > 0 ? x.rmse_base : 1;
     list.replaceChildren(...x.steps.map((s) => {
       const pct = Math.max(1, Math.min(100, 100 * (s.rmse_after || 0) / base));
       return el("li", { "data-explain-step": s.added },
-        el("strong", {}, `+ ${s.added}`), " ",
-        el("span", { class: "gap" }, `gap ${fmt(s.rmse_before)} → ${fmt(s.rmse_after)}`),
-        el("div", { class: "bar", role: "img", "aria-label": `${pct.toFixed(0)} % of the base model's RMSE` }, barFill(pct)),
-        el("div", { class: "why" }, s.why));
+        el("strong", {}, `+ ${(effectWords[s.added] || [s.added])[0]}`), " ",
+        el("span", { class: "gap" }, `misses by ${fmt(s.rmse_before)} → ${fmt(s.rmse_after)} ${unit}`),
+        el("div", { class: "bar", role: "img", "aria-label": `${pct.toFixed(0)} % of the first model's miss left` }, barFill(pct)),
+        el("p", { class: "step-words" }, stepWords(s, x.noise_level, unit, (detail && detail.run && detail.run.t_cut_s) || 0)),
+        el("details", { class: "why" }, el("summary", {}, "the statistics"), s.why));
     }));
-    const params = x.params.map((p) => `${p.name} = ${p.text}`).join(", ");
+    const params = x.params.map((p) => `${p.name} = ${spindown.inUnits(p)}`).join(", ");
     $("explain-final").textContent = x.steps.length
-      ? `final model: ${x.final.join("+")}, RMSE ${fmt(x.rmse_final)} (${(x.rmse_base / x.rmse_final).toFixed(1)}× smaller); ${params}`
-      : `nothing missing: ${x.base.join("+")} explains the run to the noise (${fmt(x.noise_level)}); ${params}`;
+      ? `final model: ${x.final.map((b) => (effectWords[b] || [b])[0]).join(" + ")}, missing by ${fmt(x.rmse_final)} ${unit} ` +
+        `(${(x.rmse_base / x.rmse_final).toFixed(1)}× closer than at the start); ${params}`
+      : `nothing missing: ${baseName} explains the run down to the reading's noise (${fmt(x.noise_level)} ${unit}); ${params}`;
   }
 
   function barFill(pct) {
@@ -298,6 +358,12 @@
     const end = r.fit && r.fit.end;
     if (end && endWords[end]) return endWords[end];
     return r.partial ? "partial: its cut was not seen" : "";
+  }
+
+  function coefCell(c, run) {
+    const td = el("td");
+    setCoefficient(td, c, run);
+    return td;
   }
 
   function showRuns(earlier, current) {
@@ -328,8 +394,8 @@
       return el("tr", { "data-run": r.number, class: cls || null },
         el("td", {}, `${r.number}${r.partial ? " (partial)" : ""}`),
         el("td", {}, f ? f.best || "–" : r.state, why ? el("div", { class: "why-not-whole" }, why) : null),
-        el("td", { "data-si": f && f.c3 ? f.c3.value : null }, f && f.c3 ? f.c3.text : "–"),
-        el("td", { "data-si": f && f.c4 ? f.c4.value : null }, f && f.c4 ? f.c4.text : "–"),
+        coefCell(f ? f.c3 : null, r.number),
+        coefCell(f ? f.c4 : null, r.number),
         el("td", {}, f ? f.health : "–"),
         el("td", {}, show),
         el("td", {}, compare),
@@ -390,6 +456,7 @@
       trace = { key: -1, n: 0, x: [], y: [] };
       takeSamples({ benches: d.samples || {} });
       labName = (d.lab && d.lab.name) || "";
+      spindown.serverUnits(d.lab ? d.lab.lab_units : undefined);
       showDetail(d.detail || { bench: id, run: null, earlier: [] });
       setText($("connection"), "live");
     },
@@ -399,6 +466,14 @@
   });
 
   $("print").addEventListener("click", () => window.print());
+  $("pause").addEventListener("click", () => {
+    paused = !paused;
+    if (!paused && rebuildWanted) { rebuildWanted = false; rebuildPlot(); }
+    showView();
+    dirty = true;
+  });
+  $("zoom-reset").addEventListener("click", () => { zoomed = false; showView(); if (plot) plot.setData(plotData(), true); });
+  spindown.unitsToggle($("units"), () => { if (detail) showExplain(detail.run ? detail.run.explain : null); });
   // The plot as a PNG for the written report: white ground, the record line above it, the legend's
   // names below (the canvas has the curves and axes; the legend is HTML).
   $("png").addEventListener("click", () => {
@@ -424,7 +499,7 @@
     a.click();
     a.remove();
   });
-  const resize = () => { if (plot) plot.setSize(plotSize(plotBox, 340)); if (residualPlot) residualPlot.setSize(plotSize(residualBox, 180)); };
+  const resize = () => { if (plot) plot.setSize(plotSize(plotBox, 340)); if (residualPlot) residualPlot.setSize(plotSize(residualBox, 200)); };
   window.addEventListener("resize", resize);
   window.addEventListener("beforeprint", resize);
   window.addEventListener("afterprint", resize);

@@ -23,21 +23,63 @@ const spindown = (() => {
     if (e.textContent !== t) e.textContent = t;
   }
 
-  // A coefficient's field: its text in the lab's units with ± error, the SI value in data-si.
+  // The units coefficients are read in: the lab's (g·cm²…) or SI. What spindown-web was started
+  // with (--si-units) until the page's toggle chooses; the choice is kept in this browser.
+  let chosenUnits = null, serverLabUnits = true;
+  try { chosenUnits = localStorage.getItem("spindown-units"); } catch (e) { /* private mode: not kept */ }
+  const units = () => (chosenUnits === "lab" || chosenUnits === "si" ? chosenUnits : serverLabUnits ? "lab" : "si");
+  const unitsListeners = [];
+  const unitButtons = [];
+  function showUnits() {
+    for (const b of unitButtons) {
+      b.textContent = units() === "lab" ? "units: g·cm² (lab) → SI" : "units: SI → g·cm² (lab)";
+      b.setAttribute("data-units", units());
+    }
+    document.documentElement.setAttribute("data-units", units());
+  }
+  // The lab's own default (the "lab" part of a snapshot: its lab_units).
+  function serverUnits(labUnits) {
+    if (typeof labUnits !== "boolean" || labUnits === serverLabUnits) return;
+    serverLabUnits = labUnits;
+    unitsChanged();
+  }
+  function unitsChanged() {
+    showUnits();
+    for (const e of document.querySelectorAll("[data-si]")) if (e.spindownCoef) setCoefficient(e, e.spindownCoef, e.spindownRun);
+    for (const f of unitsListeners) f(units());
+  }
+  // A button that switches the units (every coefficient on the page at once); f(units) after.
+  function unitsToggle(button, f) {
+    unitButtons.push(button);
+    if (f) unitsListeners.push(f);
+    button.addEventListener("click", () => {
+      chosenUnits = units() === "lab" ? "si" : "lab";
+      try { localStorage.setItem("spindown-units", chosenUnits); } catch (e) { /* not kept */ }
+      unitsChanged();
+    });
+    showUnits();
+  }
+  // A value's text ("text", "total_text") in the page's units; the service's own when it has no other.
+  function inUnits(c, key = "text") { return c[`${key}_${units()}`] || c[key]; }
+
+  // A coefficient's field: its text in the page's units with ± error, the SI value in data-si.
   function setCoefficient(e, c, fitRun) {
     if (!c || c.value === null || c.value === undefined) {
       setText(e, "–");
       e.removeAttribute("data-si");
       e.removeAttribute("data-si-stderr");
       e.removeAttribute("data-fit-run");
+      e.spindownCoef = null;
       e.title = "";
       return;
     }
-    setText(e, c.text);
+    e.spindownCoef = c;
+    e.spindownRun = fitRun;
+    setText(e, inUnits(c));
     e.setAttribute("data-si", String(c.value));
     if (c.stderr !== null && c.stderr !== undefined) e.setAttribute("data-si-stderr", String(c.stderr));
     if (fitRun !== undefined) e.setAttribute("data-fit-run", String(fitRun));
-    e.title = `${c.value} ± ${c.stderr} ${c.unit} (SI)` + (c.total_text ? `; with J and K_b: ${c.total_text}` : "");
+    e.title = `${c.value} ± ${c.stderr} ${c.unit} (SI)` + (c.total_text ? `; with J and K_b: ${inUnits(c, "total_text")}` : "");
   }
 
   function setHealth(e, fit) {
@@ -149,5 +191,6 @@ const spindown = (() => {
     open();
   }
 
-  return { el, setText, setCoefficient, setHealth, setDoubts, setBridge, bridgeDetail, servicesText, problemsText, live };
+  return { el, setText, setCoefficient, setHealth, setDoubts, setBridge, bridgeDetail, servicesText, problemsText, live,
+           unitsToggle, serverUnits, inUnits };
 })();

@@ -198,7 +198,9 @@
     requestAnimationFrame(frame);
   }
 
+  spindown.unitsToggle(document.getElementById("units"));
   function showLab(lab) {
+    spindown.serverUnits(lab ? lab.lab_units : undefined);
     setText(document.getElementById("services"), servicesText(lab));
     setText(document.getElementById("problems"), problemsText(lab));
   }

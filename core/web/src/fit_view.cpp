@@ -43,12 +43,17 @@ Json param_json(const fit_t& msg, std::string_view model_name, std::string_view 
     j["stderr"] = json_number(msg.param_stderr[k]);
     j["unit"] = msg.param_unit[k];
     j["model"] = std::string(model_name);
+    // The text in the units the service was started with, and in both (the page's units toggle).
     j["text"] = value_text(msg.param_value[k], msg.param_stderr[k], msg.param_unit[k], lab_units);
+    j["text_lab"] = value_text(msg.param_value[k], msg.param_stderr[k], msg.param_unit[k], true);
+    j["text_si"] = value_text(msg.param_value[k], msg.param_stderr[k], msg.param_unit[k], false);
     const double bench_error = k < msg.param_bench_error.size() ? msg.param_bench_error[k] : 0.0;
     if (bench_error > 0) {
       const double total = std::hypot(msg.param_stderr[k], bench_error);
       j["total_stderr"] = json_number(total);
       j["total_text"] = value_text(msg.param_value[k], total, msg.param_unit[k], lab_units);
+      j["total_text_lab"] = value_text(msg.param_value[k], total, msg.param_unit[k], true);
+      j["total_text_si"] = value_text(msg.param_value[k], total, msg.param_unit[k], false);
     }
     return j;
   }
@@ -231,7 +236,9 @@ Json explain_json(const explain_t& msg, bool lab_units) {
                       {"value", json_number(msg.param_value[k])},
                       {"stderr", json_number(msg.param_stderr[k])},
                       {"unit", msg.param_unit[k]},
-                      {"text", value_text(msg.param_value[k], msg.param_stderr[k], msg.param_unit[k], lab_units)}});
+                      {"text", value_text(msg.param_value[k], msg.param_stderr[k], msg.param_unit[k], lab_units)},
+                      {"text_lab", value_text(msg.param_value[k], msg.param_stderr[k], msg.param_unit[k], true)},
+                      {"text_si", value_text(msg.param_value[k], msg.param_stderr[k], msg.param_unit[k], false)}});
   j["params"] = std::move(params);
   j["story"] = msg.story;
   return j;
