@@ -35,7 +35,7 @@ done
 python3 - "$PORT" "$T/stamped.json" <<'PY' & STAMPER=$!
 import json, socket, sys, time
 s = socket.create_connection(("127.0.0.1", int(sys.argv[1])))
-s.sendall(b"GET /events HTTP/1.1\r\nHost: x\r\nAccept: text/event-stream\r\n\r\n")
+s.sendall(f"GET /events HTTP/1.1\r\nHost: 127.0.0.1:{sys.argv[1]}\r\nAccept: text/event-stream\r\n\r\n".encode())  # the Host it serves
 seen, buf, out = {}, b"", open(sys.argv[2], "w")
 while True:
     d = s.recv(65536)
@@ -91,5 +91,8 @@ if delays:
     q = lambda p: delays[min(len(delays) - 1, int(p * len(delays)))]
     print(f"FIT on the network -> its event at a page: {len(delays)} fits, p50 {q(0.5):.0f} ms, p95 {q(0.95):.0f} ms, max {delays[-1]:.0f} ms"
           + (f"; {len(missing)} not seen" if missing else ""))
+else:  # the main figure missing is a failed measurement, not a quiet one
+    print(f"FIT on the network -> its event at a page: none of {len(fits)} FITs reached the stamping page (refused? see web.err)")
+    sys.exit(1)
 PY
 tail -1 "$T/web.err" || true
