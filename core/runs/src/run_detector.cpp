@@ -17,27 +17,8 @@ using namespace detector_tuning;
 
 // ---- sliding least-squares line ----------------------------------------------------------
 
-void RunDetector::Impl::WindowFit::clear(std::size_t at, double t_origin) {
-  first = end = at;
-  t0 = t_origin;
-  n = stv = 0;
-  s1 = s2 = WindowFit::Pair{};
-  updates = 0;
-}
-
 double RunDetector::Impl::duration(const WindowFit& w) const {
   return w.end > w.first ? t(w.end - 1) - t(w.first) : 0.0;
-}
-
-RunDetector::Impl::WindowFit RunDetector::Impl::window_over(const Sample* ring, std::size_t mask, double span, std::size_t from,
-                                                std::size_t to) {
-  WindowFit w;
-  w.span_s = span;
-  w.clear(from, from < to ? ring[from & mask].t : 0.0);
-  for (std::size_t k = from; k < to; ++k) w.add(ring[k & mask].t, ring[k & mask].v);
-  w.end = to;
-  w.updates = 0;
-  return w;
 }
 
 void RunDetector::Impl::rebuild(WindowFit& w, std::size_t from, std::size_t to) {

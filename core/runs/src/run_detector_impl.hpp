@@ -15,6 +15,7 @@
 #include "spindown/reading_scale.hpp"
 #include "spindown/run_detector.hpp"
 #include "spindown/sample_store.hpp"
+#include "spindown/window_fit.hpp"
 
 namespace spindown {
 
@@ -39,59 +40,8 @@ class RunDetector::Impl {
   std::size_t buffered() const { return store_.size(); }
 
  private:
-  // Least-squares line over a sliding time window of the buffer, O(1) per sample. The sums are
-  // kept in pairs of lanes, (Σt, Σv) and (Σt², Σv²): each lane does the scalar operation, so
-  // every sum has the bits it would have alone, and two sums take one instruction.
-  struct WindowFit {
-    using Pair = double __attribute__((vector_size(2 * sizeof(double))));
-    double span_s = 1.0;
-    std::size_t first = 0, end = 0;  // absolute indices [first, end)
-    double t0 = 0;                   // time origin for the sums (precision)
-    double n = 0;
-    Pair s1{}, s2{};  // (Σt, Σv), (Σt², Σv²), t from t0
-    double stv = 0;   // Σt·v
-    unsigned updates = 0;
-    double st() const { return s1[0]; }
-    double sv() const { return s1[1]; }
-    double stt() const { return s2[0]; }
-    double svv() const { return s2[1]; }
-    void clear(std::size_t at, double t_origin);
-    void add(double t, double v) {
-      const Pair d{t - t0, v};
-      n += 1, s1 += d, s2 += d * d, stv += d[0] * d[1];
-      ++updates;
-    }
-    void remove(double t, double v) {
-      const Pair d{t - t0, v};
-      n -= 1, s1 -= d, s2 -= d * d, stv -= d[0] * d[1];
-      ++updates;
-    }
-    // add(t_in, v_in) then remove(t_out, v_out), bit for bit, in one pass over the sums.
-    void slide(double t_in, double v_in, double t_out, double v_out) {
-      const Pair in{t_in - t0, v_in}, out{t_out - t0, v_out};
-      s1 = s1 + in - out;
-      s2 = s2 + in * in - out * out;
-      stv = stv + in[0] * in[1] - out[0] * out[1];
-      updates += 2;
-    }
-    double mean() const { return n > 0 ? sv() / n : 0.0; }
-    double sxx() const { return stt() - st() * st() / n; }
-    double slope() const {
-      if (n < 2) return 0.0;
-      const double sxx_ = sxx();
-      if (!(sxx_ > 0)) return 0.0;
-      return (stv - st() * sv() / n) / sxx_;
-    }
-    double slope_se() const { return sxx() > 0 ? resid_sd() / std::sqrt(sxx()) : 0.0; }
-    double resid_sd() const {
-      if (n < 3) return 0.0;
-      const double syy = svv() - sv() * sv() / n;
-      const double sxy = stv - st() * sv() / n;
-      const double sxx_ = sxx();
-      const double sse = sxx_ > 0 ? syy - sxy * sxy / sxx_ : syy;
-      return std::sqrt(std::max(sse, 0.0) / (n - 2));
-    }
-  };
+  // Least-squares line over a sliding time window of the buffer, O(1) per sample (window_fit.hpp).
+  using WindowFit = spindown::WindowFit;
 
   // The samples held (sample_store.hpp).
   using Sample = SampleStore::Sample;
@@ -101,8 +51,6 @@ class RunDetector::Impl {
   // passed in: a window that is a local of a loop then stays in registers.
   static inline void advance(WindowFit& w, const Sample* ring, std::size_t mask, std::size_t i, Sample s);
   inline void advance(WindowFit& w, std::size_t i, Sample s);
-  // The window of span span over samples [from, to), its sums added afresh.
-  static WindowFit window_over(const Sample* ring, std::size_t mask, double span, std::size_t from, std::size_t to);
   void rebuild(WindowFit& w, std::size_t from, std::size_t to);
   void reset_window(WindowFit& w, std::size_t lo, std::size_t end);
   double duration(const WindowFit& w) const;
@@ -226,7 +174,8 @@ class RunDetector::Impl {
   // reading inside r's coast [cut, coast_end), long after the cut, stood at the cut's level again
   // (within its means' noise) where the coast's own pace says it must have fallen far below it, no
   // coast had begun (a drive hunting about its setpoint): r starts after the last such return.
-  void recut_after_return(Run& r, std::size_t coast_end);
+  void recut_after_return(Run& r, std::size_t coast_end);  // the decision: level_return.hpp
+  std::vector<double> return_scratch_;
   // r's cut moved to the coast after sample `at` inside it, found as any cut is: the samples up to
   // back_search_s before it (at least min_lead) as lead-in, ahead_s after it; false when there is
   // no such cut after r's (r unchanged).

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "run_detector_tuning.hpp"
+#include "spindown/signal_loss.hpp"
 
 namespace spindown {
 
@@ -513,44 +514,20 @@ void RunDetector::Impl::block_until_rise(double level) {
 }
 
 bool RunDetector::Impl::signal_lost(std::size_t i, std::size_t first_in, double z, double amp) {
-  if (first_in < run_.cut_index + 8 || !(amp > 0)) return false;
-  const double zero = motor_zero();
-  // The coast's last reading before the standstill, and the first sample that held it.
-  const std::size_t last = first_in - 1;
-  std::size_t held = last;
-  while (held > run_.cut_index && v(held - 1) == v(last)) --held;
-  // The most friction lets the reading fall in one sample: the coast's slope over the second
-  // before the held value, per period.
-  std::size_t from = held;  // the second before the held value, found from its end
-  while (from > run_.cut_index && t(held) - t(from - 1) <= 1.0) --from;
-  WindowFit f = window_over(store_.data(), store_.mask(), 1.0, from, held);
-  if (f.n < 5) return false;  // too few samples to know how fast friction lets it fall
-  // A sensor that gives up reads zero (the motor's, when the lead-in showed it) after it.
-  if (std::abs(z - zero) > 0.05 * amp) return false;
-  const double period = t(first_in) - t(last);
-  const double fall = f.n >= 5 ? std::max(-f.slope(), 0.0) * period : 0.0;
-  const double drop = v(last) - z;
-  // A collapse: a fall far beyond the coast's, from a reading held longer than the coast allows
-  // (friction would have moved it two steps), or beyond any fall the coast showed. A lab stop's
-  // last printed values (0.02, 0.01 on the 2-decimal print) are neither.
-  const double held_for = double(first_in - held);
-  const bool big_drop = drop > std::max({10.0 * fall, 6.0 * f.resid_sd(), 3.0 * coast_step_, 0.005 * amp});
-  const bool long_hold = held_for * fall > std::max(2.0 * coast_step_, 3.0 * f.resid_sd());
-  const bool collapse = big_drop && (long_hold || drop > 30.0 * fall);
-  if (!collapse) return false;
-  const double level = v(held);
+  const std::optional<SignalLoss> loss = signal_loss(store_, {run_.cut_index, first_in, z, amp, motor_zero(), coast_step_});
+  if (!loss) return false;
   run_note_severity_ = Diagnostic::Severity::warning;
-  close_unstopped(held + 1,
+  close_unstopped(loss->held + 1,
                   fmt::format("signal lost below {:g} at {}: {} where friction lets it fall about {:.2g} a sample; a "
                               "sensor that gives up at low speed (per-revolution pulses, an encoder, a display)? "
                               "Fitted up to there, as never stopped",
-                              level, fmt_s(t(held)),
-                              fmt::format("the reading fell from {:g} to {:g} in one sample", v(last), z),
-                              fall > 1e-9 * amp ? fall : 0.0),
+                              loss->level, fmt_s(t(loss->held)),
+                              fmt::format("the reading fell from {:g} to {:g} in one sample", loss->last, z),
+                              loss->fall > 1e-9 * amp ? loss->fall : 0.0),
                   Run::End::signal_lost);
   to_idle(i + 1, true);
   // No new run until the reading rises above what the sensor last showed (or after a standstill).
-  block_until_rise(std::max(level, z));
+  block_until_rise(std::max(loss->level, z));
   return true;
 }
 
