@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "run_detector_tuning.hpp"
+#include "spindown/coast_jump.hpp"
 #include "spindown/level_return.hpp"
 
 namespace spindown {
@@ -53,94 +54,21 @@ const LagNoise& RunDetector::Impl::coast_noise(std::size_t c, std::size_t coast_
 
 void RunDetector::Impl::recut_after_rise(Run& r, std::size_t coast_end) {
   const std::size_t c = r.cut_index;
-  if (coast_end < c + 16) return;
   const double zero = r.stopped ? r.zero_level : motor_zero();
-  const double amp = v0_ - zero;
-  // Medians of five: a dropout or two (a loose wire's zeros) are neither a rise nor a step down.
-  // Each sample's is taken once: both searches below read it, three times a sample (a sort of
-  // five per look was a third of `spindown fit`'s time).
-  median5_.resize(coast_end - c);
-  for (std::size_t k = c + 2; k + 2 < coast_end; ++k)
-    median5_[k - c] = median_of_five(v(k - 2), v(k - 1), v(k), v(k + 1), v(k + 2));
-  const auto med5 = [&](std::size_t k) { return median5_[k - c]; };
-  // The last rise of more than thr above the lowest reading before it, or a later step down.
-  const auto last_jump = [&](double thr, double& rose) {
-    double low = std::numeric_limits<double>::infinity(), rose_from = 0;
-    std::size_t rise = 0;
-    for (std::size_t k = c + 2; k + 2 < coast_end; ++k) {
-      const double m = med5(k);
-      if (m - low > thr) {
-        if (rise == 0 || k > rise + 1) rose_from = low;
-        rise = k, rose = m - rose_from, low = m;
-      } else {
-        low = std::min(low, m);
-      }
-    }
-    // A step down: a fall within three samples far steeper than the coast's own pace on either
-    // side of it (an open pin above the back-EMF, then connected to the motor).
-    if (coast_end >= c + 24) {
-      for (std::size_t k = c + 10; k + 10 < coast_end; ++k) {
-        const double drop = med5(k - 2) - med5(k + 1);
-        if (!(drop > thr)) continue;
-        const double before = (med5(k - 8) - med5(k - 2)) / (t(k - 2) - t(k - 8));
-        const double after = (med5(k + 1) - med5(k + 7)) / (t(k + 7) - t(k + 1));
-        const double pace = std::max({before, after, 0.0}) * (t(k + 1) - t(k - 2));
-        if (drop > 4.0 * pace + thr && k > rise) rise = k - 1, rose = -drop;
-      }
-    }
-    return rise;
-  };
-  // A jump is far beyond the coast's sample-to-sample noise (the median over the whole coast: a
-  // rough stretch before the rise, an open pin's hum, does not set it), a twentieth of the coast's
-  // height and three steps of the print. Most coasts have no jump even of that least size: then
-  // the noise (a median over the whole coast, most of this search's time) is not needed, as a
-  // higher threshold finds no jump where a lower one found none.
-  const double least = std::max(0.05 * std::abs(amp), 3.0 * coast_step_);
-  double rose = 0;
-  if (last_jump(least, rose) == 0) return;
-  const double white = rough_sd(store_, c, coast_end);
-  const std::size_t rise = last_jump(std::max(8.0 * white, least), rose);
-  if (rise == 0) return;
-  // What made it evidence, said with it: the jump in units of the reading's noise.
-  std::string evidence = white > 0 ? fmt::format(" ({:.0f} times the reading's sample-to-sample noise {:.2g})",
-                                                 std::abs(rose) / white, white)
-                                   : std::string(" (the reading shows no noise)");
-  // A ripple (a wheel's once per revolution, a commutator's) moves neighbouring samples together:
-  // its crests stand above its troughs by far more than the sample-to-sample noise says. Where the
-  // coast shows one all along (the smaller of its two halves': an open pin's hum before a
-  // connection is in one of them only), a rise or a step is evidence only when the level over a
-  // whole ripple after it stands apart from the level over a whole ripple before it, by more than
-  // those means' own noise allows.
-  // (After a floating lead-in the hum may go on past the cut found: a rise there is the connection,
-  // and the coast's noise is not asked.)
-  const LagNoise* noise_p = r.lead_in != "floating" ? &coast_noise(c, coast_end) : nullptr;
-  if (noise_p && noise_p->wander > 2.0 * noise_p->white) {
-    const LagNoise& noise = *noise_p;
-    const std::size_t len = std::max<std::size_t>(5, 2 * noise.wander_lag);
-    if (rise < c + len || rise + len > coast_end) return;
-    double before = 0, after = 0;
-    for (std::size_t k = rise - len; k < rise; ++k) before += v(k);
-    for (std::size_t k = rise; k < rise + len; ++k) after += v(k);
-    const double shift = (after - before) / double(len);
-    const double se = noise.wander * std::sqrt(2.0 / double(len));
-    // … and only on a coast: the means over whole ripples before the rise fall, each within those
-    // means' noise of the one before (an open pin's swing rises and falls by far more).
-    bool falls = true;
-    double prev = std::numeric_limits<double>::infinity();
-    for (std::size_t k0 = c; k0 + len <= rise && falls; k0 += len) {
-      double m = 0;
-      for (std::size_t k = k0; k < k0 + len; ++k) m += v(k);
-      m /= double(len);
-      falls = m <= prev + 4.0 * se;
-      prev = m;
-    }
-    if (falls) {
-      const double moved = rose > 0 ? shift : -shift;  // in the jump's own direction
-      if (!(moved > std::max(4.0 * se, least))) return;
-      evidence = fmt::format(" (its level over whole ripples of {} samples moved {:.3g}, {:.0f} times those means' noise)",
-                             len, shift, std::abs(shift) / se);
-    }
-  }
+  const std::optional<CoastJump> jump =
+      coast_jump(store_, {c, coast_end, v0_ - zero, coast_step_, r.lead_in == "floating"},
+                 [&]() -> const LagNoise& { return coast_noise(c, coast_end); }, median5_);
+  if (!jump) return;
+  const std::size_t rise = jump->at;
+  const double rose = jump->rose;
+  // What made it evidence, said with it: the jump in units of the reading's noise, or the level
+  // over whole ripples.
+  const std::string evidence =
+      jump->ripple_len > 0 ? fmt::format(" (its level over whole ripples of {} samples moved {:.3g}, {:.0f} times those means' noise)",
+                                         jump->ripple_len, jump->ripple_shift, std::abs(jump->ripple_shift) / jump->ripple_se)
+      : jump->white > 0    ? fmt::format(" ({:.0f} times the reading's sample-to-sample noise {:.2g})", std::abs(rose) / jump->white,
+                                         jump->white)
+                           : std::string(" (the reading shows no noise)");
   // The coast after the rise: its cut found as any cut is, with the samples before the rise as lead-in.
   std::size_t a = rise, b = rise;
   while (a > c && t(rise) - t(a - 1) <= back_search_s) --a;
