@@ -180,16 +180,11 @@ class RunDetector::Impl {
   // back_search_s before it (at least min_lead) as lead-in, ahead_s after it; false when there is
   // no such cut after r's (r unchanged).
   bool recut_from(Run& r, std::size_t at, std::size_t coast_end, double ahead_s, std::size_t min_lead);
-  // A coast never dwells (run_detector_dwell.cpp): when the reading inside r's coast [cut, coast_end)
-  // held a level far longer than the coast then took to fall through it, r starts after that dwell,
-  // with a warning.
+  // A coast never dwells: when the reading inside r's coast [cut, coast_end) held a level far
+  // longer than the coast then took to fall through it (the decision: coast_dwell.hpp), r starts
+  // after that dwell, with a warning.
   void recut_after_dwell(Run& r, std::size_t coast_end);
-  // Whether a later third of the coast [c, e) falls more than an earlier one by over margin (the
-  // cheap look before the dwell search).
-  bool falls_faster_later(std::size_t c, std::size_t e, double margin) const;
-  // One past the last sample of the last such dwell in [c, e) (bands of half-width h), or 0; from:
-  // where that dwell began.
-  std::size_t dwell_end(std::size_t c, std::size_t e, double h, std::size_t& from);
+  std::vector<double> dwell_scratch_;
   // Why the coast in sp has no recorded cut (the stream begins on it, or a pause hides it), with
   // sp moved to the coast's first sample; empty when its cut is in the data.
   std::string start_not_seen(CutSplit& sp);

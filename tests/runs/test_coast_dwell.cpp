@@ -1,0 +1,82 @@
+// coast_dwell: the decision that a "coast" held a level far longer than a coast can (a drive
+// under power), on its own.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstddef>
+#include <random>
+#include <vector>
+
+#include "spindown/coast_dwell.hpp"
+
+using namespace spindown;
+
+namespace {
+
+constexpr double dt = 0.02;  // the lab's 50 Hz
+
+template <class F>
+SampleStore record(F v, double until, double sigma, double step = 0.0) {
+  SampleStore s;
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> noise(0.0, sigma);
+  for (double t = 0; t < until - 1e-9; t += dt) {
+    double x = v(t) + noise(rng);
+    if (step > 0) x = std::round(x / step) * step;
+    s.push({t, x});
+  }
+  return s;
+}
+
+std::size_t at(double t) { return static_cast<std::size_t>(std::lround(t / dt)); }
+
+std::optional<CoastDwell> judge(const SampleStore& s, double end_s, double noise, double step = 0.0) {
+  std::vector<double> scratch;
+  return coast_dwell(s, {0, at(end_s), noise, step}, scratch);
+}
+
+}  // namespace
+
+TEST(CoastDwell, AStartUpOvershootSettlingOnItsSetpointIsNoCoast) {
+  // A drive overshoots to 3.0 at its start, settles on 2.5 for 8 s, then the supply is cut: a coast
+  // at 0.25 a second. Taken as a coast from the overshoot, it held 2.5 ± its noise for 8 s, where
+  // it then fell four more of those bands in about 0.3 s (a dwell counts beyond 20 times that).
+  const SampleStore s = record([](double t) {
+    if (t < 1) return 3.0 - 0.5 * t;
+    if (t < 9) return 2.5;
+    return std::max(2.5 - 0.25 * (t - 9), 0.0);
+  }, 21.0, 0.002);
+  const auto d = judge(s, 19.0, 0.002);
+  ASSERT_TRUE(d.has_value());
+  EXPECT_NEAR(double(d->at), double(at(9.0)), 25.0);  // within half a second of the cut
+  EXPECT_GT(d->at - d->from, at(6.0));  // held for most of the 8 s
+  EXPECT_NEAR(d->band, 4 * 0.002, 0.002);  // four times the coast's own noise
+}
+
+TEST(CoastDwell, AHoldShorterThanTwentyTimesTheFallIsNoDwell) {
+  // The same drive settled for only 2 s: where the coast then falls four bands in 0.3 s, a 2-s hold
+  // is within what the decision allows (a slow start, Stribeck friction): no dwell.
+  const SampleStore s = record([](double t) {
+    if (t < 1) return 3.0 - 0.5 * t;
+    if (t < 3) return 2.5;
+    return std::max(2.5 - 0.25 * (t - 3), 0.0);
+  }, 15.0, 0.002);
+  EXPECT_FALSE(judge(s, 13.0, 0.002).has_value());
+}
+
+TEST(CoastDwell, AFreeCoastNeverDwellsEvenWithStribeckFrictionNearStandstill) {
+  // Coulomb + viscous, plus friction rising near standstill: its last third falls fastest, so the
+  // search runs, and finds no level held longer than the coast's own fall allows.
+  const SampleStore s = record([](double t) {
+    const double w = 2.6 * std::exp(-0.04 * t) - 0.06 * t - 0.02 * t * t / 10;
+    return std::max(w, 0.0);
+  }, 26.0, 0.004, 0.01);
+  EXPECT_FALSE(judge(s, 24.0, 0.004, 0.01).has_value());
+}
+
+TEST(CoastDwell, AReadingFrozenOnOneValueIsASensorNotADrive) {
+  // A sensor stuck at 2.50 (one printed value, no noise) for 6 s, then a coast: one value held over
+  // half the dwell is a frozen reading, which the stop and signal checks judge, not this one.
+  const SampleStore s = record([](double t) { return t < 6 ? 2.5 : std::max(2.5 - 0.12 * (t - 6), 0.0); }, 28.0, 0.0, 0.01);
+  EXPECT_FALSE(judge(s, 26.0, 0.004, 0.01).has_value());
+}
