@@ -78,4 +78,10 @@ double smoothed(const SampleStore& s, std::size_t k, std::size_t lo, std::size_t
   return sum / double(to - from);
 }
 
+double crossing_time(const SampleStore& s, std::size_t k, std::size_t first, double level) {
+  if (k == first) return s.t(k);
+  const double va = s.v(k - 1), vb = s.v(k);
+  return va > vb ? s.t(k - 1) + (s.t(k) - s.t(k - 1)) * (va - level) / (va - vb) : s.t(k);
+}
+
 }  // namespace spindown

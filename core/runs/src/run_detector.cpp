@@ -877,9 +877,7 @@ bool RunDetector::Impl::try_start_coast(std::size_t i, const WindowFit& w) {
   // The coast's hold windows follow its own sample rate (a stream may change its rate between runs).
   set_spans(shortest_period(w));  // lost samples only lengthen periods: the shortest is the rate
   reset_window(hold_, run_.cut_index, i + 1);
-  plateau_check_t_ = run_.t_cut_s + 2.0 * hold_.span_s;  // once the hold window is clear of the first one
-  plateau_hits_ = 0;
-  half_cursor_ = run_.cut_index;
+  plateau_.start(run_.cut_index, run_.t_cut_s + 2.0 * hold_.span_s);  // once the hold window is clear of the first one
   hold_long_live_ = false;  // built when the coast gets low (saves work on the way down)
   creeping_ = false;
   coast_checks(i, store_.at(i));

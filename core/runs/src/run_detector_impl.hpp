@@ -14,6 +14,7 @@
 #include "spindown/lag_noise.hpp"
 #include "spindown/reading_scale.hpp"
 #include "spindown/run_detector.hpp"
+#include "spindown/plateau_watch.hpp"
 #include "spindown/sample_store.hpp"
 #include "spindown/window_fit.hpp"
 
@@ -75,7 +76,7 @@ class RunDetector::Impl {
   };
   CoastLimits coast_limits() const {
     return {store_.data(), store_.mask(), store_.base(), opt_.max_buffer, run_.cut_index, opt_.max_coast_s, run_.t_cut_s, hold_half_s_,
-            hold_full_s_, rise_jump_, standstill_ceiling_, v0_, plateau_check_t_};
+            hold_full_s_, rise_jump_, standstill_ceiling_, v0_, plateau_.next_look_s()};
   }
   // What the checks of a coasting sample decided: nothing (the usual case), or one of the rare
   // outcomes, which act_on() carries out.
@@ -150,12 +151,9 @@ class RunDetector::Impl {
   // coast, high above standstill at sample i, has held level (hold_) where friction would still
   // take speed off fast, three times in a row (a second and more): then its fall was a drive stepping down under power (a
   // setpoint step, a start-up overshoot settling), and the coast is given up (ignored, with why),
-  // its plateau the next cut's lead-in. Checked every half hold window (plateau_check_t_).
+  // its plateau the next cut's lead-in. Checked every half hold window.
   bool held_plateau(std::size_t i);
-  double plateau_check_t_ = std::numeric_limits<double>::infinity();
-  int plateau_hits_ = 0;
-  std::size_t plateau_from_ = 0;  // the hold window's first sample at the first hit
-  std::size_t half_cursor_ = 0;   // the open coast's first sample within a quarter of its fall of the level held now
+  PlateauWatch plateau_;  // the decision (plateau_watch.hpp)
   std::string not_coast_;  // set: the open run is ignored with this warning when it completes
   // Every re-cut of the closed coast r (ending at sample end), in order (run_detector_recut.cpp):
   // the one place a cut moves after it was found.

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "run_detector_tuning.hpp"
+#include "spindown/plateau_watch.hpp"
 #include "spindown/signal_loss.hpp"
 
 namespace spindown {
@@ -123,56 +124,18 @@ std::string RunDetector::Impl::stall_reason(std::size_t at) const {
 }
 
 bool RunDetector::Impl::held_plateau(std::size_t i) {
-  // Friction slows a coast at every speed it passes, fastest at its top (T(ω) grows with ω), and
-  // T falls with ω no faster than windage's ω² (stall_reason): at level u the coast still falls at
-  // least (u/u0)² of its rate at the cut's u0, which is at least its mean rate over the first half
-  // of its fall to u. A hold window well above standstill whose slope is resolved far below a
-  // quarter of that held a plateau: the drive holds a lower speed (a setpoint step down, an
-  // overshoot at power-on settling).
-  plateau_check_t_ = t(i) + hold_half_s_;
-  const WindowFit& h = hold_;
-  bool hit = false;
-  const double mu = h.mean(), zero = motor_zero(), u0 = v0_ - zero, u1 = mu - zero;
-  // The first crossing of a quarter of the fall above the plateau (the cursor only moves on: a
-  // coast's level only falls, and a later crossing gives a lower rate, the safe side).
-  const double near = mu + 0.25 * (v0_ - mu);
-  half_cursor_ = std::max(half_cursor_, run_.cut_index);
-  while (half_cursor_ < h.first && v(half_cursor_) > near) ++half_cursor_;
-  const double e_raw = h.resid_sd(), sxx = h.sxx(), e = std::max(e_raw, coast_step_ * step_sd);
-  // A reading that holds one value is a frozen sensor's, not a drive's (the standstill checks
-  // judge it); a plateau under power shows its noise.
-  const bool one_value = same_start_ <= h.first;  // every reading in the window the same (rounding aside)
-  if (h.n >= 8 && h.first > run_.cut_index && u0 > 0 && u1 > 0.3 * u0 && !one_value && e_raw > 0 && sxx > 0) {
-    // The coast's rate at its top is at least its mean rate over the first three quarters of its
-    // fall to the plateau, a fall that stands well out of the noise and spans a few samples (a lab
-    // motor's reading drops a step at the cut, its winding's transient, and then coasts slowly: a
-    // mean over most of the fall is not misled by it).
-    double top_rate = 0;
-    if (half_cursor_ < h.first && half_cursor_ >= run_.cut_index + 3 && v0_ - mu > 10.0 * e) {
-      const double to_near = quarter_crossing_time(half_cursor_, run_.cut_index, near) - run_.t_cut_s;
-      if (to_near > 0) top_rate = 0.75 * (v0_ - mu) / to_near;
-    }
-    {
-      const double ratio = std::min(u1, u0) / u0;
-      const double se1 = e / std::sqrt(sxx), rate1 = -h.slope();
-      const double least = 0.25 * ratio * ratio * top_rate;
-      hit = least > 0 && rate1 < 0.5 * least && 2.0 * se1 <= 0.5 * least;
-      if (hit && plateau_hits_++ == 0) plateau_from_ = h.first;
-      if (hit && plateau_hits_ >= 3) {
-        not_coast_ = fmt::format(
-            "it fell from {:.4g} and then held level at {:.4g} from {} ({:.2g} a second, where friction would "
-            "still take off at least {:.2g}): a coast never holds a plateau — a drive stepping down to a lower "
-            "speed under power (a setpoint step, a start-up overshoot settling); the cut is looked for after it",
-            v0_, h.mean(), fmt_s(t(plateau_from_)), rate1, least);
-        const std::size_t from = plateau_from_;
-        close_unstopped(from, "held a plateau under power", Run::End::power_back);
-        to_idle(from, false, from);
-        return true;
-      }
-    }
-  }
-  if (!hit) plateau_hits_ = 0;
-  return false;
+  const std::optional<Plateau> p = plateau_.look(
+      store_, hold_, t(i), hold_half_s_,
+      {run_.cut_index, run_.t_cut_s, v0_, motor_zero(), coast_step_ * step_sd, same_start_ <= hold_.first});
+  if (!p) return false;
+  not_coast_ = fmt::format(
+      "it fell from {:.4g} and then held level at {:.4g} from {} ({:.2g} a second, where friction would "
+      "still take off at least {:.2g}): a coast never holds a plateau — a drive stepping down to a lower "
+      "speed under power (a setpoint step, a start-up overshoot settling); the cut is looked for after it",
+      v0_, p->level, fmt_s(t(p->from)), p->rate, p->least);
+  close_unstopped(p->from, "held a plateau under power", Run::End::power_back);
+  to_idle(p->from, false, p->from);
+  return true;
 }
 
 void RunDetector::Impl::power_back() {
@@ -451,9 +414,7 @@ std::size_t RunDetector::Impl::last_quarter_index(std::size_t cut, std::size_t f
 }
 
 double RunDetector::Impl::quarter_crossing_time(std::size_t k, std::size_t cut, double quarter) const {
-  if (k == cut) return t(k);
-  const double va = v(k - 1), vb = v(k);
-  return va > vb ? t(k - 1) + (t(k) - t(k - 1)) * (va - quarter) / (va - vb) : t(k);
+  return crossing_time(store_, k, cut, quarter);
 }
 
 double RunDetector::Impl::last_quarter_time(std::size_t cut, std::size_t first_in, double quarter) const {

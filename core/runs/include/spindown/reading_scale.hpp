@@ -44,6 +44,10 @@ std::size_t count_from(const SampleStore& s, double lo, std::size_t from, std::s
 // The mean of readings k-1..k+1 within [lo, hi].
 double smoothed(const SampleStore& s, std::size_t k, std::size_t lo, std::size_t hi);
 
+// When the readings crossed `level` falling into sample k: interpolated between k - 1 and k, or
+// t(k) when they did not fall there (or k is `first`, the coast's first sample).
+double crossing_time(const SampleStore& s, std::size_t k, std::size_t first, double level);
+
 // Medians by min and max, the same value a sort gives.
 inline double median_of_three(double a, double b, double c) {
   return std::max(std::min(a, b), std::min(std::max(a, b), c));
