@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "run_detector_tuning.hpp"
+#include "spindown/stop_shape.hpp"
 
 namespace spindown {
 
@@ -414,7 +415,7 @@ void RunDetector::Impl::restart_stream(const std::string& why, Run::End reason) 
   if (state_ == State::coasting && store_.end() > run_.cut_index + 2) {
     const std::size_t last = store_.end() - 1;
     const double band = std::max({4.0 * coast_sd_, 3.0 * coast_step_, 1e-9 * std::abs(v0_)});
-    if (std::abs(v(last) - motor_zero()) <= band || held_into(run_.cut_index, store_.end()) < store_.end())
+    if (std::abs(v(last) - motor_zero()) <= band || held_into(store_, run_.cut_index, store_.end(), coast_step_) < store_.end())
       coast_checks(last, store_.at(last), true);
   }
   restarted_mid_coast_ = state_ == State::coasting;

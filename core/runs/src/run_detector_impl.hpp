@@ -189,21 +189,14 @@ class RunDetector::Impl {
   // Whether a standstill or floor z (spread sd_z, of a coast falling amp) sits on one value of a
   // quantized reading a step or more above the motor's reading at rest (rest_level_).
   bool quiet_dwell_above_rest(double z, double sd_z, double amp) const;
-  // The first sample of the coast cut at `cut` at or below `quarter` for good before first_in.
-  std::size_t last_quarter_index(std::size_t cut, std::size_t first_in, double quarter) const;
   // When the coast crossed `quarter` into sample k (interpolated; t(cut) when k is the cut).
   double quarter_crossing_time(std::size_t k, std::size_t cut, double quarter) const;
   // When the coast cut at `cut` crossed `quarter` for the last time before first_in (interpolated).
   double last_quarter_time(std::size_t cut, std::size_t first_in, double quarter) const;
   // Whether a coast from t_cut that crossed its last quarter at t_quarter and reached its floor at
-  // t_stop creeps in as an exponential does, rather than stopping.
+  // t_stop creeps in as an exponential does, rather than stopping (the decision: stop_shape.hpp,
+  // with the open run's stop_approach_t_ and stop_floor_t_).
   bool creeps_in(double t_cut, double t_quarter, double t_stop) const;
-  // The t-statistic of the rate the coast over [from, to) still falls at when it meets its floor z
-  // (friction a + b·height: a over its standard error); to: the approach's end (held_into).
-  double floor_rate_t(std::size_t from, std::size_t to, double z) const;
-  // The first sample of the value held up to sample to (after from) when it held longer than the
-  // coast's fall over the second before it allows (a sensor that holds its last reading); else to.
-  std::size_t held_into(std::size_t from, std::size_t to) const;
   // The same for a coast found while after_silence_: the silenced coast's rest, from the first
   // sample after the silence; empty only when nothing of it is held.
   std::string rest_after_silence(CutSplit& sp);
@@ -236,8 +229,6 @@ class RunDetector::Impl {
   std::size_t first_sample_from(double t_hit, std::size_t i) const;
   // A stop at sample stop that falls in a pause of the recording: the run's note says so.
   void note_stop_in_pause(std::size_t stop);
-  // The fall's t-statistic over the stop_hold_s before sample stop (inf when too few samples).
-  double approach_t_stat(std::size_t stop) const;
   // The run stopped at sample stop (standstill z, spread sd_z, coast falling amp): into its tail.
   void stop_at(std::size_t i, std::size_t stop, double z, double sd_z, double amp);
   // The coast crept into its floor z as an exponential does: closed, never stopped, at sample i

@@ -10,6 +10,7 @@
 #include "run_detector_tuning.hpp"
 #include "spindown/plateau_watch.hpp"
 #include "spindown/signal_loss.hpp"
+#include "spindown/stop_shape.hpp"
 
 namespace spindown {
 
@@ -210,11 +211,11 @@ void RunDetector::Impl::found_standstill(std::size_t i, bool at_end) {
   if (signal_lost(i, first_in, z, amp)) return;
 
   // Where the coast crossed the last quarter of its amplitude.
-  const std::size_t k = last_quarter_index(run_.cut_index, first_in, z + 0.25 * amp);
+  const std::size_t k = last_quarter_index(store_, run_.cut_index, first_in, z + 0.25 * amp);
   const double t_quarter = quarter_crossing_time(k, run_.cut_index, z + 0.25 * amp);
   // A value held into the standstill longer than the coast allows (a per-tooth sensor's last
   // reading, held until it gives up) is one reading: the approach ends at its first sample.
-  const std::size_t held = held_into(k, first_in);
+  const std::size_t held = held_into(store_, k, first_in, coast_step_);
   const std::size_t approach_end = held < first_in ? held + 1 : first_in;
   const std::size_t stop = first_sample_from(approach_meets_zero(first_in, approach_end, k, z, t_quarter, i), i);
   note_stop_in_pause(stop);
@@ -224,8 +225,8 @@ void RunDetector::Impl::found_standstill(std::size_t i, bool at_end) {
   run_.zero_level = z;
   run_.noise_level = sd_z;
   // … and right before it the reading still falls clearly (an exponential has flattened).
-  stop_approach_t_ = approach_t_stat(stop);
-  stop_floor_t_ = floor_rate_t(k, approach_end, z);
+  stop_approach_t_ = approach_t_stat(store_, run_.cut_index, stop, opt_.stop_hold_s);
+  stop_floor_t_ = floor_rate_t(store_, k, approach_end, z);
   if (!creeps_in(run_.t_cut_s, t_quarter, t_stop) || amp <= 0) {
     stop_at(i, stop, z, sd_z, amp);
   } else if (!creeping_ && !at_end) {
@@ -317,20 +318,6 @@ void RunDetector::Impl::note_stop_in_pause(std::size_t stop) {
   }
 }
 
-double RunDetector::Impl::approach_t_stat(std::size_t stop) const {
-  double approach_t = std::numeric_limits<double>::infinity();
-  const double t_stop = t(stop);
-  std::size_t from = stop;
-  while (from > run_.cut_index && t_stop - t(from - 1) <= opt_.stop_hold_s) --from;
-  if (stop >= from + 3) {
-    WindowFit f;
-    f.clear(from, t(from));
-    for (std::size_t j = from; j < stop; ++j) f.add(t(j), v(j));
-    const double e = f.resid_sd();
-    approach_t = e > 0 ? -f.slope() * std::sqrt(f.sxx()) / e : (f.slope() < 0 ? approach_t : 0.0);
-  }
-  return approach_t;
-}
 
 void RunDetector::Impl::stop_at(std::size_t i, std::size_t stop, double z, double sd_z, double amp) {
   const double t_stop = t(stop);
@@ -407,66 +394,20 @@ bool RunDetector::Impl::quiet_dwell_above_rest(double z, double sd_z, double amp
          z - rest_level_ < 0.25 * amp;
 }
 
-std::size_t RunDetector::Impl::last_quarter_index(std::size_t cut, std::size_t first_in, double quarter) const {
-  std::size_t k = first_in;
-  while (k > cut && v(k - 1) <= quarter) --k;
-  return k;
-}
 
 double RunDetector::Impl::quarter_crossing_time(std::size_t k, std::size_t cut, double quarter) const {
   return crossing_time(store_, k, cut, quarter);
 }
 
 double RunDetector::Impl::last_quarter_time(std::size_t cut, std::size_t first_in, double quarter) const {
-  return quarter_crossing_time(last_quarter_index(cut, first_in, quarter), cut, quarter);
+  return quarter_crossing_time(last_quarter_index(store_, cut, first_in, quarter), cut, quarter);
 }
 
 bool RunDetector::Impl::creeps_in(double t_cut, double t_quarter, double t_stop) const {
-  // A real stop arrives with a finite slope; an exponential creeps in: its last quarter of the
-  // amplitude takes far more than a quarter of the coast, and right before it the reading no
-  // longer falls clearly.
-  const double last_quarter = t_stop - t_quarter;
-  const double end_rate = last_quarter > 0 ? 0.25 * (t_stop - t_cut) / last_quarter : std::numeric_limits<double>::infinity();
-  return end_rate < stop_min_end_rate && stop_approach_t_ < stop_min_approach_t && stop_floor_t_ < floor_rate_min_t;
+  return StopShape{end_rate(t_cut, t_quarter, t_stop), stop_approach_t_, stop_floor_t_}.creeps_in();
 }
 
-std::size_t RunDetector::Impl::held_into(std::size_t from, std::size_t to) const {
-  // The value the coast shows last before sample to, and the first sample that shows it.
-  if (to < from + 3) return to;
-  const std::size_t last = to - 1;
-  std::size_t held = last;
-  while (held > from && v(held - 1) == v(last)) --held;
-  if (held == last) return to;
-  // The coast's own fall over the second before it (5 samples at least) …
-  std::size_t lo = held;
-  while (lo > from && (t(held) - t(lo - 1) <= 1.0 || held - lo < 5)) --lo;
-  const WindowFit f = window_over(store_.data(), store_.mask(), 1.0, lo, held);
-  if (f.n < 5) return to;
-  // … would have moved the reading by two of its steps there (or three of its noise) while it held.
-  const double moved = std::max(-f.slope(), 0.0) * (t(last) - t(held));
-  const double local_step = reading_step(store_, lo, held + 1);
-  return moved > std::max(2.0 * (local_step > 0 ? local_step : coast_step_), 3.0 * f.resid_sd()) ? held : to;
-}
 
-double RunDetector::Impl::floor_rate_t(std::size_t from, std::size_t to, double z) const {
-  // The coast's fall over its last quarter as friction a + b·(height above the floor): each step
-  // between neighbouring samples, −Δv = (a + b·h)·Δt by least squares. An exponential's a is 0 (its
-  // rate dies with its height); a stop's is the rate it still falls at when it meets the floor.
-  if (to < from + 6) return 0.0;
-  double s11 = 0, s12 = 0, s22 = 0, s1y = 0, s2y = 0, syy = 0, n = 0;
-  for (std::size_t j = from; j + 1 < to; ++j) {
-    const double dt = t(j + 1) - t(j);
-    if (!(dt > 0)) continue;
-    const double x1 = dt, x2 = (0.5 * (v(j) + v(j + 1)) - z) * dt, y = v(j) - v(j + 1);
-    s11 += x1 * x1, s12 += x1 * x2, s22 += x2 * x2, s1y += x1 * y, s2y += x2 * y, syy += y * y, n += 1;
-  }
-  const double det = s11 * s22 - s12 * s12;
-  if (n < 5 || !(det > 0)) return 0.0;
-  const double a = (s1y * s22 - s2y * s12) / det, b = (s11 * s2y - s12 * s1y) / det;
-  const double sse = std::max(syy - a * s1y - b * s2y, 0.0);
-  const double se = std::sqrt(sse / (n - 2) * s22 / det);
-  return se > 0 ? a / se : (a > 0 ? std::numeric_limits<double>::infinity() : 0.0);
-}
 
 void RunDetector::Impl::block_until_rise(double level) {
   need_rise_ = true;
