@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "run_detector_tuning.hpp"
+#include "spindown/two_segment_split.hpp"
 
 namespace spindown {
 
@@ -142,104 +143,8 @@ void RunDetector::Impl::find_pinned_start(std::size_t b) {
                         run_.number, m, fmt_s(t(c)), fmt_s(t(end - 1)), at_top, fmt_s(run_.t_cut_s)));
 }
 
-// The sums of a two-segment least-squares split of [a, b]: a constant lead-in [a, a+k) and a
-// linear coast [a+k, b], for every k at once (prefix sums of the lead-in, suffix sums of the line,
-// t relative to t(b)), in the detector's scratch space.
-struct RunDetector::Impl::SplitSums {
-  struct Line {
-    double v0 = 0, slope = 0, sd = 0;
-  };
-  const Impl& d;
-  std::size_t a, n;
-  double tr;
-  double *pv, *pvv;                // prefix Σv, Σv² of [a, a+k)
-  double *ss, *stt_, *sv_, *stv_;  // suffix Σt, Σt², Σv, Σtv of [a+k, b]
-  double svv_all;
-
-  SplitSums(Impl& det, std::size_t a_, std::size_t b) : d(det), a(a_), n(b - a_ + 1), tr(det.t(b)) {
-    pv = det.scratch(6 * (n + 1));
-    pvv = pv + (n + 1);
-    ss = pvv + (n + 1);
-    stt_ = ss + (n + 1);
-    sv_ = stt_ + (n + 1);
-    stv_ = sv_ + (n + 1);
-    pv[0] = pvv[0] = 0.0;
-    ss[n] = stt_[n] = sv_[n] = stv_[n] = 0.0;
-    for (std::size_t k = 0; k < n; ++k) {
-      const double x = d.v(a + k);
-      pv[k + 1] = pv[k] + x;
-      pvv[k + 1] = pvv[k] + x * x;
-    }
-    for (std::size_t k = n; k-- > 0;) {
-      const double tt = d.t(a + k) - tr, x = d.v(a + k);
-      ss[k] = ss[k + 1] + tt;
-      stt_[k] = stt_[k + 1] + tt * tt;
-      sv_[k] = sv_[k + 1] + x;
-      stv_[k] = stv_[k + 1] + tt * x;
-    }
-    svv_all = pvv[n];
-  }
-
-  // The coast's line from a+k on: its reading at a+k, slope and residual sd.
-  Line post_line(std::size_t k) const {
-    const double np = double(n - k);
-    const double sxx = stt_[k] - ss[k] * ss[k] / np;
-    const double sxy = stv_[k] - ss[k] * sv_[k] / np;
-    const double syy = (svv_all - pvv[k]) - sv_[k] * sv_[k] / np;
-    Line l;
-    l.slope = sxx > 0 ? sxy / sxx : 0.0;
-    l.v0 = sv_[k] / np + l.slope * ((d.t(a + k) - tr) - ss[k] / np);
-    l.sd = np > 2 ? std::sqrt(std::max(syy - l.slope * sxy, 0.0) / (np - 2)) : 0.0;
-    return l;
-  }
-
-  // Best split with the lead-in starting at kb. The confirming window may straddle a small
-  // step (supply → back-EMF), so the split may fall anywhere that leaves a few samples for
-  // the line.
-  std::size_t best_split(std::size_t kb) const {
-    double best = std::numeric_limits<double>::infinity();
-    std::size_t best_k = kb;
-    for (std::size_t k = kb; k + 3 <= n; ++k) {
-      const double m = double(k - kb);
-      const double sp_ = pv[k] - pv[kb];
-      const double sse_pre = k > kb ? (pvv[k] - pvv[kb]) - sp_ * sp_ / m : 0.0;
-      const double np = double(n - k);
-      const double sxx = stt_[k] - ss[k] * ss[k] / np;
-      const double sxy = stv_[k] - ss[k] * sv_[k] / np;
-      const double syy = (svv_all - pvv[k]) - sv_[k] * sv_[k] / np;
-      const double sse_post = sxx > 0 ? syy - sxy * sxy / sxx : syy;
-      const double sse = std::max(sse_pre, 0.0) + std::max(sse_post, 0.0);
-      if (sse < best) {
-        best = sse;
-        best_k = k;
-      }
-    }
-    return best_k;
-  }
-
-  // Two steps in reach (zeros → supply → back-EMF): the coast follows the later one, taken when
-  // it splits a flat plateau from the coast by a clear step. From the split k (lead-in from kb),
-  // the split the coast follows; kb becomes where its lead-in starts.
-  std::size_t later_step(std::size_t& kb, std::size_t k) const {
-    for (int again = 0; again < 3; ++again) {
-      const std::size_t k2 = best_split(k);
-      if (k2 < k + 3) break;
-      const double m = double(k2 - k);
-      const double mean = (pv[k2] - pv[k]) / m;
-      const double sd = std::sqrt(std::max((pvv[k2] - pvv[k]) / m - mean * mean, 0.0));
-      const Line l = post_line(k2);
-      const double scale = std::abs(l.v0);
-      if (std::abs(l.v0 - mean) <= std::max(5.0 * l.sd, 0.03 * scale) || sd > std::max(3.0 * l.sd, 0.02 * scale))
-        break;
-      kb = k;
-      k = k2;
-    }
-    return k;
-  }
-};
-
 void RunDetector::Impl::split_two_segments(CutSplit& sp, std::size_t a, std::size_t b, const WindowFit& w) {
-  const SplitSums sums(*this, a, b);
+  const TwoSegmentSplit sums(store_, a, b, split_scratch_);
   std::size_t kb = 0;
   std::size_t k = sums.later_step(kb, sums.best_split(0));
   // A rough lead-in (an open pin's hum) fits the coast's line about as badly as a constant, so
@@ -256,7 +161,7 @@ void RunDetector::Impl::split_two_segments(CutSplit& sp, std::size_t a, std::siz
     while (j > a + k && std::abs(v(j - 1) - (mid + slope * (t(j - 1) - t_mid))) <= tol) --j;
     k = j - a;
   }
-  const SplitSums::Line l = sums.post_line(k);
+  const TwoSegmentSplit::Line l = sums.post_line(k);
   const std::size_t c = a + k;
   sp.a = a + kb;
   sp.v0 = l.v0;
@@ -379,7 +284,7 @@ void RunDetector::Impl::refine_plateau_cut(CutSplit& sp, std::size_t b) {
 std::size_t RunDetector::Impl::level_end(std::size_t r, std::size_t p, std::size_t b) {
   // [r, b] split into a level and the coast's line by least squares (the coast's start is close to
   // a line), the level reaching from r past the peak p …
-  const SplitSums sums(*this, r, b);
+  const TwoSegmentSplit sums(store_, r, b, split_scratch_);
   const std::size_t c = r + sums.best_split(0);
   if (c < p + 8) return p;
   // … taken when the coast after the split is a second or more long (a kink with no step rests

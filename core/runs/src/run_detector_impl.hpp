@@ -129,10 +129,10 @@ class RunDetector::Impl {
   // the two do not meet within a few samples of the split.
   void refine_plateau_cut(CutSplit& sp, std::size_t b);
   // split_at_cut's steps: a reading pinned at the converter's top and left (true, sp filled), else
-  // the best two-segment least-squares split (SplitSums), then the lead-in's description.
+  // the best two-segment least-squares split (two_segment_split.hpp), then the lead-in's description.
   CutSplit split_at_cut(std::size_t a, std::size_t b, const WindowFit& w);
   bool split_at_top(CutSplit& sp, std::size_t a, std::size_t b, const WindowFit& w);
-  struct SplitSums;  // run_detector_cut.cpp
+  std::vector<double> split_scratch_;  // the split's sums
   void split_two_segments(CutSplit& sp, std::size_t a, std::size_t b, const WindowFit& w);
   void describe_lead_in(CutSplit& sp) const;
   std::string classify_lead_in(const CutSplit& sp) const;
