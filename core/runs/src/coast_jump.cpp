@@ -13,6 +13,24 @@ std::optional<CoastJump> coast_jump(const SampleStore& s, const CoastJumpInput& 
   const std::size_t c = in.cut, coast_end = in.coast_end;
   if (coast_end < c + 16) return std::nullopt;
   const double amp = in.amplitude;
+  // A jump is far beyond the coast's sample-to-sample noise (below) and at least `least`: a
+  // twentieth of the coast's height and three steps of the print.
+  const double least = std::max(0.05 * std::abs(amp), 3.0 * in.step);
+  // The cheap look first. A median of five lies between the lowest and the highest of its
+  // readings, so a rise of the medians by more than `least`, or a step down within three samples,
+  // needs a reading more than `least` above one at most seven samples after it or anywhere before
+  // it. Most coasts have none: then no median is taken. One pass back from the end: `highest` is
+  // the highest reading from seven before q on.
+  {
+    double highest = -std::numeric_limits<double>::infinity();
+    for (std::size_t p = coast_end - 7; p < coast_end; ++p) highest = std::max(highest, s.v(p));
+    bool could = false;
+    for (std::size_t q = coast_end; q-- > c && !could;) {
+      if (q >= c + 7) highest = std::max(highest, s.v(q - 7));
+      could = highest - s.v(q) > least;
+    }
+    if (!could) return std::nullopt;
+  }
   // Medians of five: a dropout or two (a loose wire's zeros) are neither a rise nor a step down.
   // Each sample's is taken once: both searches below read it, three times a sample (a sort of
   // five per look was a third of `spindown fit`'s time).
@@ -52,7 +70,6 @@ std::optional<CoastJump> coast_jump(const SampleStore& s, const CoastJumpInput& 
   // height and three steps of the print. Most coasts have no jump even of that least size: then
   // the noise (a median over the whole coast, most of this search's time) is not needed, as a
   // higher threshold finds no jump where a lower one found none.
-  const double least = std::max(0.05 * std::abs(amp), 3.0 * in.step);
   double rose = 0;
   if (last_jump(least, rose) == 0) return std::nullopt;
   const double white = rough_sd(s, c, coast_end);

@@ -15,9 +15,12 @@ double reading_step(const SampleStore& s, std::size_t from, std::size_t to) {
 
 double rough_sd(const SampleStore& s, std::size_t from, std::size_t to) {
   if (to < from + 3) return 0.0;
-  std::vector<double> d(to - from - 2);
-  for (std::size_t j = 0; j < d.size(); ++j)
-    d[j] = std::abs(s.v(from + j + 2) - 2.0 * s.v(from + j + 1) + s.v(from + j));
+  // The second differences in a buffer of this thread's, kept: run finding asks this several
+  // times for every cut, and an allocation (and its zeroing) each time was most of the cost.
+  thread_local std::vector<double> d;
+  d.clear();
+  d.reserve(to - from - 2);
+  for (std::size_t k = from; k + 2 < to; ++k) d.push_back(std::abs(s.v(k + 2) - 2.0 * s.v(k + 1) + s.v(k)));
   std::nth_element(d.begin(), d.begin() + std::ptrdiff_t(d.size() / 2), d.end());
   return 1.4826 * d[d.size() / 2] / std::sqrt(6.0);
 }
