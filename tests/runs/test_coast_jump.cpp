@@ -4,32 +4,17 @@
 
 #include <cmath>
 #include <cstddef>
-#include <random>
 #include <vector>
 
 #include "spindown/coast_jump.hpp"
 #include "spindown/reading_scale.hpp"
+#include "recorded_readings.hpp"
 
 using namespace spindown;
+using spindown::test::at;
+using spindown::test::record;
 
 namespace {
-
-constexpr double dt = 0.02;  // the lab's 50 Hz
-
-template <class F>
-SampleStore record(F v, double until, double sigma, double step = 0.0) {
-  SampleStore s;
-  std::mt19937_64 rng(11);
-  std::normal_distribution<double> noise(0.0, sigma);
-  for (double t = 0; t < until - 1e-9; t += dt) {
-    double x = v(t) + noise(rng);
-    if (step > 0) x = std::round(x / step) * step;
-    s.push({t, x});
-  }
-  return s;
-}
-
-std::size_t at(double t) { return static_cast<std::size_t>(std::lround(t / dt)); }
 
 std::optional<CoastJump> judge(const SampleStore& s, double end_s, double amp, double step = 0.0, bool floating = false,
                                int* asked = nullptr) {

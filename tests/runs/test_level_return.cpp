@@ -4,29 +4,17 @@
 
 #include <cmath>
 #include <cstddef>
-#include <random>
 #include <vector>
 
 #include "spindown/level_return.hpp"
 #include "spindown/reading_scale.hpp"
+#include "recorded_readings.hpp"
 
 using namespace spindown;
+using spindown::test::at;
+using spindown::test::record;
 
 namespace {
-
-constexpr double dt = 0.02;  // the lab's 50 Hz
-
-// Readings v(t) for t in [0, until) at 50 Hz, with white noise sigma.
-template <class F>
-SampleStore record(F v, double until, double sigma) {
-  SampleStore s;
-  std::mt19937_64 rng(7);
-  std::normal_distribution<double> noise(0.0, sigma);
-  for (double t = 0; t < until - 1e-9; t += dt) s.push({t, v(t) + noise(rng)});
-  return s;
-}
-
-std::size_t at(double t) { return static_cast<std::size_t>(std::lround(t / dt)); }
 
 struct Judged {
   std::optional<LevelReturn> ret;

@@ -5,24 +5,15 @@
 #include <cmath>
 #include <cstddef>
 #include <optional>
-#include <random>
 
 #include "spindown/plateau_watch.hpp"
+#include "recorded_readings.hpp"
 
 using namespace spindown;
+using spindown::test::at;
+using spindown::test::record;
 
 namespace {
-
-constexpr double dt = 0.02;  // the lab's 50 Hz
-
-template <class F>
-SampleStore record(F v, double until, double sigma) {
-  SampleStore s;
-  std::mt19937_64 rng(3);
-  std::normal_distribution<double> noise(0.0, sigma);
-  for (double t = 0; t < until - 1e-9; t += dt) s.push({t, v(t) + noise(rng)});
-  return s;
-}
 
 // Looks every half second from 2 s after the cut (at 0 s) over the last second of samples, until
 // a plateau or the recording's end.
@@ -69,7 +60,7 @@ TEST(PlateauWatch, AFrozenReadingIsLeftToTheStandstillChecks) {
   w.start(0, 2.0);
   const PlateauCoast frozen{0, 0.0, s.v(0), 0.0, 0.0, true};
   for (double now = 2.0; now < 8.0; now += 0.5) {
-    const std::size_t i = static_cast<std::size_t>(std::lround(now / dt)) - 1;
+    const std::size_t i = static_cast<std::size_t>(std::lround(now / spindown::test::lab_period_s)) - 1;
     EXPECT_FALSE(w.look(s, window_over(s, 1.0, i - 49, i + 1), s.t(i), 0.5, frozen).has_value());
   }
 }

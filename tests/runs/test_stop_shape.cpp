@@ -5,30 +5,15 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
-#include <random>
 
 #include "spindown/stop_shape.hpp"
+#include "recorded_readings.hpp"
 
 using namespace spindown;
+using spindown::test::at;
+using spindown::test::record;
 
 namespace {
-
-constexpr double dt = 0.02;
-
-template <class F>
-SampleStore record(F v, double until, double sigma, double step = 0.0) {
-  SampleStore s;
-  std::mt19937_64 rng(13);
-  std::normal_distribution<double> noise(0.0, sigma);
-  for (double t = 0; t < until - 1e-9; t += dt) {
-    double x = v(t) + noise(rng);
-    if (step > 0) x = std::round(x / step) * step;
-    s.push({t, x});
-  }
-  return s;
-}
-
-std::size_t at(double t) { return static_cast<std::size_t>(std::lround(t / dt)); }
 
 // The three measurements of a coast from 0 s that reaches its floor 0 at t_stop.
 StopShape shape(const SampleStore& s, double amp, double t_stop) {

@@ -4,25 +4,16 @@
 
 #include <cmath>
 #include <cstddef>
-#include <random>
 #include <vector>
 
 #include "spindown/two_segment_split.hpp"
+#include "recorded_readings.hpp"
 
 using namespace spindown;
+using spindown::test::at;
+using spindown::test::record;
 
 namespace {
-
-constexpr double dt = 0.02;
-
-template <class F>
-SampleStore record(F v, double until, double sigma) {
-  SampleStore s;
-  std::mt19937_64 rng(17);
-  std::normal_distribution<double> noise(0.0, sigma);
-  for (double t = 0; t < until - 1e-9; t += dt) s.push({t, v(t) + noise(rng)});
-  return s;
-}
 
 }  // namespace
 

@@ -64,10 +64,12 @@
     return out;
   }
 
-  function plotSize(box, height) {
+  // On screen, height; printed, printHeight (the main plot smaller, the residuals as tall as their
+  // scale needs: a tick either side of 0 and the axis's name).
+  function plotSize(box, height, printHeight = Math.round(height * 0.6)) {
     const printing = window.matchMedia && window.matchMedia("print").matches;
     const width = printing ? 680 : Math.max(240, box.clientWidth || 600);
-    return { width, height: printing ? Math.round(height * 0.6) : height };
+    return { width, height: printing ? printHeight : height };
   }
 
   // The cut and the stop as lines on the plot (drawn on the canvas: they print too).
@@ -151,15 +153,22 @@
     const x = r.points.map((p) => p[0]), y = r.points.map((p) => p[1] * k);
     const reach = Math.max(...y.map(Math.abs), 3 * (r.noise || 0) * k) * 1.1 || 1;
     residualBox.setAttribute("data-range", String(reach));
+    const decade = 10 ** Math.floor(Math.log10(reach / 1.1));
+    const tick = [5, 2, 1].map((m) => m * decade).find((v) => v <= reach / 1.1) || decade;
     residualBox.setAttribute("data-unit", unit);
     residualPlot = new uPlot({
-      ...plotSize(residualBox, 200),
+      ...plotSize(residualBox, 200, 140),
       series: [{ label: "s" }, { label: "residual", stroke: colors[r.model] || "#1f77b4", width: 0, paths: () => null,
                                   points: { show: true, size: 2.5, fill: colors[r.model] || "#1f77b4" } },
                { label: "0", stroke: "#888", width: 1 }],
       scales: { x: { time: false }, y: { range: () => [-reach, reach] } },
       axes: [{ label: "s after the cut" },
-             { label: `residual (${unit})`, size: 56, space: 18,
+             // The unit's name alone where it reads upright turned (mV, rpm: it fits a printed
+             // plot's height); a lone "V" turned reads as ">", so it is named.
+             { label: unit === "V" ? "residual (V)" : unit, size: 56,
+               // 0 and a round step either side (1, 2 or 5 × 10^k within the scale), however short
+               // the plot (printed, it is): the scale is always read off.
+               splits: () => [-tick, 0, tick],
                values: (u, splits) => { residualBox.setAttribute("data-y-ticks", splits.join()); return splits.map((v) => String(+v.toPrecision(3))); } }],
       legend: { show: false },
     }, [x, y, x.map(() => 0)], residualBox);
@@ -499,7 +508,7 @@
     a.click();
     a.remove();
   });
-  const resize = () => { if (plot) plot.setSize(plotSize(plotBox, 340)); if (residualPlot) residualPlot.setSize(plotSize(residualBox, 200)); };
+  const resize = () => { if (plot) plot.setSize(plotSize(plotBox, 340)); if (residualPlot) residualPlot.setSize(plotSize(residualBox, 200, 140)); };
   window.addEventListener("resize", resize);
   window.addEventListener("beforeprint", resize);
   window.addEventListener("afterprint", resize);

@@ -202,7 +202,7 @@
   function showLab(lab) {
     spindown.serverUnits(lab ? lab.lab_units : undefined);
     setText(document.getElementById("services"), servicesText(lab));
-    setText(document.getElementById("problems"), problemsText(lab));
+    document.getElementById("problems").textContent = problemsText(lab);  // none: nothing said (no dash)
   }
 
   spindown.live("", {
