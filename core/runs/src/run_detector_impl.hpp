@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "spindown/lag_noise.hpp"
+#include "spindown/lead_in.hpp"
 #include "spindown/reading_scale.hpp"
 #include "spindown/run_detector.hpp"
 #include "spindown/plateau_watch.hpp"
@@ -110,18 +111,7 @@ class RunDetector::Impl {
   // without its divisions and square roots.
   static inline bool clearly_sloped(const WindowFit& w, double v0, double m);
   // Where the cut lies in [a, b] (b = newest sample), and what came before it.
-  struct CutSplit {
-    std::size_t a = 0, cut_index = 0, pre_end = 0, npre = 0;
-    double t_cut_s = 0, v0 = 0, sd_post = 0, post_slope = 0;
-    double pre_mean = 0, pre_sd = 0, pre_max = 0;
-    double pre_rough = 0;   // the lead-in's sample-to-sample noise (rough_sd)
-    double post_rough = 0;  // the coast's (rough_sd: a bounce sample or two at its start do not set it)
-    bool pre_declining = false;
-    bool pre_flat = false;  // lead-in slope shown to be well below the coast's
-    bool clipped = false;
-    std::size_t pin_first = 0, pin_last = 0;
-    double pin_level = 0;
-  };
+  using CutSplit = spindown::CutSplit;  // lead_in.hpp
   // A powered plateau that runs into the coast without a step (a speed reading: the speed is
   // continuous at the cut): the cut is where a level and the coast's line meet, found to a tenth of
   // a period by least squares over the samples around it, not the sample split of split_at_cut
@@ -134,8 +124,6 @@ class RunDetector::Impl {
   bool split_at_top(CutSplit& sp, std::size_t a, std::size_t b, const WindowFit& w);
   std::vector<double> split_scratch_;  // the split's sums
   void split_two_segments(CutSplit& sp, std::size_t a, std::size_t b, const WindowFit& w);
-  void describe_lead_in(CutSplit& sp) const;
-  std::string classify_lead_in(const CutSplit& sp) const;
   // Samples of contact bounce at the start of the coast in sp (a wire pushed onto the pin), judged
   // against the line of w (the window that confirmed the coast): the cut moves to the first of
   // them, and they go to bounce_ (left out of the fit).
