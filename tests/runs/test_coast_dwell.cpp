@@ -20,17 +20,23 @@ std::optional<CoastDwell> judge(const SampleStore& s, double end_s, double noise
   return coast_dwell(s, {0, at(end_s), noise, step}, scratch);
 }
 
+// A drive that overshoots to 3.0 at its start, settles on 2.5 until cut_s, then coasts at 0.25 a
+// second to standstill (2 mV of noise), recorded until 2 s after it stops.
+SampleStore settled_drive(double cut_s) {
+  return record([cut_s](double t) {
+    if (t < 1) return 3.0 - 0.5 * t;
+    if (t < cut_s) return 2.5;
+    return std::max(2.5 - 0.25 * (t - cut_s), 0.0);
+  }, cut_s + 12.0, 0.002);
+}
+
 }  // namespace
 
 TEST(CoastDwell, AStartUpOvershootSettlingOnItsSetpointIsNoCoast) {
   // A drive overshoots to 3.0 at its start, settles on 2.5 for 8 s, then the supply is cut: a coast
   // at 0.25 a second. Taken as a coast from the overshoot, it held 2.5 ± its noise for 8 s, where
   // it then fell four more of those bands in about 0.3 s (a dwell counts beyond 20 times that).
-  const SampleStore s = record([](double t) {
-    if (t < 1) return 3.0 - 0.5 * t;
-    if (t < 9) return 2.5;
-    return std::max(2.5 - 0.25 * (t - 9), 0.0);
-  }, 21.0, 0.002);
+  const SampleStore s = settled_drive(9.0);
   const auto d = judge(s, 19.0, 0.002);
   ASSERT_TRUE(d.has_value());
   EXPECT_NEAR(double(d->at), double(at(9.0)), 25.0);  // within half a second of the cut
@@ -41,11 +47,7 @@ TEST(CoastDwell, AStartUpOvershootSettlingOnItsSetpointIsNoCoast) {
 TEST(CoastDwell, AHoldShorterThanTwentyTimesTheFallIsNoDwell) {
   // The same drive settled for only 2 s: where the coast then falls four bands in 0.3 s, a 2-s hold
   // is within what the decision allows (a slow start, Stribeck friction): no dwell.
-  const SampleStore s = record([](double t) {
-    if (t < 1) return 3.0 - 0.5 * t;
-    if (t < 3) return 2.5;
-    return std::max(2.5 - 0.25 * (t - 3), 0.0);
-  }, 15.0, 0.002);
+  const SampleStore s = settled_drive(3.0);
   EXPECT_FALSE(judge(s, 13.0, 0.002).has_value());
 }
 

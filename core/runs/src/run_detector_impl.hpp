@@ -8,7 +8,9 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "spindown/lag_noise.hpp"
@@ -148,10 +150,10 @@ class RunDetector::Impl {
   void recut_coast(Run& r, std::size_t end);
   // The noise of the coast [c, coast_end) at every lag, the quieter (less wander) of its two
   // halves' (an open pin's hum before a connection is in one of them only). Kept for the re-cuts of
-  // one recut_coast call, which ask it of the same coast (valid while coast_noise_for_ says so).
+  // one recut_coast call, which ask it of the same coast (coast_noise_for_: its c and coast_end).
   const LagNoise& coast_noise(std::size_t c, std::size_t coast_end);
   LagNoise coast_noise_;
-  std::size_t coast_noise_for_[2] = {0, 0};  // its c and coast_end; {0, 0}: none kept
+  std::optional<std::pair<std::size_t, std::size_t>> coast_noise_for_;
   // A coast never rises: when the reading rose inside r's coast [cut, coast_end) by far more than its
   // noise, what came before the rise was no part of it (an open pin's swing before it was connected,
   // a coast the power came back on unseen). r then starts at the last such rise, with a warning.
@@ -177,8 +179,6 @@ class RunDetector::Impl {
   // Whether a standstill or floor z (spread sd_z, of a coast falling amp) sits on one value of a
   // quantized reading a step or more above the motor's reading at rest (rest_level_).
   bool quiet_dwell_above_rest(double z, double sd_z, double amp) const;
-  // When the coast crossed `quarter` into sample k (interpolated; t(cut) when k is the cut).
-  double quarter_crossing_time(std::size_t k, std::size_t cut, double quarter) const;
   // When the coast cut at `cut` crossed `quarter` for the last time before first_in (interpolated).
   double last_quarter_time(std::size_t cut, std::size_t first_in, double quarter) const;
   // Whether a coast from t_cut that crossed its last quarter at t_quarter and reached its floor at

@@ -33,7 +33,7 @@ using namespace detector_tuning;
 void RunDetector::Impl::recut_coast(Run& r, std::size_t end) {
   if (!not_coast_.empty() || fragment_) return;
   const std::size_t coast_end = r.stopped ? r.stop_index : end;
-  coast_noise_for_[0] = coast_noise_for_[1] = 0;  // the store has changed since any kept
+  coast_noise_for_.reset();  // the store has changed since any was kept
   recut_after_rise(r, coast_end);
   if (!not_coast_.empty() || fragment_) return;
   recut_after_return(r, coast_end);
@@ -44,11 +44,11 @@ void RunDetector::Impl::recut_coast(Run& r, std::size_t end) {
 }
 
 const LagNoise& RunDetector::Impl::coast_noise(std::size_t c, std::size_t coast_end) {
-  if (coast_noise_for_[0] != c || coast_noise_for_[1] != coast_end || coast_end == 0) {
+  if (coast_noise_for_ != std::pair{c, coast_end}) {
     const std::size_t mid = c + (coast_end - c) / 2;
     const LagNoise early = noise_over(store_, c, mid), late = noise_over(store_, mid, coast_end);
     coast_noise_ = early.wander < late.wander ? early : late;
-    coast_noise_for_[0] = c, coast_noise_for_[1] = coast_end;
+    coast_noise_for_ = std::pair{c, coast_end};
   }
   return coast_noise_;
 }

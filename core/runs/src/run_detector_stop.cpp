@@ -212,7 +212,7 @@ void RunDetector::Impl::found_standstill(std::size_t i, bool at_end) {
 
   // Where the coast crossed the last quarter of its amplitude.
   const std::size_t k = last_quarter_index(store_, run_.cut_index, first_in, z + 0.25 * amp);
-  const double t_quarter = quarter_crossing_time(k, run_.cut_index, z + 0.25 * amp);
+  const double t_quarter = crossing_time(store_, k, run_.cut_index, z + 0.25 * amp);
   // A value held into the standstill longer than the coast allows (a per-tooth sensor's last
   // reading, held until it gives up) is one reading: the approach ends at its first sample.
   const std::size_t held = held_into(store_, k, first_in, coast_step_);
@@ -395,12 +395,8 @@ bool RunDetector::Impl::quiet_dwell_above_rest(double z, double sd_z, double amp
 }
 
 
-double RunDetector::Impl::quarter_crossing_time(std::size_t k, std::size_t cut, double quarter) const {
-  return crossing_time(store_, k, cut, quarter);
-}
-
 double RunDetector::Impl::last_quarter_time(std::size_t cut, std::size_t first_in, double quarter) const {
-  return quarter_crossing_time(last_quarter_index(store_, cut, first_in, quarter), cut, quarter);
+  return crossing_time(store_, last_quarter_index(store_, cut, first_in, quarter), cut, quarter);
 }
 
 bool RunDetector::Impl::creeps_in(double t_cut, double t_quarter, double t_stop) const {
